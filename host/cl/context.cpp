@@ -1,0 +1,214 @@
+#include "cl/context.h"
+
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+
+#include "cl/kernel_sources.h"
+#include "util/files.h"
+#include "util/hash.h"
+
+namespace pr {
+
+namespace {
+
+constexpr char kCacheMagic[8] = {'P', 'R', 'K', 'B', 'I', 'N', '0', '1'};
+
+struct CacheHeader {
+  char magic[8];
+  uint64_t size;
+  uint64_t checksum;
+};
+
+double secondsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+std::string buildLog(const cl::Program& program, const cl::Device& device) {
+  std::string log;
+  if (program.getBuildInfo(device, CL_PROGRAM_BUILD_LOG, &log) != CL_SUCCESS) return "";
+  while (!log.empty() && (log.back() == '\0' || log.back() == '\n')) log.pop_back();
+  return log;
+}
+
+std::string humanSize(uint64_t bytes) {
+  char buf[32];
+  if (bytes >= (1ull << 30))
+    std::snprintf(buf, sizeof buf, "%.2f GiB", bytes / double(1ull << 30));
+  else
+    std::snprintf(buf, sizeof buf, "%.1f MiB", bytes / double(1ull << 20));
+  return buf;
+}
+
+// The cached binary for `key`, or empty if absent or corrupt (a corrupt file is removed).
+std::string loadCachedBinary(const std::string& file) {
+  std::string data;
+  if (!readFile(file, &data)) return {};
+  CacheHeader h;
+  bool ok = data.size() >= sizeof h;
+  if (ok) {
+    std::memcpy(&h, data.data(), sizeof h);
+    ok = std::memcmp(h.magic, kCacheMagic, sizeof kCacheMagic) == 0 &&
+         h.size == data.size() - sizeof h && h.size > 0;
+  }
+  std::string binary;
+  if (ok) {
+    binary = data.substr(sizeof h);
+    ok = Hash128().add(binary.data(), binary.size()).low() == h.checksum;
+  }
+  if (!ok) {
+    std::error_code ec;
+    std::filesystem::remove(file, ec);
+    return {};
+  }
+  return binary;
+}
+
+void storeCachedBinary(const std::string& file, const std::string& binary) {
+  CacheHeader h;
+  std::memcpy(h.magic, kCacheMagic, sizeof kCacheMagic);
+  h.size = binary.size();
+  h.checksum = Hash128().add(binary.data(), binary.size()).low();
+  std::string data(reinterpret_cast<const char*>(&h), sizeof h);
+  data += binary;
+  try {
+    writeFileAtomic(file, data);
+  } catch (const RuntimeError&) {
+    // An unwritable cache costs only build time next run.
+  }
+}
+
+}  // namespace
+
+std::string programCacheDir() {
+  if (const char* dir = std::getenv("PATHREUSE_CACHE_DIR"); dir && *dir) {
+    if (std::string(dir) == "off") return "";
+    return dir;
+  }
+  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg)
+    return std::string(xdg) + "/pathreuse";
+  if (const char* home = std::getenv("HOME"); home && *home)
+    return std::string(home) + "/.cache/pathreuse";
+  return "";
+}
+
+Context::Context(const DeviceEntry& device) : device_(device) {
+  cl_int err = CL_SUCCESS;
+  context_ = cl::Context(device_.device, nullptr, nullptr, nullptr, &err);
+  CL_CHECK(err);
+  queue_ = cl::CommandQueue(context_, device_.device, 0, &err);
+  CL_CHECK(err);
+}
+
+ProgramBuild Context::buildProgram(const std::string& mainFile, const std::string& options) {
+  return buildProgramFromSource(expandKernelSource(mainFile), options, mainFile);
+}
+
+ProgramBuild Context::buildProgramFromSource(const std::string& source, const std::string& options,
+                                             const std::string& label) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::string fullOptions = "-cl-std=CL1.2 " + options;
+  const std::string key = Hash128()
+                              .add(source)
+                              .add(fullOptions)
+                              .add(device_.platformName)
+                              .add(device_.name)
+                              .add(device_.driverVersion)
+                              .add(device_.deviceVersion)
+                              .hex();
+  const std::string dir = programCacheDir();
+  const std::string file = dir.empty() ? "" : dir + "/kernels/" + key + ".bin";
+
+  ProgramBuild out;
+  out.cacheFile = file;
+  if (!file.empty()) {
+    const std::string binary = loadCachedBinary(file);
+    if (!binary.empty()) {
+      cl::Program::Binaries bins{std::vector<unsigned char>(binary.begin(), binary.end())};
+      std::vector<cl_int> status;
+      cl_int err = CL_SUCCESS;
+      cl::Program program(context_, {device_.device}, bins, &status, &err);
+      if (err == CL_SUCCESS && program.build({device_.device}, fullOptions.c_str()) == CL_SUCCESS) {
+        out.program = program;
+        out.fromCache = true;
+        out.seconds = secondsSince(t0);
+        return out;
+      }
+      // A binary the driver refuses (driver updated in place, truncated file): rebuild.
+      std::error_code ec;
+      std::filesystem::remove(file, ec);
+    }
+  }
+
+  cl_int err = CL_SUCCESS;
+  cl::Program program(context_, source, false, &err);
+  CL_CHECK(err);
+  err = program.build({device_.device}, fullOptions.c_str());
+  if (err != CL_SUCCESS) {
+    const std::string log = buildLog(program, device_.device);
+    throw RuntimeError("building kernels/" + label + " for " + device_.name + " failed with " +
+                       clErrorName(err) + "; build log:\n" + log);
+  }
+  if (!file.empty()) {
+    std::vector<std::vector<unsigned char>> binaries;
+    if (program.getInfo(CL_PROGRAM_BINARIES, &binaries) == CL_SUCCESS && binaries.size() == 1 &&
+        !binaries[0].empty())
+      storeCachedBinary(file, std::string(binaries[0].begin(), binaries[0].end()));
+  }
+  out.program = program;
+  out.seconds = secondsSince(t0);
+  return out;
+}
+
+cl::Buffer Context::allocate(const std::string& name, uint64_t bytes, cl_mem_flags flags) {
+  if (bytes == 0) bytes = 16;  // zero-sized buffers are invalid; keep a valid handle
+  if (bytes > device_.maxAllocBytes)
+    throw RuntimeError("device out of memory: " + name + " needs " + humanSize(bytes) +
+                       " but the largest allocation " + device_.name + " allows is " +
+                       humanSize(device_.maxAllocBytes));
+  cl_int err = CL_SUCCESS;
+  cl::Buffer buffer(context_, flags, bytes, nullptr, &err);
+  if (err == CL_MEM_OBJECT_ALLOCATION_FAILURE || err == CL_OUT_OF_RESOURCES ||
+      err == CL_OUT_OF_HOST_MEMORY)
+    throw RuntimeError("device out of memory: " + name + " (" + humanSize(bytes) + ") did not fit; " +
+                       humanSize(bytesInUse_) + " already in use on " + device_.name);
+  CL_CHECK(err);
+  bytesInUse_ += bytes;
+  return buffer;
+}
+
+void Context::zero(const cl::Buffer& buffer, uint64_t bytes) {
+  if (bytes == 0) return;
+  const cl_uint pattern = 0;
+  if (bytes % sizeof pattern == 0) {
+    CL_CHECK(queue_.enqueueFillBuffer(buffer, pattern, 0, bytes));
+  } else {
+    const cl_uchar bytePattern = 0;
+    CL_CHECK(queue_.enqueueFillBuffer(buffer, bytePattern, 0, bytes));
+  }
+}
+
+void Context::launch1D(const cl::Kernel& kernel, size_t global, const char* what) {
+  if (global == 0) return;
+  size_t local = 0;
+  cl_int err = kernel.getWorkGroupInfo(device_.device, CL_KERNEL_WORK_GROUP_SIZE, &local);
+  CL_CHECK(err);
+  size_t preferred = 0;
+  if (kernel.getWorkGroupInfo(device_.device, CL_KERNEL_PREFERRED_WORK_GROUP_SIZE_MULTIPLE,
+                              &preferred) == CL_SUCCESS &&
+      preferred > 0 && preferred <= local) {
+    // A multiple of the preferred size, up to 256, keeps GPUs busy and PoCL's loops long.
+    size_t want = preferred;
+    while (want * 2 <= local && want * 2 <= 256) want *= 2;
+    local = want;
+  }
+  if (local == 0) local = 1;
+  const size_t padded = (global + local - 1) / local * local;
+  err = queue_.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(padded), cl::NDRange(local));
+  if (err != CL_SUCCESS) throw ClError(std::string("launch of ") + what, err, __FILE__, __LINE__);
+}
+
+void Context::finish() { CL_CHECK(queue_.finish()); }
+
+}  // namespace pr

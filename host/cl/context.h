@@ -1,0 +1,64 @@
+// One chosen OpenCL device with its context and in-order queue; builds programs from the
+// kernel sources (cached on disk) and allocates buffers with their sizes checked and counted.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "cl/cl.h"
+#include "cl/device.h"
+
+namespace pr {
+
+struct ProgramBuild {
+  cl::Program program;
+  bool fromCache = false;  // the binary came from the on-disk cache
+  double seconds = 0.0;    // wall time of the build (or cache load)
+  std::string cacheFile;   // empty when caching is off or failed
+};
+
+// Folder for cached program binaries: $PATHREUSE_CACHE_DIR, else $XDG_CACHE_HOME/pathreuse,
+// else ~/.cache/pathreuse; empty when none can be determined. The value "off" disables it.
+std::string programCacheDir();
+
+class Context {
+ public:
+  explicit Context(const DeviceEntry& device);
+
+  const DeviceEntry& device() const { return device_; }
+  cl::Context& context() { return context_; }
+  cl::CommandQueue& queue() { return queue_; }
+
+  // Builds kernels/<mainFile> with `options` (e.g. "-DMAX_DEPTH=8"). A failed build throws
+  // RuntimeError carrying the full build log. Binaries are cached by a hash of the expanded
+  // source, the options, the device name and the driver version; a corrupt entry is rebuilt.
+  ProgramBuild buildProgram(const std::string& mainFile, const std::string& options = "");
+
+  // Same, from a source string (for tests and generated code).
+  ProgramBuild buildProgramFromSource(const std::string& source, const std::string& options,
+                                      const std::string& label);
+
+  // A device buffer of `bytes`, checked against the device's max allocation; `name` is used in
+  // errors ("device out of memory: light vertex arena (1.2 GiB) ..."). Counted in bytesInUse().
+  cl::Buffer allocate(const std::string& name, uint64_t bytes, cl_mem_flags flags = CL_MEM_READ_WRITE);
+  // Releases the count of a buffer made by allocate() (the buffer itself is reference counted).
+  void release(uint64_t bytes) { bytesInUse_ -= bytes <= bytesInUse_ ? bytes : bytesInUse_; }
+  uint64_t bytesInUse() const { return bytesInUse_; }
+
+  // Fills a buffer with zero bytes (PoCL does not zero new buffers).
+  void zero(const cl::Buffer& buffer, uint64_t bytes);
+
+  // A 1-D launch of `global` work-items, padded to a multiple of the work-group size that the
+  // device reports for the kernel; kernels guard with their own count argument.
+  void launch1D(const cl::Kernel& kernel, size_t global, const char* what);
+
+  void finish();
+
+ private:
+  DeviceEntry device_;
+  cl::Context context_;
+  cl::CommandQueue queue_;
+  uint64_t bytesInUse_ = 0;
+};
+
+}  // namespace pr

@@ -1,0 +1,174 @@
+#include "cl/device.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cstdio>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+namespace pr {
+
+namespace {
+
+std::string trimmed(std::string s) {
+  // Drivers pad some strings with spaces or NULs.
+  while (!s.empty() && (s.back() == '\0' || std::isspace(static_cast<unsigned char>(s.back()))))
+    s.pop_back();
+  size_t b = 0;
+  while (b < s.size() && std::isspace(static_cast<unsigned char>(s[b]))) ++b;
+  return s.substr(b);
+}
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+template <cl_int Name>
+auto deviceInfo(const cl::Device& d) {
+  cl_int err = CL_SUCCESS;
+  auto value = d.getInfo<Name>(&err);
+  CL_CHECK(err);
+  return value;
+}
+
+bool parseUnsigned(const std::string& s, int* out) {
+  if (s.empty() || s.size() > 6) return false;
+  for (char c : s)
+    if (!std::isdigit(static_cast<unsigned char>(c))) return false;
+  *out = std::stoi(s);
+  return true;
+}
+
+std::string humanBytes(uint64_t bytes) {
+  char buf[32];
+  const double gib = 1024.0 * 1024.0 * 1024.0;
+  if (bytes >= (1ull << 30))
+    std::snprintf(buf, sizeof buf, "%.1f GiB", bytes / gib);
+  else
+    std::snprintf(buf, sizeof buf, "%.0f MiB", bytes / (1024.0 * 1024.0));
+  return buf;
+}
+
+}  // namespace
+
+std::string deviceTypeName(cl_device_type type) {
+  if (type & CL_DEVICE_TYPE_GPU) return "GPU";
+  if (type & CL_DEVICE_TYPE_CPU) return "CPU";
+  if (type & CL_DEVICE_TYPE_ACCELERATOR) return "ACCELERATOR";
+  return "OTHER";
+}
+
+std::vector<DeviceEntry> enumerateDevices() {
+  std::vector<cl::Platform> platforms;
+  cl_int err = cl::Platform::get(&platforms);
+  // The ICD loader reports "no platform" as CL_PLATFORM_NOT_FOUND_KHR: an empty list, not a failure.
+  if (err == CL_PLATFORM_NOT_FOUND_KHR || err == CL_DEVICE_NOT_FOUND) return {};
+  CL_CHECK(err);
+
+  std::vector<DeviceEntry> out;
+  for (size_t p = 0; p < platforms.size(); ++p) {
+    std::vector<cl::Device> devices;
+    err = platforms[p].getDevices(CL_DEVICE_TYPE_ALL, &devices);
+    if (err == CL_DEVICE_NOT_FOUND) continue;
+    CL_CHECK(err);
+    std::string platformName;
+    CL_CHECK(platforms[p].getInfo(CL_PLATFORM_NAME, &platformName));
+    for (size_t d = 0; d < devices.size(); ++d) {
+      DeviceEntry e;
+      e.index = static_cast<int>(out.size());
+      e.platformIndex = static_cast<int>(p);
+      e.deviceIndex = static_cast<int>(d);
+      e.platform = platforms[p];
+      e.device = devices[d];
+      e.platformName = trimmed(platformName);
+      e.name = trimmed(deviceInfo<CL_DEVICE_NAME>(devices[d]));
+      e.vendor = trimmed(deviceInfo<CL_DEVICE_VENDOR>(devices[d]));
+      e.driverVersion = trimmed(deviceInfo<CL_DRIVER_VERSION>(devices[d]));
+      e.deviceVersion = trimmed(deviceInfo<CL_DEVICE_VERSION>(devices[d]));
+      e.openclCVersion = trimmed(deviceInfo<CL_DEVICE_OPENCL_C_VERSION>(devices[d]));
+      e.type = deviceInfo<CL_DEVICE_TYPE>(devices[d]);
+      e.computeUnits = deviceInfo<CL_DEVICE_MAX_COMPUTE_UNITS>(devices[d]);
+      e.globalMemBytes = deviceInfo<CL_DEVICE_GLOBAL_MEM_SIZE>(devices[d]);
+      e.maxAllocBytes = deviceInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>(devices[d]);
+      e.localMemBytes = deviceInfo<CL_DEVICE_LOCAL_MEM_SIZE>(devices[d]);
+      e.maxWorkGroupSize = deviceInfo<CL_DEVICE_MAX_WORK_GROUP_SIZE>(devices[d]);
+      out.push_back(std::move(e));
+    }
+  }
+  return out;
+}
+
+NoDeviceError::NoDeviceError()
+    : RuntimeError(
+          "no OpenCL device found; install an OpenCL driver (for the CPU: apt-get install "
+          "pocl-opencl-icd)") {}
+
+const DeviceEntry& selectDevice(const std::vector<DeviceEntry>& devices, const std::string& spec) {
+  if (devices.empty()) throw NoDeviceError();
+  const std::string s = lower(trimmed(spec));
+  if (s.empty() || s == "default") {
+    for (const auto& d : devices)
+      if (d.type & CL_DEVICE_TYPE_GPU) return d;
+    for (const auto& d : devices)
+      if (d.type & CL_DEVICE_TYPE_CPU) return d;
+    return devices.front();
+  }
+  auto refuse = [&](const std::string& why) -> const DeviceEntry& {
+    throw InputError("--device " + spec + ": " + why + " (run 'pathreuse devices' for the list)");
+  };
+  int index = 0;
+  if (parseUnsigned(s, &index)) {
+    if (index < static_cast<int>(devices.size())) return devices[index];
+    return refuse("no device with index " + s + "; there are " + std::to_string(devices.size()));
+  }
+  const size_t colon = s.find(':');
+  int p = 0, d = 0;
+  if (colon != std::string::npos && parseUnsigned(s.substr(0, colon), &p) &&
+      parseUnsigned(s.substr(colon + 1), &d)) {
+    for (const auto& e : devices)
+      if (e.platformIndex == p && e.deviceIndex == d) return e;
+    return refuse("no device " + std::to_string(d) + " on platform " + std::to_string(p));
+  }
+  if (s == "cpu" || s == "gpu") {
+    const cl_device_type want = s == "cpu" ? CL_DEVICE_TYPE_CPU : CL_DEVICE_TYPE_GPU;
+    for (const auto& e : devices)
+      if (e.type & want) return e;
+    return refuse("no " + s + " device");
+  }
+  for (const auto& e : devices)
+    if (lower(e.name).find(s) != std::string::npos) return e;
+  return refuse("no device whose name contains '" + spec + "'");
+}
+
+std::string describeDevice(const DeviceEntry& d) {
+  std::ostringstream os;
+  os << "[" << d.index << "] " << d.platformIndex << ":" << d.deviceIndex << "  " << d.name
+     << "  (" << d.platformName << ")  " << deviceTypeName(d.type) << ", " << d.computeUnits
+     << " compute units, " << humanBytes(d.globalMemBytes) << " global, max alloc "
+     << humanBytes(d.maxAllocBytes) << ", " << d.openclCVersion;
+  return os.str();
+}
+
+std::string devicesJson(const std::vector<DeviceEntry>& devices) {
+  nlohmann::ordered_json list = nlohmann::ordered_json::array();
+  for (const auto& d : devices) {
+    list.push_back({{"index", d.index},
+                    {"platform_index", d.platformIndex},
+                    {"device_index", d.deviceIndex},
+                    {"platform", d.platformName},
+                    {"name", d.name},
+                    {"type", deviceTypeName(d.type)},
+                    {"compute_units", d.computeUnits},
+                    {"global_mem_bytes", d.globalMemBytes},
+                    {"max_alloc_bytes", d.maxAllocBytes},
+                    {"opencl_c_version", d.openclCVersion},
+                    {"driver_version", d.driverVersion}});
+  }
+  nlohmann::ordered_json root;
+  root["devices"] = std::move(list);
+  return root.dump();
+}
+
+}  // namespace pr

@@ -1,0 +1,20 @@
+// File helpers: whole-file reads and atomic writes (temporary name, then rename), so that a
+// file is either complete or absent.
+#pragma once
+
+#include <string>
+
+namespace pr {
+
+// Reads a whole file; false when it cannot be read.
+bool readFile(const std::string& path, std::string* out);
+
+// Writes `data` to `path` through a temporary file in the same folder and a rename. Creates
+// missing parent folders. Throws RuntimeError naming the file on failure (and leaves no
+// temporary file behind).
+void writeFileAtomic(const std::string& path, const std::string& data);
+
+// A unique temporary name beside `path` (same folder, so rename is atomic).
+std::string temporaryNameFor(const std::string& path);
+
+}  // namespace pr

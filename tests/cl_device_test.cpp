@@ -1,0 +1,230 @@
+// The OpenCL device layer: enumeration, --device parsing, program builds, the binary cache,
+// errors with symbolic names, and the host/device layout agreement of shared structs.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <vector>
+
+#include "cl/context.h"
+#include "cl/device.h"
+#include "cl/kernel_sources.h"
+#include "shared/layout.h"
+#include "shared/types.h"
+#include "support/test_env.h"
+
+namespace pr {
+namespace {
+
+namespace fs = std::filesystem;
+
+DeviceEntry fakeDevice(int index, int p, int d, const std::string& name, cl_device_type type) {
+  DeviceEntry e;
+  e.index = index;
+  e.platformIndex = p;
+  e.deviceIndex = d;
+  e.name = name;
+  e.type = type;
+  return e;
+}
+
+std::vector<DeviceEntry> fakeList() {
+  return {fakeDevice(0, 0, 0, "pthread-skylake", CL_DEVICE_TYPE_CPU),
+          fakeDevice(1, 1, 0, "NVIDIA H100 PCIe", CL_DEVICE_TYPE_GPU),
+          fakeDevice(2, 1, 1, "NVIDIA RTX 4090", CL_DEVICE_TYPE_GPU)};
+}
+
+TEST(DeviceSpec, DefaultPrefersFirstGpu) {
+  const auto list = fakeList();
+  EXPECT_EQ(selectDevice(list, "").index, 1);
+  std::vector<DeviceEntry> cpuOnly = {list[0]};
+  EXPECT_EQ(selectDevice(cpuOnly, "").index, 0);
+}
+
+TEST(DeviceSpec, IndexPlatformDeviceTypeAndName) {
+  const auto list = fakeList();
+  EXPECT_EQ(selectDevice(list, "2").index, 2);
+  EXPECT_EQ(selectDevice(list, "1:1").index, 2);
+  EXPECT_EQ(selectDevice(list, "0:0").index, 0);
+  EXPECT_EQ(selectDevice(list, "cpu").index, 0);
+  EXPECT_EQ(selectDevice(list, "GPU").index, 1);
+  EXPECT_EQ(selectDevice(list, "rtx").index, 2);
+  EXPECT_EQ(selectDevice(list, "h100").index, 1);
+}
+
+TEST(DeviceSpec, RefusesWhatMatchesNothing) {
+  const auto list = fakeList();
+  EXPECT_THROW(selectDevice(list, "99"), InputError);
+  EXPECT_THROW(selectDevice(list, "0:5"), InputError);
+  EXPECT_THROW(selectDevice(list, "3:0"), InputError);
+  EXPECT_THROW(selectDevice(list, "radeon"), InputError);
+  std::vector<DeviceEntry> cpuOnly = {list[0]};
+  EXPECT_THROW(selectDevice(cpuOnly, "gpu"), InputError);
+  try {
+    selectDevice(list, "99");
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("--device 99"), std::string::npos) << e.what();
+  }
+}
+
+TEST(DeviceSpec, NoDeviceAtAll) {
+  std::vector<DeviceEntry> none;
+  EXPECT_THROW(selectDevice(none, ""), NoDeviceError);
+  try {
+    selectDevice(none, "");
+  } catch (const NoDeviceError& e) {
+    EXPECT_NE(std::string(e.what()).find("pocl-opencl-icd"), std::string::npos);
+  }
+}
+
+TEST(ClError, CarriesSymbolicNameFileAndLine) {
+  EXPECT_EQ(clErrorName(-5), "CL_OUT_OF_RESOURCES");
+  EXPECT_EQ(clErrorName(-54), "CL_INVALID_WORK_GROUP_SIZE");
+  EXPECT_EQ(clErrorName(-12345), "CL_ERROR(-12345)");
+  try {
+    CL_CHECK(CL_OUT_OF_RESOURCES);
+    FAIL() << "CL_CHECK did not throw";
+  } catch (const ClError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(e.code(), CL_OUT_OF_RESOURCES);
+    EXPECT_NE(what.find("CL_OUT_OF_RESOURCES"), std::string::npos) << what;
+    EXPECT_NE(what.find("cl_device_test.cpp:"), std::string::npos) << what;
+  }
+  EXPECT_NO_THROW(CL_CHECK(CL_SUCCESS));
+}
+
+TEST(Devices, EnumerationFindsACpuDevice) {
+  const auto devices = enumerateDevices();
+  ASSERT_FALSE(devices.empty()) << "no OpenCL device: is pocl-opencl-icd installed?";
+  bool cpu = false;
+  for (const auto& d : devices) {
+    EXPECT_FALSE(d.name.empty());
+    EXPECT_GT(d.computeUnits, 0u);
+    EXPECT_GT(d.globalMemBytes, 0u);
+    EXPECT_GT(d.maxAllocBytes, 0u);
+    EXPECT_NE(d.openclCVersion.find("OpenCL C"), std::string::npos) << d.openclCVersion;
+    cpu = cpu || (d.type & CL_DEVICE_TYPE_CPU);
+  }
+  EXPECT_TRUE(cpu) << "expected PoCL's CPU device";
+}
+
+TEST(KernelSources, EmbeddedAndExpanded) {
+  const std::string src = expandKernelSource("test/layout.cl");
+  // Both headers are inlined, once each, with #line markers naming them.
+  EXPECT_NE(src.find("#line 1 \"shared/types.h\""), std::string::npos);
+  EXPECT_NE(src.find("#line 1 \"shared/common.h\""), std::string::npos);
+  EXPECT_EQ(src.find("#include \""), std::string::npos);
+  EXPECT_THROW(readKernelFile("no/such/file.cl"), RuntimeError);
+}
+
+class ProgramTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    cacheDir_ = test::tempDir("cache");
+    setenv("PATHREUSE_CACHE_DIR", cacheDir_.c_str(), 1);
+  }
+  void TearDown() override { unsetenv("PATHREUSE_CACHE_DIR"); }
+  std::string cacheDir_;
+};
+
+TEST_F(ProgramTest, SmallKernelComputesExpectedNumbers) {
+  Context& ctx = test::testContext();
+  ProgramBuild b = ctx.buildProgram("test/smoke.cl");
+  cl_int err = CL_SUCCESS;
+  cl::Kernel k(b.program, "saxpy", &err);
+  CL_CHECK(err);
+  const cl_uint n = 1000;
+  std::vector<float> x(n), y(n);
+  for (cl_uint i = 0; i < n; ++i) {
+    x[i] = float(i);
+    y[i] = 1.0f - float(i) * 0.5f;
+  }
+  cl::Buffer bx = ctx.allocate("x", n * sizeof(float));
+  cl::Buffer by = ctx.allocate("y", n * sizeof(float));
+  CL_CHECK(ctx.queue().enqueueWriteBuffer(bx, CL_TRUE, 0, n * sizeof(float), x.data()));
+  CL_CHECK(ctx.queue().enqueueWriteBuffer(by, CL_TRUE, 0, n * sizeof(float), y.data()));
+  CL_CHECK(k.setArg(0, 3.0f));
+  CL_CHECK(k.setArg(1, bx));
+  CL_CHECK(k.setArg(2, by));
+  CL_CHECK(k.setArg(3, n));
+  ctx.launch1D(k, n, "saxpy");
+  std::vector<float> out(n);
+  CL_CHECK(ctx.queue().enqueueReadBuffer(by, CL_TRUE, 0, n * sizeof(float), out.data()));
+  for (cl_uint i = 0; i < n; ++i) ASSERT_FLOAT_EQ(out[i], 3.0f * x[i] + y[i]) << "i=" << i;
+}
+
+TEST_F(ProgramTest, SyntaxErrorThrowsWithBuildLog) {
+  Context& ctx = test::testContext();
+  const std::string bad = "__kernel void broken(__global float* x) { x[0] = undeclared_thing; }\n";
+  try {
+    ctx.buildProgramFromSource(bad, "", "broken.cl");
+    FAIL() << "a kernel with an error built";
+  } catch (const RuntimeError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("CL_BUILD_PROGRAM_FAILURE"), std::string::npos) << what;
+    EXPECT_NE(what.find("undeclared_thing"), std::string::npos) << "no build log in: " << what;
+  }
+}
+
+TEST_F(ProgramTest, SecondBuildComesFromCacheAndCorruptEntryIsRebuilt) {
+  Context& ctx = test::testContext();
+  ProgramBuild first = ctx.buildProgram("test/smoke.cl", "-DPR_CACHE_PROBE=1");
+  EXPECT_FALSE(first.fromCache);
+  ASSERT_FALSE(first.cacheFile.empty());
+  ASSERT_TRUE(fs::exists(first.cacheFile)) << first.cacheFile;
+  ProgramBuild second = ctx.buildProgram("test/smoke.cl", "-DPR_CACHE_PROBE=1");
+  EXPECT_TRUE(second.fromCache);
+  EXPECT_EQ(second.cacheFile, first.cacheFile);
+  // Other options: another key.
+  ProgramBuild other = ctx.buildProgram("test/smoke.cl", "-DPR_CACHE_PROBE=2");
+  EXPECT_FALSE(other.fromCache);
+  EXPECT_NE(other.cacheFile, first.cacheFile);
+
+  // Corrupt the cached binary: the build must still succeed, from source.
+  {
+    std::fstream f(first.cacheFile, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(40);
+    f.write("garbage!garbage!", 16);
+  }
+  ProgramBuild third = ctx.buildProgram("test/smoke.cl", "-DPR_CACHE_PROBE=1");
+  EXPECT_FALSE(third.fromCache);
+  cl_int err = CL_SUCCESS;
+  cl::Kernel k(third.program, "saxpy", &err);
+  EXPECT_EQ(err, CL_SUCCESS);
+  // Truncated to nothing: rebuilt again.
+  std::ofstream(first.cacheFile, std::ios::trunc).close();
+  EXPECT_FALSE(ctx.buildProgram("test/smoke.cl", "-DPR_CACHE_PROBE=1").fromCache);
+  EXPECT_TRUE(ctx.buildProgram("test/smoke.cl", "-DPR_CACHE_PROBE=1").fromCache);
+}
+
+TEST(Layout, DeviceAgreesWithHostOnEverySharedStruct) {
+  using namespace pr::dev;
+  std::vector<std::string> names;
+  std::vector<cl_uint> host;
+#define PR_HOST_SIZE(T)          \
+  names.push_back("sizeof " #T); \
+  host.push_back(sizeof(T));
+  PR_SHARED_STRUCTS(PR_HOST_SIZE)
+#define PR_HOST_OFFSET(T, m)             \
+  names.push_back("offsetof " #T "." #m); \
+  host.push_back(offsetof(T, m));
+  PR_SHARED_FIELDS(PR_HOST_OFFSET)
+
+  Context& ctx = test::testContext();
+  ProgramBuild b = ctx.buildProgram("test/layout.cl");
+  cl_int err = CL_SUCCESS;
+  cl::Kernel k(b.program, "struct_layout", &err);
+  CL_CHECK(err);
+  const size_t bytes = host.size() * sizeof(cl_uint);
+  cl::Buffer out = ctx.allocate("layout", bytes);
+  ctx.zero(out, bytes);
+  CL_CHECK(k.setArg(0, out));
+  ctx.launch1D(k, 1, "struct_layout");
+  std::vector<cl_uint> device(host.size(), 0xdeadbeef);
+  CL_CHECK(ctx.queue().enqueueReadBuffer(out, CL_TRUE, 0, bytes, device.data()));
+  for (size_t i = 0; i < host.size(); ++i) EXPECT_EQ(device[i], host[i]) << names[i];
+}
+
+}  // namespace
+}  // namespace pr

@@ -1,0 +1,70 @@
+// The command line as a user meets it: exit codes, one-line errors, the devices listing.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "support/test_env.h"
+
+namespace pr {
+namespace {
+
+size_t lineCount(const std::string& s) {
+  size_t n = 0;
+  for (char c : s) n += c == '\n';
+  return n;
+}
+
+TEST(Cli, DevicesListsPocl) {
+  auto r = test::runPathreuse("devices");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.out.find("[0] 0:0"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("CPU"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("OpenCL C"), std::string::npos) << r.out;
+}
+
+TEST(Cli, DevicesJson) {
+  auto r = test::runPathreuse("devices --json");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  ASSERT_TRUE(j["devices"].is_array());
+  ASSERT_GE(j["devices"].size(), 1u);
+  for (const char* key : {"index", "platform", "name", "type", "compute_units", "global_mem_bytes",
+                          "max_alloc_bytes", "opencl_c_version"})
+    EXPECT_TRUE(j["devices"][0].contains(key)) << key;
+  EXPECT_GT(j["devices"][0]["global_mem_bytes"].get<uint64_t>(), 0u);
+}
+
+TEST(Cli, TwoPoclDriversAreBothListed) {
+  auto r = test::runPathreuse("devices --json", "POCL_DEVICES='pthread basic'");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["devices"].size(), 2u) << r.out;
+  EXPECT_NE(j["devices"][0]["name"], j["devices"][1]["name"]);
+}
+
+TEST(Cli, NoPlatformIsOneLineAndExitOne) {
+  // An empty vendor folder: the ICD loader finds no platform.
+  const std::string empty = test::tempDir("icd");
+  auto r = test::runPathreuse("devices", "OCL_ICD_VENDORS='" + empty + "'");
+  EXPECT_EQ(r.exitCode, 1) << r.out << r.err;
+  EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+  EXPECT_NE(r.err.find("pocl-opencl-icd"), std::string::npos) << r.err;
+}
+
+TEST(Cli, UnknownOptionAndSubcommandAreExitTwo) {
+  auto r = test::runPathreuse("devices --frobnicate");
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+  r = test::runPathreuse("");
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+}
+
+TEST(Cli, HelpIsExitZero) {
+  auto r = test::runPathreuse("--help");
+  EXPECT_EQ(r.exitCode, 0);
+  EXPECT_NE(r.out.find("devices"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace pr

@@ -1,0 +1,83 @@
+#include "support/test_env.h"
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <sstream>
+#include <vector>
+
+#include "cl/device.h"
+
+namespace pr::test {
+
+namespace fs = std::filesystem;
+
+Context& testContext() {
+  static std::unique_ptr<Context> ctx;
+  static std::once_flag once;
+  std::call_once(once, [] {
+    const char* spec = std::getenv("PATHREUSE_TEST_DEVICE");
+    static const auto devices = enumerateDevices();
+    ctx = std::make_unique<Context>(selectDevice(devices, spec ? spec : ""));
+  });
+  return *ctx;
+}
+
+std::string sharedScene(const std::string& rel) {
+  const fs::path p = fs::path(PATHREUSE_SHARED_DIR) / "scenes" / rel;
+  return fs::exists(p) ? p.lexically_normal().string() : "";
+}
+
+std::string sourcePath(const std::string& rel) {
+  return (fs::path(PATHREUSE_SOURCE_DIR) / rel).string();
+}
+
+namespace {
+struct TempDirs {
+  std::vector<std::string> dirs;
+  ~TempDirs() {
+    for (const auto& d : dirs) {
+      std::error_code ec;
+      fs::remove_all(d, ec);
+    }
+  }
+};
+TempDirs& tempDirs() {
+  static TempDirs t;
+  return t;
+}
+}  // namespace
+
+std::string tempDir(const std::string& tag) {
+  std::string templ = (fs::temp_directory_path() / ("pathreuse-" + tag + "-XXXXXX")).string();
+  std::vector<char> buf(templ.begin(), templ.end());
+  buf.push_back('\0');
+  if (!mkdtemp(buf.data())) throw std::runtime_error("mkdtemp failed for " + templ);
+  tempDirs().dirs.emplace_back(buf.data());
+  return buf.data();
+}
+
+CommandResult runPathreuse(const std::string& args, const std::string& env) {
+  const std::string dir = tempDir("cli");
+  const std::string outFile = dir + "/stdout", errFile = dir + "/stderr";
+  const std::string cmd = env + (env.empty() ? "" : " ") + "'" + PATHREUSE_BINARY + "' " + args +
+                          " >'" + outFile + "' 2>'" + errFile + "' </dev/null";
+  const int status = std::system(cmd.c_str());
+  CommandResult r;
+  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  auto slurp = [](const std::string& f) {
+    std::ifstream in(f);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  };
+  r.out = slurp(outFile);
+  r.err = slurp(errFile);
+  return r;
+}
+
+}  // namespace pr::test

@@ -1,0 +1,33 @@
+// Helpers shared by the tests: the OpenCL device under test, paths, and running the CLI.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "cl/context.h"
+
+namespace pr::test {
+
+// The device the tests run on: --device-style spec from $PATHREUSE_TEST_DEVICE, else the
+// default choice. Created once per test process.
+Context& testContext();
+
+// Path of ../shared/scenes/<rel> beside the project, or "" when that folder is absent.
+std::string sharedScene(const std::string& rel);
+
+// Path of a file in the source tree.
+std::string sourcePath(const std::string& rel);
+
+// A fresh empty temporary folder, removed at process exit.
+std::string tempDir(const std::string& tag);
+
+struct CommandResult {
+  int exitCode = -1;
+  std::string out;  // stdout
+  std::string err;  // stderr
+};
+
+// Runs the pathreuse binary with `args` (a shell-quoted string); `env` is prefixed as-is.
+CommandResult runPathreuse(const std::string& args, const std::string& env = "");
+
+}  // namespace pr::test
