@@ -27,10 +27,20 @@ PR_INLINE u32 pr_as_uint(float v) { return as_uint(v); }
 
 PR_NAMESPACE_BEGIN
 
+// float overloads, so host arithmetic matches the device's single precision.
+using std::acos;
+using std::atan2;
+using std::cos;
+using std::exp;
 using std::fabs;
+using std::floor;
 using std::fmax;
 using std::fmin;
+using std::log;
+using std::pow;
+using std::sin;
 using std::sqrt;
+using std::tan;
 
 struct float2 {
   float x, y;

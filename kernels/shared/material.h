@@ -1,0 +1,49 @@
+// Materials as the kernels see them: glTF metallic-roughness with emission, transmission
+// (delta dielectric), alpha cut-out/coverage and a baseColor texture transform.
+#pragma once
+
+#include "shared/common.h"
+
+PR_NAMESPACE_BEGIN
+
+#define PR_MAT_DOUBLE_SIDED 1u
+#define PR_MAT_ALPHA_MASK 2u   // cut-out at alpha_cutoff
+#define PR_MAT_ALPHA_BLEND 4u  // stochastic coverage: pass through with probability 1 - alpha
+#define PR_MAT_MIRROR 8u       // delta reflection (metallic 1, roughness ~0)
+#define PR_MAT_GLASS 16u       // delta dielectric (KHR_materials_transmission)
+#define PR_MAT_EMISSIVE 32u
+
+#define PR_NO_TEXTURE (-1)
+
+// 96 bytes.
+typedef struct {
+  float base_r, base_g, base_b, base_a;  // linear baseColorFactor
+  float emit_r, emit_g, emit_b;          // emissiveFactor * emissive_strength (radiance)
+  u32 flags;
+  float metallic, roughness, ior, transmission;
+  float alpha_cutoff;
+  i32 base_texture;      // index into the texture table, or PR_NO_TEXTURE
+  i32 mr_texture;        // metallicRoughness (G = roughness, B = metallic)
+  i32 emission_texture;
+  // KHR_texture_transform of the baseColor texture as a 2x3 matrix: uv' = M * (u, v, 1).
+  float uv_m00, uv_m01, uv_m02;
+  float uv_m10, uv_m11, uv_m12;
+  float pad0, pad1;
+} Material;
+
+// One texture in the shared texel buffer (RGBA8 packed in u32, row-major). 16 bytes.
+typedef struct {
+  u32 offset;  // first texel
+  u32 width, height;
+  u32 flags;   // PR_TEX_SRGB
+} TextureInfo;
+
+#define PR_TEX_SRGB 1u
+
+PR_NAMESPACE_END
+
+PR_STATIC_ASSERT(sizeof(pr::dev::Material) == 96, "Material layout");
+PR_STATIC_ASSERT(offsetof(pr::dev::Material, flags) == 28, "Material layout");
+PR_STATIC_ASSERT(offsetof(pr::dev::Material, alpha_cutoff) == 48, "Material layout");
+PR_STATIC_ASSERT(offsetof(pr::dev::Material, uv_m00) == 64, "Material layout");
+PR_STATIC_ASSERT(sizeof(pr::dev::TextureInfo) == 16, "TextureInfo layout");

@@ -1,0 +1,207 @@
+// BSDF sampling, evaluation and pdfs agree with each other; energy is conserved; the RNG is a
+// pure function of its key; the same code gives the same numbers on the device.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <set>
+
+#include "shared/bsdf.h"
+#include "shared/rng.h"
+#include "support/test_env.h"
+
+namespace pr {
+namespace {
+
+using namespace pr::dev;
+
+BsdfParams microfacet(float3 base, float metallic, float roughness) {
+  BsdfParams m;
+  m.base = base;
+  m.metallic = metallic;
+  m.alpha = std::fmax(roughness * roughness, PR_MIN_ALPHA);
+  m.ior = 1.5f;
+  m.kind = PR_BSDF_MICROFACET;
+  return m;
+}
+
+float3 dirFromCos(float cos_t, float phi) {
+  const float s = std::sqrt(std::fmax(0.0f, 1.0f - cos_t * cos_t));
+  return make_float3(s * std::cos(phi), s * std::sin(phi), cos_t);
+}
+
+struct Estimate {
+  double mean, stderr_;
+};
+
+// E[f cos / pdf] over the sampling routine.
+Estimate albedoBySampling(const BsdfParams& m, float3 wo, int n, uint32_t seed) {
+  Rng r = rng_make(seed, PR_RNG_TEST, 0, 1, 2);
+  double s = 0, s2 = 0;
+  for (int i = 0; i < n; ++i) {
+    float3 wi, w;
+    float pdf;
+    int delta;
+    double v = 0;
+    const float u0 = rng_next(&r), u1 = rng_next(&r), u2 = rng_next(&r);
+    if (bsdf_sample(&m, wo, u0, u1, u2, PR_RADIANCE, &wi, &w, &pdf, &delta)) v = luminance(w);
+    s += v;
+    s2 += v * v;
+  }
+  const double mean = s / n;
+  return {mean, std::sqrt(std::fmax(0.0, s2 / n - mean * mean) / n)};
+}
+
+// The same integral with cosine-weighted directions and bsdf_eval: an independent estimator.
+Estimate albedoByEval(const BsdfParams& m, float3 wo, int n, uint32_t seed) {
+  Rng r = rng_make(seed, PR_RNG_TEST, 0, 3, 4);
+  double s = 0, s2 = 0;
+  for (int i = 0; i < n; ++i) {
+    const float3 wi = sample_cosine_hemisphere(rng_next(&r), rng_next(&r));
+    float pdf;
+    const float3 f = bsdf_eval(&m, wo, wi, &pdf);
+    const double v = wi.z > 0 ? luminance(f) * PR_PI : 0.0;  // f cos / (cos / pi)
+    s += v;
+    s2 += v * v;
+  }
+  const double mean = s / n;
+  return {mean, std::sqrt(std::fmax(0.0, s2 / n - mean * mean) / n)};
+}
+
+TEST(Rng, PureFunctionOfKeyAndUniform) {
+  Rng a = rng_make(1, PR_RNG_CAMERA, 2, 3, 4), b = rng_make(1, PR_RNG_CAMERA, 2, 3, 4);
+  for (int i = 0; i < 100; ++i) EXPECT_EQ(rng_next_u32(&a), rng_next_u32(&b));
+  // Any key word changes the stream.
+  const Rng base = rng_make(1, PR_RNG_CAMERA, 2, 3, 4);
+  for (Rng other : {rng_make(9, PR_RNG_CAMERA, 2, 3, 4), rng_make(1, PR_RNG_LIGHT, 2, 3, 4),
+                    rng_make(1, PR_RNG_CAMERA, 7, 3, 4), rng_make(1, PR_RNG_CAMERA, 2, 8, 4),
+                    rng_make(1, PR_RNG_CAMERA, 2, 3, 5)}) {
+    EXPECT_NE(rng_u32_at(&base, 0), rng_u32_at(&other, 0));
+  }
+  // Uniform in [0, 1): mean 1/2, variance 1/12, never 1.
+  double s = 0, s2 = 0;
+  const int n = 200000;
+  for (int i = 0; i < n; ++i) {
+    Rng r = rng_make(5, PR_RNG_TEST, 0, static_cast<uint32_t>(i), 0);
+    const float u = rng_next(&r);
+    ASSERT_GE(u, 0.0f);
+    ASSERT_LT(u, 1.0f);
+    s += u;
+    s2 += double(u) * u;
+  }
+  EXPECT_NEAR(s / n, 0.5, 4 * std::sqrt(1.0 / 12 / n));
+  EXPECT_NEAR(s2 / n - (s / n) * (s / n), 1.0 / 12, 2e-3);
+}
+
+TEST(Sampling, CosineHemispherePdfAndTriangle) {
+  Rng r = rng_make(11, PR_RNG_TEST, 0, 0, 0);
+  double meanCos = 0;
+  const int n = 100000;
+  for (int i = 0; i < n; ++i) {
+    const float3 d = sample_cosine_hemisphere(rng_next(&r), rng_next(&r));
+    ASSERT_NEAR(length(d), 1.0f, 1e-5f);
+    ASSERT_GE(d.z, 0.0f);
+    meanCos += d.z;
+  }
+  EXPECT_NEAR(meanCos / n, 2.0 / 3.0, 0.005);  // E[cos] under cos/pi = 2/3
+  double b1 = 0;
+  for (int i = 0; i < n; ++i) {
+    const float2 b = sample_triangle(rng_next(&r), rng_next(&r));
+    ASSERT_GE(b.x, 0.0f);
+    ASSERT_GE(b.y, 0.0f);
+    ASSERT_LE(b.x + b.y, 1.0f + 1e-6f);
+    b1 += b.x;
+  }
+  EXPECT_NEAR(b1 / n, 1.0 / 3.0, 0.005);
+}
+
+TEST(Bsdf, LambertAlbedoIsBaseColour) {
+  // A rough dielectric is mostly Lambert; with metallic 0 the albedo is base * (1 - F) + F-ish.
+  const BsdfParams m = microfacet(make_float3(0.5f, 0.5f, 0.5f), 0.0f, 1.0f);
+  const float3 wo = dirFromCos(0.8f, 0.3f);
+  const Estimate a = albedoBySampling(m, wo, 200000, 1);
+  EXPECT_GT(a.mean, 0.45);
+  EXPECT_LT(a.mean, 0.6);
+}
+
+TEST(Bsdf, SamplingAgreesWithEvaluation) {
+  const float3 bases[] = {make_float3(0.9f, 0.9f, 0.9f), make_float3(0.8f, 0.3f, 0.1f)};
+  for (float metallic : {0.0f, 0.5f, 1.0f})
+    for (float roughness : {0.15f, 0.4f, 1.0f})
+      for (float3 base : bases)
+        for (float cos_o : {0.95f, 0.5f, 0.15f}) {
+          const BsdfParams m = microfacet(base, metallic, roughness);
+          const float3 wo = dirFromCos(cos_o, 1.1f);
+          const Estimate s = albedoBySampling(m, wo, 60000, 2);
+          const Estimate e = albedoByEval(m, wo, 60000, 3);
+          const double tol = 5 * std::sqrt(s.stderr_ * s.stderr_ + e.stderr_ * e.stderr_) + 2e-3;
+          EXPECT_NEAR(s.mean, e.mean, tol) << "metallic " << metallic << " roughness " << roughness
+                                           << " cos_o " << cos_o;
+          // Energy: no more than the light that arrives (a little slack for noise).
+          EXPECT_LE(s.mean, 1.0 + tol);
+        }
+}
+
+TEST(Bsdf, PdfIntegratesToAtMostOne) {
+  for (float roughness : {0.2f, 0.6f, 1.0f}) {
+    const BsdfParams m = microfacet(make_float3(0.7f, 0.7f, 0.7f), 0.3f, roughness);
+    const float3 wo = dirFromCos(0.6f, 0.0f);
+    Rng r = rng_make(4, PR_RNG_TEST, 0, 0, 0);
+    double s = 0;
+    const int n = 400000;
+    for (int i = 0; i < n; ++i) {
+      const float3 wi = sample_uniform_sphere(rng_next(&r), rng_next(&r));
+      float pdf;
+      bsdf_eval(&m, wo, wi, &pdf);
+      s += pdf * 4 * PR_PI;
+    }
+    // The mass the GGX lobe puts below the horizon is lost, so <= 1, and close to 1.
+    EXPECT_LE(s / n, 1.02) << roughness;
+    EXPECT_GT(s / n, 0.85) << roughness;
+  }
+}
+
+TEST(Bsdf, Reciprocity) {
+  Rng r = rng_make(6, PR_RNG_TEST, 0, 0, 0);
+  const BsdfParams m = microfacet(make_float3(0.6f, 0.4f, 0.2f), 0.4f, 0.5f);
+  for (int i = 0; i < 1000; ++i) {
+    const float3 a = sample_cosine_hemisphere(rng_next(&r), rng_next(&r));
+    const float3 b = sample_cosine_hemisphere(rng_next(&r), rng_next(&r));
+    float p;
+    const float3 fab = bsdf_eval(&m, a, b, &p), fba = bsdf_eval(&m, b, a, &p);
+    EXPECT_NEAR(fab.x, fba.x, 1e-4f * std::fmax(1.0f, fab.x));
+    EXPECT_NEAR(fab.z, fba.z, 1e-4f * std::fmax(1.0f, fab.z));
+  }
+}
+
+TEST(Bsdf, GlassConservesEnergyAndRefractsBySnell) {
+  BsdfParams m = microfacet(make_float3(1, 1, 1), 0, 0);
+  m.kind = PR_BSDF_GLASS;
+  m.ior = 1.5f;
+  Rng r = rng_make(8, PR_RNG_TEST, 0, 0, 0);
+  for (float cos_o : {0.9f, 0.4f, -0.9f, -0.4f}) {
+    const float3 wo = dirFromCos(cos_o, 0.7f);
+    for (int i = 0; i < 200; ++i) {
+      float3 wi, w;
+      float pdf;
+      int delta;
+      ASSERT_TRUE(bsdf_sample(&m, wo, rng_next(&r), 0.5f, 0.5f, PR_IMPORTANCE, &wi, &w, &pdf, &delta));
+      EXPECT_TRUE(delta);
+      EXPECT_NEAR(length(wi), 1.0f, 1e-5f);
+      EXPECT_FLOAT_EQ(w.x, 1.0f);  // importance: no 1/eta^2
+      if (wi.z * wo.z < 0) {
+        // Snell: n_i sin_i = n_t sin_t.
+        const float sin_o = std::sqrt(1 - wo.z * wo.z), sin_i = std::sqrt(1 - wi.z * wi.z);
+        const float ni = wo.z > 0 ? 1.0f : 1.5f, nt = wo.z > 0 ? 1.5f : 1.0f;
+        EXPECT_NEAR(ni * sin_o, nt * sin_i, 1e-4f);
+        // Same plane of incidence, opposite tangential direction.
+        EXPECT_LT(wi.x * wo.x + wi.y * wo.y, 0.0f);
+      } else {
+        EXPECT_NEAR(wi.z, wo.z, 1e-6f);
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace pr
