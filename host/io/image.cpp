@@ -1,0 +1,138 @@
+#include "io/image.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include <ImfArray.h>
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfOutputFile.h>
+#include <stb_image_write.h>
+
+#include "util/error.h"
+#include "util/files.h"
+
+namespace pr {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+void ensureParent(const std::string& path) {
+  const fs::path parent = fs::path(path).parent_path();
+  if (parent.empty()) return;
+  std::error_code ec;
+  fs::create_directories(parent, ec);
+  if (ec) throw RuntimeError(path + ": cannot create folder: " + ec.message());
+}
+
+float srgbEncode(float v) {
+  v = std::clamp(v, 0.0f, 1.0f);
+  return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+}
+
+}  // namespace
+
+void writeExr(const std::string& path, const Image& image, ExrPixels pixels) {
+  ensureParent(path);
+  const std::string tmp = temporaryNameFor(path);
+  const Imf::PixelType type = pixels == ExrPixels::Half ? Imf::HALF : Imf::FLOAT;
+  try {
+    Imf::Header header(image.width, image.height);
+    header.compression() = Imf::ZIP_COMPRESSION;
+    const char* names[4] = {"R", "G", "B", "A"};
+    for (const char* n : names) header.channels().insert(n, Imf::Channel(type));
+    Imf::FrameBuffer fb;
+    // Half output converts from a float frame buffer only through a half copy.
+    std::vector<half> halves;
+    if (type == Imf::HALF) {
+      halves.resize(image.rgba.size());
+      for (size_t i = 0; i < halves.size(); ++i) halves[i] = half(image.rgba[i]);
+      for (int c = 0; c < 4; ++c)
+        fb.insert(names[c], Imf::Slice(Imf::HALF, reinterpret_cast<char*>(halves.data() + c),
+                                       sizeof(half) * 4, sizeof(half) * 4 * image.width));
+    } else {
+      for (int c = 0; c < 4; ++c)
+        fb.insert(names[c],
+                  Imf::Slice(Imf::FLOAT, const_cast<char*>(reinterpret_cast<const char*>(image.rgba.data() + c)),
+                             sizeof(float) * 4, sizeof(float) * 4 * image.width));
+    }
+    {
+      Imf::OutputFile file(tmp.c_str(), header);
+      file.setFrameBuffer(fb);
+      file.writePixels(image.height);
+    }
+  } catch (const std::exception& e) {
+    std::remove(tmp.c_str());
+    throw RuntimeError(path + ": cannot write OpenEXR: " + e.what());
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    throw RuntimeError(path + ": cannot write: rename failed");
+  }
+}
+
+void writePng(const std::string& path, const Image& image, float exposure) {
+  const float scale = std::exp2(exposure);
+  std::vector<unsigned char> bytes(static_cast<size_t>(image.width) * image.height * 3);
+  for (size_t i = 0, n = static_cast<size_t>(image.width) * image.height; i < n; ++i)
+    for (int c = 0; c < 3; ++c) {
+      const float v = image.rgba[i * 4 + c] * scale;
+      bytes[i * 3 + c] =
+          static_cast<unsigned char>(std::lround(srgbEncode(std::isfinite(v) ? v : 0.0f) * 255.0f));
+    }
+  std::string encoded;
+  auto sink = [](void* ctx, void* data, int size) {
+    static_cast<std::string*>(ctx)->append(static_cast<const char*>(data), size);
+  };
+  if (!stbi_write_png_to_func(sink, &encoded, image.width, image.height, 3, bytes.data(),
+                              image.width * 3))
+    throw RuntimeError(path + ": PNG encoding failed");
+  writeFileAtomic(path, encoded);
+}
+
+Image readExr(const std::string& path) {
+  if (!fs::exists(path)) throw InputError(path + ": no such file");
+  try {
+    Imf::InputFile file(path.c_str());
+    const Imath::Box2i dw = file.header().dataWindow();
+    const int w = dw.max.x - dw.min.x + 1, h = dw.max.y - dw.min.y + 1;
+    if (w <= 0 || h <= 0 || static_cast<long long>(w) * h > (1ll << 28))
+      throw InputError(path + ": unreasonable OpenEXR data window");
+    Image img(w, h);
+    Imf::FrameBuffer fb;
+    const char* names[4] = {"R", "G", "B", "A"};
+    for (int c = 0; c < 4; ++c) {
+      char* base = reinterpret_cast<char*>(img.rgba.data() + c) -
+                   (static_cast<ptrdiff_t>(dw.min.x) + static_cast<ptrdiff_t>(dw.min.y) * w) *
+                       static_cast<ptrdiff_t>(sizeof(float) * 4);
+      fb.insert(names[c], Imf::Slice(Imf::FLOAT, base, sizeof(float) * 4, sizeof(float) * 4 * w, 1,
+                                     1, c == 3 ? 1.0 : 0.0));
+    }
+    file.setFrameBuffer(fb);
+    if (!file.isComplete()) throw InputError(path + ": OpenEXR file is incomplete");
+    file.readPixels(dw.min.y, dw.max.y);
+    return img;
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    std::string msg = e.what();
+    std::replace(msg.begin(), msg.end(), '\n', ' ');
+    throw InputError(path + ": not a readable OpenEXR file (" + msg + ")");
+  }
+}
+
+bool isCompleteExr(const std::string& path) {
+  try {
+    readExr(path);
+    return true;
+  } catch (const InputError&) {
+    return false;
+  }
+}
+
+}  // namespace pr
