@@ -1,0 +1,115 @@
+#include "render/options.h"
+
+#include <cctype>
+#include <cstdio>
+#include <filesystem>
+
+#include "util/error.h"
+
+namespace pr {
+
+const char* renderModeName(RenderMode m) {
+  switch (m) {
+    case RenderMode::Reuse: return "reuse";
+    case RenderMode::Retrace: return "retrace";
+    case RenderMode::PathTrace: return "pathtrace";
+  }
+  return "?";
+}
+
+namespace {
+
+bool parseInt(const std::string& s, int* out) {
+  if (s.empty() || s.size() > 9) return false;
+  for (char c : s)
+    if (!std::isdigit(static_cast<unsigned char>(c))) return false;
+  *out = std::stoi(s);
+  return true;
+}
+
+// Finds the single integer conversion: its position and length. Returns false if malformed.
+bool findConversion(const std::string& p, size_t* pos, size_t* len, std::string* why) {
+  int found = 0;
+  for (size_t i = 0; i < p.size(); ++i) {
+    if (p[i] != '%') continue;
+    if (i + 1 < p.size() && p[i + 1] == '%') {
+      ++i;
+      continue;
+    }
+    size_t j = i + 1;
+    while (j < p.size() && (p[j] == '0' || p[j] == '-' || p[j] == '+' || p[j] == ' ')) ++j;
+    size_t digits = 0;
+    while (j < p.size() && std::isdigit(static_cast<unsigned char>(p[j]))) ++j, ++digits;
+    if (digits > 2) {
+      *why = "field width too large";
+      return false;
+    }
+    if (j >= p.size() || (p[j] != 'd' && p[j] != 'i' && p[j] != 'u')) {
+      *why = "only an integer conversion such as %04d is allowed";
+      return false;
+    }
+    ++found;
+    *pos = i;
+    *len = j - i + 1;
+    i = j;
+  }
+  if (found != 1) {
+    *why = found == 0 ? "no frame number conversion such as %04d"
+                      : "more than one frame number conversion";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+FrameRange parseFrameRange(const std::string& text) {
+  FrameRange r;
+  const size_t dash = text.find('-');
+  bool ok;
+  if (dash == std::string::npos) {
+    ok = parseInt(text, &r.first);
+    r.last = r.first;
+  } else {
+    ok = parseInt(text.substr(0, dash), &r.first) && parseInt(text.substr(dash + 1), &r.last);
+  }
+  if (!ok) throw InputError("--frames " + text + ": expected A-B or A, with whole numbers >= 0");
+  if (r.last < r.first) throw InputError("--frames " + text + ": the last frame is before the first");
+  return r;
+}
+
+void validateOutPattern(const std::string& pattern) {
+  size_t pos = 0, len = 0;
+  std::string why;
+  if (!findConversion(pattern, &pos, &len, &why)) throw InputError("--out " + pattern + ": " + why);
+  if (std::filesystem::path(pattern).filename().empty())
+    throw InputError("--out " + pattern + ": names a folder, not a file");
+}
+
+std::string formatOutPath(const std::string& pattern, int frame) {
+  size_t pos = 0, len = 0;
+  std::string why;
+  if (!findConversion(pattern, &pos, &len, &why)) throw InputError("--out " + pattern + ": " + why);
+  char buf[64];
+  const std::string conv = pattern.substr(pos, len - 1) + "d";
+  std::snprintf(buf, sizeof buf, conv.c_str(), frame);
+  std::string out;
+  // Unescape %% outside the conversion.
+  auto unescape = [](const std::string& s) {
+    std::string r;
+    for (size_t i = 0; i < s.size(); ++i) {
+      r += s[i];
+      if (s[i] == '%' && i + 1 < s.size() && s[i + 1] == '%') ++i;
+    }
+    return r;
+  };
+  return unescape(pattern.substr(0, pos)) + buf + unescape(pattern.substr(pos + len));
+}
+
+std::string withExtension(const std::string& path, const std::string& ext) {
+  std::filesystem::path p(path);
+  p.replace_extension(ext);
+  return p.string();
+}
+
+}  // namespace pr

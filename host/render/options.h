@@ -1,0 +1,56 @@
+// Options of `pathreuse render`, their defaults and their validation.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace pr {
+
+enum class RenderMode { Reuse, Retrace, PathTrace };
+
+const char* renderModeName(RenderMode m);
+
+struct FrameRange {
+  int first = 0;
+  int last = -1;  // -1: up to the end of the animation
+};
+
+struct RenderOptions {
+  std::string scene;
+  FrameRange frames;
+  bool framesGiven = false;
+  double fps = 24.0;
+  int width = 0;   // 0: the camera's aspect with height, else 640x480
+  int height = 0;
+  int spp = 4;
+  int maxDepth = 8;
+  uint32_t seed = 1;
+  std::string device;
+  RenderMode mode = RenderMode::Reuse;
+  int camera = -1;  // -1: the scene's first camera
+  std::string outPattern = "out/frame_%04d.exr";
+  bool exrFloat = false;
+  bool png = false;
+  float exposure = 0.0f;
+  bool quiet = false;
+  std::string statsFile;
+  // Path reuse (DESIGN.md section 5).
+  int lightPaths = 0;       // slots; 0: chosen from the image size
+  int pathsPerPixel = 4;    // C: light paths each pixel sample connects to
+  float clamp = 0.0f;       // clamp on the geometry term; 0 = off
+};
+
+// "A-B" or "A" (non-negative, A <= B). Throws InputError naming --frames.
+FrameRange parseFrameRange(const std::string& text);
+
+// Checks that `pattern` holds exactly one integer conversion (%d, %04d, %5i ...) and no other
+// conversion than "%%". Throws InputError naming --out.
+void validateOutPattern(const std::string& pattern);
+
+// The pattern with the frame number substituted.
+std::string formatOutPath(const std::string& pattern, int frame);
+
+// `path` with its extension replaced (".exr" -> ".png"), or the extension appended.
+std::string withExtension(const std::string& path, const std::string& ext);
+
+}  // namespace pr
