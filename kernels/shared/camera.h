@@ -1,0 +1,31 @@
+// The pinhole camera: a ray through a jittered point of a pixel. Pixel (0, 0) is the top left.
+#pragma once
+
+#include "shared/math.h"
+
+PR_NAMESPACE_BEGIN
+
+// 80 bytes.
+typedef struct {
+  float px, py, pz, tan_half_fov;  // position; tan(yfov / 2)
+  float fx, fy, fz, aspect;        // unit forward; width / height
+  float rx, ry, rz, pad0;          // unit right
+  float ux, uy, uz, pad1;          // unit up
+  u32 width, height, pad2, pad3;
+} CameraParams;
+
+// Direction (unit) of the ray through film point (sx, sy) in pixels, e.g. (x + jitter, y + jitter).
+PR_INLINE float3 camera_direction(const CameraParams* c, float sx, float sy) {
+  const float ndc_x = (2.0f * sx / (float)c->width - 1.0f) * c->tan_half_fov * c->aspect;
+  const float ndc_y = (1.0f - 2.0f * sy / (float)c->height) * c->tan_half_fov;
+  const float3 d = make_float3(c->fx, c->fy, c->fz) + make_float3(c->rx, c->ry, c->rz) * ndc_x +
+                   make_float3(c->ux, c->uy, c->uz) * ndc_y;
+  return normalize(d);
+}
+
+PR_INLINE float3 camera_position(const CameraParams* c) { return make_float3(c->px, c->py, c->pz); }
+
+PR_NAMESPACE_END
+
+PR_STATIC_ASSERT(sizeof(pr::dev::CameraParams) == 80, "CameraParams layout");
+PR_STATIC_ASSERT(offsetof(pr::dev::CameraParams, width) == 64, "CameraParams layout");
