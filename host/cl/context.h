@@ -50,7 +50,9 @@ class Context {
 
   // A 1-D launch of `global` work-items, padded to a multiple of the work-group size that the
   // device reports for the kernel; kernels guard with their own count argument.
-  void launch1D(const cl::Kernel& kernel, size_t global, const char* what);
+  // With `event`, the launch's event is returned for profiling (the queue profiles).
+  void launch1D(const cl::Kernel& kernel, size_t global, const char* what,
+                cl::Event* event = nullptr);
 
   void finish();
 

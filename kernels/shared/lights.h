@@ -127,7 +127,31 @@ PR_INLINE float light_pdf_triangle(float3 le, float area, float total_power, flo
   return pmf * dist * dist / (cos_l * area);
 }
 
+// The light table as kernels see it (built from PR_LIGHT_PARAMS).
+typedef struct {
+  PR_GLOBAL const Light* lights;
+  PR_GLOBAL const float* cdf;  // running sum of power; cdf[count - 1] == total_power
+  u32 count;
+  float total_power;
+} LightData;
+
 PR_NAMESPACE_END
+
+#ifdef PR_DEVICE_CODE
+#define PR_LIGHT_PARAMS                                                                  \
+  __global const Light *pr_lights, __global const float *pr_light_cdf, uint pr_light_count, \
+      float pr_total_power
+PR_INLINE LightData pr_light_data(__global const Light* l, __global const float* cdf, uint count,
+                                  float total) {
+  LightData d;
+  d.lights = l;
+  d.cdf = cdf;
+  d.count = count;
+  d.total_power = total;
+  return d;
+}
+#define PR_LIGHTS() pr_light_data(pr_lights, pr_light_cdf, pr_light_count, pr_total_power)
+#endif
 
 PR_STATIC_ASSERT(sizeof(pr::dev::Light) == 96, "Light layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::Light, le_r) == 48, "Light layout");

@@ -39,6 +39,10 @@ typedef struct {
 } TextureInfo;
 
 #define PR_TEX_SRGB 1u
+#define PR_TEX_NEAREST 2u
+// Wrap modes in bits 2-3 (S) and 4-5 (T): 0 repeat, 1 clamp to edge, 2 mirrored repeat.
+#define PR_TEX_WRAP_S_SHIFT 2u
+#define PR_TEX_WRAP_T_SHIFT 4u
 
 PR_NAMESPACE_END
 

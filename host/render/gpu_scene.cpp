@@ -1,0 +1,332 @@
+#include "render/gpu_scene.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+
+#include <glm/gtc/matrix_inverse.hpp>
+
+#include "util/error.h"
+
+namespace pr {
+
+namespace {
+
+void toRows(const glm::mat4& m, float out[12]) {
+  // glm is column-major: m[col][row].
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) out[r * 4 + c] = m[c][r];
+}
+
+float luminanceOf(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
+dev::Light triangleLight(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c,
+                         const glm::vec3& le, uint32_t prim, uint32_t inst, uint32_t material) {
+  dev::Light l{};
+  l.type = PR_LIGHT_TRIANGLE;
+  l.p0x = a.x, l.p0y = a.y, l.p0z = a.z;
+  const glm::vec3 e1 = b - a, e2 = c - a;
+  l.e1x = e1.x, l.e1y = e1.y, l.e1z = e1.z;
+  l.e2x = e2.x, l.e2y = e2.y, l.e2z = e2.z;
+  l.inst = inst;
+  l.prim = prim;
+  l.le_r = le.x, l.le_g = le.y, l.le_b = le.z;
+  l.area = 0.5f * glm::length(glm::cross(e1, e2));
+  l.power = luminanceOf(le) * 3.14159265f * l.area;
+  l.material = material;
+  return l;
+}
+
+}  // namespace
+
+dev::Material toDeviceMaterial(const Material& m) {
+  dev::Material d{};
+  d.base_r = m.baseColorFactor.r;
+  d.base_g = m.baseColorFactor.g;
+  d.base_b = m.baseColorFactor.b;
+  d.base_a = m.baseColorFactor.a;
+  const glm::vec3 e = m.emission();
+  d.emit_r = e.r, d.emit_g = e.g, d.emit_b = e.b;
+  d.metallic = m.metallicFactor;
+  d.roughness = m.roughnessFactor;
+  d.ior = m.ior > 0.0f ? m.ior : 1.5f;
+  d.transmission = m.transmission;
+  d.alpha_cutoff = m.alphaCutoff;
+  d.base_texture = m.baseColorTexture.valid() ? m.baseColorTexture.texture : PR_NO_TEXTURE;
+  d.mr_texture = m.metallicRoughnessTexture.valid() ? m.metallicRoughnessTexture.texture : PR_NO_TEXTURE;
+  d.emission_texture = m.emissiveTexture.valid() ? m.emissiveTexture.texture : PR_NO_TEXTURE;
+  uint32_t flags = 0;
+  if (m.doubleSided) flags |= PR_MAT_DOUBLE_SIDED;
+  if (m.alphaMode == AlphaMode::Mask) flags |= PR_MAT_ALPHA_MASK;
+  if (m.alphaMode == AlphaMode::Blend) flags |= PR_MAT_ALPHA_BLEND;
+  if (m.isEmissive()) flags |= PR_MAT_EMISSIVE;
+  if (m.transmission > 0.0f) {
+    flags |= PR_MAT_GLASS;
+  } else if (m.metallicFactor >= 0.999f && m.roughnessFactor <= 0.02f &&
+             !m.metallicRoughnessTexture.valid()) {
+    flags |= PR_MAT_MIRROR;
+  }
+  d.flags = flags;
+  // KHR_texture_transform: uv' = T * R * S * uv with R = [[c, s], [-s, c]].
+  const TextureRef& t = m.baseColorTexture;
+  const float c = std::cos(t.rotation), s = std::sin(t.rotation);
+  d.uv_m00 = c * t.scale.x, d.uv_m01 = s * t.scale.y, d.uv_m02 = t.offset.x;
+  d.uv_m10 = -s * t.scale.x, d.uv_m11 = c * t.scale.y, d.uv_m12 = t.offset.y;
+  return d;
+}
+
+dev::CameraParams toCameraParams(const CameraPose& pose, int width, int height) {
+  dev::CameraParams c{};
+  c.px = pose.position.x, c.py = pose.position.y, c.pz = pose.position.z;
+  const glm::vec3 f = glm::normalize(pose.forward);
+  const glm::vec3 r = glm::normalize(glm::cross(f, pose.up));
+  const glm::vec3 u = glm::cross(r, f);
+  c.fx = f.x, c.fy = f.y, c.fz = f.z;
+  c.rx = r.x, c.ry = r.y, c.rz = r.z;
+  c.ux = u.x, c.uy = u.y, c.uz = u.z;
+  c.tan_half_fov = std::tan(0.5f * pose.yfov);
+  c.aspect = float(width) / float(height);
+  c.width = static_cast<uint32_t>(width);
+  c.height = static_cast<uint32_t>(height);
+  return c;
+}
+
+GpuScene::GpuScene(Context& ctx, const Scene& scene) : ctx_(ctx), scene_(scene) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const TriangleMesh& sm = scene.staticMesh;
+  staticTriangles_ = static_cast<uint32_t>(sm.triangleCount());
+  ssg_.build(sm.positions, sm.indices);
+  // DSG prims are numbered after the static triangles, so a hit's prim is its shading triangle.
+  uint32_t next = staticTriangles_;
+  for (const TriangleMesh& m : scene.dynamicMeshes) {
+    meshFirstTriangle_.push_back(next);
+    dsg_.addMesh(m.positions, m.indices, next);
+    next += static_cast<uint32_t>(m.triangleCount());
+  }
+  bvhSeconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  deviceAccel_.uploadStatic(ctx_, ssg_);
+  deviceAccel_.uploadMeshes(ctx_, dsg_);
+  for (const Material& m : scene.materials)
+    if (m.alphaMode != AlphaMode::Opaque) hasAlpha_ = true;
+
+  // Static emitters, once.
+  for (size_t i = 0; i < sm.triangleCount(); ++i) {
+    const uint32_t mat = sm.materials[i];
+    const glm::vec3 le = scene.materials[mat].emission();
+    if (le == glm::vec3(0.0f)) continue;
+    const glm::vec3 a = sm.positions[sm.indices[3 * i]], b = sm.positions[sm.indices[3 * i + 1]],
+                    c = sm.positions[sm.indices[3 * i + 2]];
+    dev::Light l = triangleLight(a, b, c, le, static_cast<uint32_t>(i), PR_INVALID_INDEX, mat);
+    if (l.area > 0.0f && std::isfinite(l.power) && l.power > 0.0f) staticEmitters_.push_back(l);
+  }
+  for (const auto& inst : scene.instances) {
+    const TriangleMesh& m = scene.dynamicMeshes[inst.mesh];
+    for (uint32_t mat : m.materials)
+      if (scene.materials[mat].isEmissive()) lightsAnimated_ = true;
+  }
+  for (const auto& l : scene.lights)
+    if (l.dynamic) lightsAnimated_ = true;
+  uploadShading();
+}
+
+cl::Buffer GpuScene::upload(const char* name, const void* data, uint64_t bytes, uint64_t* counter) {
+  cl::Buffer b = ctx_.allocate(name, bytes, CL_MEM_READ_ONLY);
+  if (bytes > 0) {
+    CL_CHECK(ctx_.queue().enqueueWriteBuffer(b, CL_TRUE, 0, bytes, data));
+  } else {
+    ctx_.zero(b, 16);
+  }
+  *counter += bytes ? bytes : 16;
+  return b;
+}
+
+void GpuScene::uploadShading() {
+  std::vector<dev::ShadingVertex> verts;
+  std::vector<dev::ShadingTriangle> tris;
+  auto addMesh = [&](const TriangleMesh& m) {
+    const uint32_t base = static_cast<uint32_t>(verts.size());
+    for (size_t v = 0; v < m.vertexCount(); ++v) {
+      dev::ShadingVertex sv{};
+      sv.px = m.positions[v].x, sv.py = m.positions[v].y, sv.pz = m.positions[v].z;
+      if (v < m.normals.size()) sv.nx = m.normals[v].x, sv.ny = m.normals[v].y, sv.nz = m.normals[v].z;
+      if (v < m.uvs.size()) sv.u = m.uvs[v].x, sv.v = m.uvs[v].y;
+      verts.push_back(sv);
+    }
+    for (size_t t = 0; t < m.triangleCount(); ++t)
+      tris.push_back({base + m.indices[3 * t], base + m.indices[3 * t + 1], base + m.indices[3 * t + 2],
+                      m.materials[t]});
+  };
+  addMesh(scene_.staticMesh);
+  for (const TriangleMesh& m : scene_.dynamicMeshes) addMesh(m);
+
+  std::vector<dev::Material> mats;
+  for (const Material& m : scene_.materials) mats.push_back(toDeviceMaterial(m));
+  if (mats.empty()) mats.push_back(toDeviceMaterial(Material{}));
+
+  std::vector<dev::TextureInfo> infos;
+  std::vector<uint32_t> texels;
+  for (const Texture& t : scene_.textures) {
+    dev::TextureInfo info{};
+    info.offset = static_cast<uint32_t>(texels.size());
+    const bool ok = t.width > 0 && t.height > 0 && t.rgba8.size() == size_t(t.width) * t.height * 4;
+    info.width = ok ? t.width : 1;
+    info.height = ok ? t.height : 1;
+    info.flags = (t.srgb ? PR_TEX_SRGB : 0u) | (t.nearest ? PR_TEX_NEAREST : 0u) |
+                 (static_cast<uint32_t>(t.wrapS) << PR_TEX_WRAP_S_SHIFT) |
+                 (static_cast<uint32_t>(t.wrapT) << PR_TEX_WRAP_T_SHIFT);
+    if (ok) {
+      for (size_t i = 0; i < size_t(t.width) * t.height; ++i) {
+        const uint8_t* p = &t.rgba8[i * 4];
+        texels.push_back(uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24);
+      }
+    } else {
+      texels.push_back(0xffffffffu);  // a white texel stands in for an undecodable image
+    }
+    infos.push_back(info);
+  }
+  vertices_ = upload("shading vertices", verts.data(), verts.size() * sizeof(verts[0]), &shadingBytes_);
+  triangles_ = upload("shading triangles", tris.data(), tris.size() * sizeof(tris[0]), &shadingBytes_);
+  materials_ = upload("materials", mats.data(), mats.size() * sizeof(mats[0]), &shadingBytes_);
+  textures_ = upload("texture table", infos.data(), infos.size() * sizeof(infos[0]), &shadingBytes_);
+  texels_ = upload("texels", texels.data(), texels.size() * 4, &shadingBytes_);
+}
+
+void GpuScene::setTime(double t) {
+  const size_t n = scene_.instances.size();
+  std::vector<accel::InstanceInput> inputs(n);
+  instances_.resize(n);
+  anyMoved_ = firstFrame_;
+  if (lastTransforms_.size() != n) lastTransforms_.assign(n, glm::mat4(0.0f));
+  for (size_t i = 0; i < n; ++i) {
+    const glm::mat4 m = scene_.instanceTransform(i, t);
+    inputs[i].mesh = scene_.instances[i].mesh;
+    inputs[i].objectToWorld = m;
+    dev::ShadingInstance& s = instances_[i];
+    toRows(m, s.object_to_world);
+    toRows(glm::inverse(m), s.world_to_object);
+    s.first_triangle = meshFirstTriangle_[scene_.instances[i].mesh];
+    s.mesh = scene_.instances[i].mesh;
+    const bool moved = firstFrame_ || std::memcmp(&m, &lastTransforms_[i], sizeof m) != 0;
+    s.moved = moved ? 1u : 0u;
+    anyMoved_ = anyMoved_ || moved;
+    lastTransforms_[i] = m;
+  }
+  if (anyMoved_) {
+    dsg_.setInstances(inputs);
+    deviceAccel_.uploadFrame(ctx_, dsg_);
+  }
+  // The moved flags change even when no transform does (all back to 0), so always upload.
+  const uint64_t bytes = std::max<size_t>(n, 1) * sizeof(dev::ShadingInstance);
+  if (n > instanceCapacity_ || !shadingInstances_()) {
+    if (shadingInstances_()) ctx_.release(instanceBytes_);
+    shadingInstances_ = ctx_.allocate("DSG instance transforms", bytes, CL_MEM_READ_ONLY);
+    instanceBytes_ = bytes;
+    instanceCapacity_ = std::max<size_t>(n, 1);
+    ctx_.zero(shadingInstances_, bytes);
+  }
+  if (n > 0)
+    CL_CHECK(ctx_.queue().enqueueWriteBuffer(shadingInstances_, CL_TRUE, 0,
+                                             n * sizeof(dev::ShadingInstance), instances_.data()));
+  lightsChanged_ = firstFrame_ || (lightsAnimated_ && anyMoved_);
+  if (firstFrame_ || lightsAnimated_) buildLights(t);
+  firstFrame_ = false;
+}
+
+void GpuScene::buildLights(double t) {
+  lights_ = staticEmitters_;
+  for (size_t i = 0; i < scene_.instances.size(); ++i) {
+    const TriangleMesh& m = scene_.dynamicMeshes[scene_.instances[i].mesh];
+    const glm::mat4 x = scene_.instanceTransform(i, t);
+    for (size_t k = 0; k < m.triangleCount(); ++k) {
+      const uint32_t mat = m.materials[k];
+      const glm::vec3 le = scene_.materials[mat].emission();
+      if (le == glm::vec3(0.0f)) continue;
+      auto w = [&](uint32_t v) { return glm::vec3(x * glm::vec4(m.positions[v], 1.0f)); };
+      dev::Light l = triangleLight(w(m.indices[3 * k]), w(m.indices[3 * k + 1]), w(m.indices[3 * k + 2]),
+                                   le, meshFirstTriangle_[scene_.instances[i].mesh] + uint32_t(k),
+                                   uint32_t(i), mat);
+      if (l.area > 0.0f && std::isfinite(l.power) && l.power > 0.0f) lights_.push_back(l);
+    }
+  }
+  const Bounds b = scene_.bounds;
+  const float radius = b.empty() ? 1.0f : 0.5f * glm::length(b.extent());
+  for (size_t i = 0; i < scene_.lights.size(); ++i) {
+    const PunctualLight p = scene_.lightAt(i, t);
+    dev::Light l{};
+    const glm::vec3 c = p.color * p.intensity;
+    l.le_r = c.r, l.le_g = c.g, l.le_b = c.b;
+    l.p0x = p.position.x, l.p0y = p.position.y, l.p0z = p.position.z;
+    const glm::vec3 d = glm::normalize(p.direction);
+    l.e1x = d.x, l.e1y = d.y, l.e1z = d.z;
+    l.inst = PR_INVALID_INDEX;
+    l.prim = PR_INVALID_INDEX;
+    const float lum = luminanceOf(c);
+    switch (p.type) {
+      case LightType::Point:
+        l.type = PR_LIGHT_POINT;
+        l.power = 4.0f * 3.14159265f * lum;
+        break;
+      case LightType::Spot:
+        l.type = PR_LIGHT_SPOT;
+        l.cos_inner = std::cos(p.innerConeAngle);
+        l.cos_outer = std::cos(p.outerConeAngle);
+        l.power = 2.0f * 3.14159265f * (1.0f - 0.5f * (l.cos_inner + l.cos_outer)) * lum;
+        break;
+      case LightType::Directional:
+        l.type = PR_LIGHT_DIRECTIONAL;
+        l.power = 3.14159265f * radius * radius * lum;
+        break;
+    }
+    if (std::isfinite(l.power) && l.power > 0.0f) lights_.push_back(l);
+  }
+  cdf_.resize(lights_.size());
+  double sum = 0.0;
+  for (size_t i = 0; i < lights_.size(); ++i) {
+    sum += lights_[i].power;
+    cdf_[i] = static_cast<float>(sum);
+  }
+  totalPower_ = static_cast<float>(sum);
+
+  const size_t count = std::max<size_t>(lights_.size(), 1);
+  if (count > lightCapacity_) {
+    if (lightCapacity_) ctx_.release(lightBytes_);
+    lightCapacity_ = count;
+    lightBytes_ = count * (sizeof(dev::Light) + sizeof(float));
+    lightBuffer_ = ctx_.allocate("light table", count * sizeof(dev::Light), CL_MEM_READ_ONLY);
+    cdfBuffer_ = ctx_.allocate("light power table", count * sizeof(float), CL_MEM_READ_ONLY);
+    ctx_.zero(lightBuffer_, count * sizeof(dev::Light));
+    ctx_.zero(cdfBuffer_, count * sizeof(float));
+  }
+  if (!lights_.empty()) {
+    CL_CHECK(ctx_.queue().enqueueWriteBuffer(lightBuffer_, CL_TRUE, 0, lights_.size() * sizeof(dev::Light),
+                                             lights_.data()));
+    CL_CHECK(ctx_.queue().enqueueWriteBuffer(cdfBuffer_, CL_TRUE, 0, cdf_.size() * sizeof(float), cdf_.data()));
+  }
+}
+
+dev::CameraParams GpuScene::camera(int cameraIndex, double t, int width, int height) const {
+  return toCameraParams(scene_.cameraAt(cameraIndex, t), width, height);
+}
+
+cl_uint GpuScene::setKernelArgs(cl::Kernel& kernel, cl_uint first) {
+  deviceAccel_.setKernelArgs(ctx_, kernel, first);
+  cl_uint a = first + 7;
+  CL_CHECK(kernel.setArg(a++, vertices_));
+  CL_CHECK(kernel.setArg(a++, triangles_));
+  CL_CHECK(kernel.setArg(a++, shadingInstances_));
+  CL_CHECK(kernel.setArg(a++, materials_));
+  CL_CHECK(kernel.setArg(a++, textures_));
+  CL_CHECK(kernel.setArg(a++, texels_));
+  CL_CHECK(kernel.setArg(a++, lightBuffer_));
+  CL_CHECK(kernel.setArg(a++, cdfBuffer_));
+  CL_CHECK(kernel.setArg(a++, static_cast<cl_uint>(lights_.size())));
+  CL_CHECK(kernel.setArg(a++, totalPower_));
+  return a;
+}
+
+uint64_t GpuScene::deviceBytes() const {
+  return deviceAccel_.staticBytes() + deviceAccel_.meshBytes() + deviceAccel_.frameBytes() +
+         shadingBytes_ + instanceBytes_ + lightBytes_;
+}
+
+}  // namespace pr

@@ -1,0 +1,87 @@
+// The scene on the device: both BVHs (SSG once, DSG top level per frame), shading geometry,
+// materials, textures, the light table (rebuilt when lights move) and the camera.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "accel/device_accel.h"
+#include "accel/scene_accel.h"
+#include "cl/context.h"
+#include "scene/scene.h"
+#include "shared/camera.h"
+#include "shared/geometry.h"
+#include "shared/lights.h"
+#include "shared/material.h"
+
+namespace pr {
+
+// Host-side conversions, exposed for tests.
+dev::Material toDeviceMaterial(const Material& m);
+dev::CameraParams toCameraParams(const CameraPose& pose, int width, int height);
+
+class GpuScene {
+ public:
+  GpuScene(Context& ctx, const Scene& scene);
+
+  // Evaluates the animation at time t: instance transforms, the DSG's top level, moving
+  // lights. Uploads only what changed. Instances whose transform differs from the previous
+  // call are flagged `moved` (all of them on the first call).
+  void setTime(double t);
+
+  // The camera at time t for an image of width x height.
+  dev::CameraParams camera(int cameraIndex, double t, int width, int height) const;
+
+  // Kernel arguments from `first` on, in this order: PR_SCENE_GEOM_PARAMS (7),
+  // PR_SHADING_PARAMS (6), PR_LIGHT_PARAMS (4). Returns the next free index.
+  cl_uint setKernelArgs(cl::Kernel& kernel, cl_uint first);
+  static constexpr cl_uint kArgCount = 17;
+
+  const Scene& scene() const { return scene_; }
+  uint32_t lightCount() const { return static_cast<uint32_t>(lights_.size()); }
+  float totalLightPower() const { return totalPower_; }
+  const std::vector<dev::Light>& lights() const { return lights_; }
+  const std::vector<dev::ShadingInstance>& instances() const { return instances_; }
+  bool anyInstanceMoved() const { return anyMoved_; }
+  bool lightsChanged() const { return lightsChanged_; }
+  bool hasAlphaMaterials() const { return hasAlpha_; }
+  uint64_t deviceBytes() const;
+  double bvhBuildSeconds() const { return bvhSeconds_; }
+  const accel::StaticAccel& staticAccel() const { return ssg_; }
+  const accel::DynamicAccel& dynamicAccel() const { return dsg_; }
+
+ private:
+  void uploadShading();
+  void buildLights(double t);
+  cl::Buffer upload(const char* name, const void* data, uint64_t bytes, uint64_t* counter);
+
+  Context& ctx_;
+  const Scene& scene_;
+  accel::StaticAccel ssg_;
+  accel::DynamicAccel dsg_;
+  accel::DeviceAccel deviceAccel_;
+  double bvhSeconds_ = 0.0;
+
+  uint32_t staticTriangles_ = 0;
+  std::vector<uint32_t> meshFirstTriangle_;  // per dynamic mesh, in the shading triangle array
+  std::vector<dev::ShadingInstance> instances_;
+  std::vector<glm::mat4> lastTransforms_;
+  bool firstFrame_ = true;
+  bool anyMoved_ = true;
+  bool hasAlpha_ = false;
+
+  // Emissive triangles: static ones fixed, dynamic ones per (instance, mesh triangle).
+  std::vector<dev::Light> staticEmitters_;
+  std::vector<dev::Light> lights_;
+  std::vector<float> cdf_;
+  float totalPower_ = 0.0f;
+  bool lightsChanged_ = true;
+  bool lightsAnimated_ = false;
+
+  cl::Buffer vertices_, triangles_, shadingInstances_, materials_, textures_, texels_;
+  cl::Buffer lightBuffer_, cdfBuffer_;
+  uint64_t shadingBytes_ = 0, instanceBytes_ = 0, lightBytes_ = 0;
+  size_t lightCapacity_ = 0, instanceCapacity_ = 0;
+};
+
+}  // namespace pr

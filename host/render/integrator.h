@@ -1,0 +1,30 @@
+// What every rendering mode provides to the frame loop.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+
+#include "shared/camera.h"
+
+namespace pr {
+
+struct FrameStats {
+  int frame = 0;
+  double wallSeconds = 0.0;
+  std::map<std::string, double> stageSeconds;  // kernel time per stage
+  std::map<std::string, uint64_t> rays;        // rays by kind
+  std::map<std::string, uint64_t> counters;    // mode-specific counts (slots reused, ...)
+  uint64_t deviceBytes = 0;
+  uint64_t badSamples = 0;
+};
+
+class Integrator {
+ public:
+  virtual ~Integrator() = default;
+  // Renders frame `frame` (the scene already set to its time) into the film.
+  virtual void renderFrame(int frame, const dev::CameraParams& camera, FrameStats* stats) = 0;
+  virtual uint64_t deviceBytes() const = 0;
+};
+
+}  // namespace pr

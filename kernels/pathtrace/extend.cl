@@ -1,0 +1,18 @@
+// pt_extend: one work-item per path. Reads the path's ray; writes its closest hit (prim ==
+// PR_INVALID_INDEX when it escapes or the path is dead) and counts the ray in rays[0] (camera)
+// or rays[1] (bounce).
+#include "shared/integrator.h"
+#include "shared/path_state.h"
+
+__kernel void pt_extend(PR_SCENE_PARAMS, __global const PathState* states, __global Hit* hits,
+                        __global uint* rays, uint count) {
+  const uint i = (uint)get_global_id(0);
+  if (i >= count) return;
+  Hit hit = hit_none();
+  if (states[i].alive) {
+    const SceneData s = PR_SCENE();
+    atomic_inc(rays + (states[i].depth == 0u ? 0 : 1));
+    if (!trace_closest(&s, states[i].ray, &hit)) hit = hit_none();
+  }
+  hits[i] = hit;
+}

@@ -1,0 +1,35 @@
+// pt_generate: one work-item per pixel. Reads the camera; writes a fresh PathState with the
+// camera ray through a jittered point of the pixel (random dimensions 0 and 1), and zero radiance.
+#include "shared/camera.h"
+#include "shared/path_state.h"
+#include "shared/rng.h"
+
+__kernel void pt_generate(CameraParams cam, uint seed, uint frame, uint sample,
+                          __global PathState* states, __global float4* radiance,
+                          uint count) {
+  const uint i = (uint)get_global_id(0);
+  if (i >= count) return;
+  Rng rng = rng_make(seed, PR_RNG_CAMERA, frame, i, sample);
+  const float jx = rng_next(&rng), jy = rng_next(&rng);
+  const uint x = i % cam.width, y = i / cam.width;
+  const float3 d = camera_direction(&cam, (float)x + jx, (float)y + jy);
+  PathState s;
+  s.ray.ox = cam.px;
+  s.ray.oy = cam.py;
+  s.ray.oz = cam.pz;
+  s.ray.tmin = 0.0f;
+  s.ray.dx = d.x;
+  s.ray.dy = d.y;
+  s.ray.dz = d.z;
+  s.ray.tmax = PR_INF_F;
+  s.tp_r = s.tp_g = s.tp_b = 1.0f;
+  s.last_pdf = 0.0f;
+  s.depth = 0u;
+  s.pixel = i;
+  s.alive = 1u;
+  s.rng_dim = rng.dim;
+  s.flags = PR_PATH_SPECULAR;
+  s.pad0 = s.pad1 = s.pad2 = 0u;
+  states[i] = s;
+  radiance[i] = (float4)(0.0f, 0.0f, 0.0f, 0.0f);
+}

@@ -1,0 +1,94 @@
+// pt_shade: one work-item per live path. Reads the path and its hit; adds emission (MIS-weighted
+// against next-event estimation) to the sample's radiance, writes a shadow ray for next-event
+// estimation, samples the BSDF for the next ray and applies Russian roulette.
+// Writes the PathState, the radiance and the ShadowRay of the same index.
+#include "shared/integrator.h"
+#include "shared/path_state.h"
+
+__kernel void pt_shade(PR_SCENE_PARAMS, __global PathState* states, __global const Hit* hits,
+                       __global float4* radiance, __global ShadowRay* shadows, uint count, uint seed, uint frame, uint sample, uint max_depth) {
+  const uint i = (uint)get_global_id(0);
+  if (i >= count) return;
+  const SceneData s = PR_SCENE();
+  PathState p = states[i];
+  shadows[i].valid = 0u;
+  if (!p.alive) return;
+
+  const Hit hit = hits[i];
+  if (hit.prim == PR_INVALID_INDEX) {
+    p.alive = 0u;  // no environment light: escaped paths carry nothing
+    states[i] = p;
+    return;
+  }
+  Rng rng = rng_make(seed, PR_RNG_CAMERA, frame, p.pixel, sample);
+  rng.dim = p.rng_dim;
+  const float3 d = make_float3(p.ray.dx, p.ray.dy, p.ray.dz);
+  const float3 wo = -d;
+  const SurfaceHit h = surface_at(&s.sd, hit.prim, hit.inst, hit.u, hit.v);
+  float3 tp = make_float3(p.tp_r, p.tp_g, p.tp_b);
+
+  PR_GLOBAL const Material* mat = s.sd.materials + h.material;
+  if (mat->flags & PR_MAT_EMISSIVE) {
+    const float3 le = surface_emission(&s, &h);
+    float w = 1.0f;
+    if (!(p.flags & PR_PATH_SPECULAR)) w = power_heuristic(p.last_pdf, emitter_pdf(&s, &h, d, hit.t));
+    const float3 add = tp * le * w;
+    radiance[i] += (float4)(add.x, add.y, add.z, 0.0f);
+  }
+  p.depth += 1u;
+  if (p.depth >= max_depth) {
+    p.alive = 0u;
+  } else {
+    const ShadingFrame f = shading_frame(&s, &h, wo);
+    if (!bsdf_is_delta(&f.bsdf)) {
+      Ray shadow;
+      float3 c;
+      if (next_event(&s, &h, &f, wo, &rng, &shadow, &c)) {
+        c = tp * c;
+        shadows[i].ray = shadow;
+        shadows[i].c_r = c.x;
+        shadows[i].c_g = c.y;
+        shadows[i].c_b = c.z;
+        shadows[i].valid = 1u;
+      }
+    } else {
+      rng.dim += 3u;  // keep the dimension layout independent of the material
+    }
+    const float u0 = rng_next(&rng), u1 = rng_next(&rng), u2 = rng_next(&rng);
+    float3 wil, weight;
+    float pdf;
+    int delta;
+    const float3 wol = to_local(wo, f.t, f.b, f.n);
+    if (!bsdf_sample(&f.bsdf, wol, u0, u1, u2, PR_RADIANCE, &wil, &weight, &pdf, &delta)) {
+      p.alive = 0u;
+    } else {
+      const float3 wi = to_world(wil, f.t, f.b, f.n);
+      // Reflection must leave on wo's side of the geometric surface, refraction the other.
+      const int reflect = wil.z * wol.z > 0.0f;
+      const float side = dot(wi, f.ng) * dot(wo, f.ng);
+      if ((reflect && side <= 0.0f) || (!reflect && side >= 0.0f)) {
+        p.alive = 0u;
+      } else {
+        tp = tp * weight;
+        const float rr = rng_next(&rng);
+        if (p.depth >= 3u) {
+          const float q = fmin(max3(tp), 0.95f);
+          if (rr >= q) {
+            p.alive = 0u;
+          } else {
+            tp = tp / q;
+          }
+        }
+        p.ray = spawn_ray(h.p, f.ng, wi, PR_INF_F);
+        p.last_pdf = pdf;
+        p.flags = delta ? PR_PATH_SPECULAR : 0u;
+      }
+    }
+  }
+  if (!(max3(tp) < PR_INF_F)) p.alive = 0u;  // NaN or Inf throughput ends the path
+  p.tp_r = tp.x;
+  p.tp_g = tp.y;
+  p.tp_b = tp.z;
+  p.rng_dim = rng.dim;
+  states[i] = p;
+}

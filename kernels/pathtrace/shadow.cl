@@ -1,0 +1,16 @@
+// pt_shadow: one work-item per path. Reads its ShadowRay; if it is valid and unoccluded, adds
+// its contribution to the sample's radiance. Writes radiance; counts the ray in rays[2].
+#include "shared/integrator.h"
+#include "shared/path_state.h"
+
+__kernel void pt_shadow(PR_SCENE_PARAMS, __global float4* radiance,
+                        __global const ShadowRay* shadows, __global uint* rays, uint count) {
+  const uint i = (uint)get_global_id(0);
+  if (i >= count) return;
+  const ShadowRay r = shadows[i];
+  if (!r.valid) return;
+  const SceneData s = PR_SCENE();
+  atomic_inc(rays + 2);
+  if (trace_occluded(&s, r.ray)) return;
+  radiance[i] += (float4)(r.c_r, r.c_g, r.c_b, 0.0f);
+}

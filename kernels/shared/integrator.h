@@ -1,0 +1,142 @@
+// Pieces of light transport shared by the path tracer and the path-reuse kernels: the scene as
+// one parameter list, alpha coverage, next-event estimation and emission with MIS.
+#pragma once
+
+#include "shared/bvh.h"
+#include "shared/lights.h"
+#include "shared/rng.h"
+#include "shared/shading.h"
+
+PR_NAMESPACE_BEGIN
+
+typedef struct {
+  SceneGeom geom;
+  ShadingData sd;
+  LightData lights;
+} SceneData;
+
+// Alpha coverage: MASK cuts out below the cutoff; BLEND lets a ray pass with probability
+// 1 - alpha, decided by a hash of the point so that the same point always answers the same.
+PR_INLINE int surface_passes(const SceneData* s, const SurfaceHit* h) {
+  PR_GLOBAL const Material* m = s->sd.materials + h->material;
+  if (!(m->flags & (PR_MAT_ALPHA_MASK | PR_MAT_ALPHA_BLEND))) return 0;
+  const float alpha = material_base(&s->sd, h).w;
+  if (m->flags & PR_MAT_ALPHA_MASK) return alpha < m->alpha_cutoff;
+  const u32 key = pr_hash_u32(h->prim ^ pr_hash_u32(pr_as_uint(h->uv.x) ^ pr_hash_u32(pr_as_uint(h->uv.y))));
+  return (float)(key >> 8) * (1.0f / 16777216.0f) >= alpha;
+}
+
+#define PR_MAX_ALPHA_LAYERS 16
+
+// Closest hit that skips cut-out and uncovered points (a bounded number of layers).
+PR_INLINE int trace_closest(const SceneData* s, Ray ray, Hit* hit) {
+#ifdef PR_HAS_ALPHA
+  for (int layer = 0; layer < PR_MAX_ALPHA_LAYERS; ++layer) {
+    if (!intersect_scene(&s->geom, ray, hit)) return 0;
+    const SurfaceHit h = surface_at(&s->sd, hit->prim, hit->inst, hit->u, hit->v);
+    if (!surface_passes(s, &h)) return 1;
+    ray.tmin = hit->t;  // continue past this point, same ray
+  }
+  return 1;
+#else
+  return intersect_scene(&s->geom, ray, hit);
+#endif
+}
+
+// Whether anything opaque lies on the segment (tmin, tmax) of the ray.
+PR_INLINE int trace_occluded(const SceneData* s, Ray ray) {
+#ifdef PR_HAS_ALPHA
+  for (int layer = 0; layer < PR_MAX_ALPHA_LAYERS; ++layer) {
+    Hit hit;
+    if (!intersect_scene(&s->geom, ray, &hit)) return 0;
+    const SurfaceHit h = surface_at(&s->sd, hit.prim, hit.inst, hit.u, hit.v);
+    if (!surface_passes(s, &h)) return 1;
+    ray.tmin = hit.t;
+  }
+  return 1;
+#else
+  return occluded_scene(&s->geom, ray);
+#endif
+}
+
+// A shading frame: ns and ng flipped to the side of wo for reflective surfaces; glass keeps
+// its geometric orientation so that the sign of wo tells entering from leaving.
+typedef struct {
+  float3 t, b, n;  // shading frame
+  float3 ng;
+  BsdfParams bsdf;
+} ShadingFrame;
+
+PR_INLINE ShadingFrame shading_frame(const SceneData* s, const SurfaceHit* h, float3 wo) {
+  ShadingFrame f;
+  f.bsdf = material_bsdf(&s->sd, h);
+  f.ng = h->ng;
+  f.n = h->ns;
+  if (f.bsdf.kind != PR_BSDF_GLASS && dot(wo, f.ng) < 0.0f) {
+    f.ng = -f.ng;
+    f.n = -f.n;
+  }
+  orthonormal_basis(f.n, &f.t, &f.b);
+  return f;
+}
+
+// Emitted radiance leaving the surface at h (two-sided emitters).
+PR_INLINE float3 surface_emission(const SceneData* s, const SurfaceHit* h) {
+  return material_emission(&s->sd, h);
+}
+
+// The pdf that next-event estimation would have had for reaching emitter point h from a
+// point at distance dist along unit direction d.
+PR_INLINE float emitter_pdf(const SceneData* s, const SurfaceHit* h, float3 d, float dist) {
+  const float area = triangle_area_world(h, &s->sd);
+  return light_pdf_triangle(material_emission_factor(&s->sd, h->material), area,
+                            s->lights.total_power, dist, fabs(dot(d, h->ng)));
+}
+
+// Next-event estimation at a non-delta surface: picks a light by power and a point on it.
+// Returns 1 with the shadow ray and the unoccluded contribution (to be multiplied by the path
+// throughput), or 0 when the sample carries nothing.
+PR_INLINE int next_event(const SceneData* s, const SurfaceHit* h, const ShadingFrame* f, float3 wo,
+                         Rng* rng, Ray* shadow, float3* contribution) {
+  const float us = rng_next(rng), u1 = rng_next(rng), u2 = rng_next(rng);
+  if (s->lights.count == 0u || s->lights.total_power <= 0.0f) return 0;
+  const u32 idx = light_select(s->lights.cdf, s->lights.count, us);
+  const Light l = s->lights.lights[idx];
+  const float pmf = l.power / s->lights.total_power;
+  LightSample ls;
+  float b1, b2;
+  if (!light_sample(&l, pmf, h->p, u1, u2, &ls, &b1, &b2)) return 0;
+  if (dot(ls.wi, f->ng) <= 0.0f) return 0;  // below the geometric surface
+  float3 le = ls.le;
+  if (l.type == PR_LIGHT_TRIANGLE) {
+    const SurfaceHit e = surface_at(&s->sd, l.prim, l.inst, b1, b2);
+    le = material_emission(&s->sd, &e);
+  }
+  float bsdf_pdf = 0.0f;
+  const float3 wol = to_local(wo, f->t, f->b, f->n), wil = to_local(ls.wi, f->t, f->b, f->n);
+  const float3 fr = bsdf_eval(&f->bsdf, wol, wil, &bsdf_pdf);
+  const float cos_i = fabs(wil.z);
+  const float w = ls.delta ? 1.0f : power_heuristic(ls.pdf, bsdf_pdf);
+  *contribution = fr * le * (cos_i * w / ls.pdf);
+  if (max3(*contribution) <= 0.0f) return 0;
+  if (l.type == PR_LIGHT_TRIANGLE) {
+    *shadow = spawn_ray_to(h->p, f->ng, ls.pos, ls.normal);
+  } else {
+    *shadow = spawn_ray(h->p, f->ng, ls.wi, ls.dist < PR_INF_F ? ls.dist * (1.0f - 1e-4f) : PR_INF_F);
+  }
+  return 1;
+}
+
+PR_NAMESPACE_END
+
+#ifdef PR_DEVICE_CODE
+#define PR_SCENE_PARAMS PR_SCENE_GEOM_PARAMS, PR_SHADING_PARAMS, PR_LIGHT_PARAMS
+PR_INLINE SceneData pr_scene_data(SceneGeom g, ShadingData sd, LightData l) {
+  SceneData s;
+  s.geom = g;
+  s.sd = sd;
+  s.lights = l;
+  return s;
+}
+#define PR_SCENE() pr_scene_data(PR_SCENE_GEOM(), PR_SHADING(), PR_LIGHTS())
+#endif

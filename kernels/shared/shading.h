@@ -1,0 +1,216 @@
+// From a ray hit to what shading needs: the surface point, its normals and uv, its material's
+// BSDF parameters, emission and coverage (with textures).
+#pragma once
+
+#include "shared/bsdf.h"
+#include "shared/geometry.h"
+#include "shared/material.h"
+#include "shared/math.h"
+#include "shared/types.h"
+
+PR_NAMESPACE_BEGIN
+
+// Device buffers for shading; built in the kernel from its arguments (PR_SHADING_PARAMS).
+typedef struct {
+  PR_GLOBAL const ShadingVertex* vertices;
+  PR_GLOBAL const ShadingTriangle* triangles;
+  PR_GLOBAL const ShadingInstance* instances;  // by instance id
+  PR_GLOBAL const Material* materials;
+  PR_GLOBAL const TextureInfo* textures;
+  PR_GLOBAL const u32* texels;  // RGBA8
+} ShadingData;
+
+typedef struct {
+  float3 p;   // world position
+  float3 ng;  // unit geometric normal (winding order), world space
+  float3 ns;  // unit shading normal, on the same side as ng
+  float2 uv;
+  u32 material;
+  u32 prim;   // shading triangle index
+  u32 inst;   // PR_INVALID_INDEX on the SSG
+} SurfaceHit;
+
+PR_INLINE float3 xform_point12(PR_GLOBAL const float* m, float3 p) {
+  return make_float3(m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3],
+                     m[4] * p.x + m[5] * p.y + m[6] * p.z + m[7],
+                     m[8] * p.x + m[9] * p.y + m[10] * p.z + m[11]);
+}
+
+// Normals transform by the inverse transpose: n_world = (world_to_object)^T n_object.
+PR_INLINE float3 xform_normal12(PR_GLOBAL const float* w2o, float3 n) {
+  return make_float3(w2o[0] * n.x + w2o[4] * n.y + w2o[8] * n.z,
+                     w2o[1] * n.x + w2o[5] * n.y + w2o[9] * n.z,
+                     w2o[2] * n.x + w2o[6] * n.y + w2o[10] * n.z);
+}
+
+// The surface at barycentrics (b1, b2) of a triangle (b1 weights v1, b2 weights v2).
+PR_INLINE SurfaceHit surface_at(const ShadingData* sd, u32 prim, u32 inst, float b1, float b2) {
+  SurfaceHit s;
+  // Hits report shading triangle indices: DSG meshes are numbered after the SSG's triangles.
+  s.prim = prim;
+  s.inst = inst;
+  const ShadingTriangle tri = sd->triangles[s.prim];
+  s.material = tri.material;
+  const ShadingVertex a = sd->vertices[tri.v0], b = sd->vertices[tri.v1], c = sd->vertices[tri.v2];
+  const float b0 = 1.0f - b1 - b2;
+  float3 pa = make_float3(a.px, a.py, a.pz), pb = make_float3(b.px, b.py, b.pz),
+         pc = make_float3(c.px, c.py, c.pz);
+  float3 n = make_float3(a.nx, a.ny, a.nz) * b0 + make_float3(b.nx, b.ny, b.nz) * b1 +
+             make_float3(c.nx, c.ny, c.nz) * b2;
+  if (inst != PR_INVALID_INDEX) {
+    PR_GLOBAL const ShadingInstance* in = sd->instances + inst;
+    pa = xform_point12(in->object_to_world, pa);
+    pb = xform_point12(in->object_to_world, pb);
+    pc = xform_point12(in->object_to_world, pc);
+    n = xform_normal12(in->world_to_object, n);
+  }
+  s.p = pa * b0 + pb * b1 + pc * b2;
+  const float3 cr = cross(pb - pa, pc - pa);
+  const float cl = length(cr);
+  s.ng = cl > 0.0f ? cr / cl : make_float3(0.0f, 0.0f, 1.0f);
+  const float nl = length(n);
+  s.ns = nl > 0.0f && isfinite_f(nl) ? n / nl : s.ng;
+  if (dot(s.ns, s.ng) < 0.0f) s.ns = -s.ns;
+  s.uv = make_float2(a.u * b0 + b.u * b1 + c.u * b2, a.v * b0 + b.v * b1 + c.v * b2);
+  return s;
+}
+
+PR_INLINE float triangle_area_world(const SurfaceHit* s, const ShadingData* sd) {
+  const ShadingTriangle tri = sd->triangles[s->prim];
+  const ShadingVertex a = sd->vertices[tri.v0], b = sd->vertices[tri.v1], c = sd->vertices[tri.v2];
+  float3 pa = make_float3(a.px, a.py, a.pz), pb = make_float3(b.px, b.py, b.pz),
+         pc = make_float3(c.px, c.py, c.pz);
+  if (s->inst != PR_INVALID_INDEX) {
+    PR_GLOBAL const ShadingInstance* in = sd->instances + s->inst;
+    pa = xform_point12(in->object_to_world, pa);
+    pb = xform_point12(in->object_to_world, pb);
+    pc = xform_point12(in->object_to_world, pc);
+  }
+  return 0.5f * length(cross(pb - pa, pc - pa));
+}
+
+PR_INLINE float srgb_to_linear(float c) {
+  return c <= 0.04045f ? c * (1.0f / 12.92f) : pow((c + 0.055f) * (1.0f / 1.055f), 2.4f);
+}
+
+PR_INLINE int wrap_texel(int i, int n, u32 mode) {
+  if (mode == 1u) return i < 0 ? 0 : (i >= n ? n - 1 : i);
+  if (mode == 2u) {
+    const int period = 2 * n;
+    int m = i % period;
+    if (m < 0) m += period;
+    return m < n ? m : period - 1 - m;
+  }
+  int m = i % n;
+  return m < 0 ? m + n : m;
+}
+
+PR_INLINE float4 texel_at(const ShadingData* sd, TextureInfo t, int x, int y) {
+  const u32 w = sd->texels[t.offset + (u32)y * t.width + (u32)x];
+  float4 c = make_float4((float)(w & 255u), (float)((w >> 8) & 255u), (float)((w >> 16) & 255u),
+                         (float)(w >> 24)) *
+             (1.0f / 255.0f);
+  if (t.flags & PR_TEX_SRGB) {
+    c.x = srgb_to_linear(c.x);
+    c.y = srgb_to_linear(c.y);
+    c.z = srgb_to_linear(c.z);
+  }
+  return c;
+}
+
+// Bilinear (or nearest) lookup with the texture's wrap modes; linear RGBA.
+PR_INLINE float4 texture_sample(const ShadingData* sd, i32 index, float2 uv) {
+  const TextureInfo t = sd->textures[index];
+  const u32 ws = (t.flags >> PR_TEX_WRAP_S_SHIFT) & 3u, wt = (t.flags >> PR_TEX_WRAP_T_SHIFT) & 3u;
+  const float fx = uv.x * (float)t.width - 0.5f, fy = uv.y * (float)t.height - 0.5f;
+  if (!isfinite_f(fx) || !isfinite_f(fy)) return texel_at(sd, t, 0, 0);
+  // Keep the integer part in range before converting (huge uvs are legal glTF).
+  const float x0f = floor(fx), y0f = floor(fy);
+  const float big = 1048576.0f;
+  const int x0 = (int)clamp(x0f, -big, big), y0 = (int)clamp(y0f, -big, big);
+  if (t.flags & PR_TEX_NEAREST) {
+    return texel_at(sd, t, wrap_texel((int)clamp(floor(uv.x * (float)t.width), -big, big), (int)t.width, ws),
+                    wrap_texel((int)clamp(floor(uv.y * (float)t.height), -big, big), (int)t.height, wt));
+  }
+  const float ax = fx - x0f, ay = fy - y0f;
+  const int xa = wrap_texel(x0, (int)t.width, ws), xb = wrap_texel(x0 + 1, (int)t.width, ws);
+  const int ya = wrap_texel(y0, (int)t.height, wt), yb = wrap_texel(y0 + 1, (int)t.height, wt);
+  const float4 c00 = texel_at(sd, t, xa, ya), c10 = texel_at(sd, t, xb, ya);
+  const float4 c01 = texel_at(sd, t, xa, yb), c11 = texel_at(sd, t, xb, yb);
+  return (c00 * (1.0f - ax) + c10 * ax) * (1.0f - ay) + (c01 * (1.0f - ax) + c11 * ax) * ay;
+}
+
+PR_INLINE float2 material_base_uv(PR_GLOBAL const Material* m, float2 uv) {
+  return make_float2(m->uv_m00 * uv.x + m->uv_m01 * uv.y + m->uv_m02,
+                     m->uv_m10 * uv.x + m->uv_m11 * uv.y + m->uv_m12);
+}
+
+// Base colour (rgb) and alpha at the surface.
+PR_INLINE float4 material_base(const ShadingData* sd, const SurfaceHit* s) {
+  PR_GLOBAL const Material* m = sd->materials + s->material;
+  float4 c = make_float4(m->base_r, m->base_g, m->base_b, m->base_a);
+  if (m->base_texture != PR_NO_TEXTURE) {
+    const float4 t = texture_sample(sd, m->base_texture, material_base_uv(m, s->uv));
+    c = make_float4(c.x * t.x, c.y * t.y, c.z * t.z, c.w * t.w);
+  }
+  return c;
+}
+
+PR_INLINE BsdfParams material_bsdf(const ShadingData* sd, const SurfaceHit* s) {
+  PR_GLOBAL const Material* m = sd->materials + s->material;
+  const float4 base = material_base(sd, s);
+  BsdfParams p;
+  p.base = make_float3(base.x, base.y, base.z);
+  float metallic = m->metallic, roughness = m->roughness;
+  if (m->mr_texture != PR_NO_TEXTURE) {
+    const float4 t = texture_sample(sd, m->mr_texture, s->uv);
+    roughness *= t.y;
+    metallic *= t.z;
+  }
+  p.metallic = clamp(metallic, 0.0f, 1.0f);
+  roughness = clamp(roughness, 0.0f, 1.0f);
+  p.alpha = fmax(roughness * roughness, PR_MIN_ALPHA);
+  p.ior = m->ior;
+  p.kind = (m->flags & PR_MAT_GLASS) ? PR_BSDF_GLASS
+                                     : ((m->flags & PR_MAT_MIRROR) ? PR_BSDF_MIRROR : PR_BSDF_MICROFACET);
+  return p;
+}
+
+PR_INLINE float3 material_emission(const ShadingData* sd, const SurfaceHit* s) {
+  PR_GLOBAL const Material* m = sd->materials + s->material;
+  float3 e = make_float3(m->emit_r, m->emit_g, m->emit_b);
+  if (m->emission_texture != PR_NO_TEXTURE) {
+    const float4 t = texture_sample(sd, m->emission_texture, s->uv);
+    e = e * make_float3(t.x, t.y, t.z);
+  }
+  return e;
+}
+
+PR_INLINE float3 material_emission_factor(const ShadingData* sd, u32 material) {
+  PR_GLOBAL const Material* m = sd->materials + material;
+  return make_float3(m->emit_r, m->emit_g, m->emit_b);
+}
+
+PR_NAMESPACE_END
+
+#ifdef PR_DEVICE_CODE
+#define PR_SHADING_PARAMS                                                                       \
+  __global const ShadingVertex *pr_vertices, __global const ShadingTriangle *pr_triangles,     \
+      __global const ShadingInstance *pr_shading_instances, __global const Material *pr_materials, \
+      __global const TextureInfo *pr_textures, __global const uint *pr_texels
+PR_INLINE ShadingData pr_shading_data(__global const ShadingVertex* v,
+                                      __global const ShadingTriangle* t,
+                                      __global const ShadingInstance* i, __global const Material* m,
+                                      __global const TextureInfo* tx, __global const uint* tl) {
+  ShadingData sd;
+  sd.vertices = v;
+  sd.triangles = t;
+  sd.instances = i;
+  sd.materials = m;
+  sd.textures = tx;
+  sd.texels = tl;
+  return sd;
+}
+#define PR_SHADING() \
+  pr_shading_data(pr_vertices, pr_triangles, pr_shading_instances, pr_materials, pr_textures, pr_texels)
+#endif
