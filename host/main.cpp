@@ -9,6 +9,8 @@
 #include <CLI/CLI.hpp>
 
 #include "cl/device.h"
+#include "scene/gltf_loader.h"
+#include "scene/scene_info.h"
 #include "util/error.h"
 
 namespace {
@@ -24,6 +26,18 @@ int runDevices(bool json) {
   return pr::kExitOk;
 }
 
+int runInfo(const std::string& path, bool json, double fps) {
+  if (!(fps > 0.0) || fps > 1000.0) throw pr::InputError("--fps: must be in (0, 1000]");
+  pr::LoadOptions options;
+  options.printWarnings = json;  // the text summary lists them itself
+  const pr::Scene scene = pr::loadScene(path, options);
+  if (json)
+    std::cout << pr::sceneInfoJson(scene, fps).dump(2) << "\n";
+  else
+    std::cout << pr::sceneInfoText(scene, fps);
+  return pr::kExitOk;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -34,6 +48,14 @@ int main(int argc, char** argv) {
   bool devicesJson = false;
   auto* devices = app.add_subcommand("devices", "List every OpenCL platform and device");
   devices->add_flag("--json", devicesJson, "Print the list as JSON");
+
+  std::string infoScene;
+  bool infoJson = false;
+  double infoFps = 24.0;
+  auto* info = app.add_subcommand("info", "What a scene holds: static/dynamic split, lights, animation");
+  info->add_option("SCENE", infoScene, "glTF file (.gltf or .glb)")->required();
+  info->add_flag("--json", infoJson, "Print as JSON");
+  info->add_option("--fps", infoFps, "Frames per second of the animation (default 24)");
 
   try {
     app.parse(argc, argv);
@@ -50,6 +72,7 @@ int main(int argc, char** argv) {
 
   try {
     if (*devices) return runDevices(devicesJson);
+    if (*info) return runInfo(infoScene, infoJson, infoFps);
   } catch (const pr::InputError& e) {
     std::cerr << "error: " << e.what() << "\n";
     return pr::kExitBadInput;

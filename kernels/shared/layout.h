@@ -4,7 +4,10 @@
 
 #define PR_SHARED_STRUCTS(S) \
   S(Ray)                     \
-  S(Hit)
+  S(Hit)                     \
+  S(BvhNode)                 \
+  S(BvhTriangle)             \
+  S(BvhInstance)
 
 #define PR_SHARED_FIELDS(F) \
   F(Ray, ox)                \
@@ -15,4 +18,18 @@
   F(Hit, v)                 \
   F(Hit, prim)              \
   F(Hit, inst)              \
-  F(Hit, pad2)
+  F(Hit, pad2)              \
+  F(BvhNode, lo_x)          \
+  F(BvhNode, hi_x)          \
+  F(BvhNode, index)         \
+  F(BvhNode, meta)          \
+  F(BvhTriangle, prim)      \
+  F(BvhTriangle, e1x)       \
+  F(BvhTriangle, e2x)       \
+  F(BvhTriangle, pad1)      \
+  F(BvhInstance, world_to_object) \
+  F(BvhInstance, object_to_world) \
+  F(BvhInstance, root_node) \
+  F(BvhInstance, first_triangle) \
+  F(BvhInstance, mesh)      \
+  F(BvhInstance, instance_id)

@@ -1,0 +1,233 @@
+#include "accel/bvh_builder.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+#include <string>
+
+#include <glm/common.hpp>
+
+#include "shared/bvh.h"
+#include "util/error.h"
+
+namespace pr::accel {
+
+void Aabb::grow(const glm::vec3& p) {
+  lo = glm::min(lo, p);
+  hi = glm::max(hi, p);
+}
+
+void Aabb::grow(const Aabb& b) {
+  lo = glm::min(lo, b.lo);
+  hi = glm::max(hi, b.hi);
+}
+
+float Aabb::halfArea() const {
+  if (empty()) return 0.0f;
+  const glm::vec3 e = hi - lo;
+  return e.x * e.y + e.y * e.z + e.z * e.x;
+}
+
+dev::BvhNode makeNode(const Aabb& b, uint32_t index, uint32_t meta) {
+  dev::BvhNode n{};
+  if (!b.empty()) {
+    n.lo_x = b.lo.x, n.lo_y = b.lo.y, n.lo_z = b.lo.z;
+    n.hi_x = b.hi.x, n.hi_y = b.hi.y, n.hi_z = b.hi.z;
+  }
+  n.index = index;
+  n.meta = meta;
+  return n;
+}
+
+namespace {
+
+int ceilLog2(uint32_t n) {
+  int k = 0;
+  while ((uint64_t(1) << k) < n) ++k;
+  return k;
+}
+
+class Builder {
+ public:
+  Builder(const std::vector<Aabb>& boxes, const BuildOptions& o) : boxes_(boxes), o_(o) {
+    centroids_.resize(boxes.size());
+    for (size_t i = 0; i < boxes.size(); ++i)
+      centroids_[i] = boxes[i].empty() ? glm::vec3(0.0f) : boxes[i].centre();
+    bvh_.order.resize(boxes.size());
+    std::iota(bvh_.order.begin(), bvh_.order.end(), 0u);
+  }
+
+  Bvh run() {
+    const uint32_t n = uint32_t(boxes_.size());
+    bvh_.nodes.reserve(n > 0 ? 2 * size_t(n) : 1);
+    bvh_.nodes.emplace_back();
+    build(0, 0, n, 0);
+    bvh_.stats.nodes = uint32_t(bvh_.nodes.size());
+    return std::move(bvh_);
+  }
+
+ private:
+  struct Bin {
+    Aabb box;
+    uint32_t count = 0;
+  };
+
+  void build(uint32_t node, uint32_t begin, uint32_t end, int depth) {
+    Aabb bounds, cbounds;
+    for (uint32_t i = begin; i < end; ++i) {
+      const uint32_t p = bvh_.order[i];
+      bounds.grow(boxes_[p]);
+      cbounds.grow(centroids_[p]);
+    }
+    const uint32_t n = end - begin;
+    if (n <= 1) return makeLeaf(node, bounds, begin, n, depth);
+
+    uint32_t mid = 0;
+    int axis = 0;
+    const glm::vec3 extent = cbounds.hi - cbounds.lo;
+    axis = extent.y > extent[axis] ? 1 : axis;
+    axis = extent.z > extent[axis] ? 2 : axis;
+    // SAH only while a median split below could still meet the depth cap whatever SAH does.
+    const bool sahAllowed = depth + 1 + ceilLog2(n) <= o_.maxDepth;
+    bool split = false;
+    if (sahAllowed && extent[axis] > 0.0f) {
+      float bestCost = 0.0f;
+      int bestAxis = -1, bestBin = 0;
+      for (int a = 0; a < 3; ++a) {
+        if (!(extent[a] > 0.0f)) continue;
+        int bin = 0;
+        float cost = sahSplit(begin, end, cbounds, a, &bin);
+        if (bestAxis < 0 || cost < bestCost) bestCost = cost, bestAxis = a, bestBin = bin;
+      }
+      const float area = bounds.halfArea();
+      const float leafCost = float(n);
+      const float splitCost = area > 0.0f ? o_.traversalCost + bestCost / area : leafCost;
+      if (n <= o_.maxLeafSize && leafCost <= splitCost) return makeLeaf(node, bounds, begin, n, depth);
+      if (bestAxis >= 0) {
+        const float lo = cbounds.lo[bestAxis];
+        const float scale = float(o_.bins) / extent[bestAxis];
+        uint32_t* first = bvh_.order.data() + begin;
+        uint32_t* m = std::partition(first, bvh_.order.data() + end, [&](uint32_t p) {
+          return binOf(centroids_[p][bestAxis], lo, scale) <= bestBin;
+        });
+        mid = uint32_t(m - bvh_.order.data());
+        axis = bestAxis;
+        split = mid > begin && mid < end;
+      }
+    } else if (n <= o_.maxLeafSize) {
+      // All centroids equal (nothing to split) or near the depth cap: small enough to stop.
+      return makeLeaf(node, bounds, begin, n, depth);
+    }
+    if (!split) {
+      // Object median: on the widest centroid axis, or in input order when all coincide.
+      mid = begin + n / 2;
+      if (extent[axis] > 0.0f) {
+        std::nth_element(bvh_.order.begin() + begin, bvh_.order.begin() + mid,
+                         bvh_.order.begin() + end, [&](uint32_t a, uint32_t b) {
+                           return centroids_[a][axis] < centroids_[b][axis];
+                         });
+      }
+    }
+    const uint32_t left = uint32_t(bvh_.nodes.size());
+    bvh_.nodes.emplace_back();
+    build(left, begin, mid, depth + 1);
+    const uint32_t right = uint32_t(bvh_.nodes.size());
+    bvh_.nodes.emplace_back();
+    build(right, mid, end, depth + 1);
+    bvh_.nodes[node] = makeNode(bounds, right, uint32_t(axis));
+  }
+
+  int binOf(float c, float lo, float scale) const {
+    const int b = int((c - lo) * scale);
+    return std::clamp(b, 0, o_.bins - 1);
+  }
+
+  // Best binned split on `axis`: returns sum(area * count) of both sides, bin of the last left.
+  float sahSplit(uint32_t begin, uint32_t end, const Aabb& cbounds, int axis, int* bestBin) {
+    bins_.assign(size_t(o_.bins), Bin{});
+    const float lo = cbounds.lo[axis];
+    const float scale = float(o_.bins) / (cbounds.hi[axis] - lo);
+    for (uint32_t i = begin; i < end; ++i) {
+      const uint32_t p = bvh_.order[i];
+      Bin& b = bins_[size_t(binOf(centroids_[p][axis], lo, scale))];
+      b.box.grow(boxes_[p]);
+      ++b.count;
+    }
+    // Right-side sums from the top, then sweep from the left.
+    rightCost_.assign(size_t(o_.bins), 0.0f);
+    Aabb acc;
+    uint32_t count = 0;
+    for (int i = o_.bins - 1; i > 0; --i) {
+      acc.grow(bins_[size_t(i)].box);
+      count += bins_[size_t(i)].count;
+      rightCost_[size_t(i)] = count > 0 ? acc.halfArea() * float(count) : 0.0f;
+    }
+    float best = std::numeric_limits<float>::infinity();
+    *bestBin = 0;
+    acc = Aabb{};
+    count = 0;
+    const uint32_t total = end - begin;
+    for (int i = 0; i < o_.bins - 1; ++i) {
+      acc.grow(bins_[size_t(i)].box);
+      count += bins_[size_t(i)].count;
+      if (count == 0 || count == total) continue;
+      const float cost = acc.halfArea() * float(count) + rightCost_[size_t(i) + 1];
+      if (cost < best) best = cost, *bestBin = i;
+    }
+    return best;
+  }
+
+  void makeLeaf(uint32_t node, const Aabb& bounds, uint32_t begin, uint32_t n, int depth) {
+    bvh_.nodes[node] = makeNode(bounds, begin, PR_BVH_LEAF_BIT | n);
+    ++bvh_.stats.leaves;
+    bvh_.stats.depth = std::max(bvh_.stats.depth, depth);
+  }
+
+  const std::vector<Aabb>& boxes_;
+  const BuildOptions& o_;
+  std::vector<glm::vec3> centroids_;
+  std::vector<Bin> bins_;
+  std::vector<float> rightCost_;
+  Bvh bvh_;
+};
+
+}  // namespace
+
+Bvh buildBvh(const std::vector<Aabb>& boxes, const BuildOptions& options) {
+  if (options.maxDepth > PR_BVH_STACK_SIZE || options.maxDepth < 1 || options.bins < 2 ||
+      options.maxLeafSize < 1 || boxes.size() >= PR_BVH_LEAF_BIT)
+    throw RuntimeError("BVH build: bad options (maxDepth " + std::to_string(options.maxDepth) +
+                       ", stack " + std::to_string(PR_BVH_STACK_SIZE) + ")");
+  const auto t0 = std::chrono::steady_clock::now();
+  Bvh bvh = Builder(boxes, options).run();
+  bvh.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  // The traversal stack must never overflow: check what was built, not what was intended.
+  const int depth = bvhDepth(bvh.nodes);
+  if (depth > PR_BVH_STACK_SIZE || depth != bvh.stats.depth)
+    throw RuntimeError("BVH build: depth " + std::to_string(depth) + " exceeds the traversal stack (" +
+                       std::to_string(PR_BVH_STACK_SIZE) + ")");
+  return bvh;
+}
+
+int bvhDepth(const std::vector<dev::BvhNode>& nodes, uint32_t root) {
+  if (root >= nodes.size()) throw RuntimeError("BVH: root node out of range");
+  int deepest = 0;
+  std::vector<std::pair<uint32_t, int>> stack{{root, 0}};
+  while (!stack.empty()) {
+    const auto [i, d] = stack.back();
+    stack.pop_back();
+    const dev::BvhNode& n = nodes[i];
+    if (n.meta & PR_BVH_LEAF_BIT) {
+      deepest = std::max(deepest, d);
+      continue;
+    }
+    if (i + 1 >= nodes.size() || n.index >= nodes.size() || n.index <= i + 1 || d >= 1 << 20)
+      throw RuntimeError("BVH: malformed node " + std::to_string(i));
+    stack.push_back({i + 1, d + 1});
+    stack.push_back({n.index, d + 1});
+  }
+  return deepest;
+}
+
+}  // namespace pr::accel

@@ -1,0 +1,65 @@
+#include "accel/device_accel.h"
+
+#include <algorithm>
+#include <vector>
+
+#include "cl/error.h"
+#include "util/error.h"
+
+namespace pr::accel {
+
+void DeviceAccel::upload(Context& ctx, Slot& slot, const char* name, const void* data,
+                         uint64_t bytes, bool grow) {
+  if (slot.bytes < std::max<uint64_t>(bytes, 64)) {
+    if (slot.bytes > 0) ctx.release(slot.bytes);
+    // Per-frame buffers get headroom so a slowly growing instance count does not reallocate.
+    const uint64_t want = std::max<uint64_t>(grow ? bytes + bytes / 2 : bytes, 64);
+    slot.buffer = ctx.allocate(name, want, CL_MEM_READ_ONLY);
+    slot.bytes = want;
+    ctx.zero(slot.buffer, want);
+  }
+  if (bytes > 0) CL_CHECK(ctx.queue().enqueueWriteBuffer(slot.buffer, CL_TRUE, 0, bytes, data));
+}
+
+template <class T>
+static uint64_t byteSize(const std::vector<T>& v) {
+  return uint64_t(v.size()) * sizeof(T);
+}
+
+void DeviceAccel::uploadStatic(Context& ctx, const StaticAccel& ssg) {
+  upload(ctx, staticNodes_, "static BVH nodes", ssg.nodes().data(), byteSize(ssg.nodes()), false);
+  upload(ctx, staticTris_, "static BVH triangles", ssg.triangles().data(),
+         byteSize(ssg.triangles()), false);
+}
+
+void DeviceAccel::uploadMeshes(Context& ctx, const DynamicAccel& dsg) {
+  upload(ctx, meshNodes_, "dynamic mesh BVH nodes", dsg.meshNodes().data(),
+         byteSize(dsg.meshNodes()), false);
+  upload(ctx, meshTris_, "dynamic mesh triangles", dsg.meshTriangles().data(),
+         byteSize(dsg.meshTriangles()), false);
+}
+
+void DeviceAccel::uploadFrame(Context& ctx, const DynamicAccel& dsg) {
+  if (byteSize(dsg.meshNodes()) > meshNodes_.bytes && !dsg.instances().empty())
+    throw RuntimeError("DeviceAccel: uploadMeshes must follow the last addMesh");
+  upload(ctx, tlasNodes_, "top-level BVH nodes", dsg.tlasNodes().data(), byteSize(dsg.tlasNodes()),
+         true);
+  upload(ctx, instances_, "dynamic instances", dsg.instances().data(), byteSize(dsg.instances()),
+         true);
+  instanceCount_ = uint32_t(dsg.instances().size());
+}
+
+void DeviceAccel::setKernelArgs(Context& ctx, cl::Kernel& kernel, cl_uint first) {
+  if (staticNodes_.bytes == 0) throw RuntimeError("DeviceAccel: static geometry not uploaded");
+  for (Slot* s : {&tlasNodes_, &instances_, &meshNodes_, &meshTris_})
+    if (s->bytes == 0) upload(ctx, *s, "dynamic geometry placeholder", nullptr, 0, false);
+  CL_CHECK(kernel.setArg(first + 0, staticNodes_.buffer));
+  CL_CHECK(kernel.setArg(first + 1, staticTris_.buffer));
+  CL_CHECK(kernel.setArg(first + 2, tlasNodes_.buffer));
+  CL_CHECK(kernel.setArg(first + 3, instances_.buffer));
+  CL_CHECK(kernel.setArg(first + 4, meshNodes_.buffer));
+  CL_CHECK(kernel.setArg(first + 5, meshTris_.buffer));
+  CL_CHECK(kernel.setArg(first + 6, cl_uint(instanceCount_)));
+}
+
+}  // namespace pr::accel

@@ -1,0 +1,44 @@
+// The device buffers of the SSG and DSG (kernels/shared/bvh.h's SceneGeom): the static BVH and
+// the meshes' BVHs are uploaded once, the TLAS and instance records every frame.
+#pragma once
+
+#include <cstdint>
+
+#include "accel/scene_accel.h"
+#include "cl/context.h"
+
+namespace pr::accel {
+
+class DeviceAccel {
+ public:
+  void uploadStatic(Context& ctx, const StaticAccel& ssg);
+  // The meshes' BVHs (once, after the last addMesh).
+  void uploadMeshes(Context& ctx, const DynamicAccel& dsg);
+  // This frame's TLAS and instance records; buffers grow as needed and are reused.
+  void uploadFrame(Context& ctx, const DynamicAccel& dsg);
+
+  // Sets the 7 arguments of PR_SCENE_GEOM_PARAMS from argument `first` on. Needs uploadStatic;
+  // missing DSG parts are bound as small placeholder buffers with instance count 0.
+  void setKernelArgs(Context& ctx, cl::Kernel& kernel, cl_uint first);
+
+  uint32_t instanceCount() const { return instanceCount_; }
+  // Device bytes held: static part, meshes, per-frame part.
+  uint64_t staticBytes() const { return staticNodes_.bytes + staticTris_.bytes; }
+  uint64_t meshBytes() const { return meshNodes_.bytes + meshTris_.bytes; }
+  uint64_t frameBytes() const { return tlasNodes_.bytes + instances_.bytes; }
+
+ private:
+  struct Slot {
+    cl::Buffer buffer;
+    uint64_t bytes = 0;  // allocated
+  };
+  // Writes `bytes` into the slot, (re)allocating when too small (never less than 64 bytes:
+  // OpenCL has no empty buffers).
+  static void upload(Context& ctx, Slot& slot, const char* name, const void* data, uint64_t bytes,
+                     bool grow);
+
+  Slot staticNodes_, staticTris_, meshNodes_, meshTris_, tlasNodes_, instances_;
+  uint32_t instanceCount_ = 0;
+};
+
+}  // namespace pr::accel

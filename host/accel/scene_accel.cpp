@@ -1,0 +1,178 @@
+#include "accel/scene_accel.h"
+
+#include <cmath>
+#include <string>
+
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+#include <glm/mat3x3.hpp>
+#include <glm/matrix.hpp>
+#include <glm/vec4.hpp>
+
+#include "util/error.h"
+
+namespace pr::accel {
+
+dev::BvhTriangle packTriangle(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c,
+                              uint32_t prim) {
+  const glm::vec3 e1 = b - a, e2 = c - a;
+  dev::BvhTriangle t{};
+  t.v0x = a.x, t.v0y = a.y, t.v0z = a.z;
+  t.e1x = e1.x, t.e1y = e1.y, t.e1z = e1.z;
+  t.e2x = e2.x, t.e2y = e2.y, t.e2z = e2.z;
+  t.prim = prim;
+  return t;
+}
+
+bool zeroArea(const dev::BvhTriangle& t) {
+  const glm::vec3 c = glm::cross(glm::vec3(t.e1x, t.e1y, t.e1z), glm::vec3(t.e2x, t.e2y, t.e2z));
+  return c.x == 0.0f && c.y == 0.0f && c.z == 0.0f;
+}
+
+TriangleBvh buildTriangleBvh(const std::vector<glm::vec3>& positions,
+                             const std::vector<uint32_t>& indices, uint32_t primBase,
+                             const BuildOptions& options, const char* what) {
+  if (indices.size() % 3 != 0)
+    throw InputError(std::string(what) + ": " + std::to_string(indices.size()) +
+                     " indices is not a whole number of triangles");
+  for (size_t i = 0; i < positions.size(); ++i) {
+    const glm::vec3& p = positions[i];
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+      throw InputError(std::string(what) + ": position " + std::to_string(i) + " is not finite");
+  }
+  const size_t count = indices.size() / 3;
+  std::vector<dev::BvhTriangle> packed;
+  std::vector<Aabb> boxes;
+  packed.reserve(count);
+  boxes.reserve(count);
+  for (size_t t = 0; t < count; ++t) {
+    Aabb box;
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t i = indices[3 * t + size_t(k)];
+      if (i >= positions.size())
+        throw InputError(std::string(what) + ": triangle " + std::to_string(t) + " uses vertex " +
+                         std::to_string(i) + " of " + std::to_string(positions.size()));
+      box.grow(positions[i]);
+    }
+    const dev::BvhTriangle tri = packTriangle(positions[indices[3 * t]], positions[indices[3 * t + 1]],
+                                              positions[indices[3 * t + 2]], primBase + uint32_t(t));
+    if (zeroArea(tri)) continue;
+    packed.push_back(tri);
+    boxes.push_back(box);
+  }
+  Bvh bvh = buildBvh(boxes, options);
+  TriangleBvh out;
+  out.nodes = std::move(bvh.nodes);
+  out.stats = bvh.stats;
+  out.triangles.reserve(packed.size());
+  for (uint32_t k : bvh.order) {
+    out.triangles.push_back(packed[k]);
+    out.bounds.grow(boxes[k]);
+  }
+  return out;
+}
+
+void StaticAccel::build(const std::vector<glm::vec3>& positions,
+                        const std::vector<uint32_t>& indices, const BuildOptions& options) {
+  bvh_ = buildTriangleBvh(positions, indices, 0, options, "static geometry");
+}
+
+uint32_t DynamicAccel::addMesh(const std::vector<glm::vec3>& positions,
+                               const std::vector<uint32_t>& indices, const BuildOptions& options) {
+  return addMesh(positions, indices, nextPrimBase_, options);
+}
+
+uint32_t DynamicAccel::addMesh(const std::vector<glm::vec3>& positions,
+                               const std::vector<uint32_t>& indices, uint32_t primBase,
+                               const BuildOptions& options) {
+  const std::string what = "dynamic mesh " + std::to_string(meshes_.size());
+  TriangleBvh bvh = buildTriangleBvh(positions, indices, primBase, options, what.c_str());
+  Mesh m;
+  m.rootNode = uint32_t(meshNodes_.size());
+  m.firstTriangle = uint32_t(meshTris_.size());
+  m.triangleCount = uint32_t(bvh.triangles.size());
+  m.primBase = primBase;
+  m.bounds = bvh.bounds;
+  m.stats = bvh.stats;
+  // Rebase to absolute indices in the concatenated buffers.
+  for (dev::BvhNode n : bvh.nodes) {
+    n.index += (n.meta & PR_BVH_LEAF_BIT) ? m.firstTriangle : m.rootNode;
+    meshNodes_.push_back(n);
+  }
+  meshTris_.insert(meshTris_.end(), bvh.triangles.begin(), bvh.triangles.end());
+  nextPrimBase_ = std::max(nextPrimBase_, primBase + m.triangleCount);
+  meshes_.push_back(m);
+  return uint32_t(meshes_.size() - 1);
+}
+
+namespace {
+
+// glm is column-major (m[col][row]); records are 3x4 row-major.
+void store3x4(const glm::mat4& m, float* out) {
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) out[4 * r + c] = m[c][r];
+}
+
+bool finite(const glm::mat4& m) {
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r)
+      if (!std::isfinite(m[c][r])) return false;
+  return true;
+}
+
+}  // namespace
+
+void DynamicAccel::setInstances(const std::vector<InstanceInput>& instances) {
+  worldBounds_.assign(instances.size(), Aabb{});
+  std::vector<Aabb> boxes;
+  std::vector<uint32_t> kept;
+  std::vector<glm::mat4> inverses;
+  for (size_t i = 0; i < instances.size(); ++i) {
+    const InstanceInput& in = instances[i];
+    if (in.mesh >= meshes_.size())
+      throw InputError("instance " + std::to_string(i) + " refers to dynamic mesh " +
+                       std::to_string(in.mesh) + " of " + std::to_string(meshes_.size()));
+    const Mesh& mesh = meshes_[in.mesh];
+    if (mesh.triangleCount == 0 || !finite(in.objectToWorld)) continue;
+    const float det = glm::determinant(glm::mat3(in.objectToWorld));
+    const glm::mat4 inv = glm::inverse(in.objectToWorld);
+    if (!(std::fabs(det) > 0.0f) || !finite(inv)) continue;
+    Aabb box;
+    for (int c = 0; c < 8; ++c) {
+      const glm::vec3 corner((c & 1) ? mesh.bounds.hi.x : mesh.bounds.lo.x,
+                             (c & 2) ? mesh.bounds.hi.y : mesh.bounds.lo.y,
+                             (c & 4) ? mesh.bounds.hi.z : mesh.bounds.lo.z);
+      box.grow(glm::vec3(in.objectToWorld * glm::vec4(corner, 1.0f)));
+    }
+    // Rays are tested in object space; pad the world box by a few ulps of its coordinates so
+    // the transform's rounding never culls a hit at the box's edge.
+    const glm::vec3 pad = (glm::abs(box.lo) + glm::abs(box.hi)) * 1e-6f + 1e-30f;
+    box.lo -= pad;
+    box.hi += pad;
+    worldBounds_[i] = box;
+    boxes.push_back(box);
+    kept.push_back(uint32_t(i));
+    inverses.push_back(inv);
+  }
+  BuildOptions o;
+  o.maxLeafSize = 2;
+  Bvh bvh = buildBvh(boxes, o);
+  tlas_ = std::move(bvh.nodes);
+  tlasStats_ = bvh.stats;
+  records_.clear();
+  records_.reserve(bvh.order.size());
+  for (uint32_t k : bvh.order) {
+    const uint32_t i = kept[k];
+    const Mesh& mesh = meshes_[instances[i].mesh];
+    dev::BvhInstance r{};
+    store3x4(inverses[k], r.world_to_object);
+    store3x4(instances[i].objectToWorld, r.object_to_world);
+    r.root_node = mesh.rootNode;
+    r.first_triangle = mesh.firstTriangle;
+    r.mesh = instances[i].mesh;
+    r.instance_id = i;
+    records_.push_back(r);
+  }
+}
+
+}  // namespace pr::accel

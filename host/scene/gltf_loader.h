@@ -1,0 +1,26 @@
+// Loading a glTF 2.0 file (.gltf with external or data: buffers, or .glb) into a Scene, with
+// the static/dynamic split of DESIGN.md section 3. Broken input never crashes: every index,
+// range and reference is checked and the first problem becomes one pr::InputError line
+// "FILE: what is wrong (which object)".
+#pragma once
+
+#include <iosfwd>
+#include <string>
+
+#include "scene/scene.h"
+
+namespace pr {
+
+struct LoadOptions {
+  // Where warnings (skipped primitives, unsupported features) are printed, one line each;
+  // nullptr = silent. They are kept in Scene::warnings either way.
+  std::ostream* warningStream = nullptr;
+  bool printWarnings = true;  // to std::cerr when warningStream is null
+};
+
+Scene loadScene(const std::string& path, const LoadOptions& options = {});
+
+// The extensions a file may list in extensionsRequired.
+bool isSupportedExtension(const std::string& name);
+
+}  // namespace pr

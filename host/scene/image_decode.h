@@ -1,0 +1,19 @@
+// Decoding PNG/JPEG/BMP/... bytes to RGBA8 (stb_image, compiled privately here).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace pr {
+
+struct DecodedImage {
+  int width = 0;
+  int height = 0;
+  std::vector<uint8_t> rgba8;  // width * height * 4, rows top to bottom
+};
+
+// False with `why` set when the bytes are not an image stb can read.
+bool decodeImageRgba8(const std::vector<uint8_t>& encoded, DecodedImage* out, std::string* why);
+
+}  // namespace pr

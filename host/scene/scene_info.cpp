@@ -1,0 +1,65 @@
+#include "scene/scene_info.h"
+
+#include <sstream>
+
+namespace pr {
+
+namespace {
+nlohmann::ordered_json vec3Json(const glm::vec3& v) { return {v.x, v.y, v.z}; }
+}  // namespace
+
+nlohmann::ordered_json sceneInfoJson(const Scene& scene, double fps) {
+  nlohmann::ordered_json j;
+  j["file"] = scene.path;
+  j["triangles"] = {{"static", scene.staticTriangleCount()}, {"dynamic", scene.dynamicTriangleCount()}};
+  j["instances"] = {{"dynamic", scene.instances.size()}, {"dynamic_meshes", scene.dynamicMeshes.size()}};
+  j["materials"] = scene.materials.size();
+  j["textures"] = scene.textures.size();
+  j["lights"] = {{"emissive_triangles", scene.emissiveTriangleCount()},
+                 {"emissive_triangles_dynamic", scene.dynamicEmissiveTriangleCount()},
+                 {"punctual", scene.lights.size()},
+                 {"punctual_dynamic", scene.dynamicLightCount()}};
+  j["cameras"] = scene.fileCameraCount();
+  j["default_camera"] = scene.fileCameraCount() == 0;
+  j["animation"] = {{"duration_s", scene.animationDuration()}, {"frames", scene.frameCount(fps)}, {"fps", fps}};
+  const Bounds& b = scene.bounds;
+  if (b.empty()) {
+    j["bounds"] = {{"min", nullptr}, {"max", nullptr}};
+  } else {
+    j["bounds"] = {{"min", vec3Json(b.min)}, {"max", vec3Json(b.max)}};
+  }
+  j["warnings"] = scene.warnings;
+  return j;
+}
+
+std::string sceneInfoText(const Scene& scene, double fps) {
+  std::ostringstream s;
+  s << "file:       " << scene.path << "\n";
+  s << "triangles:  " << scene.staticTriangleCount() << " static (SSG), " << scene.dynamicTriangleCount()
+    << " dynamic (DSG)\n";
+  s << "instances:  " << scene.instances.size() << " dynamic, of " << scene.dynamicMeshes.size() << " meshes\n";
+  s << "materials:  " << scene.materials.size() << ", textures: " << scene.textures.size() << "\n";
+  s << "lights:     " << scene.emissiveTriangleCount() << " emissive triangles ("
+    << scene.dynamicEmissiveTriangleCount() << " dynamic), " << scene.lights.size() << " punctual ("
+    << scene.dynamicLightCount() << " dynamic)\n";
+  s << "cameras:    " << scene.fileCameraCount();
+  if (scene.fileCameraCount() == 0) s << " (a default camera frames the scene)";
+  s << "\n";
+  const double d = scene.animationDuration();
+  s << "animation:  ";
+  if (d > 0.0)
+    s << d << " s, " << scene.frameCount(fps) << " frames at " << fps << " fps\n";
+  else
+    s << "none (1 frame)\n";
+  const Bounds& b = scene.bounds;
+  s << "bounds:     ";
+  if (b.empty())
+    s << "empty (nothing to render)\n";
+  else
+    s << "[" << b.min.x << ", " << b.min.y << ", " << b.min.z << "] .. [" << b.max.x << ", " << b.max.y << ", "
+      << b.max.z << "]\n";
+  for (const std::string& w : scene.warnings) s << w << "\n";
+  return s.str();
+}
+
+}  // namespace pr

@@ -1,0 +1,739 @@
+// Acceleration structures: the BVH builder, the CPU reference traversal (kernels/shared/bvh.h
+// compiled as C++) against brute force, the DSG's two levels, self-intersection, and the same
+// rays traced on the OpenCL device.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include "accel/bvh_builder.h"
+#include "accel/device_accel.h"
+#include "accel/scene_accel.h"
+#include "shared/bvh.h"
+#include "support/test_env.h"
+
+namespace pr {
+namespace {
+
+using namespace pr::accel;
+using dev::BvhTriangle;
+using dev::Hit;
+using dev::Ray;
+using dev::SceneGeom;
+
+struct Soup {
+  std::vector<glm::vec3> positions;
+  std::vector<uint32_t> indices;
+  size_t size() const { return indices.size() / 3; }
+  glm::vec3 vertex(size_t t, int k) const { return positions[indices[3 * t + size_t(k)]]; }
+};
+
+// Random triangles in [-1, 1]^3 with edges of about `size`.
+Soup randomSoup(size_t n, float size, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  Soup s;
+  for (size_t t = 0; t < n; ++t) {
+    const glm::vec3 c(u(rng), u(rng), u(rng));
+    for (int k = 0; k < 3; ++k) {
+      s.positions.push_back(c + size * glm::vec3(u(rng), u(rng), u(rng)));
+      s.indices.push_back(uint32_t(s.positions.size() - 1));
+    }
+  }
+  return s;
+}
+
+glm::vec3 randomDir(std::mt19937& rng) {
+  std::normal_distribution<float> g;
+  for (;;) {
+    const glm::vec3 d(g(rng), g(rng), g(rng));
+    const float l = glm::length(d);
+    if (l > 1e-3f) return d / l;
+  }
+}
+
+Ray makeRay(glm::vec3 o, glm::vec3 d, float tmin, float tmax) {
+  return Ray{o.x, o.y, o.z, tmin, d.x, d.y, d.z, tmax};
+}
+
+// Half the rays random, half aimed at a random point of a random triangle of `aim` (if any).
+std::vector<Ray> randomRays(size_t n, const std::vector<glm::vec3>& aim, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(-2.5f, 2.5f), t01(0.0f, 1.0f);
+  std::vector<Ray> rays;
+  for (size_t i = 0; i < n; ++i) {
+    const glm::vec3 o(u(rng), u(rng), u(rng));
+    glm::vec3 d = randomDir(rng);
+    if (i % 2 == 1 && !aim.empty()) {
+      const glm::vec3 target = aim[rng() % aim.size()];
+      if (glm::length(target - o) > 1e-3f) d = glm::normalize(target - o);
+    }
+    // Some rays end early, some start late: the [tmin, tmax] window must be honoured.
+    const float tmax = i % 5 == 0 ? 0.5f + 3.0f * t01(rng) : PR_INF_F;
+    const float tmin = i % 7 == 0 ? t01(rng) : 0.0f;
+    rays.push_back(makeRay(o, d, tmin, tmax));
+  }
+  return rays;
+}
+
+std::vector<glm::vec3> triangleCentres(const Soup& s) {
+  std::vector<glm::vec3> c;
+  for (size_t t = 0; t < s.size(); ++t) c.push_back((s.vertex(t, 0) + s.vertex(t, 1) + s.vertex(t, 2)) / 3.0f);
+  return c;
+}
+
+std::vector<BvhTriangle> packSoup(const Soup& s, uint32_t primBase = 0) {
+  std::vector<BvhTriangle> out;
+  for (size_t t = 0; t < s.size(); ++t) {
+    const BvhTriangle tri = packTriangle(s.vertex(t, 0), s.vertex(t, 1), s.vertex(t, 2), primBase + uint32_t(t));
+    if (!zeroArea(tri)) out.push_back(tri);
+  }
+  return out;
+}
+
+// Every triangle, nearest strictly closer hit wins: what the BVH must reproduce.
+Hit bruteForce(const std::vector<BvhTriangle>& tris, Ray ray, uint32_t inst = PR_INVALID_INDEX) {
+  Hit best = dev::hit_none();
+  const dev::float3 o = dev::make_float3(ray.ox, ray.oy, ray.oz);
+  const dev::float3 d = dev::make_float3(ray.dx, ray.dy, ray.dz);
+  float tmax = ray.tmax;
+  for (const BvhTriangle& tri : tris) {
+    float t, u, v;
+    if (dev::intersect_triangle(&tri, o, d, ray.tmin, tmax, &t, &u, &v)) {
+      tmax = t;
+      best.t = t, best.u = u, best.v = v, best.prim = tri.prim, best.inst = inst;
+    }
+  }
+  return best;
+}
+
+SceneGeom cpuGeom(const StaticAccel& s, const DynamicAccel* d) {
+  SceneGeom g{};
+  g.static_nodes = s.nodes().data();
+  g.static_tris = s.triangles().data();
+  if (d) {
+    g.tlas_nodes = d->tlasNodes().data();
+    g.instances = d->instances().data();
+    g.mesh_nodes = d->meshNodes().data();
+    g.mesh_tris = d->meshTriangles().data();
+    g.instance_count = uint32_t(d->instances().size());
+  }
+  return g;
+}
+
+bool relClose(float a, float b, float rel) { return std::fabs(a - b) <= rel * std::fmax(std::fabs(a), std::fabs(b)); }
+
+// Compares closest hits; failures are counted and the first few described.
+struct HitChecker {
+  int failures = 0;
+  int hits = 0;
+  void check(const Hit& got, const Hit& want, size_t ray, const std::string& what, float rel = 1e-5f) {
+    const bool ok = got.prim == want.prim && got.inst == want.inst &&
+                    (want.prim == PR_INVALID_INDEX || relClose(got.t, want.t, rel));
+    hits += want.prim != PR_INVALID_INDEX;
+    if (!ok && ++failures <= 5)
+      ADD_FAILURE() << what << " ray " << ray << ": got prim " << got.prim << " inst " << got.inst
+                    << " t " << got.t << ", want prim " << want.prim << " inst " << want.inst
+                    << " t " << want.t;
+  }
+};
+
+// ---------------------------------------------------------------------------------------------
+// Builder
+
+// Every node's box holds its children's boxes / its triangles; every triangle is in one leaf.
+void checkStructure(const std::vector<dev::BvhNode>& nodes, const std::vector<BvhTriangle>& tris) {
+  ASSERT_FALSE(nodes.empty());
+  EXPECT_LE(bvhDepth(nodes), PR_BVH_STACK_SIZE);
+  std::vector<int> seen(tris.size(), 0);
+  auto inside = [](const dev::BvhNode& outer, const dev::BvhNode& inner) {
+    return outer.lo_x <= inner.lo_x && outer.lo_y <= inner.lo_y && outer.lo_z <= inner.lo_z &&
+           outer.hi_x >= inner.hi_x && outer.hi_y >= inner.hi_y && outer.hi_z >= inner.hi_z;
+  };
+  for (uint32_t i = 0; i < nodes.size(); ++i) {
+    const dev::BvhNode& n = nodes[i];
+    if (n.meta & PR_BVH_LEAF_BIT) {
+      const uint32_t count = n.meta & ~PR_BVH_LEAF_BIT;
+      EXPECT_LE(count, 4u);
+      ASSERT_LE(uint64_t(n.index) + count, tris.size());
+      for (uint32_t k = n.index; k < n.index + count; ++k) {
+        ++seen[k];
+        const BvhTriangle& t = tris[k];
+        for (const glm::vec3 p : {glm::vec3(t.v0x, t.v0y, t.v0z),
+                                  glm::vec3(t.v0x + t.e1x, t.v0y + t.e1y, t.v0z + t.e1z),
+                                  glm::vec3(t.v0x + t.e2x, t.v0y + t.e2y, t.v0z + t.e2z)}) {
+          // v0 + e is rounded: allow an ulp or two.
+          const float eps = 1e-6f * (1.0f + glm::length(p));
+          EXPECT_TRUE(p.x >= n.lo_x - eps && p.x <= n.hi_x + eps && p.y >= n.lo_y - eps &&
+                      p.y <= n.hi_y + eps && p.z >= n.lo_z - eps && p.z <= n.hi_z + eps);
+        }
+      }
+    } else {
+      EXPECT_TRUE(inside(n, nodes[i + 1])) << "node " << i;
+      EXPECT_TRUE(inside(n, nodes[n.index])) << "node " << i;
+    }
+  }
+  for (size_t k = 0; k < seen.size(); ++k) ASSERT_EQ(seen[k], 1) << "triangle slot " << k;
+}
+
+TEST(BvhBuild, StructureOfRandomSoups) {
+  for (size_t n : {0, 1, 2, 5, 100, 3000}) {
+    SCOPED_TRACE("n = " + std::to_string(n));
+    const Soup s = randomSoup(n, 0.1f, 11 + uint32_t(n));
+    StaticAccel a;
+    a.build(s.positions, s.indices);
+    checkStructure(a.nodes(), a.triangles());
+    EXPECT_EQ(a.triangles().size(), n);
+    std::vector<int> prims(n, 0);
+    for (const auto& t : a.triangles()) ++prims[t.prim];
+    for (int c : prims) EXPECT_EQ(c, 1);
+  }
+}
+
+TEST(BvhBuild, RejectsBadInput) {
+  StaticAccel a;
+  EXPECT_THROW(a.build({glm::vec3(0.0f)}, {0, 0}), InputError);
+  EXPECT_THROW(a.build({glm::vec3(0.0f)}, {0, 0, 1}), InputError);
+  EXPECT_THROW(a.build({glm::vec3(NAN, 0.0f, 0.0f)}, {0, 0, 0}), InputError);
+  BuildOptions o;
+  o.maxDepth = PR_BVH_STACK_SIZE + 1;
+  EXPECT_THROW(buildBvh({}, o), RuntimeError);
+}
+
+// Exponentially spaced triangles make SAH peel one off at a time: a chain far deeper than the
+// stack unless the depth cap steps in.
+Soup exponentialSoup(size_t n) {
+  Soup s;
+  float x = 1.0f;
+  for (size_t t = 0; t < n; ++t, x *= 1.5f) {
+    const float w = x * 0.01f;
+    for (const glm::vec3 p : {glm::vec3(x, 0, 0), glm::vec3(x + w, 0, w), glm::vec3(x, w, w)}) {
+      s.positions.push_back(p);
+      s.indices.push_back(uint32_t(s.positions.size() - 1));
+    }
+  }
+  return s;
+}
+
+TEST(BvhBuild, DepthNeverExceedsTheStack) {
+  const Soup deep = exponentialSoup(150);
+  StaticAccel a;
+  a.build(deep.positions, deep.indices);
+  EXPECT_LE(a.stats().depth, PR_BVH_STACK_SIZE);
+  checkStructure(a.nodes(), a.triangles());
+  // A tight cap on an ordinary soup, and the result still traces right.
+  const Soup s = randomSoup(2000, 0.1f, 5);
+  BuildOptions o;
+  o.maxDepth = 10;
+  a.build(s.positions, s.indices, o);
+  EXPECT_LE(a.stats().depth, 10);
+  checkStructure(a.nodes(), a.triangles());
+  const SceneGeom g = cpuGeom(a, nullptr);
+  const auto tris = packSoup(s);
+  HitChecker c;
+  const auto rays = randomRays(500, triangleCentres(s), 9);
+  for (size_t i = 0; i < rays.size(); ++i) {
+    Hit h;
+    dev::intersect_static(&g, rays[i], &h);
+    c.check(h, bruteForce(tris, rays[i]), i, "depth-capped");
+  }
+  EXPECT_GT(c.hits, 100);
+}
+
+// ---------------------------------------------------------------------------------------------
+// SSG traversal against brute force
+
+void expectStaticMatchesBruteForce(const Soup& s, size_t rayCount, uint32_t seed, bool exactPrim) {
+  StaticAccel a;
+  a.build(s.positions, s.indices);
+  const SceneGeom g = cpuGeom(a, nullptr);
+  const auto tris = packSoup(s);
+  const auto rays = randomRays(rayCount, triangleCentres(s), seed);
+  HitChecker c;
+  for (size_t i = 0; i < rays.size(); ++i) {
+    Hit h;
+    const int any = dev::intersect_static(&g, rays[i], &h);
+    const Hit want = bruteForce(tris, rays[i]);
+    EXPECT_EQ(any, want.prim != PR_INVALID_INDEX);
+    if (!exactPrim && h.prim != want.prim && h.prim != PR_INVALID_INDEX && want.prim != PR_INVALID_INDEX) {
+      // Coincident or coplanar triangles: either is right if it is hit at the same t (an ulp
+      // apart for coplanar ones: a box may then cull the other by that ulp).
+      EXPECT_TRUE(relClose(h.t, want.t, 1e-6f)) << "ray " << i << ": " << h.t << " vs " << want.t;
+      continue;
+    }
+    c.check(h, want, i, "static");
+    // Any hit agrees with the closest hit's existence, for the full window and a shorter one.
+    EXPECT_EQ(dev::occluded_static(&g, rays[i]), want.prim != PR_INVALID_INDEX) << "ray " << i;
+    if (want.prim != PR_INVALID_INDEX) {
+      Ray shorter = rays[i];
+      shorter.tmax = want.t * 0.999f;
+      EXPECT_EQ(dev::occluded_static(&g, shorter), 0) << "ray " << i;
+      EXPECT_EQ(dev::occluded_scene(&g, rays[i]), 1) << "ray " << i;
+    }
+  }
+  if (exactPrim && s.size() > 10) {
+    EXPECT_GT(c.hits, int(rayCount / 5));
+  }
+}
+
+TEST(StaticTraversal, MatchesBruteForceOnRandomSoups) {
+  for (size_t n : {0, 1, 2, 3, 17, 200, 10000}) {
+    SCOPED_TRACE("n = " + std::to_string(n));
+    expectStaticMatchesBruteForce(randomSoup(n, n > 1000 ? 0.05f : 0.3f, 100 + uint32_t(n)),
+                                  n > 1000 ? 1500 : 3000, 7 + uint32_t(n), true);
+  }
+}
+
+TEST(StaticTraversal, DegenerateSoups) {
+  // Many copies of one triangle: all centroids equal.
+  Soup same;
+  same.positions = {{-0.5f, -0.5f, 0.0f}, {0.5f, -0.5f, 0.1f}, {0.0f, 0.5f, -0.1f}};
+  for (int i = 0; i < 500; ++i) same.indices.insert(same.indices.end(), {0, 1, 2});
+  {
+    SCOPED_TRACE("identical");
+    expectStaticMatchesBruteForce(same, 1000, 1, false);
+  }
+  // Same centroid, different sizes (nested triangles).
+  Soup nested;
+  for (int i = 0; i < 300; ++i) {
+    const float k = 0.01f + 0.005f * float(i);
+    for (const glm::vec3 p : {glm::vec3(-k, -k, 0.2f * k), glm::vec3(2 * k, -k, -0.4f * k), glm::vec3(-k, 2 * k, 0.2f * k)}) {
+      nested.positions.push_back(p);
+      nested.indices.push_back(uint32_t(nested.positions.size() - 1));
+    }
+  }
+  {
+    SCOPED_TRACE("nested");
+    expectStaticMatchesBruteForce(nested, 1000, 2, false);
+  }
+  // Zero-area triangles (points, repeated vertices) among ordinary ones: never hit.
+  Soup mixed = randomSoup(300, 0.3f, 3);
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  for (int i = 0; i < 300; ++i) {
+    const glm::vec3 a(u(rng), u(rng), u(rng)), b(u(rng), u(rng), u(rng));
+    mixed.positions.insert(mixed.positions.end(), {a, i % 3 ? b : a, i % 3 == 1 ? b : a});
+    const uint32_t base = uint32_t(mixed.positions.size() - 3);
+    mixed.indices.insert(mixed.indices.end(), {base, base + 1, base + 2});
+  }
+  {
+    SCOPED_TRACE("zero-area");
+    expectStaticMatchesBruteForce(mixed, 2000, 5, true);
+  }
+  // Flat: every triangle in the plane z = 0, rays from both sides and in the plane.
+  Soup flat = randomSoup(1000, 0.1f, 6);
+  for (auto& p : flat.positions) p.z = 0.0f;
+  {
+    SCOPED_TRACE("flat");
+    expectStaticMatchesBruteForce(flat, 2000, 7, false);  // overlapping coplanar triangles
+  }
+  // Deep chain (the depth-capped case).
+  {
+    SCOPED_TRACE("exponential");
+    expectStaticMatchesBruteForce(exponentialSoup(150), 500, 8, true);
+  }
+}
+
+TEST(StaticTraversal, EmptySceneHitsNothing) {
+  StaticAccel a;
+  a.build({}, {});
+  const SceneGeom g = cpuGeom(a, nullptr);
+  Hit h;
+  EXPECT_EQ(dev::intersect_scene(&g, makeRay({0, 0, 0}, {0, 0, 1}, 0.0f, PR_INF_F), &h), 0);
+  EXPECT_EQ(h.prim, PR_INVALID_INDEX);
+  EXPECT_EQ(dev::occluded_scene(&g, makeRay({0, 0, 0}, {0, 0, 1}, 0.0f, PR_INF_F)), 0);
+}
+
+TEST(StaticTraversal, AxisAlignedRaysAndFaces) {
+  // A grid of axis-aligned quads probed by axis-aligned rays (zero direction components).
+  Soup s;
+  for (int i = 0; i < 10; ++i)
+    for (int j = 0; j < 10; ++j) {
+      const float x = float(i) * 0.2f - 1.0f, y = float(j) * 0.2f - 1.0f, z = float(i + j) * 0.05f;
+      const uint32_t b = uint32_t(s.positions.size());
+      s.positions.insert(s.positions.end(), {{x, y, z}, {x + 0.2f, y, z}, {x + 0.2f, y + 0.2f, z}, {x, y + 0.2f, z}});
+      s.indices.insert(s.indices.end(), {b, b + 1, b + 2, b, b + 2, b + 3});
+    }
+  StaticAccel a;
+  a.build(s.positions, s.indices);
+  const SceneGeom g = cpuGeom(a, nullptr);
+  const auto tris = packSoup(s);
+  HitChecker c;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(-1.1f, 1.1f);
+  for (int i = 0; i < 2000; ++i) {
+    const Ray r = makeRay({u(rng), u(rng), -1.0f}, {0, 0, 1}, 0.0f, PR_INF_F);
+    Hit h;
+    dev::intersect_static(&g, r, &h);
+    const Hit want = bruteForce(tris, r);
+    if (h.prim != want.prim && want.prim != PR_INVALID_INDEX && h.prim != PR_INVALID_INDEX) {
+      EXPECT_EQ(h.t, want.t);  // on a shared diagonal or edge: either quad half
+      continue;
+    }
+    c.check(h, want, size_t(i), "axis-aligned");
+  }
+  EXPECT_GT(c.hits, 1500);
+}
+
+// ---------------------------------------------------------------------------------------------
+// DSG
+
+struct DynamicScene {
+  std::vector<Soup> meshes;
+  DynamicAccel accel;
+  std::vector<InstanceInput> instances;
+};
+
+glm::mat4 randomTransform(std::mt19937& rng) {
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f), s(0.3f, 1.5f);
+  const glm::quat q = glm::normalize(glm::quat(u(rng), u(rng), u(rng), u(rng)) + glm::quat(0.01f, 0, 0, 0));
+  glm::mat4 m = glm::translate(glm::mat4(1.0f), glm::vec3(u(rng), u(rng), u(rng)) * 1.5f);
+  m = m * glm::mat4_cast(q);
+  return glm::scale(m, glm::vec3(s(rng), s(rng), s(rng)));  // non-uniform
+}
+
+void makeDynamic(DynamicScene& d, uint32_t seed) {
+  d.meshes = {randomSoup(400, 0.25f, seed), randomSoup(1, 0.8f, seed + 1), randomSoup(0, 0.1f, seed + 2),
+              randomSoup(1500, 0.1f, seed + 3)};
+  for (const Soup& m : d.meshes) d.accel.addMesh(m.positions, m.indices);
+}
+
+void setFrame(DynamicScene& d, int frame) {
+  std::mt19937 rng(1000 + uint32_t(frame));
+  d.instances.clear();
+  for (uint32_t i = 0; i < 9; ++i) d.instances.push_back({i % 4, randomTransform(rng)});
+  if (frame == 2) d.instances[5].objectToWorld = glm::scale(glm::mat4(1.0f), glm::vec3(1, 0, 1));  // singular
+  d.accel.setInstances(d.instances);
+}
+
+// Brute force over every instance in object space, using the records' world-to-object matrix.
+Hit bruteForceDynamic(const DynamicScene& d, const std::vector<std::vector<BvhTriangle>>& packed, Ray ray) {
+  Hit best = dev::hit_none();
+  const dev::BvhRay world = dev::bvh_ray_from(ray);
+  for (const dev::BvhInstance& rec : d.accel.instances()) {
+    const dev::BvhRay local = dev::instance_ray(&rec, &world);
+    Ray r = makeRay({local.o.x, local.o.y, local.o.z}, {local.d.x, local.d.y, local.d.z}, ray.tmin, ray.tmax);
+    r.tmax = best.prim == PR_INVALID_INDEX ? ray.tmax : best.t;
+    const Hit h = bruteForce(packed[rec.mesh], r, rec.instance_id);
+    if (h.prim != PR_INVALID_INDEX) best = h;
+  }
+  return best;
+}
+
+std::vector<std::vector<BvhTriangle>> packMeshes(const DynamicScene& d) {
+  std::vector<std::vector<BvhTriangle>> out;
+  uint32_t base = 0;
+  for (const Soup& m : d.meshes) {
+    out.push_back(packSoup(m, base));
+    base += uint32_t(m.size());
+  }
+  return out;
+}
+
+// World-space triangles of every instance (the transform checked independently).
+std::vector<std::vector<BvhTriangle>> worldTriangles(const DynamicScene& d) {
+  std::vector<std::vector<BvhTriangle>> out;
+  std::vector<uint32_t> bases;
+  uint32_t base = 0;
+  for (const Soup& m : d.meshes) bases.push_back(base), base += uint32_t(m.size());
+  for (const InstanceInput& in : d.instances) {
+    const Soup& m = d.meshes[in.mesh];
+    std::vector<BvhTriangle> tris;
+    for (size_t t = 0; t < m.size(); ++t) {
+      glm::vec3 v[3];
+      for (int k = 0; k < 3; ++k) v[k] = glm::vec3(in.objectToWorld * glm::vec4(m.vertex(t, k), 1.0f));
+      tris.push_back(packTriangle(v[0], v[1], v[2], bases[in.mesh] + uint32_t(t)));
+    }
+    out.push_back(tris);
+  }
+  return out;
+}
+
+std::vector<glm::vec3> instanceCentres(const DynamicScene& d) {
+  std::vector<glm::vec3> c;
+  for (const InstanceInput& in : d.instances)
+    for (const glm::vec3& p : triangleCentres(d.meshes[in.mesh])) c.push_back(glm::vec3(in.objectToWorld * glm::vec4(p, 1.0f)));
+  return c;
+}
+
+TEST(DynamicTraversal, MatchesBruteForceOverFrames) {
+  DynamicScene d;
+  makeDynamic(d, 40);
+  const auto packed = packMeshes(d);
+  StaticAccel empty;
+  empty.build({}, {});
+  for (int frame = 0; frame < 4; ++frame) {
+    SCOPED_TRACE("frame " + std::to_string(frame));
+    setFrame(d, frame);
+    EXPECT_LE(bvhDepth(d.accel.tlasNodes()), PR_BVH_STACK_SIZE);
+    // Meshes 0, 1, 3 are hittable; mesh 2 is empty, and frame 2 has one singular instance.
+    EXPECT_EQ(d.accel.instances().size(), frame == 2 ? 6u : 7u);
+    const SceneGeom g = cpuGeom(empty, &d.accel);
+    const auto world = worldTriangles(d);
+    const auto rays = randomRays(2000, instanceCentres(d), 50 + uint32_t(frame));
+    HitChecker c;
+    int worldMismatch = 0, worldFar = 0;
+    for (size_t i = 0; i < rays.size(); ++i) {
+      Hit h;
+      dev::intersect_dynamic(&g, rays[i], &h);
+      const Hit want = bruteForceDynamic(d, packed, rays[i]);
+      c.check(h, want, i, "dynamic");
+      EXPECT_EQ(dev::occluded_dynamic(&g, rays[i]), want.prim != PR_INVALID_INDEX) << "ray " << i;
+      Hit whole;
+      dev::intersect_scene(&g, rays[i], &whole);
+      c.check(whole, want, i, "scene (DSG only)");
+      // Against world-space triangles: same answer up to the transform's rounding.
+      Hit ws = dev::hit_none();
+      for (size_t k = 0; k < d.instances.size(); ++k) {
+        if (d.accel.instanceBounds()[k].empty()) continue;
+        Ray r = rays[i];
+        if (ws.prim != PR_INVALID_INDEX) r.tmax = ws.t;
+        const Hit hk = bruteForce(world[k], r, uint32_t(k));
+        if (hk.prim != PR_INVALID_INDEX) ws = hk;
+      }
+      if (ws.prim != h.prim || ws.inst != h.inst) {
+        ++worldMismatch;
+      } else if (ws.prim != PR_INVALID_INDEX) {
+        // Grazing hits magnify the vertices' rounding into t: a few may differ more.
+        EXPECT_TRUE(relClose(ws.t, h.t, 1e-2f)) << ws.t << " vs " << h.t;
+        worldFar += !relClose(ws.t, h.t, 1e-4f);
+      }
+    }
+    EXPECT_GT(c.hits, 400);
+    EXPECT_LE(worldMismatch, 4) << "object-space and world-space answers differ too often";
+    EXPECT_LE(worldFar, 10) << "object-space and world-space t differ too often";
+  }
+}
+
+TEST(DynamicTraversal, NoInstancesAndBadMesh) {
+  DynamicAccel d;
+  d.setInstances({});
+  EXPECT_EQ(d.instances().size(), 0u);
+  EXPECT_THROW(d.setInstances({{3, glm::mat4(1.0f)}}), InputError);
+}
+
+// The whole scene: the nearer of the SSG and the DSG hit.
+TEST(SceneTraversal, NearerOfStaticAndDynamic) {
+  const Soup s = randomSoup(2000, 0.1f, 77);
+  StaticAccel a;
+  a.build(s.positions, s.indices);
+  const auto stris = packSoup(s);
+  DynamicScene d;
+  makeDynamic(d, 60);
+  const auto packed = packMeshes(d);
+  for (int frame = 0; frame < 2; ++frame) {
+    setFrame(d, frame);
+    const SceneGeom g = cpuGeom(a, &d.accel);
+    auto aim = instanceCentres(d);
+    for (const auto& c : triangleCentres(s)) aim.push_back(c);
+    const auto rays = randomRays(2000, aim, 90 + uint32_t(frame));
+    HitChecker c;
+    int fromDsg = 0;
+    for (size_t i = 0; i < rays.size(); ++i) {
+      const Hit hs = bruteForce(stris, rays[i]);
+      const Hit hd = bruteForceDynamic(d, packed, rays[i]);
+      const Hit want = hd.prim != PR_INVALID_INDEX && (hs.prim == PR_INVALID_INDEX || hd.t < hs.t) ? hd : hs;
+      fromDsg += want.inst != PR_INVALID_INDEX;
+      Hit h;
+      EXPECT_EQ(dev::intersect_scene(&g, rays[i], &h), want.prim != PR_INVALID_INDEX);
+      c.check(h, want, i, "scene");
+      EXPECT_EQ(dev::occluded_scene(&g, rays[i]), want.prim != PR_INVALID_INDEX) << "ray " << i;
+    }
+    EXPECT_GT(fromDsg, 100);
+    EXPECT_GT(c.hits - fromDsg, 100);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Self-intersection
+
+TEST(SelfIntersection, RaysLeavingASurfaceNeverHitIt) {
+  // Sizes and positions over several magnitudes, so the offset's scaling is exercised.
+  for (float scale : {1e-2f, 1.0f, 1e3f}) {
+    SCOPED_TRACE("scale " + std::to_string(scale));
+    Soup s = randomSoup(3000, 0.2f, 21);
+    for (auto& p : s.positions) p = p * scale + glm::vec3(0.0f, 0.0f, scale > 100 ? 5000.0f : 0.0f);
+    StaticAccel a;
+    a.build(s.positions, s.indices);
+    DynamicScene d;
+    makeDynamic(d, 30);
+    setFrame(d, 1);
+    const SceneGeom g = cpuGeom(a, &d.accel);
+    std::mt19937 rng(99);
+    std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+    int selfHits = 0;
+    for (int i = 0; i < 20000; ++i) {
+      float u = u01(rng), v = u01(rng);
+      if (u + v > 1.0f) u = 1.0f - u, v = 1.0f - v;
+      glm::vec3 p, ng;
+      uint32_t prim, inst = PR_INVALID_INDEX;
+      if (i % 2 == 0) {
+        const size_t t = rng() % s.size();
+        const glm::vec3 v0 = s.vertex(t, 0), e1 = s.vertex(t, 1) - v0, e2 = s.vertex(t, 2) - v0;
+        p = v0 + u * e1 + v * e2;
+        ng = glm::cross(e1, e2);
+        prim = uint32_t(t);
+      } else {
+        const auto& recs = d.accel.instances();
+        const dev::BvhInstance& rec = recs[rng() % recs.size()];
+        const BvhTriangle& tri = d.accel.meshTriangles()[rec.first_triangle + rng() % (d.meshes[rec.mesh].size())];
+        const glm::vec3 v0(tri.v0x, tri.v0y, tri.v0z), e1(tri.e1x, tri.e1y, tri.e1z), e2(tri.e2x, tri.e2y, tri.e2z);
+        const glm::mat4 m = d.instances[rec.instance_id].objectToWorld;
+        p = glm::vec3(m * glm::vec4(v0 + u * e1 + v * e2, 1.0f));
+        ng = glm::transpose(glm::inverse(glm::mat3(m))) * glm::cross(e1, e2);
+        prim = tri.prim;
+        inst = rec.instance_id;
+      }
+      if (!(glm::length(ng) > 0.0f)) continue;
+      ng = glm::normalize(ng);
+      // Hemisphere on either side, including grazing directions.
+      glm::vec3 dir = randomDir(rng);
+      if (i % 4 == 1) dir = glm::normalize(dir - glm::dot(dir, ng) * ng * 0.9999f);
+      if (!(glm::length(dir) > 0.0f)) continue;
+      const Ray r = dev::spawn_ray(dev::make_float3(p.x, p.y, p.z), dev::make_float3(ng.x, ng.y, ng.z),
+                                   dev::make_float3(dir.x, dir.y, dir.z), PR_INF_F);
+      Hit h;
+      dev::intersect_scene(&g, r, &h);
+      if (h.prim == prim && h.inst == inst && ++selfHits <= 5)
+        ADD_FAILURE() << "ray " << i << " hit its own triangle at t = " << h.t;
+    }
+    EXPECT_EQ(selfHits, 0);
+  }
+}
+
+TEST(SelfIntersection, ShadowSegmentsBetweenFacingSurfaces) {
+  // Two facing quads and nothing between: no segment between them is ever occluded.
+  Soup s;
+  s.positions = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0},
+                 {-1, -1, 1.3f}, {1, -1, 1.7f}, {1, 1, 1.3f}, {-1, 1, 1.1f}};
+  s.indices = {0, 1, 2, 0, 2, 3, 4, 6, 5, 4, 7, 6};
+  StaticAccel a;
+  a.build(s.positions, s.indices);
+  const SceneGeom g = cpuGeom(a, nullptr);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+  auto point = [&](size_t t, glm::vec3* n) {
+    float u = u01(rng), v = u01(rng);
+    if (u + v > 1.0f) u = 1.0f - u, v = 1.0f - v;
+    const glm::vec3 v0 = s.vertex(t, 0), e1 = s.vertex(t, 1) - v0, e2 = s.vertex(t, 2) - v0;
+    *n = glm::cross(e1, e2);
+    return v0 + u * e1 + v * e2;
+  };
+  int blocked = 0;
+  for (int i = 0; i < 20000; ++i) {
+    glm::vec3 np, nq;
+    const glm::vec3 p = point(rng() % 2, &np), q = point(2 + rng() % 2, &nq);
+    const Ray r = dev::spawn_ray_to(dev::make_float3(p.x, p.y, p.z), dev::make_float3(np.x, np.y, np.z),
+                                    dev::make_float3(q.x, q.y, q.z), dev::make_float3(nq.x, nq.y, nq.z));
+    blocked += dev::occluded_scene(&g, r);
+  }
+  EXPECT_EQ(blocked, 0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The device runs the same code
+
+struct DeviceTrace {
+  std::vector<Hit> hits;
+  std::vector<cl_uint> occluded;
+};
+
+DeviceTrace traceOnDevice(DeviceAccel& dacc, const std::vector<Ray>& rays, cl_uint mode) {
+  Context& ctx = test::testContext();
+  static cl::Program program = ctx.buildProgram("test/trace.cl").program;
+  cl_int err = CL_SUCCESS;
+  cl::Kernel k(program, "trace_rays", &err);
+  CL_CHECK(err);
+  const cl_uint n = cl_uint(rays.size());
+  cl::Buffer rb = ctx.allocate("rays", n * sizeof(Ray)), hb = ctx.allocate("hits", n * sizeof(Hit)),
+             ob = ctx.allocate("occluded", n * sizeof(cl_uint));
+  CL_CHECK(ctx.queue().enqueueWriteBuffer(rb, CL_TRUE, 0, n * sizeof(Ray), rays.data()));
+  CL_CHECK(k.setArg(0, rb));
+  CL_CHECK(k.setArg(1, hb));
+  CL_CHECK(k.setArg(2, ob));
+  CL_CHECK(k.setArg(3, n));
+  CL_CHECK(k.setArg(4, mode));
+  dacc.setKernelArgs(ctx, k, 5);
+  ctx.launch1D(k, n, "trace_rays");
+  DeviceTrace out;
+  out.hits.resize(n);
+  out.occluded.resize(n);
+  CL_CHECK(ctx.queue().enqueueReadBuffer(hb, CL_TRUE, 0, n * sizeof(Hit), out.hits.data()));
+  CL_CHECK(ctx.queue().enqueueReadBuffer(ob, CL_TRUE, 0, n * sizeof(cl_uint), out.occluded.data()));
+  ctx.release(n * (sizeof(Ray) + sizeof(Hit) + sizeof(cl_uint)));
+  return out;
+}
+
+// A hit this close to a triangle's edge may fall on either side with another rounding.
+bool nearEdge(const Hit& h) {
+  return h.prim != PR_INVALID_INDEX && (h.u < 1e-4f || h.v < 1e-4f || 1.0f - h.u - h.v < 1e-4f);
+}
+
+void compareDevice(const SceneGeom& g, DeviceAccel& dacc, const std::vector<Ray>& rays, cl_uint mode,
+                   const std::string& what) {
+  const DeviceTrace dt = traceOnDevice(dacc, rays, mode);
+  HitChecker c;
+  int edgeCases = 0;
+  for (size_t i = 0; i < rays.size(); ++i) {
+    Hit want;
+    int occ;
+    if (mode == 1) {
+      dev::intersect_static(&g, rays[i], &want);
+      occ = dev::occluded_static(&g, rays[i]);
+    } else if (mode == 2) {
+      dev::intersect_dynamic(&g, rays[i], &want);
+      occ = dev::occluded_dynamic(&g, rays[i]);
+    } else {
+      dev::intersect_scene(&g, rays[i], &want);
+      occ = dev::occluded_scene(&g, rays[i]);
+    }
+    const Hit& got = dt.hits[i];
+    if ((got.prim != want.prim || got.inst != want.inst) && (nearEdge(want) || nearEdge(got))) {
+      ++edgeCases;
+      continue;
+    }
+    c.check(got, want, i, what);
+    EXPECT_EQ(int(dt.occluded[i]), occ) << what << " ray " << i;
+  }
+  EXPECT_LE(edgeCases, int(rays.size() / 1000) + 1) << what;
+  EXPECT_GT(c.hits, int(rays.size() / 5)) << what;
+}
+
+TEST(DeviceTraversal, MatchesCpuReference) {
+  Context& ctx = test::testContext();
+  const Soup s = randomSoup(10000, 0.05f, 123);
+  StaticAccel a;
+  a.build(s.positions, s.indices);
+  DynamicScene d;
+  makeDynamic(d, 200);
+  DeviceAccel dacc;
+  dacc.uploadStatic(ctx, a);
+  {
+    // No DSG at all: placeholders, instance count 0.
+    DynamicAccel none;
+    const SceneGeom g = cpuGeom(a, nullptr);
+    compareDevice(g, dacc, randomRays(4000, triangleCentres(s), 1), 1, "static only");
+  }
+  dacc.uploadMeshes(ctx, d.accel);
+  for (int frame = 0; frame < 3; ++frame) {
+    SCOPED_TRACE("frame " + std::to_string(frame));
+    setFrame(d, frame);
+    dacc.uploadFrame(ctx, d.accel);
+    const SceneGeom g = cpuGeom(a, &d.accel);
+    auto aim = instanceCentres(d);
+    aim.resize(aim.size() + 2000);
+    const auto sc = triangleCentres(s);
+    std::copy(sc.begin(), sc.begin() + 2000, aim.end() - 2000);
+    const auto rays = randomRays(4000, aim, 300 + uint32_t(frame));
+    compareDevice(g, dacc, rays, 0, "scene");
+    compareDevice(g, dacc, rays, 2, "dynamic");
+  }
+}
+
+}  // namespace
+}  // namespace pr
