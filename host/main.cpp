@@ -9,6 +9,8 @@
 #include <CLI/CLI.hpp>
 
 #include "cl/device.h"
+#include "render/options.h"
+#include "render/renderer.h"
 #include "scene/gltf_loader.h"
 #include "scene/scene_info.h"
 #include "util/error.h"
@@ -57,6 +59,31 @@ int main(int argc, char** argv) {
   info->add_flag("--json", infoJson, "Print as JSON");
   info->add_option("--fps", infoFps, "Frames per second of the animation (default 24)");
 
+  pr::RenderOptions ro;
+  std::string framesText, modeText = "pathtrace";
+  auto* render = app.add_subcommand("render", "Render a range of frames of the scene's animation");
+  render->add_option("SCENE", ro.scene, "glTF file (.gltf or .glb)")->required();
+  render->add_option("--frames", framesText, "Frame range A-B or one frame A (default: the whole animation)");
+  render->add_option("--fps", ro.fps, "Frames per second: frame f is at time f / fps")->capture_default_str();
+  render->add_option("--width", ro.width, "Image width (default: from the camera's aspect, else 640)");
+  render->add_option("--height", ro.height, "Image height (default 480)");
+  render->add_option("--spp", ro.spp, "Samples per pixel per frame")->capture_default_str();
+  render->add_option("--max-depth", ro.maxDepth, "Maximum path length in bounces")->capture_default_str();
+  render->add_option("--seed", ro.seed, "Random seed; the same seed reproduces a frame on one device")
+      ->capture_default_str();
+  render->add_option("--device", ro.device, "OpenCL device: index, P:D, cpu, gpu or part of its name");
+  render->add_option("--mode", modeText, "pathtrace: unidirectional path tracing (the baseline)")
+      ->check(CLI::IsMember({"pathtrace"}))
+      ->capture_default_str();
+  render->add_option("--camera", ro.camera, "Camera index (default: the scene's first)");
+  render->add_option("--out", ro.outPattern, "Output EXR path with a frame number conversion")
+      ->capture_default_str();
+  render->add_flag("--exr-float", ro.exrFloat, "Write 32-bit float EXR (default: half)");
+  render->add_flag("--png", ro.png, "Also write an sRGB PNG beside each EXR");
+  render->add_option("--exposure", ro.exposure, "Exposure in stops for the PNG")->capture_default_str();
+  render->add_flag("-q,--quiet", ro.quiet, "No progress line or summary");
+  render->add_option("--stats", ro.statsFile, "Write one JSON line per frame to this file");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -73,6 +100,14 @@ int main(int argc, char** argv) {
   try {
     if (*devices) return runDevices(devicesJson);
     if (*info) return runInfo(infoScene, infoJson, infoFps);
+    if (*render) {
+      if (!framesText.empty()) {
+        ro.frames = pr::parseFrameRange(framesText);
+        ro.framesGiven = true;
+      }
+      ro.mode = pr::RenderMode::PathTrace;
+      return pr::runRender(ro);
+    }
   } catch (const pr::InputError& e) {
     std::cerr << "error: " << e.what() << "\n";
     return pr::kExitBadInput;

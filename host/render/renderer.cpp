@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -98,6 +99,9 @@ int runRender(const RenderOptions& o) {
 
   std::unique_ptr<std::ofstream> stats;
   if (!o.statsFile.empty()) {
+    const auto parent = std::filesystem::path(o.statsFile).parent_path();
+    std::error_code ec;
+    if (!parent.empty()) std::filesystem::create_directories(parent, ec);
     stats = std::make_unique<std::ofstream>(o.statsFile, std::ios::trunc);
     if (!*stats) throw RuntimeError(o.statsFile + ": cannot write the stats file");
   }

@@ -2,12 +2,28 @@
 // host and device. Add every new shared struct here.
 #pragma once
 
+#include "shared/camera.h"
+#include "shared/geometry.h"
+#include "shared/lights.h"
+#include "shared/material.h"
+#include "shared/path_state.h"
+#include "shared/types.h"
+
 #define PR_SHARED_STRUCTS(S) \
   S(Ray)                     \
   S(Hit)                     \
   S(BvhNode)                 \
   S(BvhTriangle)             \
-  S(BvhInstance)
+  S(BvhInstance)              \
+  S(Material)                 \
+  S(TextureInfo)              \
+  S(CameraParams)             \
+  S(Light)                    \
+  S(ShadingVertex)            \
+  S(ShadingTriangle)          \
+  S(ShadingInstance)          \
+  S(PathState)                \
+  S(ShadowRay)
 
 #define PR_SHARED_FIELDS(F) \
   F(Ray, ox)                \
@@ -32,4 +48,36 @@
   F(BvhInstance, root_node) \
   F(BvhInstance, first_triangle) \
   F(BvhInstance, mesh)      \
-  F(BvhInstance, instance_id)
+  F(BvhInstance, instance_id) \
+  F(Material, emit_r)         \
+  F(Material, flags)          \
+  F(Material, alpha_cutoff)   \
+  F(Material, emission_texture) \
+  F(Material, uv_m00)         \
+  F(Material, uv_m12)         \
+  F(TextureInfo, flags)       \
+  F(CameraParams, fx)         \
+  F(CameraParams, aspect)     \
+  F(CameraParams, ux)         \
+  F(CameraParams, width)      \
+  F(CameraParams, height)     \
+  F(Light, type)              \
+  F(Light, inst)              \
+  F(Light, prim)              \
+  F(Light, le_r)              \
+  F(Light, area)              \
+  F(Light, power)             \
+  F(Light, material)          \
+  F(ShadingVertex, nx)        \
+  F(ShadingVertex, v)         \
+  F(ShadingTriangle, material) \
+  F(ShadingInstance, world_to_object) \
+  F(ShadingInstance, first_triangle) \
+  F(ShadingInstance, moved)   \
+  F(PathState, tp_r)          \
+  F(PathState, last_pdf)      \
+  F(PathState, depth)         \
+  F(PathState, rng_dim)       \
+  F(PathState, flags)         \
+  F(ShadowRay, c_r)           \
+  F(ShadowRay, valid)
