@@ -82,6 +82,8 @@ int main(int argc, char** argv) {
   render->add_flag("--png", ro.png, "Also write an sRGB PNG beside each EXR");
   render->add_option("--exposure", ro.exposure, "Exposure in stops for the PNG")->capture_default_str();
   render->add_flag("-q,--quiet", ro.quiet, "No progress line or summary");
+  render->add_flag("--force-diffuse", ro.forceDiffuse,
+                   "Shade every non-delta material as pure Lambert with its base colour (a diagnostic)");
   render->add_option("--stats", ro.statsFile, "Write one JSON line per frame to this file");
 
   try {

@@ -39,7 +39,7 @@ dev::Light triangleLight(const glm::vec3& a, const glm::vec3& b, const glm::vec3
 
 }  // namespace
 
-dev::Material toDeviceMaterial(const Material& m) {
+dev::Material toDeviceMaterial(const Material& m, bool forceDiffuse) {
   dev::Material d{};
   d.base_r = m.baseColorFactor.r;
   d.base_g = m.baseColorFactor.g;
@@ -66,6 +66,7 @@ dev::Material toDeviceMaterial(const Material& m) {
              !m.metallicRoughnessTexture.valid()) {
     flags |= PR_MAT_MIRROR;
   }
+  if (forceDiffuse && !(flags & (PR_MAT_GLASS | PR_MAT_MIRROR))) flags |= PR_MAT_LAMBERT;
   d.flags = flags;
   // KHR_texture_transform: uv' = T * R * S * uv with R = [[c, s], [-s, c]].
   const TextureRef& t = m.baseColorTexture;
@@ -91,7 +92,8 @@ dev::CameraParams toCameraParams(const CameraPose& pose, int width, int height) 
   return c;
 }
 
-GpuScene::GpuScene(Context& ctx, const Scene& scene) : ctx_(ctx), scene_(scene) {
+GpuScene::GpuScene(Context& ctx, const Scene& scene, const GpuSceneOptions& options)
+    : ctx_(ctx), scene_(scene), options_(options) {
   const auto t0 = std::chrono::steady_clock::now();
   const TriangleMesh& sm = scene.staticMesh;
   staticTriangles_ = static_cast<uint32_t>(sm.triangleCount());
@@ -160,7 +162,7 @@ void GpuScene::uploadShading() {
   for (const TriangleMesh& m : scene_.dynamicMeshes) addMesh(m);
 
   std::vector<dev::Material> mats;
-  for (const Material& m : scene_.materials) mats.push_back(toDeviceMaterial(m));
+  for (const Material& m : scene_.materials) mats.push_back(toDeviceMaterial(m, options_.forceDiffuse));
   if (mats.empty()) mats.push_back(toDeviceMaterial(Material{}));
 
   std::vector<dev::TextureInfo> infos;

@@ -16,13 +16,19 @@
 
 namespace pr {
 
+struct GpuSceneOptions {
+  // Every non-delta material becomes pure Lambert with its base colour (pbrt's --force-diffuse):
+  // a diagnostic with exactly known albedo, used by the furnace tests.
+  bool forceDiffuse = false;
+};
+
 // Host-side conversions, exposed for tests.
-dev::Material toDeviceMaterial(const Material& m);
+dev::Material toDeviceMaterial(const Material& m, bool forceDiffuse = false);
 dev::CameraParams toCameraParams(const CameraPose& pose, int width, int height);
 
 class GpuScene {
  public:
-  GpuScene(Context& ctx, const Scene& scene);
+  GpuScene(Context& ctx, const Scene& scene, const GpuSceneOptions& options = {});
 
   // Evaluates the animation at time t: instance transforms, the DSG's top level, moving
   // lights. Uploads only what changed. Instances whose transform differs from the previous
@@ -57,6 +63,7 @@ class GpuScene {
 
   Context& ctx_;
   const Scene& scene_;
+  GpuSceneOptions options_;
   accel::StaticAccel ssg_;
   accel::DynamicAccel dsg_;
   accel::DeviceAccel deviceAccel_;

@@ -33,6 +33,7 @@ struct RenderOptions {
   bool png = false;
   float exposure = 0.0f;
   bool quiet = false;
+  bool forceDiffuse = false;
   std::string statsFile;
   // Path reuse (DESIGN.md section 5).
   int lightPaths = 0;       // slots; 0: chosen from the image size

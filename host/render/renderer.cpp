@@ -85,7 +85,9 @@ int runRender(const RenderOptions& o) {
   const auto devices = enumerateDevices();
   const DeviceEntry& device = selectDevice(devices, o.device);
   Context ctx(device);
-  GpuScene gpu(ctx, scene);
+  GpuSceneOptions sceneOptions;
+  sceneOptions.forceDiffuse = o.forceDiffuse;
+  GpuScene gpu(ctx, scene, sceneOptions);
   Film film(ctx, width, height);
   std::unique_ptr<Integrator> integrator;
   switch (o.mode) {

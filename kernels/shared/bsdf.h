@@ -13,6 +13,7 @@ PR_NAMESPACE_BEGIN
 #define PR_BSDF_MICROFACET 0u
 #define PR_BSDF_MIRROR 1u
 #define PR_BSDF_GLASS 2u
+#define PR_BSDF_LAMBERT 3u  // pure Lambert (--force-diffuse: exact albedo, for furnace tests)
 
 // Transport mode: radiance (eye paths) or importance (light paths); only refraction differs.
 #define PR_RADIANCE 0
@@ -30,7 +31,9 @@ typedef struct {
   u32 kind;  // PR_BSDF_*
 } BsdfParams;
 
-PR_INLINE int bsdf_is_delta(const BsdfParams* m) { return m->kind != PR_BSDF_MICROFACET; }
+PR_INLINE int bsdf_is_delta(const BsdfParams* m) {
+  return m->kind == PR_BSDF_MIRROR || m->kind == PR_BSDF_GLASS;
+}
 
 PR_INLINE float ggx_d(float cos_h, float a2) {
   const float c2 = cos_h * cos_h;
@@ -67,8 +70,11 @@ PR_INLINE float bsdf_spec_probability(const BsdfParams* m, float cos_o) {
 // f(wo, wi) and the pdf of sampling wi given wo, for the microfacet model.
 PR_INLINE float3 bsdf_eval(const BsdfParams* m, float3 wo, float3 wi, float* pdf) {
   *pdf = 0.0f;
-  if (m->kind != PR_BSDF_MICROFACET || wo.z <= 0.0f || wi.z <= 0.0f)
-    return make_float3(0.0f, 0.0f, 0.0f);
+  if (bsdf_is_delta(m) || wo.z <= 0.0f || wi.z <= 0.0f) return make_float3(0.0f, 0.0f, 0.0f);
+  if (m->kind == PR_BSDF_LAMBERT) {
+    *pdf = wi.z * PR_INV_PI;
+    return m->base * PR_INV_PI;
+  }
   const float a2 = m->alpha * m->alpha;
   float3 h = wo + wi;
   const float hl = length(h);
@@ -157,6 +163,13 @@ PR_INLINE int bsdf_sample(const BsdfParams* m, float3 wo, float u0, float u1, fl
     return 1;
   }
   if (wo.z <= 0.0f) return 0;
+  if (m->kind == PR_BSDF_LAMBERT) {
+    *wi = sample_cosine_hemisphere(u1, u2);
+    if (wi->z <= 0.0f) return 0;
+    *pdf = wi->z * PR_INV_PI;
+    *weight = m->base;
+    return 1;
+  }
   const float ps = bsdf_spec_probability(m, wo.z);
   float3 dir;
   if (u0 < ps) {

@@ -12,6 +12,7 @@ PR_NAMESPACE_BEGIN
 #define PR_MAT_MIRROR 8u       // delta reflection (metallic 1, roughness ~0)
 #define PR_MAT_GLASS 16u       // delta dielectric (KHR_materials_transmission)
 #define PR_MAT_EMISSIVE 32u
+#define PR_MAT_LAMBERT 64u     // shaded as pure Lambert with the base colour (--force-diffuse)
 
 #define PR_NO_TEXTURE (-1)
 

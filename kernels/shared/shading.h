@@ -171,8 +171,14 @@ PR_INLINE BsdfParams material_bsdf(const ShadingData* sd, const SurfaceHit* s) {
   roughness = clamp(roughness, 0.0f, 1.0f);
   p.alpha = fmax(roughness * roughness, PR_MIN_ALPHA);
   p.ior = m->ior;
-  p.kind = (m->flags & PR_MAT_GLASS) ? PR_BSDF_GLASS
-                                     : ((m->flags & PR_MAT_MIRROR) ? PR_BSDF_MIRROR : PR_BSDF_MICROFACET);
+  if (m->flags & PR_MAT_GLASS)
+    p.kind = PR_BSDF_GLASS;
+  else if (m->flags & PR_MAT_MIRROR)
+    p.kind = PR_BSDF_MIRROR;
+  else if (m->flags & PR_MAT_LAMBERT)
+    p.kind = PR_BSDF_LAMBERT;
+  else
+    p.kind = PR_BSDF_MICROFACET;
   return p;
 }
 

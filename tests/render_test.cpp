@@ -1,0 +1,179 @@
+// The baseline path tracer against known answers: a white furnace, a diffuse plane under a point
+// light, determinism by seed, and frames free of NaN and Inf.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "io/image.h"
+#include "support/gltf_builder.h"
+#include "support/test_env.h"
+
+namespace pr {
+namespace {
+
+struct Moments {
+  double mean = 0, stderr_ = 0;
+};
+
+// Mean of channel c over a pixel rectangle, with the standard error of that mean (pixels are
+// independent estimates).
+Moments regionMean(const Image& img, int x0, int y0, int x1, int y1, int c) {
+  double s = 0, s2 = 0;
+  int n = 0;
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x) {
+      const double v = img.pixel(x, y)[c];
+      s += v;
+      s2 += v * v;
+      ++n;
+    }
+  Moments m;
+  m.mean = s / n;
+  m.stderr_ = std::sqrt(std::fmax(0.0, s2 / n - m.mean * m.mean) / n);
+  return m;
+}
+
+Image render(const std::string& scene, const std::string& args, const std::string& tag) {
+  const std::string dir = test::tempDir(tag);
+  const auto r = test::runPathreuse("render '" + scene + "' --quiet --exr-float --out '" + dir +
+                                    "/f_%04d.exr' " + args);
+  EXPECT_EQ(r.exitCode, 0) << r.err;
+  return readExr(dir + "/f_0000.exr");
+}
+
+TEST(PathTrace, WhiteFurnaceConvergesToLeOverOneMinusAlbedo) {
+  const float albedo = 0.5f, le = 1.0f;
+  test::GltfBuilder b;
+  const int mat = b.addMaterial({glm::vec4(albedo, albedo, albedo, 1), 0, 1, glm::vec3(le), 1.0f});
+  b.addNode(b.addBox(glm::vec3(-1), glm::vec3(1), mat, true));
+  b.addCamera(glm::vec3(0.1f, 0.2f, 0.3f), glm::vec3(1, 0.5f, -1), 1.2f, 1.0f);
+  const std::string scene = b.write(test::tempDir("furnace"), "furnace");
+  // Depth 40: the truncated series misses albedo^40 ~ 1e-12 of the answer.
+  const Image img = render(scene, "--frames 0 --width 48 --height 48 --spp 16 --max-depth 40 --force-diffuse",
+                           "furnace-out");
+  const double expected = le / (1.0 - albedo);
+  for (int c = 0; c < 3; ++c) {
+    const Moments m = regionMean(img, 0, 0, 48, 48, c);
+    EXPECT_NEAR(m.mean, expected, 5 * m.stderr_ + 1e-3) << "channel " << c << " stderr " << m.stderr_;
+    EXPECT_LT(m.stderr_, 0.02);  // the test has power to see a 5% error
+  }
+  // Every region, not only the whole image.
+  for (int q = 0; q < 4; ++q) {
+    const int x0 = (q % 2) * 24, y0 = (q / 2) * 24;
+    const Moments m = regionMean(img, x0, y0, x0 + 24, y0 + 24, 1);
+    EXPECT_NEAR(m.mean, expected, 5 * m.stderr_ + 1e-3) << "quadrant " << q;
+  }
+}
+
+TEST(PathTrace, DiffusePlaneUnderPointLightMatchesIrradianceLaw) {
+  // L(x) = rho / pi * I * cos(theta) / r^2 on a Lambertian plane lit by a point light.
+  const float rho = 0.8f, intensity = 10.0f, h = 2.0f;
+  test::GltfBuilder b;
+  const int mat = b.addMaterial({glm::vec4(rho, rho, rho, 1), 0, 1});
+  b.addNode(b.addQuad({-10, 0, -10}, {-10, 0, 10}, {10, 0, 10}, {10, 0, -10}, mat));
+  b.addPointLight(glm::vec3(0, h, 0), glm::vec3(1), intensity);
+  const glm::vec3 eye(0.0f, 5.0f, 0.0f);
+  const float yfov = 1.0f;
+  b.addCamera(eye, glm::vec3(0), yfov, 1.0f);
+  const std::string scene = b.write(test::tempDir("plane"), "plane");
+  const int n = 32;
+  const Image img = render(scene, "--frames 0 --width 32 --height 32 --spp 256 --max-depth 2 --force-diffuse",
+                           "plane-out");
+  // The camera looks down -Y with up = -Z: pixel (x, y) maps to world (X, Z) on the plane.
+  // Radiance changes by up to ~13% across a pixel at the edges; 256 jittered samples estimate
+  // the pixel's mean to ~0.25%, so 1% is four standard errors.
+  const float tanHalf = std::tan(yfov / 2);
+  double worst = 0;
+  for (int y = 0; y < n; y += 3)
+    for (int x = 0; x < n; x += 3) {
+      double expected = 0;
+      const int k = 8;  // the pixel's footprint, as the jittered samples cover it
+      for (int j = 0; j < k; ++j)
+        for (int i = 0; i < k; ++i) {
+          const float sx = (2.0f * (x + (i + 0.5f) / k) / n - 1.0f) * tanHalf;
+          const float sy = (1.0f - 2.0f * (y + (j + 0.5f) / k) / n) * tanHalf;
+          const glm::vec3 p(sx * eye.y, 0.0f, -sy * eye.y);
+          const glm::vec3 d = glm::vec3(0, h, 0) - p;
+          const float r2 = glm::dot(d, d);
+          expected += rho / M_PI * intensity * (h / std::sqrt(r2)) / r2;
+        }
+      expected /= k * k;
+      const double got = img.pixel(x, y)[0];
+      worst = std::fmax(worst, std::fabs(got - expected) / expected);
+      EXPECT_NEAR(got, expected, 0.01 * expected) << "pixel " << x << "," << y;
+    }
+  RecordProperty("worst_relative_error", std::to_string(worst));
+}
+
+TEST(PathTrace, SameSeedSameFrameDifferentSeedSameMean) {
+  const std::string scene = test::sourcePath("scenes/cornell-dynamic.gltf");
+  const std::string args = "--frames 10 --width 40 --height 30 --spp 8";
+  auto renderFrame = [&](const std::string& seed, const std::string& tag) {
+    const std::string dir = test::tempDir(tag);
+    const auto r = test::runPathreuse("render '" + scene + "' --quiet --exr-float --seed " + seed +
+                                      " --out '" + dir + "/f_%04d.exr' " + args);
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    return readExr(dir + "/f_0010.exr");
+  };
+  const Image a = renderFrame("7", "seed-a"), b = renderFrame("7", "seed-b"),
+              c = renderFrame("8", "seed-c");
+  EXPECT_EQ(a.rgba, b.rgba) << "the same seed must reproduce the frame bit for bit";
+  EXPECT_NE(a.rgba, c.rgba) << "another seed must give other noise";
+  for (int ch = 0; ch < 3; ++ch) {
+    const Moments ma = regionMean(a, 0, 0, 40, 30, ch), mc = regionMean(c, 0, 0, 40, 30, ch);
+    EXPECT_NEAR(ma.mean, mc.mean, 5 * std::hypot(ma.stderr_, mc.stderr_)) << "channel " << ch;
+  }
+}
+
+uint64_t badSamplesIn(const std::string& statsFile, int* lines) {
+  std::ifstream in(statsFile);
+  std::string line;
+  uint64_t bad = 0;
+  *lines = 0;
+  while (std::getline(in, line)) {
+    const auto j = nlohmann::json::parse(line);
+    bad += j.at("bad_samples").get<uint64_t>();
+    EXPECT_GT(j.at("rays").at("camera").get<uint64_t>(), 0u);
+    EXPECT_GT(j.at("wall_s").get<double>(), 0.0);
+    ++*lines;
+  }
+  return bad;
+}
+
+TEST(PathTrace, NoNonFiniteSamplesOnTheDemoScenes) {
+  for (const char* name : {"scenes/cornell-dynamic.gltf", "scenes/cornell-orbit.gltf"}) {
+    const std::string dir = test::tempDir("nan");
+    const auto r = test::runPathreuse("render '" + test::sourcePath(name) +
+                                      "' --quiet --frames 0-2 --width 48 --height 36 --spp 4 --out '" +
+                                      dir + "/f_%04d.exr' --stats '" + dir + "/stats.jsonl'");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    int lines = 0;
+    EXPECT_EQ(badSamplesIn(dir + "/stats.jsonl", &lines), 0u) << name;
+    EXPECT_EQ(lines, 3);
+    for (int f = 0; f < 3; ++f) {
+      char file[64];
+      std::snprintf(file, sizeof file, "/f_%04d.exr", f);
+      const Image img = readExr(dir + file);
+      for (float v : img.rgba) ASSERT_TRUE(std::isfinite(v)) << name;
+    }
+  }
+}
+
+TEST(PathTrace, NoNonFiniteSamplesOnCornellNvpro) {
+  const std::string scene = test::sharedScene("cornell-nvpro/cornellBox.gltf");
+  if (scene.empty()) GTEST_SKIP() << "../shared/scenes/cornell-nvpro is absent";
+  const std::string dir = test::tempDir("nan-nvpro");
+  const auto r = test::runPathreuse("render '" + scene + "' --quiet --frames 0 --width 64 --height 48 --spp 4 --out '" +
+                                    dir + "/f_%04d.exr' --stats '" + dir + "/stats.jsonl'");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  int lines = 0;
+  EXPECT_EQ(badSamplesIn(dir + "/stats.jsonl", &lines), 0u);
+  EXPECT_EQ(lines, 1);
+}
+
+}  // namespace
+}  // namespace pr

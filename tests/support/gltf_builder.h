@@ -1,0 +1,57 @@
+// Writes small glTF 2.0 scenes for tests: meshes, materials, nodes, a camera, punctual lights,
+// animations; the binary buffer goes to a .bin file beside the .gltf.
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <nlohmann/json.hpp>
+
+namespace pr::test {
+
+struct MaterialSpec {
+  glm::vec4 baseColor{1.0f};
+  float metallic = 0.0f;
+  float roughness = 1.0f;
+  glm::vec3 emissive{0.0f};
+  float emissiveStrength = 1.0f;
+  float transmission = 0.0f;
+  float ior = 1.5f;
+};
+
+class GltfBuilder {
+ public:
+  int addMaterial(const MaterialSpec& m);
+  // A mesh of triangles (3 indices each), with optional per-vertex normals.
+  int addMesh(const std::vector<glm::vec3>& positions, const std::vector<uint32_t>& indices,
+              int material, const std::vector<glm::vec3>& normals = {});
+  // Axis-aligned box as 12 triangles; `inward` flips the winding (a room seen from inside).
+  int addBox(glm::vec3 lo, glm::vec3 hi, int material, bool inward = false);
+  // A quad (two triangles) a, b, c, d in order.
+  int addQuad(glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, int material);
+  int addNode(int mesh, glm::vec3 translation = glm::vec3(0.0f),
+              glm::quat rotation = glm::quat(1, 0, 0, 0), glm::vec3 scale = glm::vec3(1.0f));
+  // A perspective camera at `eye` looking at `target`.
+  int addCamera(glm::vec3 eye, glm::vec3 target, float yfov, float aspect = 0.0f);
+  int addPointLight(glm::vec3 position, glm::vec3 color, float intensity);
+  // A LINEAR translation animation of `node` through `keys` at `times`.
+  void animateTranslation(int node, const std::vector<float>& times,
+                          const std::vector<glm::vec3>& keys);
+
+  // Writes dir/name.gltf and dir/name.bin; returns the .gltf path.
+  std::string write(const std::string& dir, const std::string& name) const;
+
+ private:
+  int addAccessor(const void* data, size_t bytes, int componentType, size_t count,
+                  const char* type, bool vertexData, const nlohmann::json& minmax = nullptr);
+  std::vector<unsigned char> bin_;
+  nlohmann::json accessors_ = nlohmann::json::array(), views_ = nlohmann::json::array(),
+                 meshes_ = nlohmann::json::array(), materials_ = nlohmann::json::array(),
+                 nodes_ = nlohmann::json::array(), cameras_ = nlohmann::json::array(),
+                 lights_ = nlohmann::json::array(), animations_ = nlohmann::json::array();
+};
+
+}  // namespace pr::test
