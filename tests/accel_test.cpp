@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <string>
 #include <vector>
@@ -193,6 +194,21 @@ TEST(BvhBuild, StructureOfRandomSoups) {
     for (const auto& t : a.triangles()) ++prims[t.prim];
     for (int c : prims) EXPECT_EQ(c, 1);
   }
+}
+
+TEST(BvhBuild, ThreadedBuildEqualsSerialBuild) {
+  const Soup s = randomSoup(40000, 0.02f, 8);
+  BuildOptions serial;
+  serial.threads = false;
+  const TriangleBvh a = buildTriangleBvh(s.positions, s.indices, 0, serial, "serial");
+  const TriangleBvh b = buildTriangleBvh(s.positions, s.indices, 0, BuildOptions{}, "threaded");
+  ASSERT_EQ(a.nodes.size(), b.nodes.size());
+  EXPECT_EQ(std::memcmp(a.nodes.data(), b.nodes.data(), a.nodes.size() * sizeof(dev::BvhNode)), 0);
+  ASSERT_EQ(a.triangles.size(), b.triangles.size());
+  EXPECT_EQ(std::memcmp(a.triangles.data(), b.triangles.data(), a.triangles.size() * sizeof(BvhTriangle)), 0);
+  EXPECT_EQ(a.stats.depth, b.stats.depth);
+  EXPECT_EQ(a.stats.leaves, b.stats.leaves);
+  checkStructure(b.nodes, b.triangles);
 }
 
 TEST(BvhBuild, RejectsBadInput) {

@@ -20,7 +20,7 @@ DURATION = 5.0
 KEY_STEP = 0.25
 CENTRE = (0.0, 1.0, 0.0)          # centre of the box's interior
 EYE_DISTANCE = 3.9                 # camera distance from CENTRE, in front of the opening
-ORBIT_DEG = 35.0                   # orbit half-angle about the vertical axis through CENTRE
+ORBIT_DEG = 25.0                   # orbit half-angle about the vertical axis through CENTRE
 WALL = 0.04                        # wall thickness: walls are slabs so they look solid
 LIGHT_Y, LIGHT_W, LIGHT_D, LIGHT_STRENGTH = 1.98, 0.5, 0.4, 17.0
 SPHERE_R, SPHERE_SEG, SPHERE_RINGS = 0.25, 32, 16
@@ -101,6 +101,8 @@ def build(orbit):
     walls = g.mesh("walls", [(shell, white), (left, red), (right, green)])
 
     lamp = gw.quad((-LIGHT_W / 2, LIGHT_Y, -LIGHT_D / 2), (LIGHT_W, 0, 0), (0, 0, LIGHT_D))
+    if lamp.nrm[1::3] != [-1.0] * lamp.vertex_count:
+        raise gw.Invalid("light quad does not face down")
     lamp_mesh = g.mesh("light", [(lamp, light)])
 
     def block(name, spec):

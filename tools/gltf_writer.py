@@ -260,7 +260,7 @@ class Gltf:
         return len(lst) - 1
 
     def accessor(self, values, ctype, atype, target=None, minmax=False):
-        fmt, size = CTYPE[ctype]
+        fmt = CTYPE[ctype][0]
         data = struct.pack("<%d%s" % (len(values), fmt), *values)
         while len(self.bin) % 4:
             self.bin.append(0)

@@ -4,7 +4,9 @@
 #include <chrono>
 #include <cmath>
 #include <numeric>
+#include <exception>
 #include <string>
+#include <thread>
 
 #include <glm/common.hpp>
 
@@ -50,22 +52,19 @@ int ceilLog2(uint32_t n) {
 
 class Builder {
  public:
-  Builder(const std::vector<Aabb>& boxes, const BuildOptions& o) : boxes_(boxes), o_(o) {
-    centroids_.resize(boxes.size());
-    for (size_t i = 0; i < boxes.size(); ++i)
-      centroids_[i] = boxes[i].empty() ? glm::vec3(0.0f) : boxes[i].centre();
-    bvh_.order.resize(boxes.size());
-    std::iota(bvh_.order.begin(), bvh_.order.end(), 0u);
+  Builder(const std::vector<Aabb>& boxes, const std::vector<glm::vec3>& centroids,
+          std::vector<uint32_t>& order, const BuildOptions& o, int parallelDepth)
+      : boxes_(boxes), centroids_(centroids), order_(order), o_(o), parallelDepth_(parallelDepth) {}
+
+  // The subtree over order[begin, end) whose root sits at `depth`; its root is node 0 here.
+  void run(uint32_t begin, uint32_t end, int depth) {
+    nodes_.reserve(end > begin ? 2 * size_t(end - begin) : 1);
+    nodes_.emplace_back();
+    build(0, begin, end, depth);
   }
 
-  Bvh run() {
-    const uint32_t n = uint32_t(boxes_.size());
-    bvh_.nodes.reserve(n > 0 ? 2 * size_t(n) : 1);
-    bvh_.nodes.emplace_back();
-    build(0, 0, n, 0);
-    bvh_.stats.nodes = uint32_t(bvh_.nodes.size());
-    return std::move(bvh_);
-  }
+  std::vector<dev::BvhNode> nodes_;
+  BvhStats stats_;
 
  private:
   struct Bin {
@@ -76,7 +75,7 @@ class Builder {
   void build(uint32_t node, uint32_t begin, uint32_t end, int depth) {
     Aabb bounds, cbounds;
     for (uint32_t i = begin; i < end; ++i) {
-      const uint32_t p = bvh_.order[i];
+      const uint32_t p = order_[i];
       bounds.grow(boxes_[p]);
       cbounds.grow(centroids_[p]);
     }
@@ -107,11 +106,11 @@ class Builder {
       if (bestAxis >= 0) {
         const float lo = cbounds.lo[bestAxis];
         const float scale = float(o_.bins) / extent[bestAxis];
-        uint32_t* first = bvh_.order.data() + begin;
-        uint32_t* m = std::partition(first, bvh_.order.data() + end, [&](uint32_t p) {
+        uint32_t* first = order_.data() + begin;
+        uint32_t* m = std::partition(first, order_.data() + end, [&](uint32_t p) {
           return binOf(centroids_[p][bestAxis], lo, scale) <= bestBin;
         });
-        mid = uint32_t(m - bvh_.order.data());
+        mid = uint32_t(m - order_.data());
         axis = bestAxis;
         split = mid > begin && mid < end;
       }
@@ -123,19 +122,44 @@ class Builder {
       // Object median: on the widest centroid axis, or in input order when all coincide.
       mid = begin + n / 2;
       if (extent[axis] > 0.0f) {
-        std::nth_element(bvh_.order.begin() + begin, bvh_.order.begin() + mid,
-                         bvh_.order.begin() + end, [&](uint32_t a, uint32_t b) {
+        std::nth_element(order_.begin() + begin, order_.begin() + mid,
+                         order_.begin() + end, [&](uint32_t a, uint32_t b) {
                            return centroids_[a][axis] < centroids_[b][axis];
                          });
       }
     }
-    const uint32_t left = uint32_t(bvh_.nodes.size());
-    bvh_.nodes.emplace_back();
-    build(left, begin, mid, depth + 1);
-    const uint32_t right = uint32_t(bvh_.nodes.size());
-    bvh_.nodes.emplace_back();
-    build(right, mid, end, depth + 1);
-    bvh_.nodes[node] = makeNode(bounds, right, uint32_t(axis));
+    const uint32_t left = uint32_t(nodes_.size());
+    nodes_.emplace_back();
+    uint32_t right = 0;
+    if (depth < parallelDepth_ && n >= kParallelMinimum) {
+      // The right subtree on another thread (disjoint range of order_), spliced in after the
+      // left one: the same tree as a serial build.
+      Builder sub(boxes_, centroids_, order_, o_, parallelDepth_);
+      std::exception_ptr failure;
+      std::thread worker([&] {
+        try {
+          sub.run(mid, end, depth + 1);
+        } catch (...) {
+          failure = std::current_exception();
+        }
+      });
+      build(left, begin, mid, depth + 1);
+      worker.join();
+      if (failure) std::rethrow_exception(failure);
+      right = uint32_t(nodes_.size());
+      for (dev::BvhNode c : sub.nodes_) {
+        if (!(c.meta & PR_BVH_LEAF_BIT)) c.index += right;
+        nodes_.push_back(c);
+      }
+      stats_.leaves += sub.stats_.leaves;
+      stats_.depth = std::max(stats_.depth, sub.stats_.depth);
+    } else {
+      build(left, begin, mid, depth + 1);
+      right = uint32_t(nodes_.size());
+      nodes_.emplace_back();
+      build(right, mid, end, depth + 1);
+    }
+    nodes_[node] = makeNode(bounds, right, uint32_t(axis));
   }
 
   int binOf(float c, float lo, float scale) const {
@@ -149,7 +173,7 @@ class Builder {
     const float lo = cbounds.lo[axis];
     const float scale = float(o_.bins) / (cbounds.hi[axis] - lo);
     for (uint32_t i = begin; i < end; ++i) {
-      const uint32_t p = bvh_.order[i];
+      const uint32_t p = order_[i];
       Bin& b = bins_[size_t(binOf(centroids_[p][axis], lo, scale))];
       b.box.grow(boxes_[p]);
       ++b.count;
@@ -179,17 +203,20 @@ class Builder {
   }
 
   void makeLeaf(uint32_t node, const Aabb& bounds, uint32_t begin, uint32_t n, int depth) {
-    bvh_.nodes[node] = makeNode(bounds, begin, PR_BVH_LEAF_BIT | n);
-    ++bvh_.stats.leaves;
-    bvh_.stats.depth = std::max(bvh_.stats.depth, depth);
+    nodes_[node] = makeNode(bounds, begin, PR_BVH_LEAF_BIT | n);
+    ++stats_.leaves;
+    stats_.depth = std::max(stats_.depth, depth);
   }
 
+  static constexpr uint32_t kParallelMinimum = 16384;  // smaller subtrees: not worth a thread
+
   const std::vector<Aabb>& boxes_;
+  const std::vector<glm::vec3>& centroids_;
+  std::vector<uint32_t>& order_;
   const BuildOptions& o_;
-  std::vector<glm::vec3> centroids_;
+  const int parallelDepth_;
   std::vector<Bin> bins_;
   std::vector<float> rightCost_;
-  Bvh bvh_;
 };
 
 }  // namespace
@@ -200,7 +227,22 @@ Bvh buildBvh(const std::vector<Aabb>& boxes, const BuildOptions& options) {
     throw RuntimeError("BVH build: bad options (maxDepth " + std::to_string(options.maxDepth) +
                        ", stack " + std::to_string(PR_BVH_STACK_SIZE) + ")");
   const auto t0 = std::chrono::steady_clock::now();
-  Bvh bvh = Builder(boxes, options).run();
+  Bvh bvh;
+  std::vector<glm::vec3> centroids(boxes.size());
+  for (size_t i = 0; i < boxes.size(); ++i)
+    centroids[i] = boxes[i].empty() ? glm::vec3(0.0f) : boxes[i].centre();
+  bvh.order.resize(boxes.size());
+  std::iota(bvh.order.begin(), bvh.order.end(), 0u);
+  // Threads for the top levels: one split per level doubles them.
+  int parallelDepth = 0;
+  for (unsigned t = std::thread::hardware_concurrency(); t > 1 && parallelDepth < 4; t /= 2)
+    ++parallelDepth;
+  if (!options.threads) parallelDepth = 0;
+  Builder builder(boxes, centroids, bvh.order, options, parallelDepth);
+  builder.run(0, uint32_t(boxes.size()), 0);
+  bvh.nodes = std::move(builder.nodes_);
+  bvh.stats = builder.stats_;
+  bvh.stats.nodes = uint32_t(bvh.nodes.size());
   bvh.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   // The traversal stack must never overflow: check what was built, not what was intended.
   const int depth = bvhDepth(bvh.nodes);

@@ -32,6 +32,7 @@ struct BuildOptions {
   // Deepest leaf allowed (root = depth 0). Traversal pushes one entry per level, so this must
   // not exceed PR_BVH_STACK_SIZE; deeper SAH splits give way to median splits.
   int maxDepth = 64;
+  bool threads = true;  // top splits on std::threads (same tree either way)
 };
 
 struct BvhStats {

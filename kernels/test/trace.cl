@@ -1,5 +1,5 @@
-// Test kernel: traces rays[i] against the SSG + DSG. Reads rays and the scene geometry; writes
-// hits[i] (closest hit) and occluded[i] (any hit within the ray's [tmin, tmax]).
+// Test kernel trace_rays: traces rays[i] against the SSG + DSG. Reads rays and the scene
+// geometry; writes hits[i] (closest hit) and occluded[i] (any hit within [tmin, tmax]).
 // mode 0: whole scene, 1: SSG only, 2: DSG only.
 #include "shared/bvh.h"
 
@@ -23,4 +23,23 @@ __kernel void trace_rays(__global const Ray* rays, __global Hit* hits, __global 
   }
   hits[i] = hit;
   occluded[i] = occ;
+}
+
+// Benchmark kernels (tools/ray_bench): closest hit only, any hit only, on the whole scene.
+__kernel void trace_closest(__global const Ray* rays, __global Hit* hits, uint n,
+                            PR_SCENE_GEOM_PARAMS) {
+  const uint i = (uint)get_global_id(0);
+  if (i >= n) return;
+  const SceneGeom g = PR_SCENE_GEOM();
+  Hit hit;
+  intersect_scene(&g, rays[i], &hit);
+  hits[i] = hit;
+}
+
+__kernel void trace_any(__global const Ray* rays, __global uint* occluded, uint n,
+                        PR_SCENE_GEOM_PARAMS) {
+  const uint i = (uint)get_global_id(0);
+  if (i >= n) return;
+  const SceneGeom g = PR_SCENE_GEOM();
+  occluded[i] = (uint)occluded_scene(&g, rays[i]);
 }

@@ -1,0 +1,357 @@
+#!/usr/bin/env python3
+"""Generates a large atrium test scene (not committed): a courtyard surrounded by two
+storeys of columns and arches, galleries, outer walls, curtains, an opening in the roof
+lit by an emissive sky quad (or a directional sun), and three moving objects.
+
+  python3 tools/gen_atrium.py --size 1 --out /tmp/atrium/atrium.gltf   # ~300k triangles
+  python3 tools/gen_atrium.py --size 0.1 --out /tmp/atrium-small.gltf  # quick test scene
+
+--size scales the tessellation (triangles grow about linearly with it); the layout and the
+cameras do not change. Writes PATH.gltf and PATH.bin, validates them, prints one line.
+"""
+
+import argparse
+import math
+import os
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import gltf_writer as gw  # noqa: E402
+
+# Layout in metres. Column centre lines run round the courtyard rectangle
+# x in [-COL_X, COL_X], z in [-COL_Z, COL_Z]; bays are BAY wide.
+COL_X, COL_Z, BAY = 8.0, 4.0, 2.0
+ARCADE_D = 0.6                                  # arcade wall thickness
+IN_X, IN_Z = COL_X - ARCADE_D / 2, COL_Z - ARCADE_D / 2   # inner face of the arcades
+OUT_X, OUT_Z, WALL_T = 11.0, 7.0, 0.5           # inside of the outer walls, their thickness
+COL_R, ARCH_R, ABACUS = 0.22, 0.7, 0.6          # column radius, arch radius, capital width
+PLINTH_H, ABACUS_H = 0.12, 0.2
+# per storey: floor level, column top (lathe), arcade top; the slab above starts there
+STOREYS = ((0.0, 4.0, 5.4), (5.7, 9.1, 10.4))
+SLAB_T = 0.3
+ROOF_TOP = STOREYS[1][2] + SLAB_T
+DURATION, KEY_STEP = 10.0, 0.25
+SKY_STRENGTH = 2.0
+
+
+def counts(size):
+    """Tessellation for a size: each 2D count scales with sqrt(size)."""
+    k = math.sqrt(size)
+
+    def n(base, lo):
+        return max(lo, int(round(base * k)))
+    return dict(col_seg=n(40, 12), col_rows=n(40, 10), arch_seg=n(40, 8),
+                arch_rows=n(5, 1), arch_depth=n(4, 1), cloth_u=n(36, 8), cloth_v=n(72, 12),
+                tiles=n(2, 1), ball_band=n(8, 2), ball_rings=n(32, 8), lantern_seg=n(24, 8))
+
+
+# ---------------------------------------------------------------- static parts
+
+def column(height, c):
+    """Fluted column from y=0 (top of the plinth) to `height`: torus base, shaft with
+    entasis, flared capital."""
+    rows = c["col_rows"]
+    nb, ns = max(3, rows // 4), max(2, rows * 2 // 5)
+    nc = max(3, rows - nb - ns - 1)
+    base_h, cap_h = 0.25, 0.35
+    shaft = height - base_h - cap_h
+    prof = []
+    for k in range(nb + 1):
+        s = k / nb
+        prof.append((base_h * s, COL_R * (1.12 + 0.18 * math.sin(math.pi * s)), 0.0))
+    for k in range(ns + 1):
+        s = k / ns
+        prof.append((base_h + shaft * s, COL_R * (1 - 0.1 * s * s), 1.0))
+    top = COL_R * 0.9
+    for k in range(1, nc + 1):
+        s = k / nc
+        prof.append((height - cap_h + cap_h * s, top + (1.3 * COL_R - top) * s * s, 0.0))
+    return gw.lathe(prof, c["col_seg"], flutes=max(6, c["col_seg"] // 3), flute_depth=0.04)
+
+
+def arcade_bay(spring, top, c):
+    """One bay of an arcade wall in a local frame: x in [-BAY/2, BAY/2] along the wall,
+    z in [-ARCADE_D/2, ARCADE_D/2] across, a semicircular arch of ARCH_R springing at
+    y = spring, solid up to y = top."""
+    n, rows, depth = c["arch_seg"], c["arch_rows"], c["arch_depth"]
+    half, d = BAY / 2, ARCADE_D / 2
+    m = gw.Mesh()
+
+    def face(z, flip):
+        def spandrel(u, v):
+            a = math.pi * (1 - u)
+            x = ARCH_R * math.cos(a)
+            y0 = spring + ARCH_R * math.sin(a)
+            return (x, y0 + (top - y0) * v, z)
+        m.add(gw.grid(spandrel, n, rows, normal=lambda u, v: (0, 0, 1), flip=flip))
+        for x0 in (-half, ARCH_R):
+            w = half - ARCH_R
+            m.add(gw.grid(lambda u, v: (x0 + w * u, spring + (top - spring) * v, z), 1, rows,
+                          normal=lambda u, v: (0, 0, 1), flip=flip))
+    face(d, False)
+    face(-d, True)
+
+    def intrados(u, w):
+        a = math.pi * (1 - u)
+        return (ARCH_R * math.cos(a), spring + ARCH_R * math.sin(a), -d + 2 * d * w)
+    m.add(gw.grid(intrados, n, depth,
+                  normal=lambda u, w: (-math.cos(math.pi * (1 - u)),
+                                       -math.sin(math.pi * (1 - u)), 0)))
+    return m
+
+
+def curtain(width, y_bottom, y_top, phase, c):
+    """Hanging cloth in a local frame, facing +z: folds whose depth grows downwards."""
+    folds = 4
+
+    def f(u, v):
+        amp = 0.05 + 0.05 * (1 - v)
+        z = amp * math.sin(2 * math.pi * folds * u + phase) + 0.02 * math.sin(math.pi * u)
+        return (-width / 2 + width * u, y_bottom + (y_top - y_bottom) * v, z)
+    return gw.grid(f, c["cloth_u"], c["cloth_v"])
+
+
+def ring_boxes(y0, y1, inner_x, inner_z):
+    """Four boxes covering the outer rectangle minus the inner one (slabs, floors)."""
+    m = gw.Mesh()
+    m.add(gw.box((-OUT_X, y0, inner_z), (OUT_X, y1, OUT_Z)))
+    m.add(gw.box((-OUT_X, y0, -OUT_Z), (OUT_X, y1, -inner_z)))
+    m.add(gw.box((inner_x, y0, -inner_z), (OUT_X, y1, inner_z)))
+    m.add(gw.box((-OUT_X, y0, -inner_z), (-inner_x, y1, inner_z)))
+    return m
+
+
+def column_positions():
+    pts = []
+    nx, nz = int(round(2 * COL_X / BAY)), int(round(2 * COL_Z / BAY))
+    for i in range(nx + 1):
+        x = -COL_X + BAY * i
+        pts += [(x, -COL_Z), (x, COL_Z)]
+    for j in range(1, nz):
+        z = -COL_Z + BAY * j
+        pts += [(-COL_X, z), (COL_X, z)]
+    return pts
+
+
+def bays():
+    """(centre x, centre z, yaw) of every arcade bay; yaw turns local x along the wall."""
+    out = []
+    nx, nz = int(round(2 * COL_X / BAY)), int(round(2 * COL_Z / BAY))
+    for i in range(nx):
+        x = -COL_X + BAY * (i + 0.5)
+        out += [(x, -COL_Z, 0.0), (x, COL_Z, math.pi)]
+    for j in range(nz):
+        z = -COL_Z + BAY * (j + 0.5)
+        out += [(-COL_X, z, math.pi / 2), (COL_X, z, -math.pi / 2)]
+    return out
+
+
+def build_static(c):
+    """Returns {material name: Mesh} of everything that does not move."""
+    stone, dark, plaster = gw.Mesh(), gw.Mesh(), gw.Mesh()
+    cloths = [gw.Mesh(), gw.Mesh(), gw.Mesh()]
+    for level, (floor_y, col_top, arcade_top) in enumerate(STOREYS):
+        shaft = column(col_top - floor_y - PLINTH_H, c)
+        spring = col_top + ABACUS_H
+        bay = arcade_bay(spring, arcade_top, c)
+        h, a = ABACUS / 2, ABACUS / 2
+        for x, z in column_positions():
+            stone.add(shaft, translation=(x, floor_y + PLINTH_H, z))
+            dark.add(gw.box((x - h, floor_y, z - h), (x + h, floor_y + PLINTH_H, z + h)))
+            dark.add(gw.box((x - a, col_top, z - a), (x + a, spring, z + a)))
+        for x, z, yaw in bays():
+            stone.add(bay, rotation=gw.quat_axis_angle((0, 1, 0), yaw), translation=(x, 0, z))
+        for sx in (-1, 1):                     # corner piers close the arcade corners
+            for sz in (-1, 1):
+                x, z, d = sx * COL_X, sz * COL_Z, ARCADE_D / 2
+                stone.add(gw.box((x - d, spring, z - d), (x + d, arcade_top, z + d)))
+        # slab above this storey: gallery floor, then the roof; open over the courtyard
+        stone.add(ring_boxes(arcade_top, arcade_top + SLAB_T, IN_X, IN_Z))
+
+    # ground floor: gallery ring plus a checkerboard of courtyard tiles
+    dark.add(ring_boxes(-0.2, 0.0, IN_X, IN_Z))
+    tx, tz = 16 * c["tiles"] // 2, 8 * c["tiles"] // 2
+    wx, wz = 2 * IN_X / tx, 2 * IN_Z / tz
+    for i in range(tx):
+        for j in range(tz):
+            tile = gw.quad((-IN_X + wx * i, 0.0, -IN_Z + wz * (j + 1)), (wx, 0, 0), (0, 0, -wz))
+            (stone if (i + j) % 2 else dark).add(tile)
+
+    # outer walls, closing the building up to the roof
+    y0, y1, t = -0.2, ROOF_TOP, WALL_T
+    plaster.add(gw.box((-OUT_X - t, y0, -OUT_Z - t), (OUT_X + t, y1, -OUT_Z)))
+    plaster.add(gw.box((-OUT_X - t, y0, OUT_Z), (OUT_X + t, y1, OUT_Z + t)))
+    plaster.add(gw.box((-OUT_X - t, y0, -OUT_Z), (-OUT_X, y1, OUT_Z)))
+    plaster.add(gw.box((OUT_X, y0, -OUT_Z), (OUT_X + t, y1, OUT_Z)))
+
+    # curtains in the ground-floor bays of the long sides, just behind the arcade
+    floor_y, col_top, arcade_top = STOREYS[0]
+    k = 0
+    for x, z, yaw in bays():
+        if yaw not in (0.0, math.pi):
+            continue
+        offset = ARCADE_D / 2 + 0.2
+        zz = z - offset if z < 0 else z + offset
+        cl = curtain(BAY - 0.4, 1.0, arcade_top - 0.05, 0.7 * k, c)
+        # local +z faces the courtyard
+        cloths[k % 3].add(cl, rotation=gw.quat_axis_angle((0, 1, 0), yaw), translation=(x, 0, zz))
+        k += 1
+    return {"stone": stone, "dark_stone": dark, "plaster": plaster, "cloth_red": cloths[0],
+            "cloth_green": cloths[1], "cloth_blue": cloths[2]}
+
+
+# ---------------------------------------------------------------- moving parts
+
+def key_times():
+    n = int(round(DURATION / KEY_STEP))
+    return [gw.f32(DURATION * k / n) for k in range(n + 1)]
+
+
+BALL_R, BALL_Z = 0.6, 1.0
+
+
+def ball_pose(t):
+    """Rolls along x across the courtyard and back; rotation matches the rolling."""
+    x = -6.0 * math.cos(2 * math.pi * t / DURATION)
+    return (x, BALL_R, BALL_Z), gw.quat_axis_angle((0, 0, 1), -x / BALL_R)
+
+
+LANTERN_PIVOT, LANTERN_ROD = (0.0, STOREYS[0][2], COL_Z + 1.6), 1.8
+
+
+def lantern_swing(t):
+    """Pendulum about x, two swings in the animation, amplitude 20 degrees."""
+    a = math.radians(20) * math.sin(4 * math.pi * t / DURATION)
+    return gw.quat_axis_angle((1, 0, 0), a)
+
+
+CRATE = 0.8
+
+
+def crate_position(t):
+    """Slides along the -z upper gallery and back."""
+    return (5.0 * math.sin(2 * math.pi * t / DURATION), STOREYS[1][0] + CRATE / 2,
+            -(COL_Z + 1.5))
+
+
+def ball_meshes(c):
+    bands = 6
+    a, b = gw.Mesh(), gw.Mesh()
+    for k in range(bands):
+        band = gw.uv_sphere(BALL_R, c["ball_band"], c["ball_rings"], k / bands, (k + 1) / bands)
+        (a if k % 2 else b).add(band)
+    return a, b
+
+
+def lantern_meshes(c):
+    """Rod and body hanging down from the pivot (local origin)."""
+    seg = c["lantern_seg"]
+    rod = gw.lathe([(-LANTERN_ROD, 0.015, 0), (0.0, 0.015, 0)], 8)
+    metal = gw.Mesh().add(rod)
+    body_top = -LANTERN_ROD
+    cap = [(body_top - 0.08, 0.2, 0), (body_top - 0.04, 0.12, 0), (body_top, 0.03, 0)]
+    metal.add(gw.lathe(cap, seg))
+    rows = max(4, seg // 2)
+    glass_prof = []
+    for k in range(rows + 1):
+        s = k / rows
+        glass_prof.append((body_top - 0.5 + 0.42 * s, 0.05 + 0.13 * math.sin(math.pi * (0.15 + 0.85 * s)), 0))
+    glass = gw.lathe(glass_prof, seg)
+    return metal, glass
+
+
+def build(size, light):
+    c = counts(size)
+    g = gw.Gltf("pathreuse tools/gen_atrium.py --size %g" % size)
+    mats = {
+        "stone": g.material("stone", (0.62, 0.58, 0.5), roughness=0.9),
+        "dark_stone": g.material("dark_stone", (0.32, 0.3, 0.27), roughness=0.8),
+        "plaster": g.material("plaster", (0.7, 0.66, 0.58)),
+        "cloth_red": g.material("cloth_red", (0.6, 0.08, 0.07), double_sided=True),
+        "cloth_green": g.material("cloth_green", (0.1, 0.35, 0.12), double_sided=True),
+        "cloth_blue": g.material("cloth_blue", (0.1, 0.15, 0.45), double_sided=True),
+    }
+    static = build_static(c)
+    roots = [g.node("atrium", mesh=g.mesh("atrium", [(static[k], mats[k]) for k in mats]))]
+
+    if light == "sky":
+        sky = g.material("sky", (0.0, 0.0, 0.0), emissive=(0.85, 0.92, 1.0),
+                         strength=SKY_STRENGTH)
+        quad = gw.quad((-IN_X, ROOF_TOP, -IN_Z), (2 * IN_X, 0, 0), (0, 0, 2 * IN_Z))
+        if quad.nrm[1::3] != [-1.0] * quad.vertex_count:
+            raise gw.Invalid("sky quad does not face down")
+        roots.append(g.node("sky", mesh=g.mesh("sky", [(quad, sky)])))
+    else:
+        sun = g.directional_light("sun", (1.0, 0.95, 0.85), 5.0)
+        roots.append(g.node("sun", rotation=gw.quat_look((0.35, -1.0, 0.25)),
+                            extensions={"KHR_lights_punctual": {"light": sun}}))
+
+    times = key_times()
+    white = g.material("ball_white", (0.8, 0.8, 0.78), roughness=0.4)
+    red = g.material("ball_red", (0.7, 0.1, 0.08), roughness=0.4)
+    wa, wb = ball_meshes(c)
+    ball = g.node("rolling_ball", mesh=g.mesh("ball", [(wa, white), (wb, red)]),
+                  translation=ball_pose(0)[0], rotation=ball_pose(0)[1],
+                  extras={"dynamic": True})
+    metal = g.material("lantern_metal", (0.2, 0.2, 0.2), metallic=1.0, roughness=0.4)
+    glass = g.material("lantern_glass", (0.9, 0.8, 0.5), roughness=0.5)
+    lm, lg = lantern_meshes(c)
+    lantern = g.node("lantern", mesh=g.mesh("lantern", [(lm, metal), (lg, glass)]),
+                     extras={"dynamic": True})
+    pivot = g.node("lantern_pivot", children=[lantern], translation=LANTERN_PIVOT,
+                   rotation=lantern_swing(0), extras={"dynamic": True})
+    wood = g.material("crate_wood", (0.45, 0.3, 0.18), roughness=0.7)
+    h = CRATE / 2
+    crate = g.node("sliding_crate", mesh=g.mesh("crate", [(gw.box((-h, -h, -h), (h, h, h)), wood)]),
+                   translation=crate_position(0), extras={"dynamic": True})
+    roots += [ball, pivot, crate]
+    g.animation("motion", [
+        (ball, "translation", times, [ball_pose(t)[0] for t in times]),
+        (ball, "rotation", times, [ball_pose(t)[1] for t in times]),
+        (pivot, "rotation", times, [lantern_swing(t) for t in times]),
+        (crate, "translation", times, [crate_position(t) for t in times])])
+
+    # cameras: in the corner arch of the upper gallery looking across the courtyard, and
+    # one standing in the courtyard
+    cams = [("gallery_corner", (-COL_X + BAY / 2, STOREYS[1][0] + 1.7, COL_Z), (4.0, 2.0, -3.0)),
+            ("courtyard", (7.0, 1.7, 2.8), (-8.0, 4.0, -2.0))]
+    for name, eye, at in cams:
+        cam = g.camera(name, 0.9, 16.0 / 9.0, 0.05, 200.0)
+        roots.append(g.node(name, camera=cam, translation=eye,
+                            rotation=gw.quat_look(gw.sub(at, eye))))
+    return g, roots
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--size", type=float, default=1.0,
+                    help="tessellation scale; 1 gives about 300k triangles (default 1)")
+    ap.add_argument("--out", required=True, help="output .gltf (a .bin is written beside it)")
+    ap.add_argument("--light", choices=("sky", "sun"), default="sky",
+                    help="emissive sky quad over the opening, or a KHR_lights_punctual sun")
+    args = ap.parse_args()
+    if not args.size > 0:
+        ap.error("--size must be positive")
+    start = time.time()
+    try:
+        g, roots = build(args.size, args.light)
+        os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
+        g.write(args.out, roots, embedded=False)
+        s = gw.validate(args.out)
+        frac = s["dynamic"] / s["triangles"]
+        if frac > 0.05:
+            raise gw.Invalid("dynamic triangles are %.1f%% of all, over 5%%" % (100 * frac))
+        if abs(s["duration"] - DURATION) > 1e-6:
+            raise gw.Invalid("animation lasts %g s, not %g" % (s["duration"], DURATION))
+    except (gw.Invalid, OSError, KeyError, ValueError) as e:
+        print("gen_atrium: %s" % e, file=sys.stderr)
+        return 1
+    print("%s: %d triangles (%d static, %d dynamic = %.2f%%), %d bytes, %.1f s"
+          % (args.out, s["triangles"], s["static"], s["dynamic"], 100 * frac, s["bytes"],
+             time.time() - start))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
