@@ -893,7 +893,10 @@ class Loader {
       const int mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
       if (mode != TINYGLTF_MODE_TRIANGLES) {
         static const char* names[] = {"POINTS", "LINES", "LINE_LOOP", "LINE_STRIP", "TRIANGLES", "TRIANGLE_STRIP", "TRIANGLE_FAN"};
-        warn(std::string("skipping primitives with mode ") + names[mode] + ": only TRIANGLES are rendered (" + where + ")");
+        // One line per mode, however many primitives use it.
+        if (skippedModes_.insert(mode).second)
+          warn(std::string("skipping primitives with mode ") + names[mode] + ": only TRIANGLES are rendered (first: " +
+               where + ")");
         continue;
       }
       if (!p.targets.empty()) unsupportedMorph_ = true;
@@ -1222,6 +1225,7 @@ class Loader {
   std::map<int, std::optional<TriangleMesh>> meshCache_;
   std::map<std::pair<int, bool>, int> textureIndex_;
   int defaultMaterial_ = -1;
+  std::set<int> skippedModes_;
   bool unsupportedMorph_ = false;
   bool unsupportedSkin_ = false;
 };
