@@ -224,6 +224,7 @@ class Loader {
     std::string baseDir = fs::path(path_).parent_path().string();
     if (baseDir.empty()) baseDir = ".";
 
+    preflight(bytes);
     tinygltf::TinyGLTF gltf;
     gltf.SetImageLoader(&keepImageBytes, &images_);
     std::string err, warnText;
@@ -247,26 +248,40 @@ class Loader {
       if (why.empty()) why = "unknown reason";
       fail("not a valid glTF file: " + why);
     }
-    checkSchema(bytes);
   }
 
-  // tinygltf drops properties of the wrong type without a word: check the JSON ourselves.
-  void checkSchema(const std::vector<uint8_t>& bytes) {
+  // Before tinygltf: the JSON's types (tinygltf silently drops a property of the wrong type),
+  // the version and the required extensions, so these get precise messages.
+  void preflight(const std::vector<uint8_t>& bytes) {
     const uint8_t* json = bytes.data();
     size_t length = bytes.size();
     if (binary_) {
-      // tinygltf has already checked the container; read the JSON chunk's header again.
-      if (bytes.size() < 20) fail("GLB file is truncated");
-      uint32_t chunkLength = 0;
+      // Header (magic, version, length) then the JSON chunk (length, type). A broken container
+      // is left to tinygltf's checks, which name the problem.
+      if (bytes.size() < 20 || std::memcmp(bytes.data(), "glTF", 4) != 0) return;
+      uint32_t chunkLength = 0, chunkType = 0;
       std::memcpy(&chunkLength, bytes.data() + 12, 4);
-      if (chunkLength > bytes.size() - 20) fail("GLB JSON chunk does not fit the file");
+      std::memcpy(&chunkType, bytes.data() + 16, 4);
+      if (chunkType != 0x4E4F534Au || chunkLength > bytes.size() - 20) return;
       json = bytes.data() + 20;
       length = chunkLength;
     }
-    nlohmann::json j = nlohmann::json::parse(json, json + length, nullptr, false);
-    if (j.is_discarded()) fail("invalid JSON");
+    nlohmann::json j;
+    try {
+      j = nlohmann::json::parse(json, json + length);
+    } catch (const nlohmann::json::exception& e) {
+      fail(std::string("invalid JSON: ") + e.what());
+    }
     const std::string problem = checkGltfSchema(j);
     if (!problem.empty()) fail(problem);
+    const std::string version = j["asset"]["version"].get<std::string>();
+    const auto dot = version.find('.');
+    if (dot == std::string::npos || version.substr(0, dot) != "2")
+      fail("unsupported glTF version \"" + version + "\" (asset.version; only 2.x is supported)");
+    if (j.contains("extensionsRequired"))
+      for (const auto& e : j["extensionsRequired"])
+        if (!isSupportedExtension(e.get<std::string>()))
+          fail("requires extension " + e.get<std::string>() + ", which is not supported", "extensionsRequired");
   }
 
   void checkAssetAndExtensions() {
@@ -878,7 +893,10 @@ class Loader {
       const int mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
       if (mode != TINYGLTF_MODE_TRIANGLES) {
         static const char* names[] = {"POINTS", "LINES", "LINE_LOOP", "LINE_STRIP", "TRIANGLES", "TRIANGLE_STRIP", "TRIANGLE_FAN"};
-        warn(std::string("skipping primitives with mode ") + names[mode] + ": only TRIANGLES are rendered (" + where + ")");
+        // One line per mode, however many primitives use it.
+        if (skippedModes_.insert(mode).second)
+          warn(std::string("skipping primitives with mode ") + names[mode] + ": only TRIANGLES are rendered (first: " +
+               where + ")");
         continue;
       }
       if (!p.targets.empty()) unsupportedMorph_ = true;
@@ -1128,6 +1146,7 @@ class Loader {
     buildMaterials();
     meshCache_.clear();
     std::map<int, uint32_t> dynamicIndex;  // glTF mesh -> dynamic mesh
+    std::set<int> staticMeshes;
     for (size_t i = 0; i < scene_.nodes.size(); ++i) {
       const Node& node = scene_.nodes[i];
       if (!node.inScene) continue;
@@ -1145,6 +1164,7 @@ class Loader {
           scene_.instances.push_back({it->second, int(i), node.name});
         } else {
           flatten(mesh, node.restWorld);
+          if (staticMeshes.insert(node.mesh).second) scene_.staticMeshTriangles += mesh.triangleCount();
         }
       }
       const int light = nodeLight(src);
@@ -1205,6 +1225,7 @@ class Loader {
   std::map<int, std::optional<TriangleMesh>> meshCache_;
   std::map<std::pair<int, bool>, int> textureIndex_;
   int defaultMaterial_ = -1;
+  std::set<int> skippedModes_;
   bool unsupportedMorph_ = false;
   bool unsupportedSkin_ = false;
 };

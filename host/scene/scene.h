@@ -206,6 +206,10 @@ struct Scene {
   std::vector<int> rootNodes;
   std::vector<std::string> warnings;  // one line each, already printed when loading
 
+  // SSG triangles counting each glTF mesh once, however many static nodes place it (the
+  // figure a per-mesh tally of the file gives; staticTriangleCount() counts every placement).
+  size_t staticMeshTriangles = 0;
+
   Bounds bounds;  // of all geometry over the whole animation (sampled)
 
   // --- evaluation at time t in seconds ---

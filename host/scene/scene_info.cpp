@@ -11,7 +11,8 @@ nlohmann::ordered_json vec3Json(const glm::vec3& v) { return {v.x, v.y, v.z}; }
 nlohmann::ordered_json sceneInfoJson(const Scene& scene, double fps) {
   nlohmann::ordered_json j;
   j["file"] = scene.path;
-  j["triangles"] = {{"static", scene.staticTriangleCount()}, {"dynamic", scene.dynamicTriangleCount()}};
+  j["triangles"] = {{"static", scene.staticTriangleCount()}, {"dynamic", scene.dynamicTriangleCount()},
+                    {"static_per_mesh", scene.staticMeshTriangles}};
   j["instances"] = {{"dynamic", scene.instances.size()}, {"dynamic_meshes", scene.dynamicMeshes.size()}};
   j["materials"] = scene.materials.size();
   j["textures"] = scene.textures.size();
@@ -36,7 +37,10 @@ std::string sceneInfoText(const Scene& scene, double fps) {
   std::ostringstream s;
   s << "file:       " << scene.path << "\n";
   s << "triangles:  " << scene.staticTriangleCount() << " static (SSG), " << scene.dynamicTriangleCount()
-    << " dynamic (DSG)\n";
+    << " dynamic (DSG)";
+  if (scene.staticMeshTriangles != scene.staticTriangleCount())
+    s << "; " << scene.staticMeshTriangles << " static counting each mesh once";
+  s << "\n";
   s << "instances:  " << scene.instances.size() << " dynamic, of " << scene.dynamicMeshes.size() << " meshes\n";
   s << "materials:  " << scene.materials.size() << ", textures: " << scene.textures.size() << "\n";
   s << "lights:     " << scene.emissiveTriangleCount() << " emissive triangles ("
