@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 
 #include <glm/gtc/matrix_inverse.hpp>
@@ -37,6 +38,21 @@ dev::Light triangleLight(const glm::vec3& a, const glm::vec3& b, const glm::vec3
   return l;
 }
 
+// Running sums of the lights' powers; returns the total.
+float runningSums(const std::vector<dev::Light>& lights, std::vector<float>* cdf) {
+  cdf->resize(lights.size());
+  double sum = 0.0;
+  for (size_t i = 0; i < lights.size(); ++i) {
+    sum += lights[i].power;
+    (*cdf)[i] = static_cast<float>(sum);
+  }
+  return static_cast<float>(sum);
+}
+
+bool sameGeometry(const dev::Light& a, const dev::Light& b) {
+  // Everything but the bookkeeping fields.
+  return std::memcmp(&a, &b, offsetof(dev::Light, moved)) == 0;
+}
 }  // namespace
 
 dev::Material toDeviceMaterial(const Material& m, bool forceDiffuse) {
@@ -121,14 +137,32 @@ GpuScene::GpuScene(Context& ctx, const Scene& scene, const GpuSceneOptions& opti
     dev::Light l = triangleLight(a, b, c, le, static_cast<uint32_t>(i), PR_INVALID_INDEX, mat);
     if (l.area > 0.0f && std::isfinite(l.power) && l.power > 0.0f) staticEmitters_.push_back(l);
   }
-  for (const auto& inst : scene.instances) {
-    const TriangleMesh& m = scene.dynamicMeshes[inst.mesh];
-    for (uint32_t mat : m.materials)
-      if (scene.materials[mat].isEmissive()) lightsAnimated_ = true;
+  for (uint32_t i = 0; i < scene.instances.size(); ++i) {
+    const TriangleMesh& m = scene.dynamicMeshes[scene.instances[i].mesh];
+    for (uint32_t k = 0; k < m.triangleCount(); ++k)
+      if (scene.materials[m.materials[k]].isEmissive()) {
+        dynamicEmitters_.push_back({i, k, m.materials[k]});
+        lightsAnimated_ = true;
+      }
   }
   for (const auto& l : scene.lights)
     if (l.dynamic) lightsAnimated_ = true;
+  const Bounds b = scene.bounds;
+  if (!b.empty()) {
+    sceneRadius_ = std::max(1e-3f, 0.5f * glm::length(b.extent()));
+    sceneCentre_ = b.centre();
+  }
   uploadShading();
+  // The light-tracing selection table, at time 0 once and for all.
+  const std::vector<dev::Light> atZero = lightsAt(0.0);
+  traceTotal_ = runningSums(atZero, &traceCdf_);
+  const size_t n = std::max<size_t>(traceCdf_.size(), 1);
+  traceCdfBuffer_ = ctx_.allocate("light tracing power table", n * sizeof(float), CL_MEM_READ_ONLY);
+  ctx_.zero(traceCdfBuffer_, n * sizeof(float));
+  if (!traceCdf_.empty())
+    CL_CHECK(ctx_.queue().enqueueWriteBuffer(traceCdfBuffer_, CL_TRUE, 0, traceCdf_.size() * sizeof(float),
+                                             traceCdf_.data()));
+  shadingBytes_ += n * sizeof(float);
 }
 
 cl::Buffer GpuScene::upload(const char* name, const void* data, uint64_t bytes, uint64_t* counter) {
@@ -234,24 +268,23 @@ void GpuScene::setTime(double t) {
   firstFrame_ = false;
 }
 
-void GpuScene::buildLights(double t) {
-  lights_ = staticEmitters_;
-  for (size_t i = 0; i < scene_.instances.size(); ++i) {
-    const TriangleMesh& m = scene_.dynamicMeshes[scene_.instances[i].mesh];
-    const glm::mat4 x = scene_.instanceTransform(i, t);
-    for (size_t k = 0; k < m.triangleCount(); ++k) {
-      const uint32_t mat = m.materials[k];
-      const glm::vec3 le = scene_.materials[mat].emission();
-      if (le == glm::vec3(0.0f)) continue;
-      auto w = [&](uint32_t v) { return glm::vec3(x * glm::vec4(m.positions[v], 1.0f)); };
-      dev::Light l = triangleLight(w(m.indices[3 * k]), w(m.indices[3 * k + 1]), w(m.indices[3 * k + 2]),
-                                   le, meshFirstTriangle_[scene_.instances[i].mesh] + uint32_t(k),
-                                   uint32_t(i), mat);
-      if (l.area > 0.0f && std::isfinite(l.power) && l.power > 0.0f) lights_.push_back(l);
-    }
+std::vector<dev::Light> GpuScene::lightsAt(double t) const {
+  std::vector<dev::Light> lights = staticEmitters_;
+  std::vector<glm::mat4> xforms(scene_.instances.size());
+  std::vector<bool> have(scene_.instances.size(), false);
+  for (const DynamicEmitter& e : dynamicEmitters_) {
+    if (!have[e.instance]) xforms[e.instance] = scene_.instanceTransform(e.instance, t), have[e.instance] = true;
+    const glm::mat4& x = xforms[e.instance];
+    const TriangleMesh& m = scene_.dynamicMeshes[scene_.instances[e.instance].mesh];
+    auto w = [&](uint32_t v) { return glm::vec3(x * glm::vec4(m.positions[v], 1.0f)); };
+    dev::Light l = triangleLight(w(m.indices[3 * e.triangle]), w(m.indices[3 * e.triangle + 1]),
+                                 w(m.indices[3 * e.triangle + 2]), scene_.materials[e.material].emission(),
+                                 meshFirstTriangle_[scene_.instances[e.instance].mesh] + e.triangle,
+                                 e.instance, e.material);
+    // A degenerate or non-finite placement keeps its slot in the table with no power.
+    if (!(l.area > 0.0f) || !std::isfinite(l.power)) l.power = 0.0f, l.area = 0.0f;
+    lights.push_back(l);
   }
-  const Bounds b = scene_.bounds;
-  const float radius = b.empty() ? 1.0f : 0.5f * glm::length(b.extent());
   for (size_t i = 0; i < scene_.lights.size(); ++i) {
     const PunctualLight p = scene_.lightAt(i, t);
     dev::Light l{};
@@ -276,18 +309,22 @@ void GpuScene::buildLights(double t) {
         break;
       case LightType::Directional:
         l.type = PR_LIGHT_DIRECTIONAL;
-        l.power = 3.14159265f * radius * radius * lum;
+        l.power = 3.14159265f * sceneRadius_ * sceneRadius_ * lum;
         break;
     }
-    if (std::isfinite(l.power) && l.power > 0.0f) lights_.push_back(l);
+    if (!std::isfinite(l.power) || !(l.power > 0.0f)) l.power = 0.0f;
+    lights.push_back(l);
   }
-  cdf_.resize(lights_.size());
-  double sum = 0.0;
-  for (size_t i = 0; i < lights_.size(); ++i) {
-    sum += lights_[i].power;
-    cdf_[i] = static_cast<float>(sum);
-  }
-  totalPower_ = static_cast<float>(sum);
+  return lights;
+}
+
+
+void GpuScene::buildLights(double t) {
+  std::vector<dev::Light> next = lightsAt(t);
+  for (size_t i = 0; i < next.size(); ++i)
+    next[i].moved = (lights_.size() != next.size() || !sameGeometry(lights_[i], next[i])) ? 1u : 0u;
+  lights_ = std::move(next);
+  totalPower_ = runningSums(lights_, &cdf_);
 
   const size_t count = std::max<size_t>(lights_.size(), 1);
   if (count > lightCapacity_) {

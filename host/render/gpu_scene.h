@@ -42,6 +42,13 @@ class GpuScene {
   // PR_SHADING_PARAMS (6), PR_LIGHT_PARAMS (4). Returns the next free index.
   cl_uint setKernelArgs(cl::Kernel& kernel, cl_uint first);
   static constexpr cl_uint kArgCount = 17;
+  // The light-tracing selection table: running sums of every light's power at time 0, fixed for
+  // the whole animation so that a light path depends only on its key and the scene at its frame.
+  const cl::Buffer& traceCdf() const { return traceCdfBuffer_; }
+  float traceTotalPower() const { return traceTotal_; }
+  // Radius and centre of the scene's bounding sphere (directional lights emit from its disk).
+  float sceneRadius() const { return sceneRadius_; }
+  glm::vec3 sceneCentre() const { return sceneCentre_; }
 
   const Scene& scene() const { return scene_; }
   uint32_t lightCount() const { return static_cast<uint32_t>(lights_.size()); }
@@ -59,6 +66,7 @@ class GpuScene {
  private:
   void uploadShading();
   void buildLights(double t);
+  std::vector<dev::Light> lightsAt(double t) const;
   cl::Buffer upload(const char* name, const void* data, uint64_t bytes, uint64_t* counter);
 
   Context& ctx_;
@@ -77,11 +85,21 @@ class GpuScene {
   bool anyMoved_ = true;
   bool hasAlpha_ = false;
 
-  // Emissive triangles: static ones fixed, dynamic ones per (instance, mesh triangle).
+  // The light table keeps one order for the whole animation: static emitters, then the
+  // emissive triangles of each instance, then punctual lights.
+  struct DynamicEmitter {
+    uint32_t instance, triangle, material;
+  };
   std::vector<dev::Light> staticEmitters_;
+  std::vector<DynamicEmitter> dynamicEmitters_;
   std::vector<dev::Light> lights_;
   std::vector<float> cdf_;
   float totalPower_ = 0.0f;
+  std::vector<float> traceCdf_;
+  float traceTotal_ = 0.0f;
+  cl::Buffer traceCdfBuffer_;
+  float sceneRadius_ = 1.0f;
+  glm::vec3 sceneCentre_{0.0f};
   bool lightsChanged_ = true;
   bool lightsAnimated_ = false;
 

@@ -2,6 +2,7 @@
 // host and device. Add every new shared struct here.
 #pragma once
 
+#include "shared/arena.h"
 #include "shared/camera.h"
 #include "shared/geometry.h"
 #include "shared/lights.h"
@@ -23,7 +24,10 @@
   S(ShadingTriangle)          \
   S(ShadingInstance)          \
   S(PathState)                \
-  S(ShadowRay)
+  S(ShadowRay)                \
+  S(PathHeader)               \
+  S(LightVertex)              \
+  S(EyeVertex)
 
 #define PR_SHARED_FIELDS(F) \
   F(Ray, ox)                \
@@ -80,4 +84,18 @@
   F(PathState, rng_dim)       \
   F(PathState, flags)         \
   F(ShadowRay, c_r)           \
-  F(ShadowRay, valid)
+  F(ShadowRay, valid)         \
+  F(PathHeader, end)          \
+  F(PathHeader, valid)        \
+  F(PathHeader, escape_z)     \
+  F(LightVertex, t)           \
+  F(LightVertex, ng_oct)      \
+  F(LightVertex, tp_r)        \
+  F(LightVertex, ns_oct)      \
+  F(LightVertex, inst)        \
+  F(LightVertex, b2)          \
+  F(EyeVertex, ng_oct)        \
+  F(EyeVertex, ns_oct)        \
+  F(EyeVertex, depth)         \
+  F(EyeVertex, b2)            \
+  F(Light, moved)

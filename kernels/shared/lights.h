@@ -28,7 +28,8 @@ typedef struct {
   float cos_inner, cos_outer;  // spot cone
   float power;                 // selection weight, the same formula as light_power()
   u32 material;
-  float pad0, pad1, pad2, pad3;
+  u32 moved;  // changed since the previous frame (for invalidation)
+  float pad1, pad2, pad3;
 } Light;
 
 // The selection weight of an emissive triangle: luminance(Le) * pi * area.
