@@ -60,7 +60,7 @@ int main(int argc, char** argv) {
   info->add_option("--fps", infoFps, "Frames per second of the animation (default 24)");
 
   pr::RenderOptions ro;
-  std::string framesText, modeText = "pathtrace";
+  std::string framesText, modeText = "reuse";
   auto* render = app.add_subcommand("render", "Render a range of frames of the scene's animation");
   render->add_option("SCENE", ro.scene, "glTF file (.gltf or .glb)")->required();
   render->add_option("--frames", framesText, "Frame range A-B or one frame A (default: the whole animation)");
@@ -72,8 +72,19 @@ int main(int argc, char** argv) {
   render->add_option("--seed", ro.seed, "Random seed; the same seed reproduces a frame on one device")
       ->capture_default_str();
   render->add_option("--device", ro.device, "OpenCL device: index, P:D, cpu, gpu or part of its name");
-  render->add_option("--mode", modeText, "pathtrace: unidirectional path tracing (the baseline)")
-      ->check(CLI::IsMember({"pathtrace"}))
+  render->add_option("--mode", modeText,
+                     "reuse: light paths kept across frames, re-traced only where moving objects "
+                     "disturb them; retrace: the same with every path re-traced each frame; "
+                     "pathtrace: unidirectional path tracing (the baseline)")
+      ->check(CLI::IsMember({"reuse", "retrace", "pathtrace"}))
+      ->capture_default_str();
+  render->add_option("--light-paths", ro.lightPaths,
+                     "Light-path slots kept in the arena (reuse/retrace; default: one per pixel)");
+  render->add_option("--paths-per-pixel", ro.pathsPerPixel,
+                     "Light paths each pixel sample connects to (reuse/retrace)")
+      ->capture_default_str();
+  render->add_option("--clamp", ro.clamp,
+                     "Upper bound on the connection geometry term (reuse/retrace; 0 = off, unbiased)")
       ->capture_default_str();
   render->add_option("--camera", ro.camera, "Camera index (default: the scene's first)");
   render->add_option("--out", ro.outPattern, "Output EXR path with a frame number conversion")
@@ -107,7 +118,9 @@ int main(int argc, char** argv) {
         ro.frames = pr::parseFrameRange(framesText);
         ro.framesGiven = true;
       }
-      ro.mode = pr::RenderMode::PathTrace;
+      ro.mode = modeText == "pathtrace" ? pr::RenderMode::PathTrace
+                : modeText == "retrace"   ? pr::RenderMode::Retrace
+                                          : pr::RenderMode::Reuse;
       return pr::runRender(ro);
     }
   } catch (const pr::InputError& e) {

@@ -264,7 +264,14 @@ void GpuScene::setTime(double t) {
     CL_CHECK(ctx_.queue().enqueueWriteBuffer(shadingInstances_, CL_TRUE, 0,
                                              n * sizeof(dev::ShadingInstance), instances_.data()));
   lightsChanged_ = firstFrame_ || (lightsAnimated_ && anyMoved_);
-  if (firstFrame_ || lightsAnimated_) buildLights(t);
+  if (firstFrame_ || lightsAnimated_) {
+    buildLights(t);
+  } else if (!lights_.empty() && lights_.front().moved) {
+    // Nothing moves any more: clear the flags the first frame set.
+    for (auto& l : lights_) l.moved = 0u;
+    CL_CHECK(ctx_.queue().enqueueWriteBuffer(lightBuffer_, CL_TRUE, 0, lights_.size() * sizeof(dev::Light),
+                                             lights_.data()));
+  }
   firstFrame_ = false;
 }
 

@@ -17,6 +17,7 @@
 #include "io/image.h"
 #include "render/film.h"
 #include "render/gpu_scene.h"
+#include "render/path_reuse.h"
 #include "render/path_tracer.h"
 #include "scene/gltf_loader.h"
 #include "util/error.h"
@@ -95,8 +96,19 @@ int runRender(const RenderOptions& o) {
       integrator = std::make_unique<PathTracer>(ctx, gpu, film,
                                                 PathTracerSettings{o.spp, o.maxDepth, o.seed});
       break;
-    default:
-      throw InputError(std::string("--mode ") + renderModeName(o.mode) + ": not available in this build");
+    case RenderMode::Reuse:
+    case RenderMode::Retrace: {
+      PathReuseSettings r;
+      r.spp = o.spp;
+      r.maxDepth = o.maxDepth;
+      r.seed = o.seed;
+      r.lightPaths = static_cast<uint32_t>(o.lightPaths);
+      r.pathsPerPixel = static_cast<uint32_t>(o.pathsPerPixel);
+      r.clamp = o.clamp;
+      r.retraceAll = o.mode == RenderMode::Retrace;
+      integrator = std::make_unique<PathReuse>(ctx, gpu, film, r);
+      break;
+    }
   }
 
   std::unique_ptr<std::ofstream> stats;

@@ -43,7 +43,7 @@ __kernel void pt_shade(PR_SCENE_PARAMS, __global PathState* states, __global con
     if (!bsdf_is_delta(&f.bsdf)) {
       Ray shadow;
       float3 c;
-      if (next_event(&s, &h, &f, wo, &rng, &shadow, &c)) {
+      if (next_event(&s, &h, &f, wo, 1, &rng, &shadow, &c)) {
         c = tp * c;
         shadows[i].ray = shadow;
         shadows[i].c_r = c.x;

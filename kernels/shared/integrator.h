@@ -95,9 +95,11 @@ PR_INLINE float emitter_pdf(const SceneData* s, const SurfaceHit* h, float3 d, f
 
 // Next-event estimation at a non-delta surface: picks a light by power and a point on it.
 // Returns 1 with the shadow ray and the unoccluded contribution (to be multiplied by the path
-// throughput), or 0 when the sample carries nothing.
+// throughput), or 0 when the sample carries nothing. With use_mis, area lights are weighted
+// against BSDF sampling (the path tracer); without, the estimate stands alone (path reuse,
+// where BSDF-sampled hits on emitters are not counted).
 PR_INLINE int next_event(const SceneData* s, const SurfaceHit* h, const ShadingFrame* f, float3 wo,
-                         Rng* rng, Ray* shadow, float3* contribution) {
+                         int use_mis, Rng* rng, Ray* shadow, float3* contribution) {
   const float us = rng_next(rng), u1 = rng_next(rng), u2 = rng_next(rng);
   if (s->lights.count == 0u || s->lights.total_power <= 0.0f) return 0;
   const u32 idx = light_select(s->lights.cdf, s->lights.count, us);
@@ -116,7 +118,7 @@ PR_INLINE int next_event(const SceneData* s, const SurfaceHit* h, const ShadingF
   const float3 wol = to_local(wo, f->t, f->b, f->n), wil = to_local(ls.wi, f->t, f->b, f->n);
   const float3 fr = bsdf_eval(&f->bsdf, wol, wil, &bsdf_pdf);
   const float cos_i = fabs(wil.z);
-  const float w = ls.delta ? 1.0f : power_heuristic(ls.pdf, bsdf_pdf);
+  const float w = (ls.delta || !use_mis) ? 1.0f : power_heuristic(ls.pdf, bsdf_pdf);
   *contribution = fr * le * (cos_i * w / ls.pdf);
   if (max3(*contribution) <= 0.0f) return 0;
   if (l.type == PR_LIGHT_TRIANGLE) {

@@ -8,6 +8,7 @@
 #include "shared/lights.h"
 #include "shared/material.h"
 #include "shared/path_state.h"
+#include "shared/reuse.h"
 #include "shared/types.h"
 
 #define PR_SHARED_STRUCTS(S) \
@@ -27,7 +28,8 @@
   S(ShadowRay)                \
   S(PathHeader)               \
   S(LightVertex)              \
-  S(EyeVertex)
+  S(EyeVertex)                \
+  S(ReuseParams)
 
 #define PR_SHARED_FIELDS(F) \
   F(Ray, ox)                \
@@ -98,4 +100,7 @@
   F(EyeVertex, ns_oct)        \
   F(EyeVertex, depth)         \
   F(EyeVertex, b2)            \
-  F(Light, moved)
+  F(Light, moved)             \
+  F(ReuseParams, clamp)       \
+  F(ReuseParams, cx)          \
+  F(ReuseParams, pad1)

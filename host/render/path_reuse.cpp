@@ -1,0 +1,154 @@
+#include "render/path_reuse.h"
+
+#include <numeric>
+
+#include "render/path_tracer.h"
+#include "shared/reuse.h"
+#include "util/error.h"
+
+namespace pr {
+
+namespace {
+cl::Kernel makeKernel(Context& ctx, const char* file, const char* name, const std::string& options) {
+  cl_int err = CL_SUCCESS;
+  cl::Kernel k(ctx.buildProgram(file, options).program, name, &err);
+  CL_CHECK(err);
+  return k;
+}
+}  // namespace
+
+PathReuse::PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseSettings& settings)
+    : ctx_(ctx), scene_(scene), film_(film), settings_(settings) {
+  if (settings_.maxDepth < 2) throw InputError("--max-depth: path reuse needs at least 2");
+  if (settings_.pathsPerPixel < 1 || settings_.pathsPerPixel > 64)
+    throw InputError("--paths-per-pixel: must be 1 to 64");
+  slots_ = settings_.lightPaths ? settings_.lightPaths : film.pixels();
+  stride_ = static_cast<uint32_t>(settings_.maxDepth - 1);
+  const std::string opts = sceneBuildOptions(scene);
+  invalidate_ = makeKernel(ctx, "reuse/invalidate.cl", "invalidate", opts);
+  lightTrace_ = makeKernel(ctx, "reuse/light_trace.cl", "light_trace", opts);
+  eyeHit_ = makeKernel(ctx, "reuse/eye_hit.cl", "eye_hit", opts);
+  connect_ = makeKernel(ctx, "reuse/connect.cl", "connect", opts);
+  auto alloc = [&](const char* name, uint64_t bytes) {
+    bytes_ += bytes;
+    cl::Buffer b = ctx_.allocate(name, bytes);
+    ctx_.zero(b, bytes);
+    return b;
+  };
+  headers_ = alloc("path headers", uint64_t(slots_) * sizeof(dev::PathHeader));
+  vertices_ = alloc("light vertex arena", uint64_t(slots_) * stride_ * sizeof(dev::LightVertex));
+  list_ = alloc("invalid slot list", uint64_t(slots_) * 4);
+  allSlots_ = alloc("slot list", uint64_t(slots_) * 4);
+  std::vector<uint32_t> all(slots_);
+  std::iota(all.begin(), all.end(), 0u);
+  CL_CHECK(ctx_.queue().enqueueWriteBuffer(allSlots_, CL_TRUE, 0, all.size() * 4, all.data()));
+  eye_ = alloc("eye vertices", uint64_t(film.pixels()) * sizeof(dev::EyeVertex));
+  radiance_ = alloc("sample radiance", uint64_t(film.pixels()) * 16);
+  counters_ = alloc("reuse counters", PR_C_COUNT * 4);
+}
+
+void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameStats* stats) {
+  StageTimer timer;
+  ctx_.zero(counters_, PR_C_COUNT * 4);
+  dev::ReuseParams rp{};
+  rp.seed = settings_.seed;
+  rp.slots = slots_;
+  rp.stride = stride_;
+  rp.max_depth = static_cast<uint32_t>(settings_.maxDepth);
+  rp.paths_per_pixel = settings_.pathsPerPixel;
+  rp.spp = static_cast<uint32_t>(settings_.spp);
+  rp.pixel_count = film_.pixels();
+  rp.frame = static_cast<uint32_t>(frame);
+  rp.clamp = settings_.clamp;
+  rp.trace_total = scene_.traceTotalPower();
+  rp.scene_radius = scene_.sceneRadius();
+  rp.cx = scene_.sceneCentre().x, rp.cy = scene_.sceneCentre().y, rp.cz = scene_.sceneCentre().z;
+  const cl_uint a = GpuScene::kArgCount;
+
+  // 1. Which slots must be traced again.
+  cl_uint toTrace = slots_;
+  const cl::Buffer* list = &allSlots_;
+  if (!settings_.retraceAll && !first_) {
+    bool anyLightMoved = false;
+    for (const auto& l : scene_.lights()) anyLightMoved = anyLightMoved || l.moved;
+    scene_.setKernelArgs(invalidate_, 0);
+    CL_CHECK(invalidate_.setArg(a + 0, rp));
+    CL_CHECK(invalidate_.setArg(a + 1, cl_uint(scene_.anyInstanceMoved() ? 1 : 0)));
+    CL_CHECK(invalidate_.setArg(a + 2, headers_));
+    CL_CHECK(invalidate_.setArg(a + 3, vertices_));
+    CL_CHECK(invalidate_.setArg(a + 4, list_));
+    CL_CHECK(invalidate_.setArg(a + 5, counters_));
+    (void)anyLightMoved;
+    ctx_.launch1D(invalidate_, slots_, "invalidate", timer.next("invalidate"));
+    CL_CHECK(ctx_.queue().enqueueReadBuffer(counters_, CL_TRUE, PR_C_LIST * 4, 4, &toTrace));
+    list = &list_;
+  }
+  first_ = false;
+
+  // 2. Trace them.
+  if (toTrace > 0) {
+    scene_.setKernelArgs(lightTrace_, 0);
+    CL_CHECK(lightTrace_.setArg(a + 0, rp));
+    CL_CHECK(lightTrace_.setArg(a + 1, scene_.traceCdf()));
+    CL_CHECK(lightTrace_.setArg(a + 2, headers_));
+    CL_CHECK(lightTrace_.setArg(a + 3, vertices_));
+    CL_CHECK(lightTrace_.setArg(a + 4, *list));
+    CL_CHECK(lightTrace_.setArg(a + 5, toTrace));
+    CL_CHECK(lightTrace_.setArg(a + 6, counters_));
+    ctx_.launch1D(lightTrace_, toTrace, "light_trace", timer.next("light_trace"));
+  }
+
+  // 3. Per sample: first hits, then connections, then the film.
+  scene_.setKernelArgs(eyeHit_, 0);
+  CL_CHECK(eyeHit_.setArg(a + 0, rp));
+  CL_CHECK(eyeHit_.setArg(a + 1, camera));
+  CL_CHECK(eyeHit_.setArg(a + 3, eye_));
+  CL_CHECK(eyeHit_.setArg(a + 4, radiance_));
+  CL_CHECK(eyeHit_.setArg(a + 5, counters_));
+  scene_.setKernelArgs(connect_, 0);
+  CL_CHECK(connect_.setArg(a + 0, rp));
+  CL_CHECK(connect_.setArg(a + 2, eye_));
+  CL_CHECK(connect_.setArg(a + 3, headers_));
+  CL_CHECK(connect_.setArg(a + 4, vertices_));
+  CL_CHECK(connect_.setArg(a + 5, radiance_));
+  CL_CHECK(connect_.setArg(a + 6, counters_));
+  const cl_uint n = film_.pixels();
+  for (int s = 0; s < settings_.spp; ++s) {
+    CL_CHECK(eyeHit_.setArg(a + 2, cl_uint(s)));
+    CL_CHECK(connect_.setArg(a + 1, cl_uint(s)));
+    ctx_.launch1D(eyeHit_, n, "eye_hit", timer.next("eye_hit"));
+    ctx_.launch1D(connect_, n, "connect", timer.next("connect"));
+    film_.accumulate(radiance_, n, &timer);
+  }
+  ctx_.finish();
+  cl_uint c[PR_C_COUNT] = {};
+  CL_CHECK(ctx_.queue().enqueueReadBuffer(counters_, CL_TRUE, 0, sizeof c, c));
+  auto times = timer.collect();
+  if (!stats) return;
+  for (const auto& [k, v] : times) stats->stageSeconds[k] += v;
+  stats->rays["invalidation"] += c[PR_C_INVALID_RAYS];
+  stats->rays["light"] += c[PR_C_LIGHT_RAYS];
+  stats->rays["camera"] += c[PR_C_CAMERA_RAYS];
+  stats->rays["shadow"] += c[PR_C_SHADOW_RAYS];
+  stats->rays["connection"] += c[PR_C_CONNECT_RAYS];
+  stats->rays["bounce"] += c[PR_C_BOUNCE_RAYS];
+  stats->counters["slots"] = slots_;
+  stats->counters["slots_retraced"] = toTrace;
+  stats->counters["slots_invalidated"] = settings_.retraceAll ? slots_ : c[PR_C_LIST];
+  stats->counters["slots_reused"] = slots_ - toTrace;
+  stats->counters["light_vertices_ssg"] = c[PR_C_SSG_VERTICES];
+  stats->counters["light_vertices_dsg"] = c[PR_C_DSG_VERTICES];
+  stats->counters["arena_bytes"] = arenaBytes();
+  if (settings_.clamp > 0.0f) stats->counters["connections_clamped"] = c[PR_C_CLAMPED];
+}
+
+void PathReuse::readArena(std::vector<dev::PathHeader>* headers, std::vector<dev::LightVertex>* vertices) {
+  headers->resize(slots_);
+  vertices->resize(size_t(slots_) * stride_);
+  CL_CHECK(ctx_.queue().enqueueReadBuffer(headers_, CL_TRUE, 0, headers->size() * sizeof(dev::PathHeader),
+                                          headers->data()));
+  CL_CHECK(ctx_.queue().enqueueReadBuffer(vertices_, CL_TRUE, 0, vertices->size() * sizeof(dev::LightVertex),
+                                          vertices->data()));
+}
+
+}  // namespace pr

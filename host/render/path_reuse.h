@@ -1,0 +1,53 @@
+// The paper's method (--mode reuse), made exact (DESIGN.md sections 4 and 5): light sub-paths
+// live in a path-record arena across frames; each frame `invalidate` finds the ones the moving
+// objects disturb, `light_trace` traces those again, and per sample `eye_hit` finds the first
+// non-delta surface and `connect` joins it to the stored light vertices. --mode retrace runs
+// the same kernels with every slot traced again each frame.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "cl/context.h"
+#include "render/film.h"
+#include "render/gpu_scene.h"
+#include "render/integrator.h"
+#include "shared/arena.h"
+
+namespace pr {
+
+struct PathReuseSettings {
+  int spp = 4;
+  int maxDepth = 8;
+  uint32_t seed = 1;
+  uint32_t lightPaths = 0;  // N_L; 0: one per pixel
+  uint32_t pathsPerPixel = 4;
+  float clamp = 0.0f;
+  bool retraceAll = false;  // --mode retrace
+};
+
+class PathReuse : public Integrator {
+ public:
+  PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseSettings& settings);
+  void renderFrame(int frame, const dev::CameraParams& camera, FrameStats* stats) override;
+  uint64_t deviceBytes() const override { return bytes_; }
+
+  uint32_t slots() const { return slots_; }
+  uint32_t stride() const { return stride_; }
+  uint64_t arenaBytes() const { return uint64_t(slots_) * (sizeof(dev::PathHeader) + stride_ * sizeof(dev::LightVertex)); }
+  // The arena as it stands (for tests and diagnostics).
+  void readArena(std::vector<dev::PathHeader>* headers, std::vector<dev::LightVertex>* vertices);
+
+ private:
+  Context& ctx_;
+  GpuScene& scene_;
+  Film& film_;
+  PathReuseSettings settings_;
+  uint32_t slots_ = 0, stride_ = 0;
+  bool first_ = true;
+  cl::Kernel invalidate_, lightTrace_, eyeHit_, connect_;
+  cl::Buffer headers_, vertices_, list_, allSlots_, eye_, radiance_, counters_;
+  uint64_t bytes_ = 0;
+};
+
+}  // namespace pr

@@ -1,0 +1,81 @@
+// eye_hit: one work-item per pixel (one pass per sample index). Traces the camera ray through a
+// jittered point of the pixel to its first non-delta surface, following mirror and glass
+// bounces, and counts the emission it sees on the way (no other technique can reach it).
+// Reads the camera and the scene; writes the pixel sample's EyeVertex and its radiance so far.
+#include "shared/camera.h"
+#include "shared/reuse.h"
+
+__kernel void eye_hit(PR_SCENE_PARAMS, ReuseParams rp, CameraParams cam, uint sample,
+                      __global EyeVertex* eye, __global float4* radiance, __global uint* counters) {
+  const uint i = (uint)get_global_id(0);
+  if (i >= rp.pixel_count) return;
+  const SceneData s = PR_SCENE();
+  Rng rng = rng_make(rp.seed, PR_RNG_CAMERA, rp.frame, i, sample);
+  const float jx = rng_next(&rng), jy = rng_next(&rng);
+  const uint x = i % cam.width, y = i / cam.width;
+  float3 d = camera_direction(&cam, (float)x + jx, (float)y + jy);
+  Ray ray;
+  ray.ox = cam.px;
+  ray.oy = cam.py;
+  ray.oz = cam.pz;
+  ray.tmin = 0.0f;
+  ray.dx = d.x;
+  ray.dy = d.y;
+  ray.dz = d.z;
+  ray.tmax = PR_INF_F;
+  float3 tp = make_float3(1.0f, 1.0f, 1.0f), L = make_float3(0.0f, 0.0f, 0.0f);
+  EyeVertex e;
+  e.prim = PR_INVALID_INDEX;
+  e.inst = PR_INVALID_INDEX;
+  e.depth = 0u;
+  uint bounces = 0u;
+  for (uint depth = 1u; depth <= rp.max_depth; ++depth) {
+    Hit hit;
+    if (!trace_closest(&s, ray, &hit)) break;
+    const SurfaceHit h = surface_at(&s.sd, hit.prim, hit.inst, hit.u, hit.v);
+    const float3 wo = -d;
+    if (s.sd.materials[h.material].flags & PR_MAT_EMISSIVE) L += tp * surface_emission(&s, &h);
+    if (depth >= rp.max_depth) break;
+    const ShadingFrame f = shading_frame(&s, &h, wo);
+    if (!bsdf_is_delta(&f.bsdf)) {
+      e.px = h.p.x;
+      e.py = h.p.y;
+      e.pz = h.p.z;
+      e.ng_oct = oct_encode(h.ng);
+      e.ns_oct = oct_encode(h.ns);
+      e.wx = wo.x;
+      e.wy = wo.y;
+      e.wz = wo.z;
+      e.tp_r = tp.x;
+      e.tp_g = tp.y;
+      e.tp_b = tp.z;
+      e.depth = depth;
+      e.prim = hit.prim;
+      e.inst = hit.inst;
+      e.b1 = hit.u;
+      e.b2 = hit.v;
+      break;
+    }
+    const float u0 = rng_next(&rng), u1 = rng_next(&rng), u2 = rng_next(&rng);
+    float3 wil, weight;
+    float pdf;
+    int delta;
+    const float3 wol = to_local(wo, f.t, f.b, f.n);
+    if (!bsdf_sample(&f.bsdf, wol, u0, u1, u2, PR_RADIANCE, &wil, &weight, &pdf, &delta)) break;
+    d = normalize(to_world(wil, f.t, f.b, f.n));
+    tp = tp * weight;
+    ray = spawn_ray(h.p, f.ng, d, PR_INF_F);
+    ++bounces;
+  }
+  if (e.prim == PR_INVALID_INDEX) {
+    e.px = e.py = e.pz = 0.0f;
+    e.wx = e.wy = e.wz = 0.0f;
+    e.ng_oct = e.ns_oct = 0u;
+    e.tp_r = e.tp_g = e.tp_b = 0.0f;
+    e.b1 = e.b2 = 0.0f;
+  }
+  eye[i] = e;
+  radiance[i] = (float4)(L.x, L.y, L.z, 0.0f);
+  atomic_inc(counters + PR_C_CAMERA_RAYS);
+  if (bounces) atomic_add(counters + PR_C_BOUNCE_RAYS, bounces);
+}

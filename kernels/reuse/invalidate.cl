@@ -1,0 +1,56 @@
+// invalidate: one work-item per slot. A stored path stays valid only if tracing it again now
+// would give the same vertices (DESIGN.md section 5): it is invalid when (c) its light moved,
+// (b) a vertex lies on a DSG instance that moved, or (a) a segment, or the final escaping ray,
+// now meets DSG geometry before its stored end. Only the DSG is tested. Reads the headers, the
+// vertices, the instances' moved flags and the light table; clears `valid` of invalid slots,
+// appends them to `list` (its order varies, the set does not), and counts the light vertices
+// of the paths that stay valid.
+#include "shared/reuse.h"
+
+__kernel void invalidate(PR_SCENE_PARAMS, ReuseParams rp, uint test_segments,
+                         __global PathHeader* headers, __global const LightVertex* vertices,
+                         __global uint* list, __global uint* counters) {
+  const uint slot = (uint)get_global_id(0);
+  if (slot >= rp.slots) return;
+  const SceneData s = PR_SCENE();
+  const PathHeader h = headers[slot];
+  __global const LightVertex* v = vertices + (size_t)slot * rp.stride;
+  int ok = h.valid != 0u;
+  uint rays = 0u;
+  if (ok && h.light != PR_INVALID_INDEX && s.lights.lights[h.light].moved) ok = 0;  // (c)
+  for (uint k = 1u; ok && k < h.vertex_count; ++k) {                               // (b)
+    const uint inst = v[k].inst;
+    if (inst != PR_INVALID_INDEX && s.sd.instances[inst].moved) ok = 0;
+  }
+  if (ok && test_segments) {  // (a)
+    for (uint k = 1u; ok && k < h.vertex_count; ++k) {
+      Ray r = light_segment_ray(vertex_pos(v + k - 1u), v[k - 1u].ng_oct, v[k - 1u].prim,
+                                vertex_dir(v + k));
+      r.tmax = v[k].t;  // strictly nearer than the stored hit, as closest-hit traversal decides
+      ++rays;
+      if (occluded_dynamic(&s.geom, r)) ok = 0;
+    }
+    if (ok && h.end == PR_END_ESCAPED && h.vertex_count > 0u) {
+      const uint last = h.vertex_count - 1u;
+      const Ray r = light_segment_ray(vertex_pos(v + last), v[last].ng_oct, v[last].prim,
+                                      make_float3(h.escape_x, h.escape_y, h.escape_z));
+      ++rays;
+      if (occluded_dynamic(&s.geom, r)) ok = 0;
+    }
+  }
+  if (rays) atomic_add(counters + PR_C_INVALID_RAYS, rays);
+  if (!ok) {
+    headers[slot].valid = 0u;
+    list[atomic_inc(counters + PR_C_LIST)] = slot;
+    return;
+  }
+  uint ssg = 0u, dsg = 0u;
+  for (uint k = 1u; k < h.vertex_count; ++k) {
+    if (v[k].inst == PR_INVALID_INDEX)
+      ++ssg;
+    else
+      ++dsg;
+  }
+  if (ssg) atomic_add(counters + PR_C_SSG_VERTICES, ssg);
+  if (dsg) atomic_add(counters + PR_C_DSG_VERTICES, dsg);
+}

@@ -1,0 +1,170 @@
+// light_trace: one work-item per slot in the compacted list of invalid slots. Traces the slot's
+// light sub-path from scratch with the random numbers keyed by (seed, slot, generation), and
+// stores its vertices. Reads the scene, the light-tracing power table and the slot's
+// generation; writes the slot's PathHeader and LightVertex records and adds to the counters.
+#include "shared/reuse.h"
+
+__kernel void light_trace(PR_SCENE_PARAMS, ReuseParams rp, __global const float* trace_cdf,
+                          __global PathHeader* headers, __global LightVertex* vertices,
+                          __global const uint* list, uint list_count, __global uint* counters) {
+  const uint i = (uint)get_global_id(0);
+  if (i >= list_count) return;
+  const uint slot = list[i];
+  const SceneData s = PR_SCENE();
+  PathHeader h;
+  h.generation = headers[slot].generation;
+  h.light = PR_INVALID_INDEX;
+  h.vertex_count = 0u;
+  h.end = PR_END_ABSORBED;
+  h.valid = 1u;
+  h.escape_x = h.escape_y = h.escape_z = 0.0f;
+  __global LightVertex* out = vertices + (size_t)slot * rp.stride;
+  Rng rng = rng_make(rp.seed, PR_RNG_LIGHT, 0u, slot, h.generation);
+  const float us = rng_next(&rng), u1 = rng_next(&rng), u2 = rng_next(&rng), u3 = rng_next(&rng),
+              u4 = rng_next(&rng), u5 = rng_next(&rng);
+  uint rays = 0u, ssg = 0u, dsg = 0u;
+  if (s.lights.count == 0u || !(rp.trace_total > 0.0f)) {
+    headers[slot] = h;
+    return;
+  }
+  const uint li = light_select(trace_cdf, s.lights.count, us);
+  const float pmf = (trace_cdf[li] - (li > 0u ? trace_cdf[li - 1u] : 0.0f)) / rp.trace_total;
+  const Light L = s.lights.lights[li];
+  h.light = li;
+
+  // Vertex 0 on the light, and the first direction.
+  float3 p0, n0 = make_float3(0.0f, 0.0f, 1.0f), dir;
+  float3 tp = make_float3(0.0f, 0.0f, 0.0f);
+  uint prim0 = PR_INVALID_INDEX, inst0 = PR_INVALID_INDEX;
+  float b1 = 0.0f, b2 = 0.0f;
+  const float3 axis = make_float3(L.e1x, L.e1y, L.e1z);
+  if (L.type == PR_LIGHT_TRIANGLE) {
+    const float2 b = sample_triangle(u1, u2);
+    b1 = b.x;
+    b2 = b.y;
+    const SurfaceHit e = surface_at(&s.sd, L.prim, L.inst, b1, b2);
+    p0 = e.p;
+    // Both faces emit: pick one, then a cosine-weighted direction about it (pdf cos / (2 pi)).
+    n0 = oct_decode(oct_encode(u3 < 0.5f ? e.ng : -e.ng));
+    float3 t, bt;
+    orthonormal_basis(n0, &t, &bt);
+    dir = normalize(to_world(sample_cosine_hemisphere(u4, u5), t, bt, n0));
+    tp = material_emission(&s.sd, &e) * (2.0f * PR_PI * L.area / pmf);
+    prim0 = L.prim;
+    inst0 = L.inst;
+  } else if (L.type == PR_LIGHT_POINT) {
+    p0 = make_float3(L.p0x, L.p0y, L.p0z);
+    dir = sample_uniform_sphere(u1, u2);
+    tp = make_float3(L.le_r, L.le_g, L.le_b) * (4.0f * PR_PI / pmf);
+  } else if (L.type == PR_LIGHT_SPOT) {
+    p0 = make_float3(L.p0x, L.p0y, L.p0z);
+    float3 t, bt;
+    orthonormal_basis(axis, &t, &bt);
+    const float3 lc = sample_uniform_cone(u1, u2, L.cos_outer);
+    dir = normalize(to_world(lc, t, bt, axis));
+    const float pdf = 1.0f / (2.0f * PR_PI * (1.0f - L.cos_outer));
+    tp = make_float3(L.le_r, L.le_g, L.le_b) *
+         (spot_attenuation(lc.z, L.cos_inner, L.cos_outer) / (pmf * pdf));
+  } else {
+    // Directional: parallel rays from a disk that covers the scene's bounding sphere.
+    dir = axis;
+    float3 t, bt;
+    orthonormal_basis(axis, &t, &bt);
+    const float3 d = sample_cosine_hemisphere(u1, u2);  // its xy is uniform on the unit disk
+    const float r = rp.scene_radius;
+    p0 = make_float3(rp.cx, rp.cy, rp.cz) - axis * (1.01f * r) + (t * d.x + bt * d.y) * r;
+    tp = make_float3(L.le_r, L.le_g, L.le_b) * (PR_PI * r * r / pmf);
+  }
+  if (!(pmf > 0.0f) || !(max3(tp) > 0.0f) || !(max3(tp) < PR_INF_F)) {
+    headers[slot] = h;
+    return;
+  }
+  LightVertex v;
+  v.px = p0.x;
+  v.py = p0.y;
+  v.pz = p0.z;
+  v.t = 0.0f;
+  v.wx = v.wy = v.wz = 0.0f;
+  v.ng_oct = oct_encode(n0);
+  v.ns_oct = v.ng_oct;
+  v.tp_r = tp.x;
+  v.tp_g = tp.y;
+  v.tp_b = tp.z;
+  v.prim = prim0;
+  v.inst = inst0;
+  v.b1 = b1;
+  v.b2 = b2;
+  out[0] = v;
+  uint count = 1u;
+  Ray ray = light_segment_ray(p0, v.ng_oct, prim0, dir);
+
+  for (uint k = 1u; k < rp.stride; ++k) {
+    Hit hit;
+    ++rays;
+    if (!trace_closest(&s, ray, &hit)) {
+      h.end = PR_END_ESCAPED;
+      h.escape_x = dir.x;
+      h.escape_y = dir.y;
+      h.escape_z = dir.z;
+      break;
+    }
+    const SurfaceHit sh = surface_at(&s.sd, hit.prim, hit.inst, hit.u, hit.v);
+    v.px = sh.p.x;
+    v.py = sh.p.y;
+    v.pz = sh.p.z;
+    v.t = hit.t;
+    v.wx = dir.x;
+    v.wy = dir.y;
+    v.wz = dir.z;
+    v.ng_oct = oct_encode(sh.ng);
+    v.ns_oct = oct_encode(sh.ns);
+    v.tp_r = tp.x;
+    v.tp_g = tp.y;
+    v.tp_b = tp.z;
+    v.prim = hit.prim;
+    v.inst = hit.inst;
+    v.b1 = hit.u;
+    v.b2 = hit.v;
+    out[k] = v;
+    count = k + 1u;
+    if (hit.inst == PR_INVALID_INDEX)
+      ++ssg;
+    else
+      ++dsg;
+    if (k + 1u >= rp.stride) {
+      h.end = PR_END_MAX_DEPTH;
+      break;
+    }
+    // Scatter, in the frame of the stored (decoded) normals.
+    const float u0 = rng_next(&rng), v1 = rng_next(&rng), v2 = rng_next(&rng), rr = rng_next(&rng);
+    SurfaceHit q = sh;
+    q.ng = oct_decode(v.ng_oct);
+    q.ns = oct_decode(v.ns_oct);
+    const float3 wo = -dir;
+    const ShadingFrame f = shading_frame(&s, &q, wo);
+    float3 wil, weight;
+    float pdf;
+    int delta;
+    const float3 wol = to_local(wo, f.t, f.b, f.n);
+    if (!bsdf_sample(&f.bsdf, wol, u0, v1, v2, PR_IMPORTANCE, &wil, &weight, &pdf, &delta)) break;
+    const float3 wi = normalize(to_world(wil, f.t, f.b, f.n));
+    const int reflect = wil.z * wol.z > 0.0f;
+    const float side = dot(wi, f.ng) * dot(wo, f.ng);
+    if ((reflect && side <= 0.0f) || (!reflect && side >= 0.0f)) break;
+    float3 w = weight * shading_normal_correction(wo, wi, f.n, f.ng);
+    const float qk = fmin(max3(w), 0.95f);
+    if (k >= 2u) {
+      if (rr >= qk) break;
+      w = w / qk;
+    }
+    tp = tp * w;
+    if (!(max3(tp) > 0.0f) || !(max3(tp) < PR_INF_F)) break;
+    dir = wi;
+    ray = light_segment_ray(sh.p, v.ng_oct, hit.prim, dir);
+  }
+  h.vertex_count = count;
+  headers[slot] = h;
+  atomic_add(counters + PR_C_LIGHT_RAYS, rays);
+  if (ssg) atomic_add(counters + PR_C_SSG_VERTICES, ssg);
+  if (dsg) atomic_add(counters + PR_C_DSG_VERTICES, dsg);
+}
