@@ -539,6 +539,7 @@ int main(int argc, char** argv) {
   double frameTime = 0.0;
   int width = 640, height = 480, repeats = 5, levels = 3, instances = 16, embreeThreads = 2;
   bool noEmbree = false;
+  accel::BuildOptions build;
   app.add_option("scene", scenePath, "glTF scene (none: the synthetic sphere flake)");
   app.add_option("--frame-time", frameTime, "Animation time of the DSG instances and camera (s)");
   app.add_option("--width", width, "Camera ray image width")->check(CLI::PositiveNumber);
@@ -549,6 +550,8 @@ int main(int argc, char** argv) {
   app.add_option("--levels", levels, "Synthetic scene: sphere-flake levels (3: about 236k triangles)");
   app.add_option("--instances", instances, "Synthetic scene: dynamic instances of a 2k-triangle sphere");
   app.add_option("--embree-threads", embreeThreads, "Threads of the Embree reference")->check(CLI::PositiveNumber);
+  app.add_option("--leaf-size", build.maxLeafSize, "BVH builder: largest leaf (tuning experiments)");
+  app.add_option("--traversal-cost", build.traversalCost, "BVH builder: SAH node cost per triangle test");
   app.add_flag("--no-embree", noEmbree, "Skip the Embree reference");
   CLI11_PARSE(app, argc, argv);
   try {
@@ -568,11 +571,11 @@ int main(int argc, char** argv) {
     // Builds as the renderer does (render/gpu_scene.cpp): SSG, each mesh, TLAS at the frame time.
     accel::StaticAccel ssg;
     t0 = now();
-    ssg.build(s.positions, s.indices);
+    ssg.build(s.positions, s.indices, build);
     const double ssgSeconds = now() - t0;
     accel::DynamicAccel dsg;
     t0 = now();
-    for (const DynMesh& m : s.meshes) dsg.addMesh(m.positions, m.indices, m.primBase);
+    for (const DynMesh& m : s.meshes) dsg.addMesh(m.positions, m.indices, m.primBase, build);
     const double meshSeconds = now() - t0;
     std::vector<double> tlasTimes;
     for (int i = 0; i < 51; ++i) {
