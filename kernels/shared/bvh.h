@@ -28,6 +28,13 @@
 
 #define PR_BVH_STACK_SIZE 64
 
+// PoCL's LLVM left the box test as a call in the traversal loop: force it inline.
+#ifdef PR_DEVICE_CODE
+#define PR_BVH_INLINE inline __attribute__((always_inline))
+#else
+#define PR_BVH_INLINE inline
+#endif
+
 // Slab distances are scaled by this before the overlap test so rounding never culls a box
 // that holds a hit (1 + 2 * gamma(3) in pbrt's terms, rounded up).
 #define PR_BVH_FAR_SCALE 1.00000036f
@@ -69,15 +76,21 @@ PR_INLINE BvhRay bvh_ray(float3 o, float3 d, float tmin, float tmax) {
   return r;
 }
 
+// min/max by comparison: slab distances are never NaN (finite boxes, bvh_safe_inverse), so
+// fmin/fmax's NaN handling is dead weight in the hottest function.
+PR_BVH_INLINE float bvh_min(float a, float b) { return a < b ? a : b; }
+PR_BVH_INLINE float bvh_max(float a, float b) { return a > b ? a : b; }
+
 // Entry distance of the ray into the node's box, or PR_INF_F when it misses it within
 // [tmin, tmax].
-PR_INLINE float bvh_box_entry(PR_GLOBAL const BvhNode* n, const BvhRay* r) {
+PR_BVH_INLINE float bvh_box_entry(PR_GLOBAL const BvhNode* n, const BvhRay* r) {
   const float x0 = (n->lo_x - r->o.x) * r->inv_d.x, x1 = (n->hi_x - r->o.x) * r->inv_d.x;
   const float y0 = (n->lo_y - r->o.y) * r->inv_d.y, y1 = (n->hi_y - r->o.y) * r->inv_d.y;
   const float z0 = (n->lo_z - r->o.z) * r->inv_d.z, z1 = (n->hi_z - r->o.z) * r->inv_d.z;
-  const float tnear = fmax(fmax(fmin(x0, x1), fmin(y0, y1)), fmax(fmin(z0, z1), r->tmin));
+  const float tnear = bvh_max(bvh_max(bvh_min(x0, x1), bvh_min(y0, y1)),
+                              bvh_max(bvh_min(z0, z1), r->tmin));
   const float tfar =
-      fmin(fmin(fmax(x0, x1), fmax(y0, y1)), fmax(z0, z1)) * PR_BVH_FAR_SCALE;
+      bvh_min(bvh_min(bvh_max(x0, x1), bvh_max(y0, y1)), bvh_max(z0, z1)) * PR_BVH_FAR_SCALE;
   return (tnear <= tfar && tnear <= r->tmax) ? tnear : PR_INF_F;
 }
 

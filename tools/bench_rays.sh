@@ -1,0 +1,110 @@
+#!/usr/bin/env bash
+# Ray-throughput benchmark (issue 4): builds ray_bench if needed, generates the large atrium,
+# runs the benchmark on cornell-nvpro and the atrium on PoCL capped to 2 threads, and writes
+# docs/ray-benchmark.md. The Embree column appears when libembree-dev was installed before
+# cmake ran (apt-get install -y libembree-dev).
+#
+#   tools/bench_rays.sh [--repeats N] [--build DIR]
+set -euo pipefail
+
+root="$(cd "$(dirname "$0")/.." && pwd)"
+build="$root/build"
+repeats=5
+while [[ $# -gt 0 ]]; do
+  case "$1" in
+    --repeats) repeats="$2"; shift 2 ;;
+    --build) build="$2"; shift 2 ;;
+    *) echo "bench_rays.sh: unknown argument $1" >&2; exit 2 ;;
+  esac
+done
+
+if [[ ! -x "$build/ray_bench" || ! -x "$build/pathreuse" ]]; then
+  cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo
+fi
+cmake --build "$build" -j2 --target ray_bench pathreuse
+
+atrium=/tmp/pathreuse-atrium/atrium.gltf
+if [[ ! -f "$atrium" ]]; then
+  python3 "$root/tools/gen_atrium.py" --size 1 --out "$atrium"
+fi
+scenes=()
+cornell="$root/../shared/scenes/cornell-nvpro/cornellBox.gltf"
+[[ -f "$cornell" ]] && scenes+=("$cornell")
+scenes+=("$atrium")
+
+# PoCL 3.1's pthread driver takes its thread count from POCL_MAX_PTHREAD_COUNT.
+export POCL_MAX_PTHREAD_COUNT=2
+out="$root/docs/ray-benchmark.md"
+mkdir -p "$root/docs"
+tmp="$(mktemp -d)"
+trap 'rm -rf "$tmp"' EXIT
+
+for scene in "${scenes[@]}"; do
+  name="$(basename "$scene" .gltf)"
+  echo "== $name" >&2
+  "$build/ray_bench" "$scene" --repeats "$repeats" --json "$tmp/$name.json" >"$tmp/$name.txt" 2>"$tmp/$name.err"
+  cat "$tmp/$name.txt" >&2
+done
+
+{
+  echo "# Ray-throughput benchmark"
+  echo
+  echo "Written by \`tools/bench_rays.sh\` (issue 4). Closest hit for camera and diffuse bounce rays,"
+  echo "any hit for shadow rays, on the SSG + DSG as the renderer builds them (frame time 0),"
+  echo "640 x 480 camera rays through pixel centres of the scene's first camera; camera rays that"
+  echo "miss are dropped from all sets. Our rate: kernel time from OpenCL profiling events,"
+  echo "median of $repeats launches after a warm-up. Embree 3 (build quality high, 2 std::threads,"
+  echo "wall time) traces the very same rays, alternating with ours: Embree-1 with rtcIntersect1 /"
+  echo "rtcOccluded1, Embree-8 with 8-wide packets; ratio = ours / the better of the two."
+  echo "\"agree\": rays with the same hit/miss (occluded) answer; \"same-prim\": same triangle and instance."
+  echo
+  echo "- date: $(date -u '+%Y-%m-%d %H:%M UTC')"
+  echo "- machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')"
+  echo "- device: \`$("$build/pathreuse" devices 2>/dev/null | head -1)\`"
+  echo "- PoCL: $(dpkg-query -W -f='${Version}' libpocl2 2>/dev/null || echo unknown), POCL_MAX_PTHREAD_COUNT=2"
+  echo "- commit: $(git -C "$root" rev-parse --short HEAD)$(git -C "$root" diff --quiet HEAD -- kernels host tools || echo ' (+ local changes)')"
+  for scene in "${scenes[@]}"; do
+    name="$(basename "$scene" .gltf)"
+    echo
+    echo "## $name"
+    echo
+    echo '```'
+    grep -v '^device:' "$tmp/$name.txt"
+    echo '```'
+    echo
+    python3 - "$tmp/$name.json" <<'EOF'
+import json, sys
+j = json.load(open(sys.argv[1]))
+ref = "embree" in j
+head = "| rays | query | count | ours Mrays/s (median [min-max]) |"
+rule = "|---|---|---:|---:|"
+if ref:
+    head += " Embree-1 | Embree-8 | ours / Embree | agree |"
+    rule += "---:|---:|---:|---:|"
+print(head)
+print(rule)
+for name in ("camera", "shadow", "bounce"):
+    s = j["sets"][name]
+    o = s["ours_mrays"]
+    row = f"| {name} | {s['query']} | {s['rays']} | {o['median']:.2f} [{o['min']:.2f}-{o['max']:.2f}] |"
+    if ref:
+        e1, e8 = s["embree1_mrays"]["median"], s["embree8_mrays"]["median"]
+        best = max(e1, e8)
+        row += f" {e1:.2f} | {e8:.2f} | {o['median'] / best if best else 0:.3f} | {100 * s['agree_hit']:.4f}% |"
+    print(row)
+ssg, dsg, mem = j["ssg"], j["dsg"], j["device_bytes"]
+print()
+print(f"BVH build: SSG {ssg['triangles']} triangles {ssg['build_ms']:.1f} ms ({ssg['nodes']} nodes, depth {ssg['depth']}, "
+      f"SAH cost {ssg['sah_cost']:.1f}); DSG meshes {dsg['mesh_triangles']} triangles {dsg['mesh_build_ms']:.2f} ms; "
+      f"TLAS over {dsg['instances']} instances {dsg['tlas_build_ms']:.3f} ms.")
+print(f"Device memory: SSG {mem['ssg'] / 2**20:.2f} MiB, DSG meshes {mem['dsg_meshes'] / 2**20:.2f} MiB, "
+      f"per frame {mem['per_frame'] / 1024:.1f} KiB.", end="")
+if ref:
+    e = j["embree"]
+    print(f" Embree {e['version']}: build {e['build_ms']:.1f} ms, {e['bytes'] / 2**20:.2f} MiB.")
+else:
+    print()
+EOF
+  done
+} >"$out"
+echo "wrote $out" >&2
