@@ -10,37 +10,19 @@
 
 #include "io/image.h"
 #include "support/gltf_builder.h"
+#include "support/render_helpers.h"
 #include "support/test_env.h"
 
 namespace pr {
 namespace {
 
-struct Moments {
-  double mean = 0, stderr_ = 0;
-};
-
-// Mean of channel c over a pixel rectangle, with the standard error of that mean (pixels are
-// independent estimates).
-Moments regionMean(const Image& img, int x0, int y0, int x1, int y1, int c) {
-  double s = 0, s2 = 0;
-  int n = 0;
-  for (int y = y0; y < y1; ++y)
-    for (int x = x0; x < x1; ++x) {
-      const double v = img.pixel(x, y)[c];
-      s += v;
-      s2 += v * v;
-      ++n;
-    }
-  Moments m;
-  m.mean = s / n;
-  m.stderr_ = std::sqrt(std::fmax(0.0, s2 / n - m.mean * m.mean) / n);
-  return m;
-}
+using test::Moments;
+using test::regionMean;
 
 Image render(const std::string& scene, const std::string& args, const std::string& tag) {
   const std::string dir = test::tempDir(tag);
-  const auto r = test::runPathreuse("render '" + scene + "' --quiet --exr-float --out '" + dir +
-                                    "/f_%04d.exr' " + args);
+  const auto r = test::runPathreuse("render '" + scene + "' --quiet --exr-float --mode pathtrace --out '" +
+                                    dir + "/f_%04d.exr' " + args);
   EXPECT_EQ(r.exitCode, 0) << r.err;
   return readExr(dir + "/f_0000.exr");
 }
@@ -114,7 +96,7 @@ TEST(PathTrace, SameSeedSameFrameDifferentSeedSameMean) {
   const std::string args = "--frames 10 --width 40 --height 30 --spp 8";
   auto renderFrame = [&](const std::string& seed, const std::string& tag) {
     const std::string dir = test::tempDir(tag);
-    const auto r = test::runPathreuse("render '" + scene + "' --quiet --exr-float --seed " + seed +
+    const auto r = test::runPathreuse("render '" + scene + "' --quiet --exr-float --mode pathtrace --seed " + seed +
                                       " --out '" + dir + "/f_%04d.exr' " + args);
     EXPECT_EQ(r.exitCode, 0) << r.err;
     return readExr(dir + "/f_0010.exr");
@@ -148,7 +130,7 @@ TEST(PathTrace, NoNonFiniteSamplesOnTheDemoScenes) {
   for (const char* name : {"scenes/cornell-dynamic.gltf", "scenes/cornell-orbit.gltf"}) {
     const std::string dir = test::tempDir("nan");
     const auto r = test::runPathreuse("render '" + test::sourcePath(name) +
-                                      "' --quiet --frames 0-2 --width 48 --height 36 --spp 4 --out '" +
+                                      "' --quiet --mode pathtrace --frames 0-2 --width 48 --height 36 --spp 4 --out '" +
                                       dir + "/f_%04d.exr' --stats '" + dir + "/stats.jsonl'");
     ASSERT_EQ(r.exitCode, 0) << r.err;
     int lines = 0;
@@ -167,7 +149,7 @@ TEST(PathTrace, NoNonFiniteSamplesOnCornellNvpro) {
   const std::string scene = test::sharedScene("cornell-nvpro/cornellBox.gltf");
   if (scene.empty()) GTEST_SKIP() << "../shared/scenes/cornell-nvpro is absent";
   const std::string dir = test::tempDir("nan-nvpro");
-  const auto r = test::runPathreuse("render '" + scene + "' --quiet --frames 0 --width 64 --height 48 --spp 4 --out '" +
+  const auto r = test::runPathreuse("render '" + scene + "' --quiet --mode pathtrace --frames 0 --width 64 --height 48 --spp 4 --out '" +
                                     dir + "/f_%04d.exr' --stats '" + dir + "/stats.jsonl'");
   ASSERT_EQ(r.exitCode, 0) << r.err;
   int lines = 0;

@@ -1,0 +1,52 @@
+#include "support/render_helpers.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+
+#include "support/test_env.h"
+
+namespace pr::test {
+
+Moments regionMean(const Image& img, int x0, int y0, int x1, int y1, int c) {
+  double s = 0, s2 = 0;
+  int n = 0;
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x) {
+      const double v = img.pixel(x, y)[c];
+      s += v;
+      s2 += v * v;
+      ++n;
+    }
+  Moments m;
+  m.mean = s / n;
+  m.stderr_ = std::sqrt(std::fmax(0.0, s2 / n - m.mean * m.mean) / n);
+  return m;
+}
+
+std::string renderFrames(const std::string& scene, const std::string& frames, const std::string& args,
+                         const std::string& tag) {
+  const std::string dir = tempDir(tag);
+  const auto r = runPathreuse("render '" + scene + "' --quiet --exr-float --frames " + frames +
+                              " --out '" + dir + "/f_%04d.exr' --stats '" + dir + "/stats.jsonl' " + args);
+  EXPECT_EQ(r.exitCode, 0) << r.err;
+  return dir;
+}
+
+Image frameImage(const std::string& dir, int frame) {
+  char name[32];
+  std::snprintf(name, sizeof name, "/f_%04d.exr", frame);
+  return readExr(dir + name);
+}
+
+std::vector<std::string> statsLines(const std::string& dir) {
+  std::vector<std::string> lines;
+  std::ifstream in(dir + "/stats.jsonl");
+  std::string line;
+  while (std::getline(in, line)) lines.push_back(line);
+  return lines;
+}
+
+}  // namespace pr::test

@@ -1,0 +1,30 @@
+// Rendering through the command line in tests, and statistics of the images.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "io/image.h"
+
+namespace pr::test {
+
+struct Moments {
+  double mean = 0, stderr_ = 0;
+};
+
+// Mean of channel c over the pixel rectangle [x0, x1) x [y0, y1), with the standard error of
+// that mean (pixels are independent estimates).
+Moments regionMean(const Image& img, int x0, int y0, int x1, int y1, int c);
+
+// Renders `frames` ("A" or "A-B") of `scene` with extra `args` into a fresh folder; returns
+// the folder. Fails the current test on a non-zero exit.
+std::string renderFrames(const std::string& scene, const std::string& frames, const std::string& args,
+                         const std::string& tag);
+
+// The float EXR of frame f in a folder made by renderFrames.
+Image frameImage(const std::string& dir, int frame);
+
+// The JSON lines of dir/stats.jsonl.
+std::vector<std::string> statsLines(const std::string& dir);
+
+}  // namespace pr::test
