@@ -257,14 +257,11 @@ class DeviceTracer {
   // One launch; returns Mrays/s from the kernel's profiled duration.
   double run(bool anyHit) {
     if (n_ == 0) return 0.0;
-    cl::Event ev;
+    StageTimer timer;
     ctx_.finish();
-    ctx_.launch1D(anyHit ? any_ : closest_, n_, "ray_bench", &ev);
-    CL_CHECK(ev.wait());
-    cl_ulong start = 0, end = 0;
-    CL_CHECK(ev.getProfilingInfo(CL_PROFILING_COMMAND_START, &start));
-    CL_CHECK(ev.getProfilingInfo(CL_PROFILING_COMMAND_END, &end));
-    return double(n_) / (double(end - start) * 1e-9) * 1e-6;
+    ctx_.launch1D(anyHit ? any_ : closest_, n_, "ray_bench", &timer);
+    const double seconds = timer.collect()["ray_bench"];
+    return seconds > 0.0 ? double(n_) / seconds * 1e-6 : 0.0;
   }
 
   std::vector<Hit> hits() {

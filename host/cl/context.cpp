@@ -1,5 +1,6 @@
 #include "cl/context.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
@@ -190,12 +191,10 @@ void Context::zero(const cl::Buffer& buffer, uint64_t bytes) {
   }
 }
 
-void Context::launch1D(const cl::Kernel& kernel, size_t global, const char* what,
-                       cl::Event* event) {
+void Context::launch1D(const cl::Kernel& kernel, size_t global, const char* stage, StageTimer* timer) {
   if (global == 0) return;
   size_t local = 0;
-  cl_int err = kernel.getWorkGroupInfo(device_.device, CL_KERNEL_WORK_GROUP_SIZE, &local);
-  CL_CHECK(err);
+  CL_CHECK(kernel.getWorkGroupInfo(device_.device, CL_KERNEL_WORK_GROUP_SIZE, &local));
   size_t preferred = 0;
   if (kernel.getWorkGroupInfo(device_.device, CL_KERNEL_PREFERRED_WORK_GROUP_SIZE_MULTIPLE,
                               &preferred) == CL_SUCCESS &&
@@ -207,9 +206,14 @@ void Context::launch1D(const cl::Kernel& kernel, size_t global, const char* what
   }
   if (local == 0) local = 1;
   const size_t padded = (global + local - 1) / local * local;
-  err = queue_.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(padded), cl::NDRange(local),
-                                    nullptr, event);
-  if (err != CL_SUCCESS) throw ClError(std::string("launch of ") + what, err, __FILE__, __LINE__);
+  const size_t chunk = std::max(local, kMaxLaunchItems / local * local);
+  for (size_t offset = 0; offset < padded; offset += chunk) {
+    const size_t n = std::min(chunk, padded - offset);
+    const cl_int err = queue_.enqueueNDRangeKernel(kernel, cl::NDRange(offset), cl::NDRange(n),
+                                                   cl::NDRange(local), nullptr,
+                                                   timer ? timer->next(stage) : nullptr);
+    if (err != CL_SUCCESS) throw ClError(std::string("launch of ") + stage, err, __FILE__, __LINE__);
+  }
 }
 
 void Context::finish() { CL_CHECK(queue_.finish()); }

@@ -7,6 +7,7 @@
 
 #include "cl/cl.h"
 #include "cl/device.h"
+#include "cl/stage_timer.h"
 
 namespace pr {
 
@@ -49,10 +50,12 @@ class Context {
   void zero(const cl::Buffer& buffer, uint64_t bytes);
 
   // A 1-D launch of `global` work-items, padded to a multiple of the work-group size that the
-  // device reports for the kernel; kernels guard with their own count argument.
-  // With `event`, the launch's event is returned for profiling (the queue profiles).
-  void launch1D(const cl::Kernel& kernel, size_t global, const char* what,
-                cl::Event* event = nullptr);
+  // device reports for the kernel; kernels guard with their own count argument. Large launches
+  // are split into chunks of kMaxLaunchItems (with a global offset) so that no single launch
+  // runs long enough to trip a GPU watchdog. With a timer, each chunk's time counts for `stage`.
+  void launch1D(const cl::Kernel& kernel, size_t global, const char* stage,
+                StageTimer* timer = nullptr);
+  static constexpr size_t kMaxLaunchItems = size_t(1) << 18;
 
   void finish();
 

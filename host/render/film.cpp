@@ -24,7 +24,7 @@ void Film::accumulate(const cl::Buffer& radiance, uint32_t count, StageTimer* ti
   CL_CHECK(accumulate_.setArg(2, bad_));
   CL_CHECK(accumulate_.setArg(3, count));
   CL_CHECK(accumulate_.setArg(4, pixels()));
-  ctx_.launch1D(accumulate_, count, "accumulate", timer ? timer->next("accumulate") : nullptr);
+  ctx_.launch1D(accumulate_, count, "accumulate", timer);
 }
 
 Image Film::read(uint64_t* badSamples) {

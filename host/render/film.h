@@ -5,7 +5,7 @@
 
 #include "cl/context.h"
 #include "io/image.h"
-#include "render/stage_timer.h"
+#include "cl/stage_timer.h"
 
 namespace pr {
 

@@ -79,7 +79,7 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
     CL_CHECK(invalidate_.setArg(a + 4, list_));
     CL_CHECK(invalidate_.setArg(a + 5, counters_));
     (void)anyLightMoved;
-    ctx_.launch1D(invalidate_, slots_, "invalidate", timer.next("invalidate"));
+    ctx_.launch1D(invalidate_, slots_, "invalidate", &timer);
     CL_CHECK(ctx_.queue().enqueueReadBuffer(counters_, CL_TRUE, PR_C_LIST * 4, 4, &toTrace));
     list = &list_;
   }
@@ -95,7 +95,7 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
     CL_CHECK(lightTrace_.setArg(a + 4, *list));
     CL_CHECK(lightTrace_.setArg(a + 5, toTrace));
     CL_CHECK(lightTrace_.setArg(a + 6, counters_));
-    ctx_.launch1D(lightTrace_, toTrace, "light_trace", timer.next("light_trace"));
+    ctx_.launch1D(lightTrace_, toTrace, "light_trace", &timer);
   }
 
   // 3. Per sample: first hits, then connections, then the film.
@@ -116,8 +116,8 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
   for (int s = 0; s < settings_.spp; ++s) {
     CL_CHECK(eyeHit_.setArg(a + 2, cl_uint(s)));
     CL_CHECK(connect_.setArg(a + 1, cl_uint(s)));
-    ctx_.launch1D(eyeHit_, n, "eye_hit", timer.next("eye_hit"));
-    ctx_.launch1D(connect_, n, "connect", timer.next("connect"));
+    ctx_.launch1D(eyeHit_, n, "eye_hit", &timer);
+    ctx_.launch1D(connect_, n, "connect", &timer);
     film_.accumulate(radiance_, n, &timer);
   }
   ctx_.finish();

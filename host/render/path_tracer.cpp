@@ -73,11 +73,11 @@ void PathTracer::renderFrame(int frame, const dev::CameraParams& camera, FrameSt
   for (int s = 0; s < settings_.spp; ++s) {
     CL_CHECK(generate_.setArg(3, cl_uint(s)));
     CL_CHECK(shade_.setArg(first + 7, cl_uint(s)));
-    ctx_.launch1D(generate_, n, "pt_generate", timer.next("generate"));
+    ctx_.launch1D(generate_, n, "generate", &timer);
     for (int d = 0; d < settings_.maxDepth; ++d) {
-      ctx_.launch1D(extend_, n, "pt_extend", timer.next("extend"));
-      ctx_.launch1D(shade_, n, "pt_shade", timer.next("shade"));
-      ctx_.launch1D(shadow_, n, "pt_shadow", timer.next("shadow"));
+      ctx_.launch1D(extend_, n, "extend", &timer);
+      ctx_.launch1D(shade_, n, "shade", &timer);
+      ctx_.launch1D(shadow_, n, "shadow", &timer);
     }
     film_.accumulate(radiance_, n, &timer);
   }

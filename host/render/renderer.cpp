@@ -19,6 +19,7 @@
 #include "render/gpu_scene.h"
 #include "render/path_reuse.h"
 #include "render/path_tracer.h"
+#include "render/session.h"
 #include "scene/gltf_loader.h"
 #include "util/error.h"
 
@@ -36,79 +37,25 @@ std::string clock(double seconds) {
   return buf;
 }
 
-void chooseSize(const RenderOptions& o, const CameraPose& pose, int* w, int* h) {
-  const double aspect = pose.aspect > 0.0f ? pose.aspect : 4.0 / 3.0;
-  *w = o.width;
-  *h = o.height;
-  if (*w == 0 && *h == 0) {
-    *h = 480;
-    *w = pose.aspect > 0.0f ? std::max(1, int(std::lround(480 * aspect))) : 640;
-  } else if (*w == 0) {
-    *w = std::max(1, int(std::lround(*h * aspect)));
-  } else if (*h == 0) {
-    *h = std::max(1, int(std::lround(*w / aspect)));
-  }
-}
-
 }  // namespace
 
 int runRender(const RenderOptions& o) {
-  validateOutPattern(o.outPattern);
-  if (o.spp < 1) throw InputError("--spp " + std::to_string(o.spp) + ": must be at least 1");
-  if (o.maxDepth < 1 || o.maxDepth > 64)
-    throw InputError("--max-depth " + std::to_string(o.maxDepth) + ": must be 1 to 64");
-  if (!(o.fps > 0.0) || !std::isfinite(o.fps)) throw InputError("--fps: must be positive");
-  if (o.width < 0 || o.height < 0 || o.width > 16384 || o.height > 16384)
-    throw InputError("--width/--height: must be 1 to 16384");
-
+  validateRenderOptions(o);
   const Scene scene = loadScene(o.scene);
-  if (scene.staticTriangleCount() + scene.dynamicTriangleCount() == 0)
-    throw InputError(o.scene + ": nothing to render (no triangles)");
-  if (scene.emissiveTriangleCount() == 0 && scene.lights.empty())
+  if (scene.emissiveTriangleCount() == 0 && scene.lights.empty() && !o.quiet)
     std::cerr << "warning: " << o.scene << ": no lights; frames will be black\n";
-  const int cameraCount = static_cast<int>(scene.cameras.size());
-  const int cam = o.camera < 0 ? 0 : o.camera;
-  if (cam >= cameraCount)
-    throw InputError("--camera " + std::to_string(o.camera) + ": " + o.scene + " has " +
-                     std::to_string(cameraCount) + " camera(s)");
-  if (!scene.cameras[cam].perspective)
-    throw InputError(o.scene + ": camera " + std::to_string(cam) +
-                     " is orthographic; only perspective cameras are supported");
-
-  const int frameCount = static_cast<int>(scene.frameCount(o.fps));
-  FrameRange range = o.frames;
-  if (!o.framesGiven) range = {0, frameCount - 1};
-  if (range.last < 0) range.last = frameCount - 1;
-
-  int width = 0, height = 0;
-  chooseSize(o, scene.cameraAt(cam, 0.0), &width, &height);
-
   const auto devices = enumerateDevices();
   const DeviceEntry& device = selectDevice(devices, o.device);
-  Context ctx(device);
-  GpuSceneOptions sceneOptions;
-  sceneOptions.forceDiffuse = o.forceDiffuse;
-  GpuScene gpu(ctx, scene, sceneOptions);
-  Film film(ctx, width, height);
-  std::unique_ptr<Integrator> integrator;
-  switch (o.mode) {
-    case RenderMode::PathTrace:
-      integrator = std::make_unique<PathTracer>(ctx, gpu, film,
-                                                PathTracerSettings{o.spp, o.maxDepth, o.seed});
-      break;
-    case RenderMode::Reuse:
-    case RenderMode::Retrace: {
-      PathReuseSettings r;
-      r.spp = o.spp;
-      r.maxDepth = o.maxDepth;
-      r.seed = o.seed;
-      r.lightPaths = static_cast<uint32_t>(o.lightPaths);
-      r.pathsPerPixel = static_cast<uint32_t>(o.pathsPerPixel);
-      r.clamp = o.clamp;
-      r.retraceAll = o.mode == RenderMode::Retrace;
-      integrator = std::make_unique<PathReuse>(ctx, gpu, film, r);
-      break;
-    }
+  RenderSession session(scene, device, o);
+  const FrameRange range = session.frameRange();
+  if (!o.quiet) {
+    std::cerr << "rendering " << o.scene << " frames " << range.first << "-" << range.last << " at "
+              << session.width() << "x" << session.height() << ", " << o.spp << " spp, mode "
+              << renderModeName(o.mode) << ", on " << device.name;
+    if (auto* reuse = dynamic_cast<PathReuse*>(&session.integrator()))
+      std::cerr << "; arena " << reuse->slots() << " slots x " << reuse->stride() << " vertices = "
+                << (reuse->arenaBytes() >> 20) << " MiB";
+    std::cerr << "\n";
   }
 
   std::unique_ptr<std::ofstream> stats;
@@ -125,18 +72,12 @@ int runRender(const RenderOptions& o) {
   uint64_t raysSoFar = 0;
   for (int f = range.first; f <= range.last; ++f) {
     const auto t0 = std::chrono::steady_clock::now();
-    const double time = f / o.fps;
-    gpu.setTime(time);
-    film.clear();
     FrameStats fs;
-    fs.frame = f;
-    integrator->renderFrame(f, gpu.camera(cam, time, width, height), &fs);
-    Image img = film.read(&fs.badSamples);
+    const Image img = session.renderFrame(f, &fs);
     const std::string exr = formatOutPath(o.outPattern, f);
     writeExr(exr, img, o.exrFloat ? ExrPixels::Float : ExrPixels::Half);
     if (o.png) writePng(withExtension(exr, ".png"), img, o.exposure);
     fs.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    fs.deviceBytes = ctx.bytesInUse();
     uint64_t frameRays = 0;
     for (const auto& [k, v] : fs.rays) frameRays += v;
     raysSoFar += frameRays;

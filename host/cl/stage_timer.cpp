@@ -1,4 +1,4 @@
-#include "render/stage_timer.h"
+#include "cl/stage_timer.h"
 
 namespace pr {
 

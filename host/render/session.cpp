@@ -1,0 +1,106 @@
+#include "render/session.h"
+
+#include <cmath>
+
+#include "render/path_reuse.h"
+#include "render/path_tracer.h"
+#include "util/error.h"
+
+namespace pr {
+
+namespace {
+
+void chooseSize(const RenderOptions& o, const CameraPose& pose, int* w, int* h) {
+  const double aspect = pose.aspect > 0.0f ? pose.aspect : 4.0 / 3.0;
+  *w = o.width;
+  *h = o.height;
+  if (*w == 0 && *h == 0) {
+    *h = 480;
+    *w = pose.aspect > 0.0f ? std::max(1, int(std::lround(480 * aspect))) : 640;
+  } else if (*w == 0) {
+    *w = std::max(1, int(std::lround(*h * aspect)));
+  } else if (*h == 0) {
+    *h = std::max(1, int(std::lround(*w / aspect)));
+  }
+}
+
+int checkedCamera(const Scene& scene, const RenderOptions& o) {
+  const int count = static_cast<int>(scene.cameras.size());
+  const int cam = o.camera < 0 ? 0 : o.camera;
+  if (cam >= count)
+    throw InputError("--camera " + std::to_string(o.camera) + ": " + o.scene + " has " +
+                     std::to_string(count) + " camera(s)");
+  if (!scene.cameras[cam].perspective)
+    throw InputError(o.scene + ": camera " + std::to_string(cam) +
+                     " is orthographic; only perspective cameras are supported");
+  return cam;
+}
+
+}  // namespace
+
+void validateRenderOptions(const RenderOptions& o) {
+  validateOutPattern(o.outPattern);
+  if (o.spp < 1 || o.spp > 1 << 20) throw InputError("--spp " + std::to_string(o.spp) + ": must be 1 to 1048576");
+  if (o.maxDepth < 1 || o.maxDepth > 64)
+    throw InputError("--max-depth " + std::to_string(o.maxDepth) + ": must be 1 to 64");
+  if (o.mode != RenderMode::PathTrace && o.maxDepth < 2)
+    throw InputError("--max-depth " + std::to_string(o.maxDepth) + ": path reuse needs at least 2");
+  if (!(o.fps > 0.0) || !std::isfinite(o.fps) || o.fps > 1000.0) throw InputError("--fps: must be in (0, 1000]");
+  if (o.width < 0 || o.height < 0 || o.width > 16384 || o.height > 16384)
+    throw InputError("--width/--height: must be 1 to 16384");
+  if (o.lightPaths < 0 || o.lightPaths > (1 << 26))
+    throw InputError("--light-paths " + std::to_string(o.lightPaths) + ": must be 1 to 67108864");
+  if (o.pathsPerPixel < 1 || o.pathsPerPixel > 64)
+    throw InputError("--paths-per-pixel " + std::to_string(o.pathsPerPixel) + ": must be 1 to 64");
+  if (!(o.clamp >= 0.0f) || !std::isfinite(o.clamp)) throw InputError("--clamp: must be 0 (off) or positive");
+  if (!std::isfinite(o.exposure)) throw InputError("--exposure: must be finite");
+}
+
+RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device, const RenderOptions& options)
+    : scene_(scene), options_(options), ctx_(device) {
+  if (scene.staticTriangleCount() + scene.dynamicTriangleCount() == 0)
+    throw InputError(options.scene + ": nothing to render (no triangles)");
+  camera_ = checkedCamera(scene, options);
+  frameCount_ = static_cast<int>(scene.frameCount(options.fps));
+  chooseSize(options, scene.cameraAt(camera_, 0.0), &width_, &height_);
+  GpuSceneOptions sceneOptions;
+  sceneOptions.forceDiffuse = options.forceDiffuse;
+  gpu_ = std::make_unique<GpuScene>(ctx_, scene, sceneOptions);
+  film_ = std::make_unique<Film>(ctx_, width_, height_);
+  const RenderOptions& o = options_;
+  if (o.mode == RenderMode::PathTrace) {
+    integrator_ = std::make_unique<PathTracer>(ctx_, *gpu_, *film_, PathTracerSettings{o.spp, o.maxDepth, o.seed});
+  } else {
+    PathReuseSettings r;
+    r.spp = o.spp;
+    r.maxDepth = o.maxDepth;
+    r.seed = o.seed;
+    r.lightPaths = static_cast<uint32_t>(o.lightPaths);
+    r.pathsPerPixel = static_cast<uint32_t>(o.pathsPerPixel);
+    r.clamp = o.clamp;
+    r.retraceAll = o.mode == RenderMode::Retrace;
+    integrator_ = std::make_unique<PathReuse>(ctx_, *gpu_, *film_, r);
+  }
+}
+
+FrameRange RenderSession::frameRange() const {
+  FrameRange range = options_.frames;
+  if (!options_.framesGiven) range = {0, frameCount_ - 1};
+  if (range.last < 0) range.last = frameCount_ - 1;
+  return range;
+}
+
+Image RenderSession::renderFrame(int frame, FrameStats* stats) {
+  const double time = frame / options_.fps;
+  gpu_->setTime(time);
+  film_->clear();
+  FrameStats local;
+  FrameStats* fs = stats ? stats : &local;
+  fs->frame = frame;
+  integrator_->renderFrame(frame, gpu_->camera(camera_, time, width_, height_), fs);
+  Image img = film_->read(&fs->badSamples);
+  fs->deviceBytes = ctx_.bytesInUse();
+  return img;
+}
+
+}  // namespace pr

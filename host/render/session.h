@@ -1,0 +1,52 @@
+// One scene on one device with one rendering mode: everything needed to render its frames to
+// images in memory. `pathreuse render` writes them to files; `pathreuse portability` compares
+// them across devices.
+#pragma once
+
+#include <memory>
+
+#include "cl/context.h"
+#include "cl/device.h"
+#include "io/image.h"
+#include "render/film.h"
+#include "render/gpu_scene.h"
+#include "render/integrator.h"
+#include "render/options.h"
+#include "scene/scene.h"
+
+namespace pr {
+
+// Checks the options that do not need the scene; throws InputError naming the option.
+void validateRenderOptions(const RenderOptions& o);
+
+class RenderSession {
+ public:
+  // `scene` must outlive the session. Picks the camera and image size, builds the device scene
+  // and the integrator. Throws InputError for a camera that does not exist or is orthographic.
+  RenderSession(const Scene& scene, const DeviceEntry& device, const RenderOptions& options);
+
+  // Renders frame f (time f / fps). Frames must come in increasing order for reuse to apply;
+  // any order gives correct images.
+  Image renderFrame(int frame, FrameStats* stats);
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  Context& context() { return ctx_; }
+  Integrator& integrator() { return *integrator_; }
+  // The frames of the animation at the session's fps, and the range the options ask for.
+  int frameCount() const { return frameCount_; }
+  FrameRange frameRange() const;
+
+ private:
+  const Scene& scene_;
+  RenderOptions options_;
+  int camera_ = 0;
+  int width_ = 0, height_ = 0;
+  int frameCount_ = 1;
+  Context ctx_;
+  std::unique_ptr<GpuScene> gpu_;
+  std::unique_ptr<Film> film_;
+  std::unique_ptr<Integrator> integrator_;
+};
+
+}  // namespace pr
