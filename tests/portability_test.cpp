@@ -47,7 +47,9 @@ Image noisy(uint32_t seed, double gain = 1.0, int w = 64, int h = 48) {
 struct Synthetic {
   Image ref = noisy(1);
   std::vector<NoiseFloor> floors = measureNoiseFloors({ref}, {{noisy(2)}, {noisy(3)}});
-  Verdict judgeImage(const Image& test) const { return judge(compareImages(test, ref), floors[0], Tolerance{}); }
+  Verdict judgeImage(const Image& test) const {
+    return judge(compareImages(test, ref), floors[0], Tolerance{});
+  }
 };
 
 TEST(PortabilityCompare, MetricsOfKnownImages) {
@@ -163,10 +165,11 @@ TEST_P(PortabilityVerdict, AnotherSeedAgreesAFaultDisagrees) {
     if (m.name == "red") m.baseColorFactor = glm::vec4(0.05f, 0.065f, 0.63f, 1.0f);
   const RenderMode mode = GetParam();
   const auto ref = renderFrames(scene, mode, 1);
-  const auto floors = measureNoiseFloors(ref, {renderFrames(scene, mode, 2), renderFrames(scene, mode, 3)});
+  const auto floors =
+      measureNoiseFloors(ref, {renderFrames(scene, mode, 2), renderFrames(scene, mode, 3)});
   const auto other = renderFrames(scene, mode, 7);
-  const auto dimmed = renderFrames(dim, mode, 1);   // same seed: the paths are the reference's
-  const auto wrong = renderFrames(blue, mode, 8);   // other seed: the fault under fresh noise
+  const auto dimmed = renderFrames(dim, mode, 1);  // same seed: the paths are the reference's
+  const auto wrong = renderFrames(blue, mode, 8);  // other seed: the fault under fresh noise
   for (size_t f = 0; f < ref.size(); ++f) {
     const Verdict ok = judge(compareImages(other[f], ref[f]), floors[f], Tolerance{});
     EXPECT_TRUE(ok.agree) << "frame " << f << " ratio " << ok.relMseRatio << " z " << ok.lumZ;
@@ -187,8 +190,10 @@ std::string smallScene() {
   const int white = b.addMaterial({glm::vec4(0.7f, 0.7f, 0.7f, 1), 0, 1});
   const int lamp = b.addMaterial({glm::vec4(0, 0, 0, 1), 0, 1, glm::vec3(1), 10.0f});
   b.addNode(b.addBox(glm::vec3(-1, 0, -1), glm::vec3(1, 2, 1), white, true));
-  b.addNode(b.addQuad({-0.3f, 1.98f, -0.3f}, {0.3f, 1.98f, -0.3f}, {0.3f, 1.98f, 0.3f}, {-0.3f, 1.98f, 0.3f}, lamp));
-  const int cube = b.addNode(b.addBox(glm::vec3(-0.2f), glm::vec3(0.2f), white), glm::vec3(0, 0.5f, 0));
+  b.addNode(b.addQuad({-0.3f, 1.98f, -0.3f}, {0.3f, 1.98f, -0.3f}, {0.3f, 1.98f, 0.3f},
+                      {-0.3f, 1.98f, 0.3f}, lamp));
+  const int cube =
+      b.addNode(b.addBox(glm::vec3(-0.2f), glm::vec3(0.2f), white), glm::vec3(0, 0.5f, 0));
   b.animateTranslation(cube, {0.0f, 1.0f}, {glm::vec3(-0.4f, 0.5f, 0), glm::vec3(0.4f, 0.5f, 0)});
   b.addCamera(glm::vec3(0, 1, 0.95f), glm::vec3(0, 1, -1), 1.2f, 4.0f / 3.0f);
   return b.write(test::tempDir("port-scene"), "small_box");
@@ -197,9 +202,10 @@ std::string smallScene() {
 TEST(PortabilityCli, TwoPoclDriversAgreeOnTheSuite) {
   const std::string out = test::tempDir("port-out");
   const std::string scene = smallScene();
-  const auto r = test::runPathreuse("portability '" + scene + "' --json --quiet --frames 0-1 --width 32 --spp 4 --out '" +
-                                        out + "'",
-                                    kTwoDrivers);
+  const auto r =
+      test::runPathreuse("portability '" + scene +
+                             "' --json --quiet --frames 0-1 --width 32 --spp 4 --out '" + out + "'",
+                         kTwoDrivers);
   ASSERT_EQ(r.exitCode, 0) << r.out << r.err;
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_EQ(j["devices"].size(), 2u);
@@ -229,7 +235,8 @@ TEST(PortabilityCli, TwoPoclDriversAgreeOnTheSuite) {
 TEST(PortabilityCli, TableAndSummaryOnStdout) {
   const std::string out = test::tempDir("port-table");
   const auto r = test::runPathreuse(
-      "portability --quiet --frames 0 --width 32 --spp 2 --mode pathtrace --out '" + out + "'", kTwoDrivers);
+      "portability --quiet --frames 0 --width 32 --spp 2 --mode pathtrace --out '" + out + "'",
+      kTwoDrivers);
   ASSERT_EQ(r.exitCode, 0) << r.out << r.err;
   EXPECT_NE(r.out.find("relMSE*"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("cornell-orbit      pathtrace     0"), std::string::npos) << r.out;
@@ -238,16 +245,17 @@ TEST(PortabilityCli, TableAndSummaryOnStdout) {
 }
 
 TEST(PortabilityCli, OneDeviceHasNothingToCompare) {
-  const auto r = test::runPathreuse("portability --quiet --frames 0 --width 16 --spp 1 --mode pathtrace --device 0 --out '" +
-                                        test::tempDir("port-one") + "'",
-                                    kTwoDrivers);
+  const auto r = test::runPathreuse(
+      "portability --quiet --frames 0 --width 16 --spp 1 --mode pathtrace --device 0 --out '" +
+          test::tempDir("port-one") + "'",
+      kTwoDrivers);
   EXPECT_EQ(r.exitCode, 0) << r.err;
   EXPECT_NE(r.out.find("nothing to compare"), std::string::npos) << r.out;
 }
 
 TEST(PortabilityCli, BadInputIsOneLineAndExitTwo) {
-  for (const std::string args : {"--device 9", "/no/such/scene.gltf", "--frames 2-1", "--mode fast", "--tolerance 0.5",
-                                 "--no-demo", "--spp 0"}) {
+  for (const std::string args : {"--device 9", "/no/such/scene.gltf", "--frames 2-1", "--mode fast",
+                                 "--tolerance 0.5", "--no-demo", "--spp 0"}) {
     const auto r = test::runPathreuse("portability --quiet " + args, kTwoDrivers);
     EXPECT_EQ(r.exitCode, 2) << args << ": " << r.err;
     EXPECT_EQ(lineCount(r.err), 1u) << args << ": " << r.err;

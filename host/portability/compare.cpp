@@ -14,7 +14,9 @@ namespace {
 // Share of pixels left out of each statistic of the verdict (compare.h says why).
 constexpr double kTrimFraction = 0.01;
 
-double luminance(const float* p) { return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]; }
+double luminance(const float* p) {
+  return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+}
 
 void checkSizes(const Image& a, const Image& b) {
   if (a.width != b.width || a.height != b.height || a.rgba.size() != b.rgba.size() ||
@@ -30,7 +32,8 @@ ImageDiff compareImages(const Image& test, const Image& ref) {
   checkSizes(test, ref);
   ImageDiff d;
   const size_t pixels = static_cast<size_t>(test.width) * test.height;
-  d.identical = std::memcmp(test.rgba.data(), ref.rgba.data(), test.rgba.size() * sizeof(float)) == 0;
+  d.identical =
+      std::memcmp(test.rgba.data(), ref.rgba.data(), test.rgba.size() * sizeof(float)) == 0;
   std::vector<double> rel, lumDiff;  // per finite pixel
   rel.reserve(pixels);
   lumDiff.reserve(pixels);
@@ -123,7 +126,7 @@ Verdict judge(const ImageDiff& diff, const NoiseFloor& floor, const Tolerance& t
   Verdict v;
   const double inf = std::numeric_limits<double>::infinity();
   v.relMseRatio = floor.relMseTrimmed > 0.0 ? diff.relMseTrimmed / floor.relMseTrimmed
-                                             : (diff.relMseTrimmed > 0.0 ? inf : 0.0);
+                                            : (diff.relMseTrimmed > 0.0 ? inf : 0.0);
   const double dLum = std::fabs(diff.lumDiff);
   v.lumZ = floor.lumStdErr > 0.0 ? dLum / floor.lumStdErr : (dLum > 0.0 ? inf : 0.0);
   auto fail = [&](std::string why) {

@@ -28,15 +28,17 @@ namespace pr {
 
 // Per-pixel error metrics of `test` against `ref` (same size; RGB only, alpha ignored).
 struct ImageDiff {
-  double relMse = 0.0;         // mean over pixels and channels of (I - R)^2 / (R^2 + 0.01)
-  double relMseTrimmed = 0.0;  // the same sum without the pixels with the 1% largest terms, over all pixels
-  double mad = 0.0;            // mean absolute difference over pixels and channels
-  double meanLum = 0.0;        // mean Rec.709 luminance of `test`
-  double refMeanLum = 0.0;     // same of `ref`
-  double lumDiff = 0.0;        // trimmed mean (1% off each end) of the per-pixel luminance difference
-  double lumDiffStdErr = 0.0;  // its standard error from the winsorized spread, pixels taken as independent
-  uint64_t nonFinite = 0;      // non-finite values in either image
-  bool identical = false;      // bit for bit
+  double relMse = 0.0;  // mean over pixels and channels of (I - R)^2 / (R^2 + 0.01)
+  double relMseTrimmed =
+      0.0;           // the same sum without the pixels with the 1% largest terms, over all pixels
+  double mad = 0.0;  // mean absolute difference over pixels and channels
+  double meanLum = 0.0;     // mean Rec.709 luminance of `test`
+  double refMeanLum = 0.0;  // same of `ref`
+  double lumDiff = 0.0;     // trimmed mean (1% off each end) of the per-pixel luminance difference
+  double lumDiffStdErr =
+      0.0;  // its standard error from the winsorized spread, pixels taken as independent
+  uint64_t nonFinite = 0;  // non-finite values in either image
+  bool identical = false;  // bit for bit
 };
 
 // Throws RuntimeError when the sizes differ (an internal error: both come from one session setup).
@@ -54,7 +56,7 @@ struct NoiseFloor {
   double lumStdErr = 0.0;
   double lumStdErrPixels = 0.0;
   double lumStdErrSeeds = 0.0;
-  uint64_t nonFinite = 0;      // non-finite values in the renders
+  uint64_t nonFinite = 0;  // non-finite values in the renders
 };
 
 // Per frame, from the reference renders `ref[f]` and renders of the same frames with other
@@ -76,8 +78,9 @@ struct Tolerance {
 
 struct Verdict {
   bool agree = true;
-  double relMseRatio = 0.0;  // trimmed relMSE / the floor's (0 when both are 0, inf for a zero floor)
-  double lumZ = 0.0;         // |trimmed mean luminance difference| in floor standard errors
+  double relMseRatio =
+      0.0;            // trimmed relMSE / the floor's (0 when both are 0, inf for a zero floor)
+  double lumZ = 0.0;  // |trimmed mean luminance difference| in floor standard errors
   std::vector<std::string> reasons;  // why it disagrees; empty when it agrees
 };
 

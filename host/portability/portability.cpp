@@ -70,15 +70,19 @@ std::string executableDir() {
 // File-name-safe form of a label.
 std::string safeName(const std::string& s) {
   std::string out;
-  for (char c : s) out += (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '.') ? c : '_';
+  for (char c : s)
+    out += (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '.') ? c : '_';
   return out;
 }
 
 void validate(const PortabilityOptions& o) {
-  if (o.width < 1 || o.width > 4096) throw InputError("--width " + std::to_string(o.width) + ": must be 1 to 4096");
+  if (o.width < 1 || o.width > 4096)
+    throw InputError("--width " + std::to_string(o.width) + ": must be 1 to 4096");
   if (o.height < 0 || o.height > 4096)
-    throw InputError("--height " + std::to_string(o.height) + ": must be 1 to 4096 (0: from the camera)");
-  if (o.spp < 1 || o.spp > 4096) throw InputError("--spp " + std::to_string(o.spp) + ": must be 1 to 4096");
+    throw InputError("--height " + std::to_string(o.height) +
+                     ": must be 1 to 4096 (0: from the camera)");
+  if (o.spp < 1 || o.spp > 4096)
+    throw InputError("--spp " + std::to_string(o.spp) + ": must be 1 to 4096");
   if (!(o.tolerance.relMseFactor >= 1.0) || !std::isfinite(o.tolerance.relMseFactor))
     throw InputError("--tolerance: must be at least 1 (a multiple of the noise floor)");
   if (!(o.tolerance.lumSigmas > 0.0) || !std::isfinite(o.tolerance.lumSigmas))
@@ -90,8 +94,8 @@ void validate(const PortabilityOptions& o) {
 FrameSet renderSet(const SuiteScene& s, const DeviceEntry& device, const RenderOptions& ro,
                    const std::vector<int>& frames, bool quiet) {
   if (!quiet)
-    std::cerr << "portability: " << s.label << " " << renderModeName(ro.mode) << " seed " << ro.seed << " on ["
-              << device.index << "] " << device.name << "\n";
+    std::cerr << "portability: " << s.label << " " << renderModeName(ro.mode) << " seed " << ro.seed
+              << " on [" << device.index << "] " << device.name << "\n";
   RenderSession session(*s.scene, device, ro);
   FrameSet set;
   for (int f : frames) {  // increasing, so reuse carries paths from frame to frame
@@ -123,7 +127,9 @@ std::string sci(double v) {
 }
 
 // JSON has no infinity; a zero floor with a non-zero difference is reported as null.
-nlohmann::json number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+nlohmann::json number(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
 
 }  // namespace
 
@@ -136,7 +142,8 @@ std::vector<int> parseFrameList(const std::string& text) {
     if (r.last - r.first > 1000) throw InputError("--frames " + text + ": at most 1000 frames");
     for (int f = r.first; f <= r.last; ++f) frames.push_back(f);
   }
-  if (frames.empty() || text.back() == ',') throw InputError("--frames " + text + ": expected A, A-B or a list A,B-C");
+  if (frames.empty() || text.back() == ',')
+    throw InputError("--frames " + text + ": expected A, A-B or a list A,B-C");
   std::sort(frames.begin(), frames.end());
   frames.erase(std::unique(frames.begin(), frames.end()), frames.end());
   if (frames.size() > 1000) throw InputError("--frames " + text + ": at most 1000 frames");
@@ -151,13 +158,15 @@ std::vector<std::string> demoScenePaths() {
   for (const auto& dir : dirs) {
     std::vector<std::string> paths;
     for (const char* name : kDemoScenes)
-      if (fs::is_regular_file(dir / name)) paths.push_back((dir / name).lexically_normal().string());
+      if (fs::is_regular_file(dir / name))
+        paths.push_back((dir / name).lexically_normal().string());
     if (paths.size() == std::size(kDemoScenes)) return paths;
   }
   std::string tried;
-  for (const auto& dir : dirs) tried += (tried.empty() ? "" : ", ") + dir.lexically_normal().string();
-  throw InputError("demo scenes cornell-dynamic.gltf and cornell-orbit.gltf not found (looked in " + tried +
-                   "); pass scenes with --no-demo");
+  for (const auto& dir : dirs)
+    tried += (tried.empty() ? "" : ", ") + dir.lexically_normal().string();
+  throw InputError("demo scenes cornell-dynamic.gltf and cornell-orbit.gltf not found (looked in " +
+                   tried + "); pass scenes with --no-demo");
 }
 
 int runPortability(const PortabilityOptions& o) {
@@ -204,7 +213,8 @@ int runPortability(const PortabilityOptions& o) {
 
   const bool compare = devices.size() > 1;
   std::vector<Row> rows;
-  double worstBadness = -1.0;  // the comparison furthest past its tolerance gets its difference written
+  double worstBadness =
+      -1.0;  // the comparison furthest past its tolerance gets its difference written
   const Row* worstRow = nullptr;
   size_t worstIndex = 0;
   Image worstImage;
@@ -256,9 +266,10 @@ int runPortability(const PortabilityOptions& o) {
   std::string worstPng;
   if (!rows.empty()) {
     worstRow = &rows[worstIndex];
-    worstPng = (fs::path(o.outDir) / ("worst_" + safeName(scenes[worstRow->scene].label) + "_" +
-                                      renderModeName(worstRow->mode) + "_f" + std::to_string(worstRow->frame) +
-                                      "_dev" + std::to_string(devices[worstRow->device]->index) + ".png"))
+    worstPng = (fs::path(o.outDir) /
+                ("worst_" + safeName(scenes[worstRow->scene].label) + "_" +
+                 renderModeName(worstRow->mode) + "_f" + std::to_string(worstRow->frame) + "_dev" +
+                 std::to_string(devices[worstRow->device]->index) + ".png"))
                    .string();
     writePng(worstPng, worstImage);
   }
@@ -272,12 +283,9 @@ int runPortability(const PortabilityOptions& o) {
 
   if (o.json) {
     nlohmann::ordered_json j;
-    j["settings"] = {{"frames", frames},
-                     {"width", width},
-                     {"height", height},
-                     {"spp", o.spp},
-                     {"seed", o.seed},
-                     {"noise_floor_seeds", {o.seed + 1, o.seed + kFloorSeeds}}};
+    j["settings"] = {{"frames", frames}, {"width", width},
+                     {"height", height}, {"spp", o.spp},
+                     {"seed", o.seed},   {"noise_floor_seeds", {o.seed + 1, o.seed + kFloorSeeds}}};
     j["tolerance"] = {{"relmse_factor", o.tolerance.relMseFactor},
                       {"luminance_sigmas", o.tolerance.lumSigmas},
                       {"relmse_slack", o.tolerance.relMseSlack}};
@@ -344,34 +352,43 @@ int runPortability(const PortabilityOptions& o) {
               << (i == 0 ? " (reference)" : "");
   std::cout << "\n";
   if (!compare) {
-    std::cout << "nothing to compare: only one device; rendered the suite on it (" << scenes.size()
-              << " scene(s) x " << modes.size() << " mode(s) x " << frames.size()
-              << " frame(s)). Name a second one with --device, e.g. POCL_DEVICES=\"pthread basic\".\n";
+    std::cout
+        << "nothing to compare: only one device; rendered the suite on it (" << scenes.size()
+        << " scene(s) x " << modes.size() << " mode(s) x " << frames.size()
+        << " frame(s)). Name a second one with --device, e.g. POCL_DEVICES=\"pthread basic\".\n";
     return kExitOk;
   }
   std::cout << "suite: " << width << "x" << height << ", " << o.spp << " spp, seed " << o.seed
             << "; floor = reference device at seeds " << o.seed + 1 << "-" << o.seed + kFloorSeeds
             << "; * = without the worst 1% of pixels\n"
-            << "a device disagrees when relMSE* > " << o.tolerance.relMseFactor << " x floor*, when its mean luminance is "
-            << o.tolerance.lumSigmas << " standard errors off (lum z), or on any NaN/Inf\n";
+            << "a device disagrees when relMSE* > " << o.tolerance.relMseFactor
+            << " x floor*, when its mean luminance is " << o.tolerance.lumSigmas
+            << " standard errors off (lum z), or on any NaN/Inf\n";
   char line[256];
-  std::snprintf(line, sizeof line, "%-18s %-9s %5s %4s %10s %10s %10s %6s %10s %6s %4s %s", "scene", "mode",
-                "frame", "dev", "relMSE", "relMSE*", "floor*", "ratio", "MAD", "lum z", "same", "verdict");
+  std::snprintf(line, sizeof line, "%-18s %-9s %5s %4s %10s %10s %10s %6s %10s %6s %4s %s", "scene",
+                "mode", "frame", "dev", "relMSE", "relMSE*", "floor*", "ratio", "MAD", "lum z",
+                "same", "verdict");
   std::cout << line << "\n";
   for (const auto& r : rows) {
     std::string verdict = r.verdict.agree ? "agree" : "DISAGREE";
     for (size_t i = 0; i < r.verdict.reasons.size(); ++i)
       verdict += (i ? "; " : ": ") + r.verdict.reasons[i];
     std::snprintf(line, sizeof line, "%-18s %-9s %5d %4d %10s %10s %10s %6s %10s %6s %4s ",
-                  scenes[r.scene].label.c_str(), renderModeName(r.mode), r.frame, devices[r.device]->index,
-                  sci(r.diff.relMse).c_str(), sci(r.diff.relMseTrimmed).c_str(), sci(r.floor.relMseTrimmed).c_str(),
-                  fixed(r.verdict.relMseRatio, 2).c_str(), sci(r.diff.mad).c_str(), fixed(r.verdict.lumZ, 2).c_str(),
-                  r.diff.identical ? "yes" : "no");
+                  scenes[r.scene].label.c_str(), renderModeName(r.mode), r.frame,
+                  devices[r.device]->index, sci(r.diff.relMse).c_str(),
+                  sci(r.diff.relMseTrimmed).c_str(), sci(r.floor.relMseTrimmed).c_str(),
+                  fixed(r.verdict.relMseRatio, 2).c_str(), sci(r.diff.mad).c_str(),
+                  fixed(r.verdict.lumZ, 2).c_str(), r.diff.identical ? "yes" : "no");
     std::cout << line << verdict << "\n";
   }
-  std::cout << "worst difference: " << worstPng << " (|device - reference| x " << sci(worstScale) << ")\n";
-  std::cout << (disagree ? "FAIL: " : "OK: ") << disagree << " of " << rows.size() << " comparisons disagree ("
-            << identical << " bit-identical) across " << devices.size() << " devices\n";
+  std::cout << "worst difference: " << worstPng;
+  if (worstRow->diff.identical)
+    std::cout << " (black: every frame is bit-identical)\n";
+  else
+    std::cout << " (|device - reference| x " << sci(worstScale) << ")\n";
+  std::cout << (disagree ? "FAIL: " : "OK: ") << disagree << " of " << rows.size()
+            << " comparisons disagree (" << identical << " bit-identical) across " << devices.size()
+            << " devices\n";
   return exitCode;
 }
 

@@ -12,15 +12,15 @@
 namespace pr {
 
 struct PortabilityOptions {
-  std::vector<std::string> scenes;    // added to the demo scenes
-  bool demoScenes = true;             // false: only `scenes`
-  std::string frames = "0-2,24";      // consecutive frames so reuse reuses, and a later one
+  std::vector<std::string> scenes;  // added to the demo scenes
+  bool demoScenes = true;           // false: only `scenes`
+  std::string frames = "0-2,24";    // consecutive frames so reuse reuses, and a later one
   int width = 64;
-  int height = 0;                     // 0: from the camera's aspect (48 for the demo scenes)
+  int height = 0;  // 0: from the camera's aspect (48 for the demo scenes)
   int spp = 8;
   uint32_t seed = 1;
-  std::vector<std::string> modes;     // empty: reuse, retrace, pathtrace
-  std::vector<std::string> devices;   // --device specs; empty: every device found
+  std::vector<std::string> modes;    // empty: reuse, retrace, pathtrace
+  std::vector<std::string> devices;  // --device specs; empty: every device found
   Tolerance tolerance;
   bool json = false;
   std::string outDir = "out/portability";
