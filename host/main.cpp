@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cl/device.h"
+#include "portability/portability.h"
 #include "render/options.h"
 #include "render/renderer.h"
 #include "scene/gltf_loader.h"
@@ -97,6 +98,53 @@ int main(int argc, char** argv) {
                    "Shade every non-delta material as pure Lambert with its base colour (a diagnostic)");
   render->add_option("--stats", ro.statsFile, "Write one JSON line per frame to this file");
 
+  pr::PortabilityOptions po;
+  bool noDemo = false;
+  auto* portability = app.add_subcommand(
+      "portability", "Render a fixed suite on every OpenCL device and compare the images");
+  portability->footer(
+      // clang-format off
+      "Renders a fixed suite on every OpenCL device and compares each device's frames with the\n"
+      "first's. Round-off may send paths another way on another device, so the check is\n"
+      "statistical: the first device renders the suite again with seeds seed+1 and seed+2, and\n"
+      "these independent estimates give each frame's noise floor. A device whose paths diverge\n"
+      "is at worst another seed; a fault adds a systematic error. Leaving out the 1% most\n"
+      "extreme pixels (fireflies), a device disagrees when its relMSE > TOLERANCE x the floor's,\n"
+      "when its mean luminance is more than SIGMAS standard errors off, or on any NaN/Inf.\n"
+      "Exit 0: all agree (or only one device: nothing to compare); 1: a device disagrees;\n"
+      "2: bad input.");
+  // clang-format on
+  portability->add_option("SCENES", po.scenes, "glTF files tested besides the demo scenes");
+  portability->add_flag("--no-demo", noDemo, "Test only the given scenes, not the demo scenes");
+  portability->add_option("--frames", po.frames, "Frames: A, A-B or a list (A,B-C)")
+      ->capture_default_str();
+  portability->add_option("--width", po.width, "Image width")->capture_default_str();
+  portability->add_option("--height", po.height,
+                          "Image height (default: from the camera's aspect)");
+  portability->add_option("--spp", po.spp, "Samples per pixel per frame")->capture_default_str();
+  portability->add_option("--seed", po.seed, "Random seed (the noise floor uses seed+1 and seed+2)")
+      ->capture_default_str();
+  portability
+      ->add_option("--mode", po.modes,
+                   "reuse, retrace or pathtrace; repeatable (default: all three)")
+      ->check(CLI::IsMember({"reuse", "retrace", "pathtrace"}));
+  portability->add_option(
+      "--device", po.devices,
+      "Device (index, P:D, cpu, gpu or part of its name); repeatable, the first is the "
+      "reference (default: every device found)");
+  portability
+      ->add_option("--tolerance", po.tolerance.relMseFactor,
+                   "A device disagrees when its relMSE exceeds this multiple of the noise floor")
+      ->capture_default_str();
+  portability
+      ->add_option("--sigmas", po.tolerance.lumSigmas,
+                   "... or when its mean luminance is this many standard errors off")
+      ->capture_default_str();
+  portability->add_flag("--json", po.json, "Print one JSON document instead of the table");
+  portability->add_option("--out", po.outDir, "Folder for the PNG of the worst difference")
+      ->capture_default_str();
+  portability->add_flag("-q,--quiet", po.quiet, "No progress lines on stderr");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -122,6 +170,10 @@ int main(int argc, char** argv) {
                 : modeText == "retrace"   ? pr::RenderMode::Retrace
                                           : pr::RenderMode::Reuse;
       return pr::runRender(ro);
+    }
+    if (*portability) {
+      po.demoScenes = !noDemo;
+      return pr::runPortability(po);
     }
   } catch (const pr::InputError& e) {
     std::cerr << "error: " << e.what() << "\n";
