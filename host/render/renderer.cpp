@@ -163,7 +163,7 @@ int runRender(const RenderOptions& o) {
     }
   }
   if (progress) std::fprintf(stderr, "\n");
-  if (interrupted()) {
+  if (interrupted() && f <= range.last) {  // a signal after the last frame changes nothing
     // Frames before f are complete (rendered now or found complete); f onwards are not.
     const int sig = interruptSignal();
     std::cerr << "interrupted by " << (sig == SIGTERM ? "SIGTERM" : sig == SIGINT ? "SIGINT" : "signal")
