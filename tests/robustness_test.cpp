@@ -13,10 +13,10 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <regex>
 #include <sstream>
 #include <thread>
 #include <vector>
@@ -134,11 +134,14 @@ TEST(Interrupt, SigintKeepsCompleteFramesOnlyAndSaysWhich) {
   EXPECT_LT(seconds, 5.0);
 
   const std::string err = run.err();
-  std::smatch m;
-  const std::regex line("interrupted by SIGINT: frames 0-([0-9]+) complete in .*f_%04d\\.exr; ([0-9]+)-5000 not rendered");
-  ASSERT_TRUE(std::regex_search(err, m, line)) << err;
-  const int last = std::stoi(m[1]);
-  EXPECT_EQ(std::stoi(m[2]), last + 1);
+  const std::string head = "interrupted by SIGINT: frames 0-";
+  const size_t at = err.find(head);
+  ASSERT_NE(at, std::string::npos) << err;
+  const int last = std::atoi(err.c_str() + at + head.size());
+  EXPECT_NE(err.find(head + std::to_string(last) + " complete in " + out + "/f_%04d.exr; " +
+                     std::to_string(last + 1) + "-5000 not rendered"),
+            std::string::npos)
+      << err;
   EXPECT_EQ(err.find("error"), std::string::npos) << err;
 
   // Exactly the frames it names, each complete with its PNG, and nothing half written.
@@ -296,8 +299,8 @@ TEST(DeviceMemory, ArenaTooLargeNamesItAndItsSize) {
                                     "--light-paths 67108864 --max-depth 64 --out '" + dir + "/f_%04d.exr'");
   EXPECT_EQ(r.exitCode, 1) << r.err;
   EXPECT_EQ(lineCount(r.err), 1u) << r.err;
-  EXPECT_TRUE(std::regex_search(r.err, std::regex("device out of memory: light vertex arena (needs )?\\(?[0-9.]+ GiB")))
-      << r.err;
+  EXPECT_NE(r.err.find("device out of memory: light vertex arena needs "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(" GiB"), std::string::npos) << r.err;
   EXPECT_TRUE(fs::is_empty(dir));
 }
 
