@@ -97,6 +97,9 @@ int main(int argc, char** argv) {
   render->add_flag("--force-diffuse", ro.forceDiffuse,
                    "Shade every non-delta material as pure Lambert with its base colour (a diagnostic)");
   render->add_option("--stats", ro.statsFile, "Write one JSON line per frame to this file");
+  render->add_flag("--resume", ro.resume,
+                   "Skip frames whose complete EXR already exists (a truncated one is rendered again); "
+                   "append to the stats file");
 
   pr::PortabilityOptions po;
   bool noDemo = false;

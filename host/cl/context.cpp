@@ -169,6 +169,11 @@ cl::Buffer Context::allocate(const std::string& name, uint64_t bytes, cl_mem_fla
     throw RuntimeError("device out of memory: " + name + " needs " + humanSize(bytes) +
                        " but the largest allocation " + device_.name + " allows is " +
                        humanSize(device_.maxAllocBytes));
+  // Some drivers allocate on first use; this names the buffer before a later launch fails.
+  if (device_.globalMemBytes > 0 && bytes > device_.globalMemBytes - std::min(bytesInUse_, device_.globalMemBytes))
+    throw RuntimeError("device out of memory: " + name + " (" + humanSize(bytes) + ") does not fit beside the " +
+                       humanSize(bytesInUse_) + " already in use of " + humanSize(device_.globalMemBytes) +
+                       " on " + device_.name);
   cl_int err = CL_SUCCESS;
   cl::Buffer buffer(context_, flags, bytes, nullptr, &err);
   if (err == CL_MEM_OBJECT_ALLOCATION_FAILURE || err == CL_OUT_OF_RESOURCES ||

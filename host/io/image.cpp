@@ -3,12 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 
 #include <ImfArray.h>
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
+#include <ImfIO.h>
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
 #include <stb_image_write.h>
@@ -22,13 +24,23 @@ namespace fs = std::filesystem;
 
 namespace {
 
-void ensureParent(const std::string& path) {
-  const fs::path parent = fs::path(path).parent_path();
-  if (parent.empty()) return;
-  std::error_code ec;
-  fs::create_directories(parent, ec);
-  if (ec) throw RuntimeError(path + ": cannot create folder: " + ec.message());
-}
+// An OpenEXR output stream into a string.
+class MemoryOStream : public Imf::OStream {
+ public:
+  MemoryOStream() : Imf::OStream("memory") {}
+  void write(const char c[], int n) override {
+    if (pos_ + n > bytes_.size()) bytes_.resize(pos_ + n);
+    std::memcpy(&bytes_[pos_], c, n);
+    pos_ += n;
+  }
+  uint64_t tellp() override { return pos_; }
+  void seekp(uint64_t pos) override { pos_ = pos; }
+  const std::string& bytes() const { return bytes_; }
+
+ private:
+  std::string bytes_;
+  size_t pos_ = 0;
+};
 
 float srgbEncode(float v) {
   v = std::clamp(v, 0.0f, 1.0f);
@@ -38,9 +50,11 @@ float srgbEncode(float v) {
 }  // namespace
 
 void writeExr(const std::string& path, const Image& image, ExrPixels pixels) {
-  ensureParent(path);
-  const std::string tmp = temporaryNameFor(path);
   const Imf::PixelType type = pixels == ExrPixels::Half ? Imf::HALF : Imf::FLOAT;
+  // Encoded in memory, then written by writeFileAtomic: OpenEXR's own file output ignores
+  // errors in its destructor (the last block and the offset table), so a full disk could
+  // leave a truncated file under the final name.
+  MemoryOStream encoded;
   try {
     Imf::Header header(image.width, image.height);
     header.compression() = Imf::ZIP_COMPRESSION;
@@ -61,19 +75,13 @@ void writeExr(const std::string& path, const Image& image, ExrPixels pixels) {
                   Imf::Slice(Imf::FLOAT, const_cast<char*>(reinterpret_cast<const char*>(image.rgba.data() + c)),
                              sizeof(float) * 4, sizeof(float) * 4 * image.width));
     }
-    {
-      Imf::OutputFile file(tmp.c_str(), header);
-      file.setFrameBuffer(fb);
-      file.writePixels(image.height);
-    }
+    Imf::OutputFile file(encoded, header);
+    file.setFrameBuffer(fb);
+    file.writePixels(image.height);
   } catch (const std::exception& e) {
-    std::remove(tmp.c_str());
     throw RuntimeError(path + ": cannot write OpenEXR: " + e.what());
   }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    throw RuntimeError(path + ": cannot write: rename failed");
-  }
+  writeFileAtomic(path, encoded.bytes());
 }
 
 void writePng(const std::string& path, const Image& image, float exposure) {

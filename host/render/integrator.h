@@ -22,7 +22,8 @@ struct FrameStats {
 class Integrator {
  public:
   virtual ~Integrator() = default;
-  // Renders frame `frame` (the scene already set to its time) into the film.
+  // Renders frame `frame` (the scene already set to its time) into the film. Returns early,
+  // leaving the film partial, once pr::interrupted(); the caller then drops the frame.
   virtual void renderFrame(int frame, const dev::CameraParams& camera, FrameStats* stats) = 0;
   virtual uint64_t deviceBytes() const = 0;
 };

@@ -35,6 +35,7 @@ struct RenderOptions {
   bool quiet = false;
   bool forceDiffuse = false;
   std::string statsFile;
+  bool resume = false;  // skip frames whose complete EXR exists; append to the stats file
   // Path reuse (DESIGN.md section 5).
   int lightPaths = 0;       // slots; 0: chosen from the image size
   int pathsPerPixel = 4;    // C: light paths each pixel sample connects to

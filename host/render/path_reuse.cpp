@@ -5,6 +5,7 @@
 #include "render/path_tracer.h"
 #include "shared/reuse.h"
 #include "util/error.h"
+#include "util/interrupt.h"
 
 namespace pr {
 
@@ -35,8 +36,9 @@ PathReuse::PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseS
     ctx_.zero(b, bytes);
     return b;
   };
-  headers_ = alloc("path headers", uint64_t(slots_) * sizeof(dev::PathHeader));
+  // The arena first: the largest buffer, so a too large request fails naming it.
   vertices_ = alloc("light vertex arena", uint64_t(slots_) * stride_ * sizeof(dev::LightVertex));
+  headers_ = alloc("path headers", uint64_t(slots_) * sizeof(dev::PathHeader));
   list_ = alloc("invalid slot list", uint64_t(slots_) * 4);
   allSlots_ = alloc("slot list", uint64_t(slots_) * 4);
   std::vector<uint32_t> all(slots_);
@@ -119,8 +121,10 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
     ctx_.launch1D(eyeHit_, n, "eye_hit", &timer);
     ctx_.launch1D(connect_, n, "connect", &timer);
     film_.accumulate(radiance_, n, &timer);
+    // Wait for each pass, so that an interrupt stops a frame of many samples within one pass.
+    ctx_.finish();
+    if (interrupted()) return;
   }
-  ctx_.finish();
   cl_uint c[PR_C_COUNT] = {};
   CL_CHECK(ctx_.queue().enqueueReadBuffer(counters_, CL_TRUE, 0, sizeof c, c));
   auto times = timer.collect();

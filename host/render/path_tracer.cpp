@@ -3,6 +3,7 @@
 #include <chrono>
 
 #include "shared/path_state.h"
+#include "util/interrupt.h"
 
 namespace pr {
 
@@ -80,8 +81,10 @@ void PathTracer::renderFrame(int frame, const dev::CameraParams& camera, FrameSt
       ctx_.launch1D(shadow_, n, "shadow", &timer);
     }
     film_.accumulate(radiance_, n, &timer);
+    // Wait for each pass, so that an interrupt stops a frame of many samples within one pass.
+    ctx_.finish();
+    if (interrupted()) return;
   }
-  ctx_.finish();
   cl_uint rays[4] = {0, 0, 0, 0};
   CL_CHECK(ctx_.queue().enqueueReadBuffer(rays_, CL_TRUE, 0, 16, rays));
   if (stats) {

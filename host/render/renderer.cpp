@@ -2,11 +2,13 @@
 
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <memory>
 
@@ -22,6 +24,8 @@
 #include "render/session.h"
 #include "scene/gltf_loader.h"
 #include "util/error.h"
+#include "util/files.h"
+#include "util/interrupt.h"
 
 namespace pr {
 
@@ -37,13 +41,61 @@ std::string clock(double seconds) {
   return buf;
 }
 
+// One JSON line per frame, flushed at once so that an interrupted run keeps its lines; a
+// failed write (disk full) is an error naming the file.
+class StatsFile {
+ public:
+  StatsFile(const std::string& path, bool append) : path_(path) {
+    const auto parent = std::filesystem::path(path).parent_path();
+    std::error_code ec;
+    if (!parent.empty()) std::filesystem::create_directories(parent, ec);
+    file_ = std::fopen(path.c_str(), append ? "a" : "w");
+    if (!file_) fail();
+  }
+  ~StatsFile() {
+    if (file_) std::fclose(file_);
+  }
+  StatsFile(const StatsFile&) = delete;
+  StatsFile& operator=(const StatsFile&) = delete;
+  void writeLine(const std::string& line) {
+    errno = 0;
+    if (std::fputs(line.c_str(), file_) < 0 || std::fputc('\n', file_) == EOF || std::fflush(file_) != 0) fail();
+  }
+
+ private:
+  [[noreturn]] void fail() const {
+    throw RuntimeError(path_ + ": cannot write the stats file: " + std::strerror(errno ? errno : EIO));
+  }
+  std::string path_;
+  FILE* file_ = nullptr;
+};
+
+std::string frameSpan(int a, int b) { return a == b ? std::to_string(a) : std::to_string(a) + "-" + std::to_string(b); }
+
+// A frame that --resume may skip: a complete EXR of the session's size (and its PNG when asked).
+bool frameDone(const std::string& exr, const RenderOptions& o, int width, int height) {
+  if (!std::filesystem::exists(exr)) return false;
+  if (o.png && !std::filesystem::exists(withExtension(exr, ".png"))) return false;
+  try {
+    const Image img = readExr(exr);
+    return img.width == width && img.height == height;
+  } catch (const InputError&) {
+    return false;  // truncated or corrupt: render it again
+  }
+}
+
 }  // namespace
 
 int runRender(const RenderOptions& o) {
+  installInterruptHandlers();
   validateRenderOptions(o);
   const Scene scene = loadScene(o.scene);
   if (scene.emissiveTriangleCount() == 0 && scene.lights.empty() && !o.quiet)
     std::cerr << "warning: " << o.scene << ": no lights; frames will be black\n";
+  // Unwritable output is found before the kernels are built, not after the first frame.
+  checkWritable(formatOutPath(o.outPattern, o.framesGiven ? o.frames.first : 0));
+  std::unique_ptr<StatsFile> stats;
+  if (!o.statsFile.empty()) stats = std::make_unique<StatsFile>(o.statsFile, o.resume);
   const auto devices = enumerateDevices();
   const DeviceEntry& device = selectDevice(devices, o.device);
   RenderSession session(scene, device, o);
@@ -58,25 +110,25 @@ int runRender(const RenderOptions& o) {
     std::cerr << "\n";
   }
 
-  std::unique_ptr<std::ofstream> stats;
-  if (!o.statsFile.empty()) {
-    const auto parent = std::filesystem::path(o.statsFile).parent_path();
-    std::error_code ec;
-    if (!parent.empty()) std::filesystem::create_directories(parent, ec);
-    stats = std::make_unique<std::ofstream>(o.statsFile, std::ios::trunc);
-    if (!*stats) throw RuntimeError(o.statsFile + ": cannot write the stats file");
-  }
   const bool progress = !o.quiet && isatty(STDERR_FILENO);
   const int total = range.last - range.first + 1;
   const auto start = std::chrono::steady_clock::now();
-  uint64_t raysSoFar = 0;
-  for (int f = range.first; f <= range.last; ++f) {
+  uint64_t raysSoFar = 0, badSamples = 0;
+  int rendered = 0, skipped = 0, badFrames = 0;
+  int f = range.first;
+  for (; f <= range.last && !interrupted(); ++f) {
+    const std::string exr = formatOutPath(o.outPattern, f);
+    if (o.resume && frameDone(exr, o, session.width(), session.height())) {
+      ++skipped;
+      continue;
+    }
     const auto t0 = std::chrono::steady_clock::now();
     FrameStats fs;
     const Image img = session.renderFrame(f, &fs);
-    const std::string exr = formatOutPath(o.outPattern, f);
+    if (interrupted()) break;  // the film may be partial: drop the frame
     writeExr(exr, img, o.exrFloat ? ExrPixels::Float : ExrPixels::Half);
     if (o.png) writePng(withExtension(exr, ".png"), img, o.exposure);
+    ++rendered;
     fs.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     uint64_t frameRays = 0;
     for (const auto& [k, v] : fs.rays) frameRays += v;
@@ -91,15 +143,19 @@ int runRender(const RenderOptions& o) {
       if (!fs.counters.empty()) j["counters"] = fs.counters;
       j["device_bytes"] = fs.deviceBytes;
       j["bad_samples"] = fs.badSamples;
-      *stats << j.dump() << "\n" << std::flush;
+      stats->writeLine(j.dump());
     }
-    if (fs.badSamples > 0 && !o.quiet)
-      std::cerr << "warning: frame " << f << ": " << fs.badSamples
-                << " non-finite samples were dropped\n";
+    if (fs.badSamples > 0) {
+      badSamples += fs.badSamples;
+      ++badFrames;
+      if (!o.quiet)
+        std::cerr << (progress ? "\n" : "") << "warning: frame " << f << ": " << fs.badSamples
+                  << " non-finite samples were dropped\n";
+    }
     if (progress) {
       const int done = f - range.first + 1;
       const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      const double eta = elapsed / done * (total - done);
+      const double eta = rendered > 0 ? elapsed / rendered * (total - done) : 0.0;
       std::fprintf(stderr, "\rframe %d of %d (#%d)  %.2f Mrays/s  elapsed %s  ETA %s   ", done, total, f,
                    elapsed > 0 ? raysSoFar / elapsed * 1e-6 : 0.0, clock(elapsed).c_str(),
                    clock(eta).c_str());
@@ -107,9 +163,24 @@ int runRender(const RenderOptions& o) {
     }
   }
   if (progress) std::fprintf(stderr, "\n");
-  if (!o.quiet)
-    std::cerr << "rendered " << total << " frame(s) to " << formatOutPath(o.outPattern, range.first)
-              << (total > 1 ? " ... " + formatOutPath(o.outPattern, range.last) : "") << "\n";
+  if (interrupted() && f <= range.last) {  // a signal after the last frame changes nothing
+    // Frames before f are complete (rendered now or found complete); f onwards are not.
+    const int sig = interruptSignal();
+    std::cerr << "interrupted by " << (sig == SIGTERM ? "SIGTERM" : sig == SIGINT ? "SIGINT" : "signal")
+              << ": " << (f > range.first ? "frames " + frameSpan(range.first, f - 1) + " complete" : "no frame complete")
+              << " in " << o.outPattern << "; " << frameSpan(f, range.last)
+              << " not rendered (run again with --resume to finish)\n";
+    return 128 + sig;
+  }
+  if (!o.quiet) {
+    std::cerr << "rendered " << rendered << " frame(s) to " << formatOutPath(o.outPattern, range.first)
+              << (total > 1 ? " ... " + formatOutPath(o.outPattern, range.last) : "");
+    if (skipped > 0) std::cerr << "; " << skipped << " already complete, skipped";
+    std::cerr << "\n";
+    if (badSamples > 0)
+      std::cerr << "warning: " << badSamples << " non-finite samples were dropped in " << badFrames
+                << " frame(s)\n";
+  }
   return kExitOk;
 }
 

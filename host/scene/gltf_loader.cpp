@@ -172,6 +172,10 @@ struct AccessorRule {
 class Loader {
  public:
   Loader(std::string path, const LoadOptions& options) : path_(std::move(path)), options_(options) {}
+  // In memory: `bytes` stand for the file at `path_` (named in errors; external URIs resolve
+  // beside it).
+  Loader(std::string path, const std::string& bytes, const LoadOptions& options)
+      : path_(std::move(path)), options_(options), bytes_(bytes.begin(), bytes.end()), inMemory_(true) {}
 
   Scene load() {
     parse();
@@ -206,15 +210,20 @@ class Loader {
 
   // --- parsing -------------------------------------------------------------------------------
 
-  void parse() {
+  void readFileBytes() {
     std::error_code ec;
     const fs::file_status st = fs::status(path_, ec);
     if (ec || !fs::exists(st)) fail("no such file");
     if (fs::is_directory(st)) fail("is a directory, not a glTF file");
     std::ifstream in(path_, std::ios::binary);
     if (!in) fail("cannot open file");
-    std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    bytes_.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
     if (in.bad()) fail("cannot read file");
+  }
+
+  void parse() {
+    if (!inMemory_) readFileBytes();
+    const std::vector<uint8_t>& bytes = bytes_;
     if (bytes.empty()) fail("file is empty");
 
     std::string ext = fs::path(path_).extension().string();
@@ -248,6 +257,7 @@ class Loader {
       if (why.empty()) why = "unknown reason";
       fail("not a valid glTF file: " + why);
     }
+    std::vector<uint8_t>().swap(bytes_);  // the model holds what is needed now
   }
 
   // Before tinygltf: the JSON's types (tinygltf silently drops a property of the wrong type),
@@ -1216,6 +1226,8 @@ class Loader {
 
   std::string path_;
   LoadOptions options_;
+  std::vector<uint8_t> bytes_;  // the whole file, until parsed
+  bool inMemory_ = false;
   bool binary_ = false;
   tinygltf::Model model_;
   ImageBytes images_;
@@ -1241,6 +1253,10 @@ bool isSupportedExtension(const std::string& name) {
 
 Scene loadScene(const std::string& path, const LoadOptions& options) {
   return Loader(path, options).load();
+}
+
+Scene loadSceneFromMemory(const std::string& bytes, const std::string& path, const LoadOptions& options) {
+  return Loader(path, bytes, options).load();
 }
 
 }  // namespace pr

@@ -1,5 +1,6 @@
 #include "scene/gltf_schema.h"
 
+#include <cmath>
 #include <map>
 
 namespace pr {
@@ -135,7 +136,8 @@ bool isUint(const json& v) {
   // 3.0 is an integer in JSON's eyes; 3.5 is not.
   if (v.is_number_float()) {
     const double d = v.get<double>();
-    return d >= 0.0 && d == static_cast<double>(static_cast<int64_t>(d)) && d < 9.0e15;
+    // Range first: casting a double beyond int64 to an integer is undefined (found by fuzzing).
+    return d >= 0.0 && d < 9.0e15 && d == std::floor(d);
   }
   return false;
 }

@@ -33,17 +33,35 @@ std::string temporaryNameFor(const std::string& path) {
   return (p.parent_path() / name).string();
 }
 
-void writeFileAtomic(const std::string& path, const std::string& data) {
+namespace {
+
+void createParent(const std::string& path) {
   namespace fs = std::filesystem;
   const fs::path parent = fs::path(path).parent_path();
   std::error_code ec;
   if (!parent.empty()) {
     fs::create_directories(parent, ec);
-    if (ec) throw RuntimeError(path + ": cannot create folder: " + ec.message());
+    if (ec) throw RuntimeError(path + ": cannot create folder " + parent.string() + ": " + ec.message());
   }
+}
+
+}  // namespace
+
+void checkWritable(const std::string& path) {
+  createParent(path);
   const std::string tmp = temporaryNameFor(path);
   FILE* f = std::fopen(tmp.c_str(), "wb");
   if (!f) throw RuntimeError(path + ": cannot write: " + std::strerror(errno));
+  std::fclose(f);
+  std::remove(tmp.c_str());
+}
+
+void writeFileAtomic(const std::string& path, const std::string& data) {
+  createParent(path);
+  const std::string tmp = temporaryNameFor(path);
+  FILE* f = std::fopen(tmp.c_str(), "wb");
+  if (!f) throw RuntimeError(path + ": cannot write: " + std::strerror(errno));
+  errno = 0;
   const size_t written = std::fwrite(data.data(), 1, data.size(), f);
   const int flushErr = std::fflush(f);
   const int err = errno;

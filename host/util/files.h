@@ -14,6 +14,10 @@ bool readFile(const std::string& path, std::string* out);
 // temporary file behind).
 void writeFileAtomic(const std::string& path, const std::string& data);
 
+// Checks, before any work, that `path` could be written: creates its missing parent folders and
+// a temporary file beside it, then removes that file. Throws RuntimeError naming `path`.
+void checkWritable(const std::string& path);
+
 // A unique temporary name beside `path` (same folder, so rename is atomic).
 std::string temporaryNameFor(const std::string& path);
 

@@ -1,0 +1,350 @@
+// Long unattended runs: SIGINT/SIGTERM stop cleanly, --resume finishes a run bit for bit as an
+// uninterrupted one would, unwritable output and full disks are one line and exit 1 with no
+// partial file, a device allocation that cannot fit names the buffer, and the loader's
+// in-memory entry point (the fuzz target's) checks what the file entry point checks.
+#include <gtest/gtest.h>
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+#include <vector>
+
+#include "io/image.h"
+#include "scene/gltf_loader.h"
+#include "support/test_env.h"
+#include "util/error.h"
+
+extern char** environ;
+
+namespace pr {
+namespace {
+
+namespace fs = std::filesystem;
+
+size_t lineCount(const std::string& s) {
+  size_t n = 0;
+  for (char c : s) n += c == '\n';
+  return n;
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// Files in `dir` that are not finished outputs: temporary names start with a dot.
+std::vector<std::string> temporaryFiles(const std::string& dir) {
+  std::vector<std::string> found;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    const std::string name = e.path().filename().string();
+    if (name[0] == '.' || name.find(".tmp") != std::string::npos) found.push_back(name);
+  }
+  return found;
+}
+
+// The renderer running in the background, its stderr going to a file.
+class Background {
+ public:
+  Background(const std::vector<std::string>& args, const std::string& dir) : errFile_(dir + "/stderr") {
+    std::vector<std::string> all = {PATHREUSE_BINARY};
+    all.insert(all.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (auto& a : all) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+    posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
+    posix_spawn_file_actions_addopen(&actions, 2, errFile_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int rc = posix_spawn(&pid_, argv[0], &actions, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    if (rc != 0) pid_ = -1;
+  }
+  ~Background() {
+    if (pid_ > 0 && !exited_) {
+      kill(pid_, SIGKILL);
+      waitpid(pid_, nullptr, 0);
+    }
+  }
+  bool started() const { return pid_ > 0; }
+  void signal(int sig) { kill(pid_, sig); }
+  std::string err() const { return slurp(errFile_); }
+
+  // Waits until `ready` holds, up to `seconds`; false when the process ended or time ran out.
+  template <class F>
+  bool waitUntil(F ready, double seconds) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+    while (std::chrono::steady_clock::now() < end) {
+      if (ready()) return true;
+      if (!exited_ && waitpid(pid_, &status_, WNOHANG) == pid_) exited_ = true;
+      if (exited_) return ready();
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return false;
+  }
+
+  // The exit code (128 + signal when killed), or -1 when it has not ended within `seconds`.
+  int wait(double seconds) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+    while (!exited_ && std::chrono::steady_clock::now() < end) {
+      if (waitpid(pid_, &status_, WNOHANG) == pid_) exited_ = true;
+      else std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    if (!exited_) return -1;
+    return WIFEXITED(status_) ? WEXITSTATUS(status_) : 128 + WTERMSIG(status_);
+  }
+
+ private:
+  std::string errFile_;
+  pid_t pid_ = -1;
+  int status_ = 0;
+  bool exited_ = false;
+};
+
+const std::string kScene = test::sourcePath("scenes/cornell-dynamic.gltf");
+
+// --fps 1000 turns the 5 s animation into 5001 small frames: far more than the test waits for.
+TEST(Interrupt, SigintKeepsCompleteFramesOnlyAndSaysWhich) {
+  const std::string dir = test::tempDir("sigint");
+  const std::string out = dir + "/frames";
+  Background run({"render", kScene, "--fps", "1000", "--width", "64", "--height", "48", "--spp", "2", "--png",
+                  "--stats", dir + "/stats.jsonl", "--out", out + "/f_%04d.exr"},
+                 dir);
+  ASSERT_TRUE(run.started());
+  ASSERT_TRUE(run.waitUntil([&] { return fs::exists(out + "/f_0002.exr"); }, 120)) << run.err();
+  const auto sent = std::chrono::steady_clock::now();
+  run.signal(SIGINT);
+  const int code = run.wait(10);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count();
+  ASSERT_EQ(code, 130) << run.err();
+  EXPECT_LT(seconds, 5.0);
+
+  const std::string err = run.err();
+  const std::string head = "interrupted by SIGINT: frames 0-";
+  const size_t at = err.find(head);
+  ASSERT_NE(at, std::string::npos) << err;
+  const int last = std::atoi(err.c_str() + at + head.size());
+  EXPECT_NE(err.find(head + std::to_string(last) + " complete in " + out + "/f_%04d.exr; " +
+                     std::to_string(last + 1) + "-5000 not rendered"),
+            std::string::npos)
+      << err;
+  EXPECT_EQ(err.find("error"), std::string::npos) << err;
+
+  // Exactly the frames it names, each complete with its PNG, and nothing half written.
+  char name[32];
+  for (int f = 0; f <= last; ++f) {
+    std::snprintf(name, sizeof name, "/f_%04d", f);
+    EXPECT_TRUE(isCompleteExr(out + name + ".exr")) << f;
+    EXPECT_TRUE(fs::exists(out + name + ".png")) << f;
+  }
+  std::snprintf(name, sizeof name, "/f_%04d.exr", last + 1);
+  EXPECT_FALSE(fs::exists(out + name));
+  EXPECT_TRUE(temporaryFiles(out).empty()) << temporaryFiles(out)[0];
+  // One stats line per complete frame.
+  EXPECT_EQ(lineCount(slurp(dir + "/stats.jsonl")), size_t(last + 1));
+}
+
+// A frame of a million samples per pixel: the integrators check between passes, so SIGTERM
+// still ends the run within seconds, and the partial frame is dropped.
+TEST(Interrupt, SigtermStopsWithinALongFrame) {
+  const std::string dir = test::tempDir("sigterm");
+  const std::string out = dir + "/frames";
+  Background run({"render", kScene, "--frames", "0-3", "--width", "64", "--height", "48", "--spp", "1000000",
+                  "--out", out + "/f_%04d.exr"},
+                 dir);
+  ASSERT_TRUE(run.started());
+  // The "rendering ..." line comes once the kernels are built, just before the first frame.
+  ASSERT_TRUE(run.waitUntil([&] { return run.err().find("rendering ") != std::string::npos; }, 120)) << run.err();
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  const auto sent = std::chrono::steady_clock::now();
+  run.signal(SIGTERM);
+  const int code = run.wait(10);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count();
+  ASSERT_EQ(code, 143) << run.err();
+  EXPECT_LT(seconds, 5.0);
+  EXPECT_NE(run.err().find("interrupted by SIGTERM: no frame complete in " + out + "/f_%04d.exr; 0-3 not rendered"),
+            std::string::npos)
+      << run.err();
+  EXPECT_TRUE(fs::is_empty(out));
+}
+
+bool samePixels(const std::string& a, const std::string& b) {
+  const Image x = readExr(a), y = readExr(b);
+  return x.width == y.width && x.height == y.height &&
+         std::memcmp(x.rgba.data(), y.rgba.data(), x.rgba.size() * sizeof(float)) == 0;
+}
+
+// A run cut short after frame 2 with frame 1 truncated (as by a crash of some other tool), then
+// resumed: frame 0 and 2 are kept, 1 and 3-5 are rendered, and every frame equals the
+// uninterrupted run's bit for bit, in both reuse and path-tracing modes.
+TEST(Resume, FinishesARunBitForBitAsAnUninterruptedOne) {
+  for (const char* mode : {"reuse", "pathtrace"}) {
+    SCOPED_TRACE(mode);
+    const std::string dir = test::tempDir("resume");
+    const std::string common = "render '" + kScene + "' --exr-float --width 64 --height 48 --spp 2 --mode " + mode;
+    auto r = test::runPathreuse(common + " --quiet --frames 0-5 --out '" + dir + "/whole/f_%04d.exr'");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    r = test::runPathreuse(common + " --quiet --frames 0-2 --out '" + dir + "/cut/f_%04d.exr'");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const std::string truncated = dir + "/cut/f_0001.exr";
+    fs::resize_file(truncated, fs::file_size(truncated) / 2);
+    ASSERT_FALSE(isCompleteExr(truncated));
+    const auto keptTime = fs::last_write_time(dir + "/cut/f_0000.exr");
+
+    r = test::runPathreuse(common + " --resume --frames 0-5 --out '" + dir + "/cut/f_%04d.exr'");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.err.find("rendered 4 frame(s)"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("2 already complete, skipped"), std::string::npos) << r.err;
+    EXPECT_EQ(fs::last_write_time(dir + "/cut/f_0000.exr"), keptTime);
+    char name[32];
+    for (int f = 0; f <= 5; ++f) {
+      std::snprintf(name, sizeof name, "/f_%04d.exr", f);
+      EXPECT_TRUE(samePixels(dir + "/whole" + name, dir + "/cut" + name)) << "frame " << f;
+    }
+  }
+}
+
+TEST(Resume, AFrameOfAnotherSizeIsRenderedAgain) {
+  const std::string dir = test::tempDir("resize");
+  const std::string common = "render '" + kScene + "' --quiet --frames 0 --spp 1 --out '" + dir + "/f_%04d.exr'";
+  auto r = test::runPathreuse(common + " --width 32 --height 24");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  r = test::runPathreuse(common + " --width 64 --height 48 --resume");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(readExr(dir + "/f_0000.exr").width, 64);
+}
+
+TEST(WriteErrors, OutputUnderARegularFileIsOneLineAndExitOne) {
+  const std::string dir = test::tempDir("notdir");
+  std::ofstream(dir + "/file") << "x";
+  const auto r = test::runPathreuse("render '" + kScene + "' --frames 0 --width 32 --height 24 --spp 1 --out '" +
+                                    dir + "/file/f_%04d.exr'");
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+  EXPECT_NE(r.err.find(dir + "/file/f_0000.exr: cannot create folder"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("Not a directory"), std::string::npos) << r.err;
+}
+
+TEST(WriteErrors, ReadOnlyFolderIsOneLineAndExitOne) {
+  if (geteuid() == 0) GTEST_SKIP() << "running as root, which writes into read-only folders";
+  const std::string dir = test::tempDir("readonly");
+  fs::create_directory(dir + "/ro");
+  fs::permissions(dir + "/ro", fs::perms::owner_read | fs::perms::owner_exec);
+  const auto r = test::runPathreuse("render '" + kScene + "' --frames 0 --width 32 --height 24 --spp 1 --out '" +
+                                    dir + "/ro/f_%04d.exr'");
+  fs::permissions(dir + "/ro", fs::perms::owner_all);
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+  EXPECT_NE(r.err.find(dir + "/ro/f_0000.exr: cannot write: Permission denied"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::is_empty(dir + "/ro"));
+}
+
+TEST(WriteErrors, FullDiskForTheStatsFileIsOneLineAndExitOne) {
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "/dev/full is absent";
+  const std::string dir = test::tempDir("devfull");
+  const auto r = test::runPathreuse("render '" + kScene + "' --quiet --frames 0 --width 32 --height 24 --spp 1 "
+                                    "--stats /dev/full --out '" + dir + "/f_%04d.exr'");
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+  EXPECT_NE(r.err.find("/dev/full: cannot write the stats file: No space left on device"), std::string::npos)
+      << r.err;
+}
+
+// A file-size limit makes write() fail the way a full disk does (EFBIG instead of ENOSPC), for
+// this process only: the EXR write reports the file, and neither it nor its temporary remains.
+TEST(WriteErrors, FailingExrWriteLeavesNoFile) {
+  const std::string dir = test::tempDir("fsize");
+  Image img(256, 256);
+  for (size_t i = 0; i < img.rgba.size(); ++i) img.rgba[i] = float((i * 2654435761u) % 1000) / 7.0f;
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    signal(SIGXFSZ, SIG_IGN);
+    const rlimit limit{16384, 16384};
+    setrlimit(RLIMIT_FSIZE, &limit);
+    try {
+      writeExr(dir + "/f.exr", img, ExrPixels::Float);
+      _exit(3);
+    } catch (const RuntimeError& e) {
+      const std::string what = e.what();
+      _exit(what.find(dir + "/f.exr: cannot write: File too large") == 0 ? 0 : 4);
+    } catch (...) {
+      _exit(5);
+    }
+  }
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0) << "3: no error, 4: wrong message, 5: wrong exception";
+  EXPECT_TRUE(fs::is_empty(dir));
+}
+
+TEST(DeviceMemory, ArenaTooLargeNamesItAndItsSize) {
+  const std::string dir = test::tempDir("oom");
+  const auto r = test::runPathreuse("render '" + kScene + "' --frames 0 --width 32 --height 24 --spp 1 "
+                                    "--light-paths 67108864 --max-depth 64 --out '" + dir + "/f_%04d.exr'");
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+  EXPECT_NE(r.err.find("device out of memory: light vertex arena needs "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(" GiB"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::is_empty(dir));
+}
+
+TEST(DeviceMemory, AbsurdSizesAreBadInput) {
+  for (const char* args : {"--light-paths 100000000", "--width 100000", "--max-depth 1000", "--spp 0"}) {
+    const auto r = test::runPathreuse("render '" + kScene + "' --frames 0 " + args);
+    EXPECT_EQ(r.exitCode, 2) << args << ": " << r.err;
+    EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+  }
+}
+
+TEST(LoaderFromMemory, SameSceneAsFromTheFile) {
+  std::string bytes;
+  bytes = slurp(kScene);
+  LoadOptions quiet;
+  quiet.printWarnings = false;
+  const Scene a = loadScene(kScene, quiet);
+  const Scene b = loadSceneFromMemory(bytes, kScene, quiet);
+  EXPECT_EQ(a.staticTriangleCount(), b.staticTriangleCount());
+  EXPECT_EQ(a.dynamicTriangleCount(), b.dynamicTriangleCount());
+  EXPECT_EQ(a.emissiveTriangleCount(), b.emissiveTriangleCount());
+  EXPECT_EQ(a.frameCount(24.0), b.frameCount(24.0));
+}
+
+TEST(LoaderFromMemory, BrokenBytesAreAnInputErrorNamingTheFile) {
+  for (const std::string& bytes : {std::string(), std::string("{"), std::string("glTF\x02\0\0\0", 8),
+                                  std::string("{\"asset\":{\"version\":\"1.0\"}}")}) {
+    try {
+      loadSceneFromMemory(bytes, "mem/x.gltf");
+      ADD_FAILURE() << "loaded: " << bytes;
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("mem/x.gltf: ", 0), 0u) << e.what();
+    }
+  }
+}
+
+// Found by tools/fuzz.sh: an index of 2e78 was cast to int64 before its range was checked,
+// which is undefined behaviour (UBSan in build-asan stops here if it comes back).
+TEST(LoaderFromMemory, HugeIndexIsAnInputError) {
+  for (const char* text : {R"({"asset":{"version":"2.0"},"scene":2e78})", R"({"asset":{"version":"2.0"},"scene":-1e300})",
+                           R"({"asset":{"version":"2.0"},"scenes":[{"nodes":[1e19]}]})"}) {
+    EXPECT_THROW(loadSceneFromMemory(text, "mem/huge.gltf"), InputError) << text;
+  }
+}
+
+}  // namespace
+}  // namespace pr
