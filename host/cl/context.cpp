@@ -107,6 +107,13 @@ ProgramBuild Context::buildProgram(const std::string& mainFile, const std::strin
   return buildProgramFromSource(expandKernelSource(mainFile), options, mainFile);
 }
 
+cl::Kernel Context::kernel(const std::string& file, const char* name, const std::string& options) {
+  cl_int err = CL_SUCCESS;
+  cl::Kernel k(buildProgram(file, options).program, name, &err);
+  if (err != CL_SUCCESS) throw ClError(std::string("kernel ") + name + " of kernels/" + file, err, __FILE__, __LINE__);
+  return k;
+}
+
 ProgramBuild Context::buildProgramFromSource(const std::string& source, const std::string& options,
                                              const std::string& label) {
   const auto t0 = std::chrono::steady_clock::now();

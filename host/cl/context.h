@@ -35,6 +35,9 @@ class Context {
   // source, the options, the device name and the driver version; a corrupt entry is rebuilt.
   ProgramBuild buildProgram(const std::string& mainFile, const std::string& options = "");
 
+  // The kernel `name` of kernels/<file> built with `options`.
+  cl::Kernel kernel(const std::string& file, const char* name, const std::string& options = "");
+
   // Same, from a source string (for tests and generated code).
   ProgramBuild buildProgramFromSource(const std::string& source, const std::string& options,
                                       const std::string& label);

@@ -7,9 +7,7 @@ namespace pr {
 Film::Film(Context& ctx, int width, int height) : ctx_(ctx), width_(width), height_(height) {
   film_ = ctx_.allocate("film", uint64_t(pixels()) * 16);
   bad_ = ctx_.allocate("bad sample counter", 4);
-  cl_int err = CL_SUCCESS;
-  accumulate_ = cl::Kernel(ctx_.buildProgram("accumulate.cl").program, "accumulate", &err);
-  CL_CHECK(err);
+  accumulate_ = ctx_.kernel("accumulate.cl", "accumulate");
   clear();
 }
 

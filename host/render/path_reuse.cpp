@@ -9,14 +9,6 @@
 
 namespace pr {
 
-namespace {
-cl::Kernel makeKernel(Context& ctx, const char* file, const char* name, const std::string& options) {
-  cl_int err = CL_SUCCESS;
-  cl::Kernel k(ctx.buildProgram(file, options).program, name, &err);
-  CL_CHECK(err);
-  return k;
-}
-}  // namespace
 
 PathReuse::PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseSettings& settings)
     : ctx_(ctx), scene_(scene), film_(film), settings_(settings) {
@@ -26,10 +18,10 @@ PathReuse::PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseS
   slots_ = settings_.lightPaths ? settings_.lightPaths : film.pixels();
   stride_ = static_cast<uint32_t>(settings_.maxDepth - 1);
   const std::string opts = sceneBuildOptions(scene);
-  invalidate_ = makeKernel(ctx, "reuse/invalidate.cl", "invalidate", opts);
-  lightTrace_ = makeKernel(ctx, "reuse/light_trace.cl", "light_trace", opts);
-  eyeHit_ = makeKernel(ctx, "reuse/eye_hit.cl", "eye_hit", opts);
-  connect_ = makeKernel(ctx, "reuse/connect.cl", "connect", opts);
+  invalidate_ = ctx.kernel("reuse/invalidate.cl", "invalidate", opts);
+  lightTrace_ = ctx.kernel("reuse/light_trace.cl", "light_trace", opts);
+  eyeHit_ = ctx.kernel("reuse/eye_hit.cl", "eye_hit", opts);
+  connect_ = ctx.kernel("reuse/connect.cl", "connect", opts);
   auto alloc = [&](const char* name, uint64_t bytes) {
     bytes_ += bytes;
     cl::Buffer b = ctx_.allocate(name, bytes);

@@ -11,22 +11,14 @@ std::string sceneBuildOptions(const GpuScene& scene) {
   return scene.hasAlphaMaterials() ? "-DPR_HAS_ALPHA=1" : "";
 }
 
-namespace {
-cl::Kernel makeKernel(Context& ctx, const char* file, const char* name, const std::string& options) {
-  cl_int err = CL_SUCCESS;
-  cl::Kernel k(ctx.buildProgram(file, options).program, name, &err);
-  CL_CHECK(err);
-  return k;
-}
-}  // namespace
 
 PathTracer::PathTracer(Context& ctx, GpuScene& scene, Film& film, const PathTracerSettings& settings)
     : ctx_(ctx), scene_(scene), film_(film), settings_(settings) {
   const std::string opts = sceneBuildOptions(scene);
-  generate_ = makeKernel(ctx, "pathtrace/generate.cl", "pt_generate", opts);
-  extend_ = makeKernel(ctx, "pathtrace/extend.cl", "pt_extend", opts);
-  shade_ = makeKernel(ctx, "pathtrace/shade.cl", "pt_shade", opts);
-  shadow_ = makeKernel(ctx, "pathtrace/shadow.cl", "pt_shadow", opts);
+  generate_ = ctx.kernel("pathtrace/generate.cl", "pt_generate", opts);
+  extend_ = ctx.kernel("pathtrace/extend.cl", "pt_extend", opts);
+  shade_ = ctx.kernel("pathtrace/shade.cl", "pt_shade", opts);
+  shadow_ = ctx.kernel("pathtrace/shadow.cl", "pt_shadow", opts);
   const uint64_t n = film.pixels();
   auto alloc = [&](const char* name, uint64_t bytes) {
     bytes_ += bytes;

@@ -1,5 +1,6 @@
 // pt_generate: one work-item per pixel. Reads the camera; writes a fresh PathState with the
 // camera ray through a jittered point of the pixel (random dimensions 0 and 1), and zero radiance.
+#include "shared/bvh.h"
 #include "shared/camera.h"
 #include "shared/path_state.h"
 #include "shared/rng.h"
@@ -14,14 +15,7 @@ __kernel void pt_generate(CameraParams cam, uint seed, uint frame, uint sample,
   const uint x = i % cam.width, y = i / cam.width;
   const float3 d = camera_direction(&cam, (float)x + jx, (float)y + jy);
   PathState s;
-  s.ray.ox = cam.px;
-  s.ray.oy = cam.py;
-  s.ray.oz = cam.pz;
-  s.ray.tmin = 0.0f;
-  s.ray.dx = d.x;
-  s.ray.dy = d.y;
-  s.ray.dz = d.z;
-  s.ray.tmax = PR_INF_F;
+  s.ray = make_ray(camera_position(&cam), d, 0.0f, PR_INF_F);
   s.tp_r = s.tp_g = s.tp_b = 1.0f;
   s.last_pdf = 0.0f;
   s.depth = 0u;

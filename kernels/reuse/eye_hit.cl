@@ -14,15 +14,7 @@ __kernel void eye_hit(PR_SCENE_PARAMS, ReuseParams rp, CameraParams cam, uint sa
   const float jx = rng_next(&rng), jy = rng_next(&rng);
   const uint x = i % cam.width, y = i / cam.width;
   float3 d = camera_direction(&cam, (float)x + jx, (float)y + jy);
-  Ray ray;
-  ray.ox = cam.px;
-  ray.oy = cam.py;
-  ray.oz = cam.pz;
-  ray.tmin = 0.0f;
-  ray.dx = d.x;
-  ray.dy = d.y;
-  ray.dz = d.z;
-  ray.tmax = PR_INF_F;
+  Ray ray = make_ray(camera_position(&cam), d, 0.0f, PR_INF_F);
   float3 tp = make_float3(1.0f, 1.0f, 1.0f), L = make_float3(0.0f, 0.0f, 0.0f);
   EyeVertex e;
   e.prim = PR_INVALID_INDEX;

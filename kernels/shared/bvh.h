@@ -313,20 +313,23 @@ PR_INLINE float3 offset_ray_origin(float3 p, float3 ng) {
                      fabs(p.z) < origin_zone ? p.z + abs_step * n.z : pz);
 }
 
-// A ray leaving surface point p (geometric normal ng, either orientation) in direction dir.
-PR_INLINE Ray spawn_ray(float3 p, float3 ng, float3 dir, float tmax) {
-  const float3 n = dot(ng, dir) < 0.0f ? -ng : ng;
-  const float3 o = offset_ray_origin(p, n);
+PR_INLINE Ray make_ray(float3 o, float3 dir, float tmin, float tmax) {
   Ray r;
   r.ox = o.x;
   r.oy = o.y;
   r.oz = o.z;
-  r.tmin = 0.0f;
+  r.tmin = tmin;
   r.dx = dir.x;
   r.dy = dir.y;
   r.dz = dir.z;
   r.tmax = tmax;
   return r;
+}
+
+// A ray leaving surface point p (geometric normal ng, either orientation) in direction dir.
+PR_INLINE Ray spawn_ray(float3 p, float3 ng, float3 dir, float tmax) {
+  const float3 n = dot(ng, dir) < 0.0f ? -ng : ng;
+  return make_ray(offset_ray_origin(p, n), dir, 0.0f, tmax);
 }
 
 // A shadow segment between two surface points, each offset off its own surface towards the
@@ -335,17 +338,7 @@ PR_INLINE Ray spawn_ray_to(float3 p, float3 ng, float3 q, float3 nq) {
   const float3 d = q - p;
   const float3 o = offset_ray_origin(p, dot(ng, d) < 0.0f ? -ng : ng);
   const float3 e = offset_ray_origin(q, dot(nq, d) > 0.0f ? -nq : nq);
-  const float3 dir = e - o;
-  Ray r;
-  r.ox = o.x;
-  r.oy = o.y;
-  r.oz = o.z;
-  r.tmin = 0.0f;
-  r.dx = dir.x;
-  r.dy = dir.y;
-  r.dz = dir.z;
-  r.tmax = 1.0f;
-  return r;
+  return make_ray(o, e - o, 0.0f, 1.0f);
 }
 
 PR_NAMESPACE_END

@@ -43,18 +43,7 @@ typedef struct {
 // punctual lights (prim == PR_INVALID_INDEX), else offset off the surface along the decoded
 // geometric normal.
 PR_INLINE Ray light_segment_ray(float3 p, u32 ng_oct, u32 prim, float3 dir) {
-  if (prim == PR_INVALID_INDEX) {
-    Ray r;
-    r.ox = p.x;
-    r.oy = p.y;
-    r.oz = p.z;
-    r.tmin = 0.0f;
-    r.dx = dir.x;
-    r.dy = dir.y;
-    r.dz = dir.z;
-    r.tmax = PR_INF_F;
-    return r;
-  }
+  if (prim == PR_INVALID_INDEX) return make_ray(p, dir, 0.0f, PR_INF_F);
   return spawn_ray(p, oct_decode(ng_oct), dir, PR_INF_F);
 }
 
