@@ -13,7 +13,11 @@ struct DecodedImage {
   std::vector<uint8_t> rgba8;  // width * height * 4, rows top to bottom
 };
 
-// False with `why` set when the bytes are not an image stb can read.
+// The largest image loaded: 8192 x 8192 (256 MiB as RGBA8).
+constexpr uint64_t kMaxImagePixels = uint64_t(8192) * 8192;
+
+// False with `why` set when the bytes are not an image stb can read, declare more than
+// kMaxImagePixels, or (PNG) hold a chunk longer than the data.
 bool decodeImageRgba8(const std::vector<uint8_t>& encoded, DecodedImage* out, std::string* why);
 
 }  // namespace pr
