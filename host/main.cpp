@@ -97,6 +97,9 @@ int main(int argc, char** argv) {
   render->add_flag("--force-diffuse", ro.forceDiffuse,
                    "Shade every non-delta material as pure Lambert with its base colour (a diagnostic)");
   render->add_option("--stats", ro.statsFile, "Write one JSON line per frame to this file");
+  render->add_flag("--fixed-noise", ro.fixedNoise,
+                   "Key the camera samples' random numbers by frame 0 on every frame (the same "
+                   "noise pattern each frame; the scene still animates)");
 
   pr::PortabilityOptions po;
   bool noDemo = false;
