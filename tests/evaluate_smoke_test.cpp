@@ -52,8 +52,8 @@ TEST(Evaluate, QuickFormWritesEveryOutputWithSaneNumbers) {
   const std::string build = fs::path(PATHREUSE_BINARY).parent_path().string();
   const std::string log = dir + "/log.txt";
   const std::string cmd = "/usr/bin/python3 '" + test::sourcePath("tools/evaluate.py") +
-                          "' --quick --quiet --out-dir '" + dir + "' --build '" + build + "' >'" + log +
-                          "' 2>&1";
+                          "' --quick --quiet --out-dir '" + dir + "' --build '" + build + "' >'" +
+                          log + "' 2>&1";
   const int status = std::system(cmd.c_str());
   ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << cmd << "\n" << slurp(log);
 
