@@ -100,6 +100,9 @@ int main(int argc, char** argv) {
   render->add_flag("--resume", ro.resume,
                    "Skip frames whose complete EXR already exists (a truncated one is rendered again); "
                    "append to the stats file");
+  render->add_flag("--fixed-noise", ro.fixedNoise,
+                   "Key the camera samples' random numbers by frame 0 on every frame (the same "
+                   "noise pattern each frame; the scene still animates)");
 
   pr::PortabilityOptions po;
   bool noDemo = false;

@@ -16,18 +16,16 @@ import argparse
 import datetime
 import json
 import os
-import platform
 import shutil
-import statistics
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parent.parent
+from benchlib import ATRIUM, REPO, ensure_atrium, fmt_rng, kernel_s, machine_lines, median
+
 DEMO = REPO / "scenes" / "cornell-dynamic.gltf"
-ATRIUM = Path("/tmp/pathreuse-atrium/atrium.gltf")
 MODES = ("reuse", "retrace", "pathtrace")
 PAPER_RATIO = 0.7   # "up to 30%" less time (paper, abstract and section 5)
 GOAL_RATIO = 0.5    # issue 5: reuse at most half the time of retrace
@@ -36,14 +34,6 @@ GOAL_RATIO = 0.5    # issue 5: reuse at most half the time of retrace
 def die(msg):
     print(f"bench_reuse: {msg}", file=sys.stderr)
     sys.exit(2)
-
-
-def median(xs):
-    return statistics.median(xs) if xs else float("nan")
-
-
-def kernel_s(rec):
-    return sum(rec["stages_s"].values())
 
 
 class Runner:
@@ -121,10 +111,6 @@ def summarize_runs(runs):
 def ratios(a, b, key):
     """Per-repeat ratios a/b of the per-run medians (runs r of a and b were back to back)."""
     return [x[key] / y[key] for x, y in zip(a["per_run"], b["per_run"])]
-
-
-def fmt_rng(xs, f="{:.3f}"):
-    return f"{f.format(median(xs))} [{f.format(min(xs))}-{f.format(max(xs))}]"
 
 
 def scene_section(name, scene, frames, res):
@@ -207,12 +193,7 @@ def main():
     if not exe.is_file():
         die(f"{exe} not found; build first: cmake -S . -B build -DCMAKE_BUILD_TYPE=RelWithDebInfo "
             "&& cmake --build build -j2")
-    atrium = Path(args.atrium)
-    if not atrium.is_file():
-        print(f"generating {atrium} ...", flush=True)
-        atrium.parent.mkdir(parents=True, exist_ok=True)
-        subprocess.run([sys.executable, str(REPO / "tools" / "gen_atrium.py"), "--size", "1",
-                        "--out", str(atrium)], check=True)
+    atrium = ensure_atrium(args.atrium)
     scenes = [("Demo: cornell-dynamic", DEMO), ("Atrium", atrium)]
     for _, sc in scenes:
         info = json.loads(subprocess.run([str(exe), "info", str(sc), "--json"], check=True,
@@ -261,30 +242,6 @@ def main():
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     Path(args.out).write_text(report)
     print(f"wrote {args.out} ({elapsed:.0f} s)")
-
-
-def machine_lines(exe):
-    cpu = "unknown"
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    dev = subprocess.run([str(exe), "devices"], capture_output=True, text=True).stdout.strip()
-    commit = subprocess.run(["git", "-C", str(REPO), "rev-parse", "--short", "HEAD"],
-                            capture_output=True, text=True).stdout.strip() or "unknown"
-    dirty = subprocess.run(["git", "-C", str(REPO), "status", "--porcelain", "--untracked-files=no"],
-                           capture_output=True, text=True).stdout.strip()
-    pocl = subprocess.run(["dpkg-query", "-W", "-f", "${Version}", "pocl-opencl-icd"],
-                          capture_output=True, text=True).stdout.strip() if shutil.which("dpkg-query") else ""
-    return [f"- machine: {os.cpu_count()} logical CPUs (nproc), {cpu}, {platform.system()} "
-            f"{platform.release()}",
-            "- device: " + "; ".join(f"`{d}`" for d in dev.splitlines()),
-            f"- PoCL package: {pocl or 'n/a'}; POCL_MAX_PTHREAD_COUNT="
-            f"{os.environ.get('POCL_MAX_PTHREAD_COUNT', 'unset')}",
-            f"- commit: {commit}{' (tracked files modified)' if dirty else ''}"]
 
 
 def render_report(args, argv, exe, scenes, results, sweep, loads, elapsed):

@@ -1,18 +1,54 @@
 // exr_compare: the mean of one OpenEXR image, or how two differ (relMSE, mean absolute
 // difference, mean of each). For scripts and notes: one JSON object on stdout.
 //   exr_compare A.exr [B.exr]
+//   exr_compare --raw A.exr A.raw [B.exr B.raw ...]
+// --raw writes width and height (uint32, little-endian) then float32 RGB, row by row from the
+// top, so that scripts without an EXR reader (tools/evaluate.py, numpy) can load the pixels.
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <fstream>
 #include <iostream>
+#include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "io/image.h"
 #include "util/error.h"
 
+namespace {
+
+void writeRaw(const pr::Image& img, const std::string& path) {
+  std::vector<float> rgb;
+  rgb.reserve(img.rgba.size() / 4 * 3);
+  for (size_t i = 0; i < img.rgba.size(); i += 4)
+    for (int c = 0; c < 3; ++c) rgb.push_back(img.rgba[i + c]);
+  const uint32_t size[2] = {uint32_t(img.width), uint32_t(img.height)};
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(reinterpret_cast<const char*>(size), sizeof size);
+  out.write(reinterpret_cast<const char*>(rgb.data()), std::streamsize(rgb.size() * sizeof(float)));
+  if (!out) throw std::runtime_error(path + ": cannot write");
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
+  if (argc >= 2 && std::string(argv[1]) == "--raw") {
+    if (argc < 4 || argc % 2 != 0) {
+      std::cerr << "usage: exr_compare --raw A.exr A.raw [B.exr B.raw ...]\n";
+      return 2;
+    }
+    try {
+      for (int i = 2; i + 1 < argc; i += 2) writeRaw(pr::readExr(argv[i]), argv[i + 1]);
+    } catch (const std::exception& e) {
+      std::cerr << "error: " << e.what() << "\n";
+      return 2;
+    }
+    return 0;
+  }
   if (argc < 2 || argc > 3) {
-    std::cerr << "usage: exr_compare A.exr [B.exr]\n";
+    std::cerr << "usage: exr_compare A.exr [B.exr] | exr_compare --raw A.exr A.raw [...]\n";
     return 2;
   }
   try {

@@ -9,6 +9,7 @@ packages=(
   libglm-dev libtinygltf-dev nlohmann-json3-dev libstb-dev
   libopenexr-dev libcli11-dev libgtest-dev
   assimp-testmodels python3
+  python3-matplotlib python3-numpy
 )
 
 missing=()

@@ -52,7 +52,7 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
   rp.paths_per_pixel = settings_.pathsPerPixel;
   rp.spp = static_cast<uint32_t>(settings_.spp);
   rp.pixel_count = film_.pixels();
-  rp.frame = static_cast<uint32_t>(frame);
+  rp.frame = settings_.fixedNoise ? 0u : static_cast<uint32_t>(frame);  // RNG key only
   rp.clamp = settings_.clamp;
   rp.trace_total = scene_.traceTotalPower();
   rp.scene_radius = scene_.sceneRadius();

@@ -24,6 +24,7 @@ struct PathReuseSettings {
   uint32_t pathsPerPixel = 4;
   float clamp = 0.0f;
   bool retraceAll = false;  // --mode retrace
+  bool fixedNoise = false;  // camera samples keyed by frame 0 on every frame
 };
 
 class PathReuse : public Integrator {

@@ -36,6 +36,7 @@ PathTracer::PathTracer(Context& ctx, GpuScene& scene, Film& film, const PathTrac
 void PathTracer::renderFrame(int frame, const dev::CameraParams& camera, FrameStats* stats) {
   StageTimer timer;
   const cl_uint n = film_.pixels();
+  const cl_uint rngFrame = settings_.fixedNoise ? 0 : cl_uint(frame);
   ctx_.zero(rays_, 16);
   const cl_uint first = GpuScene::kArgCount;
   scene_.setKernelArgs(extend_, 0);
@@ -51,7 +52,7 @@ void PathTracer::renderFrame(int frame, const dev::CameraParams& camera, FrameSt
   CL_CHECK(shade_.setArg(first + 3, shadows_));
   CL_CHECK(shade_.setArg(first + 4, n));
   CL_CHECK(shade_.setArg(first + 5, settings_.seed));
-  CL_CHECK(shade_.setArg(first + 6, cl_uint(frame)));
+  CL_CHECK(shade_.setArg(first + 6, rngFrame));
   CL_CHECK(shade_.setArg(first + 8, cl_uint(settings_.maxDepth)));
   CL_CHECK(shadow_.setArg(first + 0, radiance_));
   CL_CHECK(shadow_.setArg(first + 1, shadows_));
@@ -59,7 +60,7 @@ void PathTracer::renderFrame(int frame, const dev::CameraParams& camera, FrameSt
   CL_CHECK(shadow_.setArg(first + 3, n));
   CL_CHECK(generate_.setArg(0, camera));
   CL_CHECK(generate_.setArg(1, settings_.seed));
-  CL_CHECK(generate_.setArg(2, cl_uint(frame)));
+  CL_CHECK(generate_.setArg(2, rngFrame));
   CL_CHECK(generate_.setArg(4, states_));
   CL_CHECK(generate_.setArg(5, radiance_));
   CL_CHECK(generate_.setArg(6, n));

@@ -14,6 +14,7 @@ struct PathTracerSettings {
   int spp = 4;
   int maxDepth = 8;
   uint32_t seed = 1;
+  bool fixedNoise = false;  // RNG keyed by frame 0 on every frame
 };
 
 class PathTracer : public Integrator {

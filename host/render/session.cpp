@@ -69,7 +69,8 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device, cons
   film_ = std::make_unique<Film>(ctx_, width_, height_);
   const RenderOptions& o = options_;
   if (o.mode == RenderMode::PathTrace) {
-    integrator_ = std::make_unique<PathTracer>(ctx_, *gpu_, *film_, PathTracerSettings{o.spp, o.maxDepth, o.seed});
+    integrator_ = std::make_unique<PathTracer>(
+        ctx_, *gpu_, *film_, PathTracerSettings{o.spp, o.maxDepth, o.seed, o.fixedNoise});
   } else {
     PathReuseSettings r;
     r.spp = o.spp;
@@ -79,6 +80,7 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device, cons
     r.pathsPerPixel = static_cast<uint32_t>(o.pathsPerPixel);
     r.clamp = o.clamp;
     r.retraceAll = o.mode == RenderMode::Retrace;
+    r.fixedNoise = o.fixedNoise;
     integrator_ = std::make_unique<PathReuse>(ctx_, *gpu_, *film_, r);
   }
 }

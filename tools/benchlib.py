@@ -1,0 +1,64 @@
+"""Helpers shared by the benchmark scripts (bench_reuse.py, evaluate.py): statistics of the
+renderer's per-frame stats, the machine description for a report, and the large atrium.
+Standard library only, so that any Python 3 can import it."""
+
+import os
+import platform
+import shutil
+import statistics
+import subprocess
+import sys
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parent.parent
+ATRIUM = Path("/tmp/pathreuse-atrium/atrium.gltf")
+
+
+def median(xs):
+    return statistics.median(xs) if xs else float("nan")
+
+
+def kernel_s(rec):
+    """Kernel seconds of one frame: the sum of its stages."""
+    return sum(rec["stages_s"].values())
+
+
+def fmt_rng(xs, f="{:.3f}"):
+    """'median [min-max]'."""
+    return f"{f.format(median(xs))} [{f.format(min(xs))}-{f.format(max(xs))}]"
+
+
+def ensure_atrium(path, python=None):
+    """Generates the atrium (size 1, ~300k triangles) at `path` when it is absent."""
+    path = Path(path)
+    if not path.is_file():
+        print(f"generating {path} ...", flush=True)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        subprocess.run([python or sys.executable, str(REPO / "tools" / "gen_atrium.py"), "--size", "1",
+                        "--out", str(path)], check=True)
+    return path
+
+
+def machine_lines(exe):
+    """Markdown list items: machine, OpenCL devices, PoCL package, commit."""
+    cpu = "unknown"
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    dev = subprocess.run([str(exe), "devices"], capture_output=True, text=True).stdout.strip()
+    commit = subprocess.run(["git", "-C", str(REPO), "rev-parse", "--short", "HEAD"],
+                            capture_output=True, text=True).stdout.strip() or "unknown"
+    dirty = subprocess.run(["git", "-C", str(REPO), "status", "--porcelain", "--untracked-files=no"],
+                           capture_output=True, text=True).stdout.strip()
+    pocl = subprocess.run(["dpkg-query", "-W", "-f", "${Version}", "pocl-opencl-icd"],
+                          capture_output=True, text=True).stdout.strip() if shutil.which("dpkg-query") else ""
+    return [f"- machine: {os.cpu_count()} logical CPUs (nproc), {cpu}, {platform.system()} "
+            f"{platform.release()}",
+            "- device: " + "; ".join(f"`{d}`" for d in dev.splitlines()),
+            f"- PoCL package: {pocl or 'n/a'}; POCL_MAX_PTHREAD_COUNT="
+            f"{os.environ.get('POCL_MAX_PTHREAD_COUNT', 'unset')}",
+            f"- commit: {commit}{' (tracked files modified)' if dirty else ''}"]
