@@ -55,7 +55,8 @@ int main(int argc, char** argv) {
   std::string infoScene;
   bool infoJson = false;
   double infoFps = 24.0;
-  auto* info = app.add_subcommand("info", "What a scene holds: static/dynamic split, lights, animation");
+  auto* info =
+      app.add_subcommand("info", "What a scene holds: static/dynamic split, lights, animation");
   info->add_option("SCENE", infoScene, "glTF file (.gltf or .glb)")->required();
   info->add_flag("--json", infoJson, "Print as JSON");
   info->add_option("--fps", infoFps, "Frames per second of the animation (default 24)");
@@ -64,42 +65,62 @@ int main(int argc, char** argv) {
   std::string framesText, modeText = "reuse";
   auto* render = app.add_subcommand("render", "Render a range of frames of the scene's animation");
   render->add_option("SCENE", ro.scene, "glTF file (.gltf or .glb)")->required();
-  render->add_option("--frames", framesText, "Frame range A-B or one frame A (default: the whole animation)");
-  render->add_option("--fps", ro.fps, "Frames per second: frame f is at time f / fps")->capture_default_str();
-  render->add_option("--width", ro.width, "Image width (default: from the camera's aspect, else 640)");
+  render->add_option("--frames", framesText,
+                     "Frame range A-B or one frame A (default: the whole animation)");
+  render->add_option("--fps", ro.fps, "Frames per second: frame f is at time f / fps")
+      ->capture_default_str();
+  render->add_option("--width", ro.width,
+                     "Image width (default: from the camera's aspect, else 640)");
   render->add_option("--height", ro.height, "Image height (default 480)");
   render->add_option("--spp", ro.spp, "Samples per pixel per frame")->capture_default_str();
-  render->add_option("--max-depth", ro.maxDepth, "Maximum path length in bounces")->capture_default_str();
-  render->add_option("--seed", ro.seed, "Random seed; the same seed reproduces a frame on one device")
+  render->add_option("--max-depth", ro.maxDepth, "Maximum path length in bounces")
       ->capture_default_str();
-  render->add_option("--device", ro.device, "OpenCL device: index, P:D, cpu, gpu or part of its name");
-  render->add_option("--mode", modeText,
-                     "reuse: light paths kept across frames, re-traced only where moving objects "
-                     "disturb them; retrace: the same with every path re-traced each frame; "
-                     "pathtrace: unidirectional path tracing (the baseline)")
+  render
+      ->add_option("--seed", ro.seed, "Random seed; the same seed reproduces a frame on one device")
+      ->capture_default_str();
+  render->add_option("--device", ro.device,
+                     "OpenCL device: index, P:D, cpu, gpu or part of its name");
+  render
+      ->add_option("--mode", modeText,
+                   "reuse: light paths kept across frames, re-traced only where moving objects "
+                   "disturb them; retrace: the same with every path re-traced each frame; "
+                   "pathtrace: unidirectional path tracing (the baseline)")
       ->check(CLI::IsMember({"reuse", "retrace", "pathtrace"}))
       ->capture_default_str();
   render->add_option("--light-paths", ro.lightPaths,
                      "Light-path slots kept in the arena (reuse/retrace; default: one per pixel)");
-  render->add_option("--paths-per-pixel", ro.pathsPerPixel,
-                     "Light paths each pixel sample connects to (reuse/retrace)")
+  render
+      ->add_option("--paths-per-pixel", ro.pathsPerPixel,
+                   "Light paths each pixel sample connects to (reuse/retrace)")
       ->capture_default_str();
-  render->add_option("--clamp", ro.clamp,
-                     "Upper bound on the connection geometry term (reuse/retrace; 0 = off, unbiased)")
+  render
+      ->add_option("--clamp", ro.clamp,
+                   "Upper bound on the connection geometry term (reuse/retrace; 0 = off, unbiased)")
+      ->capture_default_str();
+  render
+      ->add_option(
+          "--connection-mis", ro.connectionMis,
+          "Connection MIS threshold R (reuse/retrace): where the eye's BSDF sample finds a "
+          "connected light vertex R or more times likelier than the light tracer did, the "
+          "path is shared with a connection from that sample (fewer fireflies near "
+          "corners; 0 = off)")
       ->capture_default_str();
   render->add_option("--camera", ro.camera, "Camera index (default: the scene's first)");
   render->add_option("--out", ro.outPattern, "Output EXR path with a frame number conversion")
       ->capture_default_str();
   render->add_flag("--exr-float", ro.exrFloat, "Write 32-bit float EXR (default: half)");
   render->add_flag("--png", ro.png, "Also write an sRGB PNG beside each EXR");
-  render->add_option("--exposure", ro.exposure, "Exposure in stops for the PNG")->capture_default_str();
+  render->add_option("--exposure", ro.exposure, "Exposure in stops for the PNG")
+      ->capture_default_str();
   render->add_flag("-q,--quiet", ro.quiet, "No progress line or summary");
-  render->add_flag("--force-diffuse", ro.forceDiffuse,
-                   "Shade every non-delta material as pure Lambert with its base colour (a diagnostic)");
+  render->add_flag(
+      "--force-diffuse", ro.forceDiffuse,
+      "Shade every non-delta material as pure Lambert with its base colour (a diagnostic)");
   render->add_option("--stats", ro.statsFile, "Write one JSON line per frame to this file");
-  render->add_flag("--resume", ro.resume,
-                   "Skip frames whose complete EXR already exists (a truncated one is rendered again); "
-                   "append to the stats file");
+  render->add_flag(
+      "--resume", ro.resume,
+      "Skip frames whose complete EXR already exists (a truncated one is rendered again); "
+      "append to the stats file");
   render->add_flag("--fixed-noise", ro.fixedNoise,
                    "Key the camera samples' random numbers by frame 0 on every frame (the same "
                    "noise pattern each frame; the scene still animates)");
@@ -173,8 +194,8 @@ int main(int argc, char** argv) {
         ro.framesGiven = true;
       }
       ro.mode = modeText == "pathtrace" ? pr::RenderMode::PathTrace
-                : modeText == "retrace"   ? pr::RenderMode::Retrace
-                                          : pr::RenderMode::Reuse;
+                : modeText == "retrace" ? pr::RenderMode::Retrace
+                                        : pr::RenderMode::Reuse;
       return pr::runRender(ro);
     }
     if (*portability) {

@@ -19,7 +19,9 @@ void toRows(const glm::mat4& m, float out[12]) {
     for (int c = 0; c < 4; ++c) out[r * 4 + c] = m[c][r];
 }
 
-float luminanceOf(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+float luminanceOf(const glm::vec3& c) {
+  return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z;
+}
 
 dev::Light triangleLight(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c,
                          const glm::vec3& le, uint32_t prim, uint32_t inst, uint32_t material) {
@@ -69,7 +71,8 @@ dev::Material toDeviceMaterial(const Material& m, bool forceDiffuse) {
   d.transmission = m.transmission;
   d.alpha_cutoff = m.alphaCutoff;
   d.base_texture = m.baseColorTexture.valid() ? m.baseColorTexture.texture : PR_NO_TEXTURE;
-  d.mr_texture = m.metallicRoughnessTexture.valid() ? m.metallicRoughnessTexture.texture : PR_NO_TEXTURE;
+  d.mr_texture =
+      m.metallicRoughnessTexture.valid() ? m.metallicRoughnessTexture.texture : PR_NO_TEXTURE;
   d.emission_texture = m.emissiveTexture.valid() ? m.emissiveTexture.texture : PR_NO_TEXTURE;
   uint32_t flags = 0;
   if (m.doubleSided) flags |= PR_MAT_DOUBLE_SIDED;
@@ -160,8 +163,8 @@ GpuScene::GpuScene(Context& ctx, const Scene& scene, const GpuSceneOptions& opti
   traceCdfBuffer_ = ctx_.allocate("light tracing power table", n * sizeof(float), CL_MEM_READ_ONLY);
   ctx_.zero(traceCdfBuffer_, n * sizeof(float));
   if (!traceCdf_.empty())
-    CL_CHECK(ctx_.queue().enqueueWriteBuffer(traceCdfBuffer_, CL_TRUE, 0, traceCdf_.size() * sizeof(float),
-                                             traceCdf_.data()));
+    CL_CHECK(ctx_.queue().enqueueWriteBuffer(traceCdfBuffer_, CL_TRUE, 0,
+                                             traceCdf_.size() * sizeof(float), traceCdf_.data()));
   shadingBytes_ += n * sizeof(float);
 }
 
@@ -184,19 +187,21 @@ void GpuScene::uploadShading() {
     for (size_t v = 0; v < m.vertexCount(); ++v) {
       dev::ShadingVertex sv{};
       sv.px = m.positions[v].x, sv.py = m.positions[v].y, sv.pz = m.positions[v].z;
-      if (v < m.normals.size()) sv.nx = m.normals[v].x, sv.ny = m.normals[v].y, sv.nz = m.normals[v].z;
+      if (v < m.normals.size())
+        sv.nx = m.normals[v].x, sv.ny = m.normals[v].y, sv.nz = m.normals[v].z;
       if (v < m.uvs.size()) sv.u = m.uvs[v].x, sv.v = m.uvs[v].y;
       verts.push_back(sv);
     }
     for (size_t t = 0; t < m.triangleCount(); ++t)
-      tris.push_back({base + m.indices[3 * t], base + m.indices[3 * t + 1], base + m.indices[3 * t + 2],
-                      m.materials[t]});
+      tris.push_back({base + m.indices[3 * t], base + m.indices[3 * t + 1],
+                      base + m.indices[3 * t + 2], m.materials[t]});
   };
   addMesh(scene_.staticMesh);
   for (const TriangleMesh& m : scene_.dynamicMeshes) addMesh(m);
 
   std::vector<dev::Material> mats;
-  for (const Material& m : scene_.materials) mats.push_back(toDeviceMaterial(m, options_.forceDiffuse));
+  for (const Material& m : scene_.materials)
+    mats.push_back(toDeviceMaterial(m, options_.forceDiffuse));
   if (mats.empty()) mats.push_back(toDeviceMaterial(Material{}));
 
   std::vector<dev::TextureInfo> infos;
@@ -213,17 +218,21 @@ void GpuScene::uploadShading() {
     if (ok) {
       for (size_t i = 0; i < size_t(t.width) * t.height; ++i) {
         const uint8_t* p = &t.rgba8[i * 4];
-        texels.push_back(uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24);
+        texels.push_back(uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 |
+                         uint32_t(p[3]) << 24);
       }
     } else {
       texels.push_back(0xffffffffu);  // a white texel stands in for an undecodable image
     }
     infos.push_back(info);
   }
-  vertices_ = upload("shading vertices", verts.data(), verts.size() * sizeof(verts[0]), &shadingBytes_);
-  triangles_ = upload("shading triangles", tris.data(), tris.size() * sizeof(tris[0]), &shadingBytes_);
+  vertices_ =
+      upload("shading vertices", verts.data(), verts.size() * sizeof(verts[0]), &shadingBytes_);
+  triangles_ =
+      upload("shading triangles", tris.data(), tris.size() * sizeof(tris[0]), &shadingBytes_);
   materials_ = upload("materials", mats.data(), mats.size() * sizeof(mats[0]), &shadingBytes_);
-  textures_ = upload("texture table", infos.data(), infos.size() * sizeof(infos[0]), &shadingBytes_);
+  textures_ =
+      upload("texture table", infos.data(), infos.size() * sizeof(infos[0]), &shadingBytes_);
   texels_ = upload("texels", texels.data(), texels.size() * 4, &shadingBytes_);
 }
 
@@ -269,8 +278,8 @@ void GpuScene::setTime(double t) {
   } else if (!lights_.empty() && lights_.front().moved) {
     // Nothing moves any more: clear the flags the first frame set.
     for (auto& l : lights_) l.moved = 0u;
-    CL_CHECK(ctx_.queue().enqueueWriteBuffer(lightBuffer_, CL_TRUE, 0, lights_.size() * sizeof(dev::Light),
-                                             lights_.data()));
+    CL_CHECK(ctx_.queue().enqueueWriteBuffer(lightBuffer_, CL_TRUE, 0,
+                                             lights_.size() * sizeof(dev::Light), lights_.data()));
   }
   firstFrame_ = false;
 }
@@ -280,14 +289,15 @@ std::vector<dev::Light> GpuScene::lightsAt(double t) const {
   std::vector<glm::mat4> xforms(scene_.instances.size());
   std::vector<bool> have(scene_.instances.size(), false);
   for (const DynamicEmitter& e : dynamicEmitters_) {
-    if (!have[e.instance]) xforms[e.instance] = scene_.instanceTransform(e.instance, t), have[e.instance] = true;
+    if (!have[e.instance])
+      xforms[e.instance] = scene_.instanceTransform(e.instance, t), have[e.instance] = true;
     const glm::mat4& x = xforms[e.instance];
     const TriangleMesh& m = scene_.dynamicMeshes[scene_.instances[e.instance].mesh];
     auto w = [&](uint32_t v) { return glm::vec3(x * glm::vec4(m.positions[v], 1.0f)); };
-    dev::Light l = triangleLight(w(m.indices[3 * e.triangle]), w(m.indices[3 * e.triangle + 1]),
-                                 w(m.indices[3 * e.triangle + 2]), scene_.materials[e.material].emission(),
-                                 meshFirstTriangle_[scene_.instances[e.instance].mesh] + e.triangle,
-                                 e.instance, e.material);
+    dev::Light l = triangleLight(
+        w(m.indices[3 * e.triangle]), w(m.indices[3 * e.triangle + 1]),
+        w(m.indices[3 * e.triangle + 2]), scene_.materials[e.material].emission(),
+        meshFirstTriangle_[scene_.instances[e.instance].mesh] + e.triangle, e.instance, e.material);
     // A degenerate or non-finite placement keeps its slot in the table with no power.
     if (!(l.area > 0.0f) || !std::isfinite(l.power)) l.power = 0.0f, l.area = 0.0f;
     lights.push_back(l);
@@ -325,7 +335,6 @@ std::vector<dev::Light> GpuScene::lightsAt(double t) const {
   return lights;
 }
 
-
 void GpuScene::buildLights(double t) {
   std::vector<dev::Light> next = lightsAt(t);
   for (size_t i = 0; i < next.size(); ++i)
@@ -344,9 +353,10 @@ void GpuScene::buildLights(double t) {
     ctx_.zero(cdfBuffer_, count * sizeof(float));
   }
   if (!lights_.empty()) {
-    CL_CHECK(ctx_.queue().enqueueWriteBuffer(lightBuffer_, CL_TRUE, 0, lights_.size() * sizeof(dev::Light),
-                                             lights_.data()));
-    CL_CHECK(ctx_.queue().enqueueWriteBuffer(cdfBuffer_, CL_TRUE, 0, cdf_.size() * sizeof(float), cdf_.data()));
+    CL_CHECK(ctx_.queue().enqueueWriteBuffer(lightBuffer_, CL_TRUE, 0,
+                                             lights_.size() * sizeof(dev::Light), lights_.data()));
+    CL_CHECK(ctx_.queue().enqueueWriteBuffer(cdfBuffer_, CL_TRUE, 0, cdf_.size() * sizeof(float),
+                                             cdf_.data()));
   }
 }
 

@@ -10,9 +10,12 @@ namespace pr {
 
 const char* renderModeName(RenderMode m) {
   switch (m) {
-    case RenderMode::Reuse: return "reuse";
-    case RenderMode::Retrace: return "retrace";
-    case RenderMode::PathTrace: return "pathtrace";
+    case RenderMode::Reuse:
+      return "reuse";
+    case RenderMode::Retrace:
+      return "retrace";
+    case RenderMode::PathTrace:
+      return "pathtrace";
   }
   return "?";
 }
@@ -74,7 +77,8 @@ FrameRange parseFrameRange(const std::string& text) {
     ok = parseInt(text.substr(0, dash), &r.first) && parseInt(text.substr(dash + 1), &r.last);
   }
   if (!ok) throw InputError("--frames " + text + ": expected A-B or A, with whole numbers >= 0");
-  if (r.last < r.first) throw InputError("--frames " + text + ": the last frame is before the first");
+  if (r.last < r.first)
+    throw InputError("--frames " + text + ": the last frame is before the first");
   return r;
 }
 

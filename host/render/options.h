@@ -20,7 +20,7 @@ struct RenderOptions {
   FrameRange frames;
   bool framesGiven = false;
   double fps = 24.0;
-  int width = 0;   // 0: the camera's aspect with height, else 640x480
+  int width = 0;  // 0: the camera's aspect with height, else 640x480
   int height = 0;
   int spp = 4;
   int maxDepth = 8;
@@ -40,9 +40,10 @@ struct RenderOptions {
   // the same noise pattern each frame, to measure how much flicker fresh noise adds.
   bool fixedNoise = false;
   // Path reuse (DESIGN.md section 5).
-  int lightPaths = 0;       // slots; 0: chosen from the image size
-  int pathsPerPixel = 4;    // C: light paths each pixel sample connects to
-  float clamp = 0.0f;       // clamp on the geometry term; 0 = off
+  int lightPaths = 0;          // slots; 0: chosen from the image size
+  int pathsPerPixel = 4;       // C: light paths each pixel sample connects to
+  float clamp = 0.0f;          // clamp on the geometry term; 0 = off
+  float connectionMis = 4.0f;  // MIS threshold on p_E / p_L (kernels/reuse/connect.cl); 0 = off
 };
 
 // "A-B" or "A" (non-negative, A <= B). Throws InputError naming --frames.

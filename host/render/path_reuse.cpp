@@ -9,7 +9,6 @@
 
 namespace pr {
 
-
 PathReuse::PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseSettings& settings)
     : ctx_(ctx), scene_(scene), film_(film), settings_(settings) {
   if (settings_.maxDepth < 2) throw InputError("--max-depth: path reuse needs at least 2");
@@ -54,6 +53,7 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
   rp.pixel_count = film_.pixels();
   rp.frame = settings_.fixedNoise ? 0u : static_cast<uint32_t>(frame);  // RNG key only
   rp.clamp = settings_.clamp;
+  rp.mis_threshold = settings_.misThreshold;
   rp.trace_total = scene_.traceTotalPower();
   rp.scene_radius = scene_.sceneRadius();
   rp.cx = scene_.sceneCentre().x, rp.cy = scene_.sceneCentre().y, rp.cz = scene_.sceneCentre().z;
@@ -136,15 +136,17 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
   stats->counters["light_vertices_dsg"] = c[PR_C_DSG_VERTICES];
   stats->counters["arena_bytes"] = arenaBytes();
   if (settings_.clamp > 0.0f) stats->counters["connections_clamped"] = c[PR_C_CLAMPED];
+  if (settings_.misThreshold > 0.0f) stats->counters["connections_mis"] = c[PR_C_MIS_RAYS];
 }
 
-void PathReuse::readArena(std::vector<dev::PathHeader>* headers, std::vector<dev::LightVertex>* vertices) {
+void PathReuse::readArena(std::vector<dev::PathHeader>* headers,
+                          std::vector<dev::LightVertex>* vertices) {
   headers->resize(slots_);
   vertices->resize(size_t(slots_) * stride_);
-  CL_CHECK(ctx_.queue().enqueueReadBuffer(headers_, CL_TRUE, 0, headers->size() * sizeof(dev::PathHeader),
-                                          headers->data()));
-  CL_CHECK(ctx_.queue().enqueueReadBuffer(vertices_, CL_TRUE, 0, vertices->size() * sizeof(dev::LightVertex),
-                                          vertices->data()));
+  CL_CHECK(ctx_.queue().enqueueReadBuffer(
+      headers_, CL_TRUE, 0, headers->size() * sizeof(dev::PathHeader), headers->data()));
+  CL_CHECK(ctx_.queue().enqueueReadBuffer(
+      vertices_, CL_TRUE, 0, vertices->size() * sizeof(dev::LightVertex), vertices->data()));
 }
 
 }  // namespace pr

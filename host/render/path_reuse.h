@@ -23,8 +23,9 @@ struct PathReuseSettings {
   uint32_t lightPaths = 0;  // N_L; 0: one per pixel
   uint32_t pathsPerPixel = 4;
   float clamp = 0.0f;
-  bool retraceAll = false;  // --mode retrace
-  bool fixedNoise = false;  // camera samples keyed by frame 0 on every frame
+  float misThreshold = 4.0f;  // connection MIS (kernels/reuse/connect.cl); 0 = off
+  bool retraceAll = false;    // --mode retrace
+  bool fixedNoise = false;    // camera samples keyed by frame 0 on every frame
 };
 
 class PathReuse : public Integrator {
@@ -35,7 +36,9 @@ class PathReuse : public Integrator {
 
   uint32_t slots() const { return slots_; }
   uint32_t stride() const { return stride_; }
-  uint64_t arenaBytes() const { return uint64_t(slots_) * (sizeof(dev::PathHeader) + stride_ * sizeof(dev::LightVertex)); }
+  uint64_t arenaBytes() const {
+    return uint64_t(slots_) * (sizeof(dev::PathHeader) + stride_ * sizeof(dev::LightVertex));
+  }
   // The arena as it stands (for tests and diagnostics).
   void readArena(std::vector<dev::PathHeader>* headers, std::vector<dev::LightVertex>* vertices);
 

@@ -11,8 +11,8 @@ std::string sceneBuildOptions(const GpuScene& scene) {
   return scene.hasAlphaMaterials() ? "-DPR_HAS_ALPHA=1" : "";
 }
 
-
-PathTracer::PathTracer(Context& ctx, GpuScene& scene, Film& film, const PathTracerSettings& settings)
+PathTracer::PathTracer(Context& ctx, GpuScene& scene, Film& film,
+                       const PathTracerSettings& settings)
     : ctx_(ctx), scene_(scene), film_(film), settings_(settings) {
   const std::string opts = sceneBuildOptions(scene);
   generate_ = ctx.kernel("pathtrace/generate.cl", "pt_generate", opts);

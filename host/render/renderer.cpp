@@ -59,18 +59,23 @@ class StatsFile {
   StatsFile& operator=(const StatsFile&) = delete;
   void writeLine(const std::string& line) {
     errno = 0;
-    if (std::fputs(line.c_str(), file_) < 0 || std::fputc('\n', file_) == EOF || std::fflush(file_) != 0) fail();
+    if (std::fputs(line.c_str(), file_) < 0 || std::fputc('\n', file_) == EOF ||
+        std::fflush(file_) != 0)
+      fail();
   }
 
  private:
   [[noreturn]] void fail() const {
-    throw RuntimeError(path_ + ": cannot write the stats file: " + std::strerror(errno ? errno : EIO));
+    throw RuntimeError(path_ +
+                       ": cannot write the stats file: " + std::strerror(errno ? errno : EIO));
   }
   std::string path_;
   FILE* file_ = nullptr;
 };
 
-std::string frameSpan(int a, int b) { return a == b ? std::to_string(a) : std::to_string(a) + "-" + std::to_string(b); }
+std::string frameSpan(int a, int b) {
+  return a == b ? std::to_string(a) : std::to_string(a) + "-" + std::to_string(b);
+}
 
 // A frame that --resume may skip: a complete EXR of the session's size (and its PNG when asked).
 bool frameDone(const std::string& exr, const RenderOptions& o, int width, int height) {
@@ -105,8 +110,8 @@ int runRender(const RenderOptions& o) {
               << session.width() << "x" << session.height() << ", " << o.spp << " spp, mode "
               << renderModeName(o.mode) << ", on " << device.name;
     if (auto* reuse = dynamic_cast<PathReuse*>(&session.integrator()))
-      std::cerr << "; arena " << reuse->slots() << " slots x " << reuse->stride() << " vertices = "
-                << (reuse->arenaBytes() >> 20) << " MiB";
+      std::cerr << "; arena " << reuse->slots() << " slots x " << reuse->stride()
+                << " vertices = " << (reuse->arenaBytes() >> 20) << " MiB";
     std::cerr << "\n";
   }
 
@@ -154,10 +159,11 @@ int runRender(const RenderOptions& o) {
     }
     if (progress) {
       const int done = f - range.first + 1;
-      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const double elapsed =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       const double eta = rendered > 0 ? elapsed / rendered * (total - done) : 0.0;
-      std::fprintf(stderr, "\rframe %d of %d (#%d)  %.2f Mrays/s  elapsed %s  ETA %s   ", done, total, f,
-                   elapsed > 0 ? raysSoFar / elapsed * 1e-6 : 0.0, clock(elapsed).c_str(),
+      std::fprintf(stderr, "\rframe %d of %d (#%d)  %.2f Mrays/s  elapsed %s  ETA %s   ", done,
+                   total, f, elapsed > 0 ? raysSoFar / elapsed * 1e-6 : 0.0, clock(elapsed).c_str(),
                    clock(eta).c_str());
       std::fflush(stderr);
     }
@@ -166,14 +172,20 @@ int runRender(const RenderOptions& o) {
   if (interrupted() && f <= range.last) {  // a signal after the last frame changes nothing
     // Frames before f are complete (rendered now or found complete); f onwards are not.
     const int sig = interruptSignal();
-    std::cerr << "interrupted by " << (sig == SIGTERM ? "SIGTERM" : sig == SIGINT ? "SIGINT" : "signal")
-              << ": " << (f > range.first ? "frames " + frameSpan(range.first, f - 1) + " complete" : "no frame complete")
+    std::cerr << "interrupted by "
+              << (sig == SIGTERM  ? "SIGTERM"
+                  : sig == SIGINT ? "SIGINT"
+                                  : "signal")
+              << ": "
+              << (f > range.first ? "frames " + frameSpan(range.first, f - 1) + " complete"
+                                  : "no frame complete")
               << " in " << o.outPattern << "; " << frameSpan(f, range.last)
               << " not rendered (run again with --resume to finish)\n";
     return 128 + sig;
   }
   if (!o.quiet) {
-    std::cerr << "rendered " << rendered << " frame(s) to " << formatOutPath(o.outPattern, range.first)
+    std::cerr << "rendered " << rendered << " frame(s) to "
+              << formatOutPath(o.outPattern, range.first)
               << (total > 1 ? " ... " + formatOutPath(o.outPattern, range.last) : "");
     if (skipped > 0) std::cerr << "; " << skipped << " already complete, skipped";
     std::cerr << "\n";

@@ -40,23 +40,29 @@ int checkedCamera(const Scene& scene, const RenderOptions& o) {
 
 void validateRenderOptions(const RenderOptions& o) {
   validateOutPattern(o.outPattern);
-  if (o.spp < 1 || o.spp > 1 << 20) throw InputError("--spp " + std::to_string(o.spp) + ": must be 1 to 1048576");
+  if (o.spp < 1 || o.spp > 1 << 20)
+    throw InputError("--spp " + std::to_string(o.spp) + ": must be 1 to 1048576");
   if (o.maxDepth < 1 || o.maxDepth > 64)
     throw InputError("--max-depth " + std::to_string(o.maxDepth) + ": must be 1 to 64");
   if (o.mode != RenderMode::PathTrace && o.maxDepth < 2)
     throw InputError("--max-depth " + std::to_string(o.maxDepth) + ": path reuse needs at least 2");
-  if (!(o.fps > 0.0) || !std::isfinite(o.fps) || o.fps > 1000.0) throw InputError("--fps: must be in (0, 1000]");
+  if (!(o.fps > 0.0) || !std::isfinite(o.fps) || o.fps > 1000.0)
+    throw InputError("--fps: must be in (0, 1000]");
   if (o.width < 0 || o.height < 0 || o.width > 16384 || o.height > 16384)
     throw InputError("--width/--height: must be 1 to 16384");
   if (o.lightPaths < 0 || o.lightPaths > (1 << 26))
     throw InputError("--light-paths " + std::to_string(o.lightPaths) + ": must be 1 to 67108864");
   if (o.pathsPerPixel < 1 || o.pathsPerPixel > 64)
     throw InputError("--paths-per-pixel " + std::to_string(o.pathsPerPixel) + ": must be 1 to 64");
-  if (!(o.clamp >= 0.0f) || !std::isfinite(o.clamp)) throw InputError("--clamp: must be 0 (off) or positive");
+  if (!(o.clamp >= 0.0f) || !std::isfinite(o.clamp))
+    throw InputError("--clamp: must be 0 (off) or positive");
+  if (!(o.connectionMis >= 0.0f) || !std::isfinite(o.connectionMis))
+    throw InputError("--connection-mis: must be 0 (off) or positive");
   if (!std::isfinite(o.exposure)) throw InputError("--exposure: must be finite");
 }
 
-RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device, const RenderOptions& options)
+RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
+                             const RenderOptions& options)
     : scene_(scene), options_(options), ctx_(device) {
   if (scene.staticTriangleCount() + scene.dynamicTriangleCount() == 0)
     throw InputError(options.scene + ": nothing to render (no triangles)");
@@ -79,6 +85,7 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device, cons
     r.lightPaths = static_cast<uint32_t>(o.lightPaths);
     r.pathsPerPixel = static_cast<uint32_t>(o.pathsPerPixel);
     r.clamp = o.clamp;
+    r.misThreshold = o.connectionMis;
     r.retraceAll = o.mode == RenderMode::Retrace;
     r.fixedNoise = o.fixedNoise;
     integrator_ = std::make_unique<PathReuse>(ctx_, *gpu_, *film_, r);

@@ -1,25 +1,59 @@
 // connect: one work-item per pixel (one pass per sample index). At the pixel sample's eye
-// vertex x: next-event estimation, and connections to every stored non-delta vertex k >= 1 of
+// vertex x: next-event estimation (MIS-weighted against the BSDF sample's emitter hit, as in the
+// path tracer), and connections to every stored non-delta vertex k >= 1 of
 // the C light paths interleaved to this sample (DESIGN.md section 5). Then, for completeness
 // with mirrors and glass, one BSDF direction from x: if it meets a delta surface, the delta
 // chain is followed and its end is treated like x (emission, next-event estimation,
-// connections), up to the maximum depth; otherwise it is dropped, as the connections and
-// next-event estimation at x already count those paths.
+// connections), up to the maximum depth. If it meets a non-delta surface Y, that surface is
+// connected to the same light paths where connection MIS gives it a share (below).
 // Reads the EyeVertex, the arena and the scene; adds to the sample's radiance and the counters.
+//
+// Connection MIS. A connected path x - Y - y_{k-1} - ... can be found two ways: the light
+// tracer stepped from y_{k-1} to Y = y_k and x connects to it (strategy L), or x's BSDF sample
+// found Y and Y connects to y_{k-1} (strategy E). L alone has unbounded variance where Y comes
+// close to x (G ~ 1/d^2): the rare bright pixels of corners and contact. Both strategies weigh
+// the path by the power heuristic on r = p_E / p_L, the area pdfs of Y under each, and E only
+// runs where r >= rp.mis_threshold, so that it costs shadow rays only near that singularity;
+// below the threshold L keeps weight 1. The weights add to 1 for every path, so the estimator
+// stays unbiased. E needs y_{k-1} to be connectable: not a delta surface, nor a spot or
+// directional light's vertex 0 (left to L alone).
 #include "shared/reuse.h"
 
-// Connections from surface x (eye depth `depth`, throughput tp) to the light paths of sample j.
+// Weight of strategy L; strategy E's is 1 minus it. r NaN or below the threshold: L alone.
+PR_INLINE float mis_weight_l(float r, float threshold) {
+  if (!(threshold > 0.0f) || !(r >= threshold)) return 1.0f;
+  return 1.0f / (1.0f + r * r);
+}
+
+// Solid-angle pdf with which the light tracer leaves vertex 0 along dir; 0 where strategy E does
+// not connect to vertex 0 (spot and directional lights).
+PR_INLINE float light_emit_pdf(const SceneData* s, u32 light, PR_GLOBAL const LightVertex* v0,
+                               float3 dir) {
+  const u32 type = s->lights.lights[light].type;
+  // Triangles: a face with probability 1/2, then cosine-weighted about it.
+  if (type == PR_LIGHT_TRIANGLE) return fabs(dot(oct_decode(v0->ng_oct), dir)) * (0.5f * PR_INV_PI);
+  if (type == PR_LIGHT_POINT) return 0.25f * PR_INV_PI;
+  return 0.0f;
+}
+
+// Strategy L: connections from surface x (eye depth `depth`, throughput tp) to the light paths
+// of sample j.
 PR_INLINE float3 connect_light_paths(const SceneData* s, const ReuseParams* rp, const SurfaceHit* x,
-                                     const ShadingFrame* fx, float3 wo, float3 tp, uint depth, uint j,
-                                     __global const PathHeader* headers,
-                                     __global const LightVertex* vertices, uint* rays, uint* clamped) {
+                                     const ShadingFrame* fx, float3 wo, float3 tp, uint depth,
+                                     uint j, __global const PathHeader* headers,
+                                     __global const LightVertex* vertices, uint* rays,
+                                     uint* clamped) {
   float3 sum = make_float3(0.0f, 0.0f, 0.0f);
   const float3 wol = to_local(wo, fx->t, fx->b, fx->n);
   const float inv_c = 1.0f / (float)rp->paths_per_pixel;
+  const int mis = rp->mis_threshold > 0.0f;
   for (uint c = 0u; c < rp->paths_per_pixel; ++c) {
     const uint slot = (uint)(((ulong)j * rp->paths_per_pixel + c) % rp->slots);
     const uint count = headers[slot].vertex_count;
     __global const LightVertex* v = vertices + (size_t)slot * rp->stride;
+    // Solid-angle pdf of the light tracer's step from y_{k-1} to y_k; 0: E cannot reach y_{k-1}.
+    float pdf_step =
+        (mis && count > 1u) ? light_emit_pdf(s, headers[slot].light, v, vertex_dir(v + 1)) : 0.0f;
     for (uint k = 1u; k < count && depth + k + 1u <= rp->max_depth; ++k) {
       SurfaceHit y = surface_at(&s->sd, v[k].prim, v[k].inst, v[k].b1, v[k].b2);
       y.p = vertex_pos(v + k);
@@ -27,16 +61,29 @@ PR_INLINE float3 connect_light_paths(const SceneData* s, const ReuseParams* rp, 
       y.ns = oct_decode(v[k].ns_oct);
       const float3 wy_prev = -vertex_dir(v + k);  // towards the previous light vertex
       const ShadingFrame fy = shading_frame(s, &y, wy_prev);
-      if (bsdf_is_delta(&fy.bsdf)) continue;
+      const int y_delta = bsdf_is_delta(&fy.bsdf);
+      const float pdf_arrive = pdf_step;
+      const float3 wyl = to_local(wy_prev, fy.t, fy.b, fy.n);
+      pdf_step = 0.0f;
+      if (mis && !y_delta && k + 1u < count) {
+        // The light tracer sampled the same BSDF, in the same frame, to reach y_{k+1}.
+        bsdf_eval(&fy.bsdf, wyl, to_local(vertex_dir(v + k + 1u), fy.t, fy.b, fy.n), &pdf_step);
+      }
+      if (y_delta) continue;
       const float3 dxy = y.p - x->p;
       const float dist2 = dot(dxy, dxy);
       if (!(dist2 > 0.0f)) continue;
       const float3 dir = dxy * (1.0f / sqrt(dist2));  // from x to y
       if (dot(dir, fx->ng) <= 0.0f || dot(-dir, fy.ng) <= 0.0f) continue;
-      float pdf_unused;
-      const float3 f_x = bsdf_eval(&fx->bsdf, wol, to_local(dir, fx->t, fx->b, fx->n), &pdf_unused);
-      const float3 f_y = bsdf_eval(&fy.bsdf, to_local(wy_prev, fy.t, fy.b, fy.n),
-                                   to_local(-dir, fy.t, fy.b, fy.n), &pdf_unused);
+      float pdf_x, pdf_unused;
+      const float3 f_x = bsdf_eval(&fx->bsdf, wol, to_local(dir, fx->t, fx->b, fx->n), &pdf_x);
+      const float3 f_y = bsdf_eval(&fy.bsdf, wyl, to_local(-dir, fy.t, fy.b, fy.n), &pdf_unused);
+      float w = 1.0f;
+      if (pdf_arrive > 0.0f) {
+        const float p_e = pdf_x * fabs(dot(fy.ng, dir)) / dist2;
+        const float p_l = pdf_arrive * fabs(dot(fy.ng, vertex_dir(v + k))) / (v[k].t * v[k].t);
+        w = mis_weight_l(p_e / p_l, rp->mis_threshold);
+      }
       float g = fabs(dot(fx->n, dir)) * fabs(dot(fy.n, dir)) / dist2;
       if (rp->clamp > 0.0f && g > rp->clamp) {
         g = rp->clamp;
@@ -44,10 +91,96 @@ PR_INLINE float3 connect_light_paths(const SceneData* s, const ReuseParams* rp, 
       }
       const float corr = shading_normal_correction(wy_prev, -dir, fy.n, fy.ng);
       const float3 tpy = make_float3(v[k].tp_r, v[k].tp_g, v[k].tp_b);
-      const float3 contrib = tp * f_x * f_y * tpy * (g * corr * inv_c);
+      const float3 contrib = tp * f_x * f_y * tpy * (g * corr * inv_c * w);
       if (!(max3(contrib) > 0.0f)) continue;
       ++*rays;
       const Ray r = spawn_ray_to(x->p, fx->ng, y.p, fy.ng);
+      if (!trace_occluded(s, r)) sum += contrib;
+    }
+  }
+  return sum;
+}
+
+// Strategy E: connections from Y, the non-delta first hit of the BSDF sample taken at the eye
+// vertex at xp with solid-angle pdf pdf_x (Y at eye depth `depth`, throughput tp), to the
+// vertices k >= 0 of the light paths of sample j, each weighted by its share of the MIS.
+PR_INLINE float3 connect_sampled_vertex(const SceneData* s, const ReuseParams* rp, float3 xp,
+                                        const SurfaceHit* yh, const ShadingFrame* fy, float3 wo,
+                                        float3 tp, float pdf_x, uint depth, uint j,
+                                        __global const PathHeader* headers,
+                                        __global const LightVertex* vertices, uint* rays,
+                                        uint* mis_rays, uint* clamped) {
+  float3 sum = make_float3(0.0f, 0.0f, 0.0f);
+  const float3 dxy = yh->p - xp;
+  const float dxy2 = dot(dxy, dxy);
+  if (!(dxy2 > 0.0f) || !(pdf_x > 0.0f)) return sum;
+  const float p_e = pdf_x * fabs(dot(fy->ng, dxy)) / (dxy2 * sqrt(dxy2));
+  const float3 wol = to_local(wo, fy->t, fy->b, fy->n);
+  const float inv_c = 1.0f / (float)rp->paths_per_pixel;
+  for (uint c = 0u; c < rp->paths_per_pixel; ++c) {
+    const uint slot = (uint)(((ulong)j * rp->paths_per_pixel + c) % rp->slots);
+    const uint count = headers[slot].vertex_count;
+    __global const LightVertex* v = vertices + (size_t)slot * rp->stride;
+    for (uint k = 0u; k < count && depth + k + 1u <= rp->max_depth; ++k) {
+      float3 zp, zng, f_z, tpz;
+      float pdf_l, cos_z, corr = 1.0f;
+      if (k == 0u) {
+        // Vertex 0: the point on the light; f_z * tpz is its emission over the position pdf.
+        const u32 type = s->lights.lights[headers[slot].light].type;
+        if (type != PR_LIGHT_TRIANGLE && type != PR_LIGHT_POINT) continue;
+        zp = vertex_pos(v);
+        zng = oct_decode(v[0].ng_oct);
+        const float3 d = zp - yh->p;
+        const float dist2 = dot(d, d);
+        if (!(dist2 > 0.0f)) continue;
+        const float3 dir = d * (1.0f / sqrt(dist2));
+        pdf_l = light_emit_pdf(s, headers[slot].light, v, dir);
+        // The stored throughput is emission over (position pdf times pdf_l / cos).
+        const int tri = type == PR_LIGHT_TRIANGLE;
+        cos_z = tri ? fabs(dot(zng, dir)) : 1.0f;
+        f_z = make_float3(1.0f, 1.0f, 1.0f) * (tri ? 0.5f * PR_INV_PI : 0.25f * PR_INV_PI);
+      } else {
+        SurfaceHit z = surface_at(&s->sd, v[k].prim, v[k].inst, v[k].b1, v[k].b2);
+        z.p = vertex_pos(v + k);
+        z.ng = oct_decode(v[k].ng_oct);
+        z.ns = oct_decode(v[k].ns_oct);
+        const float3 wz_prev = -vertex_dir(v + k);
+        const ShadingFrame fz = shading_frame(s, &z, wz_prev);
+        if (bsdf_is_delta(&fz.bsdf)) continue;
+        zp = z.p;
+        zng = fz.ng;
+        const float3 d = zp - yh->p;
+        const float dist2 = dot(d, d);
+        if (!(dist2 > 0.0f)) continue;
+        const float3 dir = d * (1.0f / sqrt(dist2));
+        if (dot(-dir, fz.ng) <= 0.0f) continue;
+        f_z = bsdf_eval(&fz.bsdf, to_local(wz_prev, fz.t, fz.b, fz.n),
+                        to_local(-dir, fz.t, fz.b, fz.n), &pdf_l);
+        cos_z = fabs(dot(fz.n, dir));
+        corr = shading_normal_correction(wz_prev, -dir, fz.n, fz.ng);
+      }
+      tpz = make_float3(v[k].tp_r, v[k].tp_g, v[k].tp_b);
+      const float3 d = zp - yh->p;
+      const float dist2 = dot(d, d);
+      const float3 dir = d * (1.0f / sqrt(dist2));  // from Y to z
+      if (dot(dir, fy->ng) <= 0.0f) continue;
+      const float p_l = pdf_l * fabs(dot(fy->ng, dir)) / dist2;
+      const float w = 1.0f - mis_weight_l(p_e / p_l, rp->mis_threshold);
+      if (!(w > 0.0f)) continue;
+      float pdf_unused;
+      const float3 f_y = bsdf_eval(&fy->bsdf, wol, to_local(dir, fy->t, fy->b, fy->n), &pdf_unused);
+      float g = fabs(dot(fy->n, dir)) * cos_z / dist2;
+      if (rp->clamp > 0.0f && g > rp->clamp) {
+        g = rp->clamp;
+        ++*clamped;
+      }
+      const float3 contrib = tp * f_y * f_z * tpz * (g * corr * inv_c * w);
+      if (!(max3(contrib) > 0.0f)) continue;
+      ++*rays;
+      ++*mis_rays;
+      const Ray r = (k == 0u && v[0].prim == PR_INVALID_INDEX)
+                        ? spawn_ray(yh->p, fy->ng, dir, sqrt(dist2) * (1.0f - 1e-4f))
+                        : spawn_ray_to(yh->p, fy->ng, zp, zng);
       if (!trace_occluded(s, r)) sum += contrib;
     }
   }
@@ -71,13 +204,14 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
   float3 tp = make_float3(e.tp_r, e.tp_g, e.tp_b);
   uint depth = e.depth;
   float3 L = make_float3(0.0f, 0.0f, 0.0f);
-  uint shadow_rays = 0u, connect_rays = 0u, bounce_rays = 0u, clamped = 0u;
+  uint shadow_rays = 0u, connect_rays = 0u, mis_rays = 0u, bounce_rays = 0u, clamped = 0u;
   for (;;) {
     const ShadingFrame f = shading_frame(&s, &x, wo);
     if (depth + 1u <= rp.max_depth) {
       Ray shadow;
       float3 c;
-      if (next_event(&s, &x, &f, wo, 0, &rng, &shadow, &c)) {
+      // Weighted against the BSDF sample's emitter hit below, when there is a sample.
+      if (next_event(&s, &x, &f, wo, depth + 1u < rp.max_depth, &rng, &shadow, &c)) {
         ++shadow_rays;
         if (!trace_occluded(&s, shadow)) L += tp * c;
       }
@@ -106,7 +240,16 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
       const SurfaceHit h = surface_at(&s.sd, hit.prim, hit.inst, hit.u, hit.v);
       const ShadingFrame fh = shading_frame(&s, &h, -d);
       const int is_delta = bsdf_is_delta(&fh.bsdf);
-      if (chain == 0u && !is_delta) break;  // already counted at x
+      // An emitter met by the sample from x: its MIS share against next-event estimation at x.
+      if (chain == 0u && (s.sd.materials[h.material].flags & PR_MAT_EMISSIVE))
+        L += t2 * surface_emission(&s, &h) * power_heuristic(pdf, emitter_pdf(&s, &h, d, hit.t));
+      if (chain == 0u && !is_delta) {
+        // Strategy L at x counts these paths, apart from E's share.
+        if (rp.mis_threshold > 0.0f && !delta)
+          L += connect_sampled_vertex(&s, &rp, x.p, &h, &fh, -d, t2, pdf, depth + 1u, j, headers,
+                                      vertices, &connect_rays, &mis_rays, &clamped);
+        break;
+      }
       ++depth;
       // Emission behind at least one delta bounce (the first delta surface's own emission is
       // next-event estimation's at x).
@@ -133,5 +276,6 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
   if (shadow_rays) atomic_add(counters + PR_C_SHADOW_RAYS, shadow_rays);
   if (connect_rays) atomic_add(counters + PR_C_CONNECT_RAYS, connect_rays);
   if (bounce_rays) atomic_add(counters + PR_C_BOUNCE_RAYS, bounce_rays);
+  if (mis_rays) atomic_add(counters + PR_C_MIS_RAYS, mis_rays);
   if (clamped) atomic_add(counters + PR_C_CLAMPED, clamped);
 }

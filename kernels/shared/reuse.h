@@ -21,7 +21,7 @@ typedef struct {
   float clamp;  // upper bound on the connection geometry term; 0 = off
   float trace_total;
   float scene_radius;
-  float pad0;
+  float mis_threshold;  // connection MIS: strategy E runs where p_E / p_L >= this; 0 = off
   float cx, cy, cz;  // scene centre
   float pad1;
 } ReuseParams;
@@ -37,7 +37,8 @@ typedef struct {
 #define PR_C_SSG_VERTICES 7  // light vertices k >= 1 on static geometry
 #define PR_C_DSG_VERTICES 8
 #define PR_C_CLAMPED 9       // connections whose geometry term was clamped
-#define PR_C_COUNT 10
+#define PR_C_MIS_RAYS 10     // connection rays of strategy E (a subset of PR_C_CONNECT_RAYS)
+#define PR_C_COUNT 11
 
 // The ray of the segment leaving a stored vertex in direction dir: from the exact point for
 // punctual lights (prim == PR_INVALID_INDEX), else offset off the surface along the decoded

@@ -40,6 +40,7 @@ namespace {
 struct TempDirs {
   std::vector<std::string> dirs;
   ~TempDirs() {
+    if (std::getenv("PATHREUSE_KEEP_TEST_FILES")) return;  // to look into a failure
     for (const auto& d : dirs) {
       std::error_code ec;
       fs::remove_all(d, ec);
