@@ -59,7 +59,8 @@ std::vector<std::string> temporaryFiles(const std::string& dir) {
 // The renderer running in the background, its stderr going to a file.
 class Background {
  public:
-  Background(const std::vector<std::string>& args, const std::string& dir) : errFile_(dir + "/stderr") {
+  Background(const std::vector<std::string>& args, const std::string& dir)
+      : errFile_(dir + "/stderr") {
     std::vector<std::string> all = {PATHREUSE_BINARY};
     all.insert(all.end(), args.begin(), args.end());
     std::vector<char*> argv;
@@ -69,7 +70,8 @@ class Background {
     posix_spawn_file_actions_init(&actions);
     posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
     posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
-    posix_spawn_file_actions_addopen(&actions, 2, errFile_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_addopen(&actions, 2, errFile_.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                     0644);
     const int rc = posix_spawn(&pid_, argv[0], &actions, nullptr, argv.data(), environ);
     posix_spawn_file_actions_destroy(&actions);
     if (rc != 0) pid_ = -1;
@@ -101,8 +103,10 @@ class Background {
   int wait(double seconds) {
     const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
     while (!exited_ && std::chrono::steady_clock::now() < end) {
-      if (waitpid(pid_, &status_, WNOHANG) == pid_) exited_ = true;
-      else std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      if (waitpid(pid_, &status_, WNOHANG) == pid_)
+        exited_ = true;
+      else
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
     if (!exited_) return -1;
     return WIFEXITED(status_) ? WEXITSTATUS(status_) : 128 + WTERMSIG(status_);
@@ -121,15 +125,16 @@ const std::string kScene = test::sourcePath("scenes/cornell-dynamic.gltf");
 TEST(Interrupt, SigintKeepsCompleteFramesOnlyAndSaysWhich) {
   const std::string dir = test::tempDir("sigint");
   const std::string out = dir + "/frames";
-  Background run({"render", kScene, "--fps", "1000", "--width", "64", "--height", "48", "--spp", "2", "--png",
-                  "--stats", dir + "/stats.jsonl", "--out", out + "/f_%04d.exr"},
+  Background run({"render", kScene, "--fps", "1000", "--width", "64", "--height", "48", "--spp",
+                  "2", "--png", "--stats", dir + "/stats.jsonl", "--out", out + "/f_%04d.exr"},
                  dir);
   ASSERT_TRUE(run.started());
   ASSERT_TRUE(run.waitUntil([&] { return fs::exists(out + "/f_0002.exr"); }, 120)) << run.err();
   const auto sent = std::chrono::steady_clock::now();
   run.signal(SIGINT);
   const int code = run.wait(10);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count();
   ASSERT_EQ(code, 130) << run.err();
   EXPECT_LT(seconds, 5.0);
 
@@ -163,20 +168,23 @@ TEST(Interrupt, SigintKeepsCompleteFramesOnlyAndSaysWhich) {
 TEST(Interrupt, SigtermStopsWithinALongFrame) {
   const std::string dir = test::tempDir("sigterm");
   const std::string out = dir + "/frames";
-  Background run({"render", kScene, "--frames", "0-3", "--width", "64", "--height", "48", "--spp", "1000000",
-                  "--out", out + "/f_%04d.exr"},
+  Background run({"render", kScene, "--frames", "0-3", "--width", "64", "--height", "48", "--spp",
+                  "1000000", "--out", out + "/f_%04d.exr"},
                  dir);
   ASSERT_TRUE(run.started());
   // The "rendering ..." line comes once the kernels are built, just before the first frame.
-  ASSERT_TRUE(run.waitUntil([&] { return run.err().find("rendering ") != std::string::npos; }, 120)) << run.err();
+  ASSERT_TRUE(run.waitUntil([&] { return run.err().find("rendering ") != std::string::npos; }, 120))
+      << run.err();
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   const auto sent = std::chrono::steady_clock::now();
   run.signal(SIGTERM);
   const int code = run.wait(10);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count();
   ASSERT_EQ(code, 143) << run.err();
   EXPECT_LT(seconds, 5.0);
-  EXPECT_NE(run.err().find("interrupted by SIGTERM: no frame complete in " + out + "/f_%04d.exr; 0-3 not rendered"),
+  EXPECT_NE(run.err().find("interrupted by SIGTERM: no frame complete in " + out +
+                           "/f_%04d.exr; 0-3 not rendered"),
             std::string::npos)
       << run.err();
   EXPECT_TRUE(fs::is_empty(out));
@@ -195,8 +203,10 @@ TEST(Resume, FinishesARunBitForBitAsAnUninterruptedOne) {
   for (const char* mode : {"reuse", "pathtrace"}) {
     SCOPED_TRACE(mode);
     const std::string dir = test::tempDir("resume");
-    const std::string common = "render '" + kScene + "' --exr-float --width 64 --height 48 --spp 2 --mode " + mode;
-    auto r = test::runPathreuse(common + " --quiet --frames 0-5 --out '" + dir + "/whole/f_%04d.exr'");
+    const std::string common =
+        "render '" + kScene + "' --exr-float --width 64 --height 48 --spp 2 --mode " + mode;
+    auto r =
+        test::runPathreuse(common + " --quiet --frames 0-5 --out '" + dir + "/whole/f_%04d.exr'");
     ASSERT_EQ(r.exitCode, 0) << r.err;
     r = test::runPathreuse(common + " --quiet --frames 0-2 --out '" + dir + "/cut/f_%04d.exr'");
     ASSERT_EQ(r.exitCode, 0) << r.err;
@@ -220,7 +230,8 @@ TEST(Resume, FinishesARunBitForBitAsAnUninterruptedOne) {
 
 TEST(Resume, AFrameOfAnotherSizeIsRenderedAgain) {
   const std::string dir = test::tempDir("resize");
-  const std::string common = "render '" + kScene + "' --quiet --frames 0 --spp 1 --out '" + dir + "/f_%04d.exr'";
+  const std::string common =
+      "render '" + kScene + "' --quiet --frames 0 --spp 1 --out '" + dir + "/f_%04d.exr'";
   auto r = test::runPathreuse(common + " --width 32 --height 24");
   ASSERT_EQ(r.exitCode, 0) << r.err;
   r = test::runPathreuse(common + " --width 64 --height 48 --resume");
@@ -231,36 +242,62 @@ TEST(Resume, AFrameOfAnotherSizeIsRenderedAgain) {
 TEST(WriteErrors, OutputUnderARegularFileIsOneLineAndExitOne) {
   const std::string dir = test::tempDir("notdir");
   std::ofstream(dir + "/file") << "x";
-  const auto r = test::runPathreuse("render '" + kScene + "' --frames 0 --width 32 --height 24 --spp 1 --out '" +
-                                    dir + "/file/f_%04d.exr'");
+  const auto r = test::runPathreuse("render '" + kScene +
+                                    "' --frames 0 --width 32 --height 24 --spp 1 --out '" + dir +
+                                    "/file/f_%04d.exr'");
   EXPECT_EQ(r.exitCode, 1) << r.err;
   EXPECT_EQ(lineCount(r.err), 1u) << r.err;
   EXPECT_NE(r.err.find(dir + "/file/f_0000.exr: cannot create folder"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("Not a directory"), std::string::npos) << r.err;
 }
 
+// Root writes into read-only folders, so as root the render runs as user nobody (setpriv), with
+// its caches in a folder nobody can write.
 TEST(WriteErrors, ReadOnlyFolderIsOneLineAndExitOne) {
-  if (geteuid() == 0) GTEST_SKIP() << "running as root, which writes into read-only folders";
   const std::string dir = test::tempDir("readonly");
+  std::string env;
+  if (geteuid() == 0) {
+    const std::string cache = dir + "/cache";
+    fs::create_directory(cache);
+    fs::permissions(cache, fs::perms::all);
+    fs::permissions(dir, fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec |
+                             fs::perms::others_read | fs::perms::others_exec);
+    const std::string drop = "setpriv --reuid=65534 --regid=65534 --clear-groups";
+    const std::string probe = drop + " test -x '" + std::string(PATHREUSE_BINARY) + "' -a -r '" +
+                              kScene + "' 2>/dev/null";
+    if (std::system(probe.c_str()) != 0)
+      GTEST_SKIP() << "running as root, and user nobody cannot run " << PATHREUSE_BINARY
+                   << " (or setpriv is absent)";
+    env = "HOME='" + cache + "' XDG_CACHE_HOME='" + cache + "' POCL_CACHE_DIR='" + cache +
+          "' PATHREUSE_CACHE_DIR='" + cache + "' " + drop;
+  }
   fs::create_directory(dir + "/ro");
-  fs::permissions(dir + "/ro", fs::perms::owner_read | fs::perms::owner_exec);
-  const auto r = test::runPathreuse("render '" + kScene + "' --frames 0 --width 32 --height 24 --spp 1 --out '" +
-                                    dir + "/ro/f_%04d.exr'");
+  fs::permissions(dir + "/ro", fs::perms::owner_read | fs::perms::owner_exec |
+                                   fs::perms::group_read | fs::perms::group_exec |
+                                   fs::perms::others_read | fs::perms::others_exec);
+  const auto r = test::runPathreuse("render '" + kScene +
+                                        "' --frames 0 --width 32 --height 24 --spp 1 --out '" +
+                                        dir + "/ro/f_%04d.exr'",
+                                    env);
   fs::permissions(dir + "/ro", fs::perms::owner_all);
   EXPECT_EQ(r.exitCode, 1) << r.err;
   EXPECT_EQ(lineCount(r.err), 1u) << r.err;
-  EXPECT_NE(r.err.find(dir + "/ro/f_0000.exr: cannot write: Permission denied"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(dir + "/ro/f_0000.exr: cannot write: Permission denied"), std::string::npos)
+      << r.err;
   EXPECT_TRUE(fs::is_empty(dir + "/ro"));
 }
 
 TEST(WriteErrors, FullDiskForTheStatsFileIsOneLineAndExitOne) {
   if (!fs::exists("/dev/full")) GTEST_SKIP() << "/dev/full is absent";
   const std::string dir = test::tempDir("devfull");
-  const auto r = test::runPathreuse("render '" + kScene + "' --quiet --frames 0 --width 32 --height 24 --spp 1 "
-                                    "--stats /dev/full --out '" + dir + "/f_%04d.exr'");
+  const auto r = test::runPathreuse("render '" + kScene +
+                                    "' --quiet --frames 0 --width 32 --height 24 --spp 1 "
+                                    "--stats /dev/full --out '" +
+                                    dir + "/f_%04d.exr'");
   EXPECT_EQ(r.exitCode, 1) << r.err;
   EXPECT_EQ(lineCount(r.err), 1u) << r.err;
-  EXPECT_NE(r.err.find("/dev/full: cannot write the stats file: No space left on device"), std::string::npos)
+  EXPECT_NE(r.err.find("/dev/full: cannot write the stats file: No space left on device"),
+            std::string::npos)
       << r.err;
 }
 
@@ -295,17 +332,21 @@ TEST(WriteErrors, FailingExrWriteLeavesNoFile) {
 
 TEST(DeviceMemory, ArenaTooLargeNamesItAndItsSize) {
   const std::string dir = test::tempDir("oom");
-  const auto r = test::runPathreuse("render '" + kScene + "' --frames 0 --width 32 --height 24 --spp 1 "
-                                    "--light-paths 67108864 --max-depth 64 --out '" + dir + "/f_%04d.exr'");
+  const auto r = test::runPathreuse("render '" + kScene +
+                                    "' --frames 0 --width 32 --height 24 --spp 1 "
+                                    "--light-paths 67108864 --max-depth 64 --out '" +
+                                    dir + "/f_%04d.exr'");
   EXPECT_EQ(r.exitCode, 1) << r.err;
   EXPECT_EQ(lineCount(r.err), 1u) << r.err;
-  EXPECT_NE(r.err.find("device out of memory: light vertex arena needs "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("device out of memory: light vertex arena needs "), std::string::npos)
+      << r.err;
   EXPECT_NE(r.err.find(" GiB"), std::string::npos) << r.err;
   EXPECT_TRUE(fs::is_empty(dir));
 }
 
 TEST(DeviceMemory, AbsurdSizesAreBadInput) {
-  for (const char* args : {"--light-paths 100000000", "--width 100000", "--max-depth 1000", "--spp 0"}) {
+  for (const char* args :
+       {"--light-paths 100000000", "--width 100000", "--max-depth 1000", "--spp 0"}) {
     const auto r = test::runPathreuse("render '" + kScene + "' --frames 0 " + args);
     EXPECT_EQ(r.exitCode, 2) << args << ": " << r.err;
     EXPECT_EQ(lineCount(r.err), 1u) << r.err;
@@ -326,8 +367,9 @@ TEST(LoaderFromMemory, SameSceneAsFromTheFile) {
 }
 
 TEST(LoaderFromMemory, BrokenBytesAreAnInputErrorNamingTheFile) {
-  for (const std::string& bytes : {std::string(), std::string("{"), std::string("glTF\x02\0\0\0", 8),
-                                  std::string("{\"asset\":{\"version\":\"1.0\"}}")}) {
+  for (const std::string& bytes :
+       {std::string(), std::string("{"), std::string("glTF\x02\0\0\0", 8),
+        std::string("{\"asset\":{\"version\":\"1.0\"}}")}) {
     try {
       loadSceneFromMemory(bytes, "mem/x.gltf");
       ADD_FAILURE() << "loaded: " << bytes;
@@ -340,7 +382,8 @@ TEST(LoaderFromMemory, BrokenBytesAreAnInputErrorNamingTheFile) {
 // Found by tools/fuzz.sh: an index of 2e78 was cast to int64 before its range was checked,
 // which is undefined behaviour (UBSan in build-asan stops here if it comes back).
 TEST(LoaderFromMemory, HugeIndexIsAnInputError) {
-  for (const char* text : {R"({"asset":{"version":"2.0"},"scene":2e78})", R"({"asset":{"version":"2.0"},"scene":-1e300})",
+  for (const char* text : {R"({"asset":{"version":"2.0"},"scene":2e78})",
+                           R"({"asset":{"version":"2.0"},"scene":-1e300})",
                            R"({"asset":{"version":"2.0"},"scenes":[{"nodes":[1e19]}]})"}) {
     EXPECT_THROW(loadSceneFromMemory(text, "mem/huge.gltf"), InputError) << text;
   }
