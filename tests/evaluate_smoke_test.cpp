@@ -93,7 +93,12 @@ TEST(Evaluate, QuickFormWritesEveryOutputWithSaneNumbers) {
     EXPECT_GT(s.at("equal_error").at("target_relmse").get<double>(), 0.0) << name;
   }
   ASSERT_GE(j.at("goals").size(), 3u);
-  for (const auto& g : j.at("goals")) EXPECT_TRUE(g.at("met").is_boolean());
+  for (const auto& g : j.at("goals")) {
+    EXPECT_TRUE(g.at("met").is_boolean());
+    const std::string v = g.at("verdict").get<std::string>();
+    EXPECT_TRUE(v == "met" || v == "not met" || v == "undetermined") << v;
+    EXPECT_EQ(g.at("met").get<bool>(), v == "met") << v;
+  }
 }
 
 }  // namespace

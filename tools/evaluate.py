@@ -935,7 +935,9 @@ def main():
                         "atrium_sweep_spp": asweep, "reference_seed": REF_SEED},
            "elapsed_s": elapsed, "load_avg": stats_of(runner.loads),
            "scenes": json_ready(res, scenes, args),
-           "goals": [{"goal": g, "scene": s, "measured": v, "met": ok} for g, s, v, ok in gl],
+           "goals": [{"goal": g, "scene": s, "measured": v, "met": ok is True,
+                      "verdict": "undetermined" if ok is None else ("met" if ok else "not met")}
+                     for g, s, v, ok in gl],
            "plots": [names["time"], names["error"], names["equal"], names["perframe"],
                      *names["sheet"].values()], "videos": mp4s}
     (out_dir / "results.json").write_text(json.dumps(doc, indent=1, allow_nan=False) + "\n")
