@@ -122,18 +122,19 @@ PR_INLINE float3 connect_sampled_vertex(const SceneData* s, const ReuseParams* r
     const uint count = headers[slot].vertex_count;
     __global const LightVertex* v = vertices + (size_t)slot * rp->stride;
     for (uint k = 0u; k < count && depth + k + 1u <= rp->max_depth; ++k) {
-      float3 zp, zng, f_z, tpz;
+      const float3 zp = vertex_pos(v + k);
+      const float3 d = zp - yh->p;
+      const float dist2 = dot(d, d);
+      if (!(dist2 > 0.0f)) continue;
+      const float3 dir = d * (1.0f / sqrt(dist2));  // from Y to z
+      if (dot(dir, fy->ng) <= 0.0f) continue;
+      float3 zng, f_z;
       float pdf_l, cos_z, corr = 1.0f;
       if (k == 0u) {
         // Vertex 0: the point on the light; f_z * tpz is its emission over the position pdf.
         const u32 type = s->lights.lights[headers[slot].light].type;
         if (type != PR_LIGHT_TRIANGLE && type != PR_LIGHT_POINT) continue;
-        zp = vertex_pos(v);
         zng = oct_decode(v[0].ng_oct);
-        const float3 d = zp - yh->p;
-        const float dist2 = dot(d, d);
-        if (!(dist2 > 0.0f)) continue;
-        const float3 dir = d * (1.0f / sqrt(dist2));
         pdf_l = light_emit_pdf(s, headers[slot].light, v, dir);
         // The stored throughput is emission over (position pdf times pdf_l / cos).
         const int tri = type == PR_LIGHT_TRIANGLE;
@@ -141,29 +142,19 @@ PR_INLINE float3 connect_sampled_vertex(const SceneData* s, const ReuseParams* r
         f_z = make_float3(1.0f, 1.0f, 1.0f) * (tri ? 0.5f * PR_INV_PI : 0.25f * PR_INV_PI);
       } else {
         SurfaceHit z = surface_at(&s->sd, v[k].prim, v[k].inst, v[k].b1, v[k].b2);
-        z.p = vertex_pos(v + k);
+        z.p = zp;
         z.ng = oct_decode(v[k].ng_oct);
         z.ns = oct_decode(v[k].ns_oct);
         const float3 wz_prev = -vertex_dir(v + k);
         const ShadingFrame fz = shading_frame(s, &z, wz_prev);
-        if (bsdf_is_delta(&fz.bsdf)) continue;
-        zp = z.p;
+        if (bsdf_is_delta(&fz.bsdf) || dot(-dir, fz.ng) <= 0.0f) continue;
         zng = fz.ng;
-        const float3 d = zp - yh->p;
-        const float dist2 = dot(d, d);
-        if (!(dist2 > 0.0f)) continue;
-        const float3 dir = d * (1.0f / sqrt(dist2));
-        if (dot(-dir, fz.ng) <= 0.0f) continue;
         f_z = bsdf_eval(&fz.bsdf, to_local(wz_prev, fz.t, fz.b, fz.n),
                         to_local(-dir, fz.t, fz.b, fz.n), &pdf_l);
         cos_z = fabs(dot(fz.n, dir));
         corr = shading_normal_correction(wz_prev, -dir, fz.n, fz.ng);
       }
-      tpz = make_float3(v[k].tp_r, v[k].tp_g, v[k].tp_b);
-      const float3 d = zp - yh->p;
-      const float dist2 = dot(d, d);
-      const float3 dir = d * (1.0f / sqrt(dist2));  // from Y to z
-      if (dot(dir, fy->ng) <= 0.0f) continue;
+      const float3 tpz = make_float3(v[k].tp_r, v[k].tp_g, v[k].tp_b);
       const float p_l = pdf_l * fabs(dot(fy->ng, dir)) / dist2;
       const float w = 1.0f - mis_weight_l(p_e / p_l, rp->mis_threshold);
       if (!(w > 0.0f)) continue;
