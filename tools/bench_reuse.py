@@ -23,7 +23,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from benchlib import ATRIUM, REPO, ensure_atrium, fmt_rng, kernel_s, machine_lines, median
+from benchlib import (ATRIUM, REPO, ensure_atrium, fmt_rng, frame_breakdown, kernel_s,
+                      machine_lines, median)
 
 DEMO = REPO / "scenes" / "cornell-dynamic.gltf"
 MODES = ("reuse", "retrace", "pathtrace")
@@ -84,12 +85,8 @@ def summarize_runs(runs):
             "body": body,
         })
     frames = [r for p in per_run for r in p["body"]]
-    stage_tot = {}
-    for r in frames:
-        for k, v in r["stages_s"].items():
-            stage_tot[k] = stage_tot.get(k, 0.0) + v
+    stage_tot, share, stage_med, rays = frame_breakdown(frames)
     ktot = sum(stage_tot.values())
-    kinds = sorted({k for r in frames for k in r["rays"]})
     return {
         "per_run": per_run,
         "wall_med": median([r["wall_s"] for r in frames]),
@@ -98,10 +95,10 @@ def summarize_runs(runs):
         "kern_runs": [p["kern_med"] for p in per_run],
         "frame0": median([p["frame0"] for p in per_run]),
         "process": median([p["process"] for p in per_run]),
-        "share": {k: 100.0 * v / ktot for k, v in stage_tot.items()} if ktot else {},
+        "share": share,
         "kern_of_wall": 100.0 * ktot / sum(r["wall_s"] for r in frames),
-        "stage_med": {k: median([r["stages_s"].get(k, 0.0) for r in frames]) for k in stage_tot},
-        "rays": {k: median([r["rays"].get(k, 0) for r in frames]) for k in kinds},
+        "stage_med": stage_med,
+        "rays": rays,
         "reused": [r["counters"]["slots_reused"] / r["counters"]["slots"]
                    for r in frames if "counters" in r],
         "slots": frames[0]["counters"]["slots"] if "counters" in frames[0] else None,

@@ -23,6 +23,23 @@ def kernel_s(rec):
     return sum(rec["stages_s"].values())
 
 
+def frame_breakdown(frames):
+    """Over a list of per-frame stats records: kernel seconds summed per stage, each stage's
+    percent of all kernel time, each stage's median seconds per frame, and each ray kind's
+    median count per frame (stages and kinds sorted by name)."""
+    totals = {}
+    for r in frames:
+        for k, v in r["stages_s"].items():
+            totals[k] = totals.get(k, 0.0) + v
+    totals = dict(sorted(totals.items()))
+    ktot = sum(totals.values())
+    share = {k: 100.0 * v / ktot for k, v in totals.items()} if ktot else {}
+    stage_med = {k: median([r["stages_s"].get(k, 0.0) for r in frames]) for k in totals}
+    kinds = sorted({k for r in frames for k in r["rays"]})
+    rays = {k: median([r["rays"].get(k, 0) for r in frames]) for k in kinds}
+    return totals, share, stage_med, rays
+
+
 def fmt_rng(xs, f="{:.3f}"):
     """'median [min-max]'."""
     return f"{f.format(median(xs))} [{f.format(min(xs))}-{f.format(max(xs))}]"

@@ -29,7 +29,8 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from benchlib import ATRIUM, REPO, ensure_atrium, kernel_s, machine_lines, median  # noqa: E402
+from benchlib import (ATRIUM, REPO, ensure_atrium, frame_breakdown, kernel_s,  # noqa: E402
+                      machine_lines, median)
 
 try:
     import numpy as np
@@ -357,12 +358,7 @@ def summarize_timing(runs):
                         "total": sum(r["wall_s"] for r in recs),
                         "frame0": recs[0]["wall_s"], "process": wall})
     frames = [r for recs, _ in runs for r in recs[1:]]
-    stage_tot = {}
-    for r in frames:
-        for k, v in r["stages_s"].items():
-            stage_tot[k] = stage_tot.get(k, 0.0) + v
-    ktot = sum(stage_tot.values())
-    kinds = sorted({k for r in frames for k in r["rays"]})
+    _, share, stage_med, rays = frame_breakdown(frames)
     reused = [r["counters"]["slots_reused"] / r["counters"]["slots"] for r in frames
               if "counters" in r and r["counters"].get("slots")]
     return {
@@ -372,15 +368,22 @@ def summarize_timing(runs):
         "frame0_s": median([p["frame0"] for p in per_run]),
         "process_s": stats_of([p["process"] for p in per_run]),
         "per_run_wall": [p["wall"] for p in per_run],
-        "stage_share_percent": {k: 100.0 * v / ktot for k, v in sorted(stage_tot.items())} if ktot else {},
-        "stage_s_per_frame": {k: median([r["stages_s"].get(k, 0.0) for r in frames]) for k in sorted(stage_tot)},
-        "rays_per_frame": {k: median([r["rays"].get(k, 0) for r in frames]) for k in kinds},
+        "stage_share_percent": share,
+        "stage_s_per_frame": stage_med,
+        "rays_per_frame": rays,
         "slots_reused_fraction": median(reused) if reused else None,
         "per_frame_wall": [[r["wall_s"] for r in recs] for recs, _ in runs],
     }
 
 
 # ---------------------------------------------------------------- plots
+
+def finish_figure(fig, title, path):
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
 
 MODE_STYLE = {"reuse": ("tab:blue", "-"), "retrace": ("tab:orange", "--"),
               "pathtrace": ("tab:green", "-"), "pathtrace fixed": ("tab:red", ":")}
@@ -402,10 +405,7 @@ def plot_time_per_frame(scenes, res, path):
         ax.set_ylim(bottom=0)
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7)
-    fig.suptitle("Time per frame (median of runs; band: min-max)", fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    finish_figure(fig, "Time per frame (median of runs; band: min-max)", path)
 
 
 def plot_equal_error(scenes, res, args, path):
@@ -430,10 +430,7 @@ def plot_equal_error(scenes, res, args, path):
         ax.set_ylabel("relMSE")
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=6)
-    fig.suptitle("Error against time (labels: spp; mean over frames and seeds)", fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    finish_figure(fig, "Error against time (labels: spp; mean over frames and seeds)", path)
 
 
 def plot_equal_time(scenes, res, path):
@@ -456,10 +453,7 @@ def plot_equal_time(scenes, res, path):
             if i == 0:
                 ax.set_title(f"{sc['key']}: time pathtrace/reuse = "
                              f"{et['time_ratio_pathtrace_over_reuse']:.2f}", fontsize=8)
-    fig.suptitle("Equal time: error and flicker (mean over seeds; bars: min-max)", fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    finish_figure(fig, "Equal time: error and flicker (mean over seeds; bars: min-max)", path)
 
 
 def plot_per_frame_error(scenes, res, path):
@@ -481,10 +475,7 @@ def plot_per_frame_error(scenes, res, path):
         for ax in axes[:, j]:
             ax.grid(alpha=0.3, which="both")
             ax.legend(fontsize=6)
-    fig.suptitle("Equal time, per frame (mean over seeds)", fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    finish_figure(fig, "Equal time, per frame (mean over seeds)", path)
 
 
 def tonemap(img, ev):
