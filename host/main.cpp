@@ -78,8 +78,11 @@ int main(int argc, char** argv) {
   render
       ->add_option("--seed", ro.seed, "Random seed; the same seed reproduces a frame on one device")
       ->capture_default_str();
-  render->add_option("--device", ro.device,
-                     "OpenCL device: index, P:D, cpu, gpu or part of its name");
+  render
+      ->add_option("--device", ro.device,
+                   "OpenCL device: index, P:D, cpu, gpu or part of its name (default: "
+                   "$PATHREUSE_DEVICE, else the first GPU, else the first CPU)")
+      ->envname("PATHREUSE_DEVICE");
   render
       ->add_option("--mode", modeText,
                    "reuse: light paths kept across frames, re-traced only where moving objects "

@@ -53,6 +53,23 @@ TEST(DeviceSpec, IndexPlatformDeviceTypeAndName) {
   EXPECT_EQ(selectDevice(list, "h100").index, 1);
 }
 
+TEST(DeviceSpec, PlatformNameOrVendorWhenNoDeviceNameMatches) {
+  auto list = fakeList();
+  list[0].platformName = "Portable Computing Language";
+  list[0].platformVendor = "The pocl project";
+  list[1].platformName = list[2].platformName = "NVIDIA CUDA";
+  list[1].platformVendor = list[2].platformVendor = "NVIDIA Corporation";
+  list.push_back(fakeDevice(3, 2, 0, "Intel(R) Xeon(R) Gold", CL_DEVICE_TYPE_CPU));
+  list[3].platformName = "Intel(R) OpenCL";
+  list[3].platformVendor = "Intel(R) Corporation";
+  list[0].name = "pthread-skylake-Intel(R) Xeon(R) Gold";
+  EXPECT_EQ(selectDevice(list, "pocl").index, 0);
+  EXPECT_EQ(selectDevice(list, "nvidia").index, 1);
+  EXPECT_EQ(selectDevice(list, "Intel(R) OpenCL").index, 3);
+  // A device name match comes first: PoCL's device carries the CPU's name.
+  EXPECT_EQ(selectDevice(list, "xeon").index, 0);
+}
+
 TEST(DeviceSpec, RefusesWhatMatchesNothing) {
   const auto list = fakeList();
   EXPECT_THROW(selectDevice(list, "99"), InputError);

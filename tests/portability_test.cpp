@@ -1,8 +1,11 @@
 // `pathreuse portability`: the comparison metrics and verdict on synthetic images, the verdict on
-// real renders with a deliberate fault, and the command with two PoCL drivers.
+// real renders with a deliberate fault, the command with two PoCL drivers, and every platform
+// found.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <limits>
 #include <random>
@@ -202,10 +205,11 @@ std::string smallScene() {
 TEST(PortabilityCli, TwoPoclDriversAgreeOnTheSuite) {
   const std::string out = test::tempDir("port-out");
   const std::string scene = smallScene();
-  const auto r =
-      test::runPathreuse("portability '" + scene +
-                             "' --json --quiet --frames 0-1 --width 32 --spp 4 --out '" + out + "'",
-                         kTwoDrivers);
+  const auto r = test::runPathreuse("portability '" + scene +
+                                        "' --json --quiet --frames 0-1 --width 32 --spp 4 --device "
+                                        "basic --device pthread --out '" +
+                                        out + "'",
+                                    kTwoDrivers);
   ASSERT_EQ(r.exitCode, 0) << r.out << r.err;
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_EQ(j["devices"].size(), 2u);
@@ -232,10 +236,43 @@ TEST(PortabilityCli, TwoPoclDriversAgreeOnTheSuite) {
   EXPECT_TRUE(std::filesystem::is_regular_file(png)) << png;
 }
 
+// The default suite (both demo scenes, frames 0-2 and 24, every mode) on the first device of
+// every OpenCL platform found. tools/test.sh sets PATHREUSE_REQUIRE_PLATFORMS=2 after setting up
+// Intel's CPU runtime beside PoCL, so there a missing platform fails instead of skipping.
+TEST(PortabilityCli, EveryPlatformAgreesOnTheDefaultSuite) {
+  const auto list = test::runPathreuse("devices --json");
+  ASSERT_EQ(list.exitCode, 0) << list.err;
+  std::string devices;
+  std::vector<std::string> platforms;
+  const auto found = nlohmann::json::parse(list.out);
+  for (const auto& d : found["devices"]) {
+    const std::string platform = d["platform"];
+    if (std::find(platforms.begin(), platforms.end(), platform) != platforms.end()) continue;
+    platforms.push_back(platform);
+    devices += " --device " + std::to_string(d["index"].get<int>());
+  }
+  const char* required = std::getenv("PATHREUSE_REQUIRE_PLATFORMS");
+  const size_t need = required ? std::strtoul(required, nullptr, 10) : 0;
+  ASSERT_GE(platforms.size(), need)
+      << "PATHREUSE_REQUIRE_PLATFORMS=" << need << " but found: " << list.out;
+  if (platforms.size() < 2)
+    GTEST_SKIP()
+        << "one OpenCL platform only; tools/intel-opencl.sh sets up a second (Intel's CPU runtime)";
+  const auto r = test::runPathreuse("portability --json --quiet" + devices + " --out '" +
+                                    test::tempDir("port-platforms") + "'");
+  ASSERT_EQ(r.exitCode, 0) << r.out << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["results"].size(), 24u * (platforms.size() - 1));
+  for (const auto& e : j["results"]) EXPECT_TRUE(e["agree"].get<bool>()) << e.dump();
+  EXPECT_EQ(j["summary"]["disagree"], 0);
+}
+
 TEST(PortabilityCli, TableAndSummaryOnStdout) {
   const std::string out = test::tempDir("port-table");
   const auto r = test::runPathreuse(
-      "portability --quiet --frames 0 --width 32 --spp 2 --mode pathtrace --out '" + out + "'",
+      "portability --quiet --frames 0 --width 32 --spp 2 --mode pathtrace --device basic --device "
+      "pthread --out '" +
+          out + "'",
       kTwoDrivers);
   ASSERT_EQ(r.exitCode, 0) << r.out << r.err;
   EXPECT_NE(r.out.find("relMSE*"), std::string::npos) << r.out;

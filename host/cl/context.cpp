@@ -117,7 +117,10 @@ cl::Kernel Context::kernel(const std::string& file, const char* name, const std:
 ProgramBuild Context::buildProgramFromSource(const std::string& source, const std::string& options,
                                              const std::string& label) {
   const auto t0 = std::chrono::steady_clock::now();
-  const std::string fullOptions = "-cl-std=CL1.2 " + options;
+  std::string fullOptions = "-cl-std=CL1.2 " + options;
+  // Extra options for diagnosing a platform, e.g. -cl-opt-disable (part of the cache key).
+  if (const char* extra = std::getenv("PATHREUSE_CL_OPTIONS"); extra && *extra)
+    fullOptions += std::string(" ") + extra;
   const std::string key = Hash128()
                               .add(source)
                               .add(fullOptions)

@@ -73,8 +73,9 @@ std::vector<DeviceEntry> enumerateDevices() {
     err = platforms[p].getDevices(CL_DEVICE_TYPE_ALL, &devices);
     if (err == CL_DEVICE_NOT_FOUND) continue;
     CL_CHECK(err);
-    std::string platformName;
+    std::string platformName, platformVendor;
     CL_CHECK(platforms[p].getInfo(CL_PLATFORM_NAME, &platformName));
+    CL_CHECK(platforms[p].getInfo(CL_PLATFORM_VENDOR, &platformVendor));
     for (size_t d = 0; d < devices.size(); ++d) {
       DeviceEntry e;
       e.index = static_cast<int>(out.size());
@@ -83,6 +84,7 @@ std::vector<DeviceEntry> enumerateDevices() {
       e.platform = platforms[p];
       e.device = devices[d];
       e.platformName = trimmed(platformName);
+      e.platformVendor = trimmed(platformVendor);
       e.name = trimmed(deviceInfo<CL_DEVICE_NAME>(devices[d]));
       e.vendor = trimmed(deviceInfo<CL_DEVICE_VENDOR>(devices[d]));
       e.driverVersion = trimmed(deviceInfo<CL_DRIVER_VERSION>(devices[d]));
@@ -139,7 +141,11 @@ const DeviceEntry& selectDevice(const std::vector<DeviceEntry>& devices, const s
   }
   for (const auto& e : devices)
     if (lower(e.name).find(s) != std::string::npos) return e;
-  return refuse("no device whose name contains '" + spec + "'");
+  for (const auto& e : devices)
+    if (lower(e.platformName).find(s) != std::string::npos ||
+        lower(e.platformVendor).find(s) != std::string::npos)
+      return e;
+  return refuse("no device or platform whose name contains '" + spec + "'");
 }
 
 std::string describeDevice(const DeviceEntry& d) {
@@ -158,6 +164,7 @@ std::string devicesJson(const std::vector<DeviceEntry>& devices) {
                     {"platform_index", d.platformIndex},
                     {"device_index", d.deviceIndex},
                     {"platform", d.platformName},
+                    {"platform_vendor", d.platformVendor},
                     {"name", d.name},
                     {"type", deviceTypeName(d.type)},
                     {"compute_units", d.computeUnits},

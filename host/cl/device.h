@@ -16,6 +16,7 @@ struct DeviceEntry {
   cl::Platform platform;
   cl::Device device;
   std::string platformName;
+  std::string platformVendor;  // "The pocl project", "Intel(R) Corporation", ...
   std::string name;
   std::string vendor;
   std::string driverVersion;
@@ -42,9 +43,10 @@ class NoDeviceError : public RuntimeError {
 };
 
 // Picks a device from SPEC: an index in the list, "P:D", "cpu", "gpu", or a case-insensitive
-// substring of the device name. An empty SPEC picks the first GPU, else the first CPU, else the
-// first device. Throws NoDeviceError when `devices` is empty and InputError when SPEC matches
-// nothing.
+// substring of the device name, else of the platform's name or vendor (so "pocl", "intel(r)
+// opencl" and "nvidia" name a platform whatever its devices are called). An empty SPEC picks the
+// first GPU, else the first CPU, else the first device. Throws NoDeviceError when `devices` is
+// empty and InputError when SPEC matches nothing.
 const DeviceEntry& selectDevice(const std::vector<DeviceEntry>& devices, const std::string& spec);
 
 // One line describing a device, as `pathreuse devices` prints it.

@@ -28,13 +28,6 @@
 
 #define PR_BVH_STACK_SIZE 64
 
-// PoCL's LLVM left the box test as a call in the traversal loop: force it inline.
-#ifdef PR_DEVICE_CODE
-#define PR_BVH_INLINE inline __attribute__((always_inline))
-#else
-#define PR_BVH_INLINE inline
-#endif
-
 // Slab distances are scaled by this before the overlap test so rounding never culls a box
 // that holds a hit (1 + 2 * gamma(3) in pbrt's terms, rounded up).
 #define PR_BVH_FAR_SCALE 1.00000036f
@@ -78,12 +71,16 @@ PR_INLINE BvhRay bvh_ray(float3 o, float3 d, float tmin, float tmax) {
 
 // min/max by comparison: slab distances are never NaN (finite boxes, bvh_safe_inverse), so
 // fmin/fmax's NaN handling is dead weight in the hottest function.
-PR_BVH_INLINE float bvh_min(float a, float b) { return a < b ? a : b; }
-PR_BVH_INLINE float bvh_max(float a, float b) { return a > b ? a : b; }
+PR_INLINE float bvh_min(float a, float b) {
+  return a < b ? a : b;
+}
+PR_INLINE float bvh_max(float a, float b) {
+  return a > b ? a : b;
+}
 
 // Entry distance of the ray into the node's box, or PR_INF_F when it misses it within
 // [tmin, tmax].
-PR_BVH_INLINE float bvh_box_entry(PR_GLOBAL const BvhNode* n, const BvhRay* r) {
+PR_INLINE float bvh_box_entry(PR_GLOBAL const BvhNode* n, const BvhRay* r) {
   const float x0 = (n->lo_x - r->o.x) * r->inv_d.x, x1 = (n->hi_x - r->o.x) * r->inv_d.x;
   const float y0 = (n->lo_y - r->o.y) * r->inv_d.y, y1 = (n->hi_y - r->o.y) * r->inv_d.y;
   const float z0 = (n->lo_z - r->o.z) * r->inv_d.z, z1 = (n->hi_z - r->o.z) * r->inv_d.z;
@@ -94,23 +91,32 @@ PR_BVH_INLINE float bvh_box_entry(PR_GLOBAL const BvhNode* n, const BvhRay* r) {
   return (tnear <= tfar && tnear <= r->tmax) ? tnear : PR_INF_F;
 }
 
+// dot and cross written out: OpenCL's built-ins may fuse or reorder (their error bounds allow
+// it, and Intel's CPU runtime does), which moves hits on grazing rays away from the CPU reference.
+PR_INLINE float bvh_dot(float3 a, float3 b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+PR_INLINE float3 bvh_cross(float3 a, float3 b) {
+  return make_float3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+
 // Moller-Trumbore against one packed triangle. Writes t and the barycentrics (u for v1, v for
 // v2) when tmin < t < tmax. Zero-area triangles give det == 0 (or NaN) and are never hit.
 PR_INLINE int intersect_triangle(PR_GLOBAL const BvhTriangle* tri, float3 o, float3 d, float tmin,
                                  float tmax, float* t, float* u, float* v) {
   const float3 e1 = make_float3(tri->e1x, tri->e1y, tri->e1z);
   const float3 e2 = make_float3(tri->e2x, tri->e2y, tri->e2z);
-  const float3 p = cross(d, e2);
-  const float det = dot(e1, p);
+  const float3 p = bvh_cross(d, e2);
+  const float det = bvh_dot(e1, p);
   if (det == 0.0f) return 0;
   const float inv_det = 1.0f / det;
   const float3 s = o - make_float3(tri->v0x, tri->v0y, tri->v0z);
-  const float uu = dot(s, p) * inv_det;
+  const float uu = bvh_dot(s, p) * inv_det;
   if (!(uu >= 0.0f && uu <= 1.0f)) return 0;
-  const float3 q = cross(s, e1);
-  const float vv = dot(d, q) * inv_det;
+  const float3 q = bvh_cross(s, e1);
+  const float vv = bvh_dot(d, q) * inv_det;
   if (!(vv >= 0.0f && uu + vv <= 1.0f)) return 0;
-  const float tt = dot(e2, q) * inv_det;
+  const float tt = bvh_dot(e2, q) * inv_det;
   if (!(tt > tmin && tt < tmax)) return 0;
   *t = tt;
   *u = uu;
@@ -254,21 +260,21 @@ PR_INLINE BvhRay bvh_ray_from(Ray ray) {
 }
 
 // Closest hit on the SSG. *hit is always written (prim == PR_INVALID_INDEX: no hit).
-PR_INLINE int intersect_static(const SceneGeom* g, Ray ray, Hit* hit) {
+PR_CALLABLE int intersect_static(const SceneGeom* g, Ray ray, Hit* hit) {
   BvhRay r = bvh_ray_from(ray);
   *hit = hit_none();
   return bvh_traverse(g->static_nodes, g->static_tris, 0u, &r, hit, PR_INVALID_INDEX, 0);
 }
 
 // Closest hit on the DSG (hit->inst is the instance id).
-PR_INLINE int intersect_dynamic(const SceneGeom* g, Ray ray, Hit* hit) {
+PR_CALLABLE int intersect_dynamic(const SceneGeom* g, Ray ray, Hit* hit) {
   BvhRay r = bvh_ray_from(ray);
   *hit = hit_none();
   return tlas_traverse(g, &r, hit, 0);
 }
 
 // Closest hit on the whole scene: the nearer of the SSG hit and the DSG hit.
-PR_INLINE int intersect_scene(const SceneGeom* g, Ray ray, Hit* hit) {
+PR_CALLABLE int intersect_scene(const SceneGeom* g, Ray ray, Hit* hit) {
   BvhRay r = bvh_ray_from(ray);
   *hit = hit_none();
   const int s = bvh_traverse(g->static_nodes, g->static_tris, 0u, &r, hit, PR_INVALID_INDEX, 0);
@@ -277,19 +283,19 @@ PR_INLINE int intersect_scene(const SceneGeom* g, Ray ray, Hit* hit) {
 }
 
 // Any hit in (tmin, tmax): for shadow rays and invalidation.
-PR_INLINE int occluded_static(const SceneGeom* g, Ray ray) {
+PR_CALLABLE int occluded_static(const SceneGeom* g, Ray ray) {
   BvhRay r = bvh_ray_from(ray);
   Hit unused;
   return bvh_traverse(g->static_nodes, g->static_tris, 0u, &r, &unused, PR_INVALID_INDEX, 1);
 }
 
-PR_INLINE int occluded_dynamic(const SceneGeom* g, Ray ray) {
+PR_CALLABLE int occluded_dynamic(const SceneGeom* g, Ray ray) {
   BvhRay r = bvh_ray_from(ray);
   Hit unused;
   return tlas_traverse(g, &r, &unused, 1);
 }
 
-PR_INLINE int occluded_scene(const SceneGeom* g, Ray ray) {
+PR_CALLABLE int occluded_scene(const SceneGeom* g, Ray ray) {
   // The DSG first: a few triangles, and the likelier blocker of a changed path.
   return occluded_dynamic(g, ray) || occluded_static(g, ray);
 }

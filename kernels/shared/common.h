@@ -9,7 +9,14 @@ typedef int i32;
 typedef ulong u64;
 #define PR_GLOBAL __global
 #define PR_CONSTANT __constant
-#define PR_INLINE inline
+// Helpers are inlined. Intel's OpenCL CPU compiler (2026.2) miscompiles an out-of-line function
+// that passes a float3, by value or inside a struct it points to, once it vectorises across
+// work-items (lanes read their float3 at a 16-byte stride where 12 were written). PR_CALLABLE
+// marks the few large functions that may stay out of line, where inlining every call site would
+// multiply compile time: their parameters and results must hold no float3. `static`: C99
+// `inline` alone promises an external definition that no kernel file provides.
+#define PR_INLINE static inline __attribute__((always_inline))
+#define PR_CALLABLE static inline
 #define PR_NAMESPACE_BEGIN
 #define PR_NAMESPACE_END
 #define PR_STATIC_ASSERT(cond, msg)
@@ -19,6 +26,7 @@ typedef ulong u64;
 #define PR_GLOBAL
 #define PR_CONSTANT
 #define PR_INLINE inline
+#define PR_CALLABLE inline
 #define PR_NAMESPACE_BEGIN \
   namespace pr {           \
   namespace dev {

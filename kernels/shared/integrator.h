@@ -29,7 +29,7 @@ PR_INLINE int surface_passes(const SceneData* s, const SurfaceHit* h) {
 #define PR_MAX_ALPHA_LAYERS 16
 
 // Closest hit that skips cut-out and uncovered points (a bounded number of layers).
-PR_INLINE int trace_closest(const SceneData* s, Ray ray, Hit* hit) {
+PR_CALLABLE int trace_closest(const SceneData* s, Ray ray, Hit* hit) {
 #ifdef PR_HAS_ALPHA
   for (int layer = 0; layer < PR_MAX_ALPHA_LAYERS; ++layer) {
     if (!intersect_scene(&s->geom, ray, hit)) return 0;
@@ -44,7 +44,7 @@ PR_INLINE int trace_closest(const SceneData* s, Ray ray, Hit* hit) {
 }
 
 // Whether anything opaque lies on the segment (tmin, tmax) of the ray.
-PR_INLINE int trace_occluded(const SceneData* s, Ray ray) {
+PR_CALLABLE int trace_occluded(const SceneData* s, Ray ray) {
 #ifdef PR_HAS_ALPHA
   for (int layer = 0; layer < PR_MAX_ALPHA_LAYERS; ++layer) {
     Hit hit;

@@ -119,7 +119,7 @@ PR_INLINE float4 texel_at(const ShadingData* sd, TextureInfo t, int x, int y) {
 }
 
 // Bilinear (or nearest) lookup with the texture's wrap modes; linear RGBA.
-PR_INLINE float4 texture_sample(const ShadingData* sd, i32 index, float2 uv) {
+PR_CALLABLE float4 texture_sample(const ShadingData* sd, i32 index, float2 uv) {
   const TextureInfo t = sd->textures[index];
   const u32 ws = (t.flags >> PR_TEX_WRAP_S_SHIFT) & 3u, wt = (t.flags >> PR_TEX_WRAP_T_SHIFT) & 3u;
   const float fx = uv.x * (float)t.width - 0.5f, fy = uv.y * (float)t.height - 0.5f;

@@ -65,8 +65,13 @@ std::string tempDir(const std::string& tag) {
 CommandResult runPathreuse(const std::string& args, const std::string& env) {
   const std::string dir = tempDir("cli");
   const std::string outFile = dir + "/stdout", errFile = dir + "/stderr";
-  const std::string cmd = env + (env.empty() ? "" : " ") + "'" + PATHREUSE_BINARY + "' " + args +
-                          " >'" + outFile + "' 2>'" + errFile + "' </dev/null";
+  // Renders run on the device under test too, unless the caller names one.
+  std::string prefix = env;
+  const char* spec = std::getenv("PATHREUSE_TEST_DEVICE");
+  if (spec && *spec && env.find("PATHREUSE_DEVICE=") == std::string::npos)
+    prefix = "PATHREUSE_DEVICE='" + std::string(spec) + "' " + prefix;
+  const std::string cmd = prefix + (prefix.empty() ? "" : " ") + "'" + PATHREUSE_BINARY + "' " +
+                          args + " >'" + outFile + "' 2>'" + errFile + "' </dev/null";
   const int status = std::system(cmd.c_str());
   CommandResult r;
   r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);

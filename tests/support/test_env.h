@@ -27,7 +27,8 @@ struct CommandResult {
   std::string err;  // stderr
 };
 
-// Runs the pathreuse binary with `args` (a shell-quoted string); `env` is prefixed as-is.
+// Runs the pathreuse binary with `args` (a shell-quoted string); `env` is prefixed as-is. Under
+// $PATHREUSE_TEST_DEVICE its renders use that device (as $PATHREUSE_DEVICE) unless `env` names one.
 CommandResult runPathreuse(const std::string& args, const std::string& env = "");
 
 }  // namespace pr::test

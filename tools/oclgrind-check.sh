@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# Runs every rendering kernel of every mode on tiny frames under Oclgrind (an OpenCL device
+# simulator, Debian package oclgrind) with its out-of-bounds, API and data-race checks. Any
+# report, or a render that fails, fails the check. Usage: tools/oclgrind-check.sh [BUILD_DIR]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+build="${1:-build}"
+bin="$build/pathreuse"
+command -v oclgrind >/dev/null || { echo "oclgrind-check: oclgrind is not installed (apt-get install oclgrind)" >&2; exit 1; }
+[ -x "$bin" ] || { echo "oclgrind-check: $bin not built" >&2; exit 1; }
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+# Oclgrind compiles with its own front end: keep its binaries apart from the real devices'.
+export PATHREUSE_CACHE_DIR="$work/cache"
+unset PATHREUSE_DEVICE
+
+fail=0
+run() {
+  local name=$1; shift
+  local log="$work/$name.log"
+  if ! oclgrind --check-api --data-races --log "$log" "$bin" render "$@" --quiet \
+      --width 16 --height 12 --spp 1 --out "$work/$name/f_%04d.exr" 2>"$work/$name.err"; then
+    echo "oclgrind-check: $name: render failed: $(head -c 2000 "$work/$name.err")"
+    fail=1
+  fi
+  if [ -s "$log" ]; then
+    echo "oclgrind-check: $name: Oclgrind reported:"
+    head -n 40 "$log"
+    fail=1
+  else
+    echo "oclgrind-check: $name: clean"
+  fi
+}
+
+# Frames 0-2: the second and third frames invalidate and re-trace what the sphere disturbs.
+for mode in pathtrace reuse retrace; do
+  run "cornell-dynamic-$mode" scenes/cornell-dynamic.gltf --frames 0-2 --mode "$mode"
+done
+run "cornell-orbit-reuse" scenes/cornell-orbit.gltf --frames 0-1 --mode reuse
+exit $fail
