@@ -174,6 +174,12 @@ int main(int argc, char** argv) {
   portability->add_option("--out", po.outDir, "Folder for the PNG of the worst difference")
       ->capture_default_str();
   portability->add_flag("-q,--quiet", po.quiet, "No progress lines on stderr");
+  portability->add_option("--save-reference", po.saveReferenceDir,
+                          "Also write the reference device's frames (and noise-floor seeds) to "
+                          "this folder, to compare a device on another machine with");
+  portability->add_option("--reference", po.referenceDir,
+                          "Compare every device with the frames saved in this folder by "
+                          "--save-reference, instead of with the first device");
 
   try {
     app.parse(argc, argv);

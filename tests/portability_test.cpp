@@ -26,6 +26,23 @@ namespace {
 
 const char* const kTwoDrivers = "POCL_DEVICES='pthread basic'";
 
+// " --device I --device J" for PoCL's two drivers under kTwoDrivers (named pthread or cpu, and
+// basic, by PoCL's version), whatever other platforms are listed.
+std::string twoPoclDevices() {
+  const auto r = test::runPathreuse("devices --json", kTwoDrivers);
+  std::string args;
+  int found = 0;
+  const auto list = r.exitCode == 0 ? nlohmann::json::parse(r.out) : nlohmann::json::object();
+  if (list.contains("devices"))
+    for (const auto& d : list["devices"])
+      if (d["platform_vendor"] == "The pocl project") {
+        args += " --device " + std::to_string(d["index"].get<int>());
+        ++found;
+      }
+  EXPECT_EQ(found, 2) << r.out << r.err;
+  return args;
+}
+
 size_t lineCount(const std::string& s) {
   size_t n = 0;
   for (char c : s) n += c == '\n';
@@ -206,9 +223,8 @@ TEST(PortabilityCli, TwoPoclDriversAgreeOnTheSuite) {
   const std::string out = test::tempDir("port-out");
   const std::string scene = smallScene();
   const auto r = test::runPathreuse("portability '" + scene +
-                                        "' --json --quiet --frames 0-1 --width 32 --spp 4 --device "
-                                        "basic --device pthread --out '" +
-                                        out + "'",
+                                        "' --json --quiet --frames 0-1 --width 32 --spp 4" +
+                                        twoPoclDevices() + " --out '" + out + "'",
                                     kTwoDrivers);
   ASSERT_EQ(r.exitCode, 0) << r.out << r.err;
   const auto j = nlohmann::json::parse(r.out);
@@ -267,13 +283,47 @@ TEST(PortabilityCli, EveryPlatformAgreesOnTheDefaultSuite) {
   EXPECT_EQ(j["summary"]["disagree"], 0);
 }
 
+// A reference saved on one machine is what a device elsewhere is compared with.
+TEST(PortabilityCli, SavedReferenceIsComparedWithEveryDevice) {
+  const std::string ref = test::tempDir("port-ref");
+  const std::string suite =
+      " --quiet --frames 0-1 --width 32 --spp 2 --mode pathtrace --mode reuse";
+  const std::string pocl = twoPoclDevices();  // " --device I --device J"
+  const std::string first = pocl.substr(0, pocl.find(" --device", 1));
+  const std::string second = pocl.substr(first.size());
+  auto r = test::runPathreuse("portability" + suite + first + " --save-reference '" + ref +
+                                  "' --out '" + test::tempDir("port-save") + "'",
+                              kTwoDrivers);
+  ASSERT_EQ(r.exitCode, 0) << r.out << r.err;
+  // Two demo scenes x two modes x two frames x three seeds, and the manifest.
+  size_t files = 0;
+  for (const auto& e : std::filesystem::directory_iterator(ref)) files += e.is_regular_file();
+  EXPECT_EQ(files, 2u * 2u * 2u * 3u + 1u);
+  r = test::runPathreuse("portability" + suite + " --json" + second + " --reference '" + ref +
+                             "' --out '" + test::tempDir("port-cmp") + "'",
+                         kTwoDrivers);
+  ASSERT_EQ(r.exitCode, 0) << r.out << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["results"].size(), 8u);
+  EXPECT_FALSE(j["devices"][0]["reference"].get<bool>());
+  for (const auto& e : j["results"]) EXPECT_TRUE(e["identical"].get<bool>()) << e.dump();
+  // Another suite than the one saved, or no manifest: one line, exit 2.
+  for (const std::string& bad :
+       {" --spp 3 --reference '" + ref + "'", " --reference '" + test::tempDir("port-empty") + "'",
+        " --reference '" + ref + "' --save-reference '" + ref + "'"}) {
+    r = test::runPathreuse("portability --quiet --frames 0-1 --width 32 --spp 2" + bad,
+                           kTwoDrivers);
+    EXPECT_EQ(r.exitCode, 2) << bad << ": " << r.out << r.err;
+    EXPECT_EQ(lineCount(r.err), 1u) << bad << ": " << r.err;
+  }
+}
+
 TEST(PortabilityCli, TableAndSummaryOnStdout) {
   const std::string out = test::tempDir("port-table");
-  const auto r = test::runPathreuse(
-      "portability --quiet --frames 0 --width 32 --spp 2 --mode pathtrace --device basic --device "
-      "pthread --out '" +
-          out + "'",
-      kTwoDrivers);
+  const auto r =
+      test::runPathreuse("portability --quiet --frames 0 --width 32 --spp 2 --mode pathtrace" +
+                             twoPoclDevices() + " --out '" + out + "'",
+                         kTwoDrivers);
   ASSERT_EQ(r.exitCode, 0) << r.out << r.err;
   EXPECT_NE(r.out.find("relMSE*"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("cornell-orbit      pathtrace     0"), std::string::npos) << r.out;

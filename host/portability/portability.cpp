@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <limits>
 #include <memory>
@@ -19,6 +20,7 @@
 #include "render/session.h"
 #include "scene/gltf_loader.h"
 #include "util/error.h"
+#include "util/files.h"
 
 namespace pr {
 
@@ -89,6 +91,8 @@ void validate(const PortabilityOptions& o) {
     throw InputError("--sigmas: must be positive");
   if (o.outDir.empty()) throw InputError("--out: must name a folder");
   if (!o.demoScenes && o.scenes.empty()) throw InputError("--no-demo: no scene given to test");
+  if (!o.saveReferenceDir.empty() && !o.referenceDir.empty())
+    throw InputError("--save-reference and --reference: give one of them");
 }
 
 FrameSet renderSet(const SuiteScene& s, const DeviceEntry& device, const RenderOptions& ro,
@@ -105,6 +109,65 @@ FrameSet renderSet(const SuiteScene& s, const DeviceEntry& device, const RenderO
   }
   return set;
 }
+
+// A saved reference: frames as float EXRs named by scene, mode, seed and frame, and
+// reference.json with the suite's settings (checked on load) and each frame's dropped samples.
+const char* const kManifest = "reference.json";
+
+std::string referenceFile(const std::string& label, RenderMode mode, uint32_t seed, int frame) {
+  return safeName(label) + "_" + renderModeName(mode) + "_s" + std::to_string(seed) + "_f" +
+         std::to_string(frame) + ".exr";
+}
+
+nlohmann::json suiteSettings(const std::vector<int>& frames, int width, int height, int spp,
+                             uint32_t seed) {
+  return {{"frames", frames}, {"width", width}, {"height", height},
+          {"spp", spp},       {"seed", seed},   {"noise_floor_seeds", kFloorSeeds}};
+}
+
+class StoredReference {
+ public:
+  explicit StoredReference(const std::string& dir) : dir_(dir) {
+    const fs::path manifest = fs::path(dir) / kManifest;
+    std::ifstream in(manifest);
+    if (!in) throw InputError(manifest.string() + ": cannot read (make one with --save-reference)");
+    try {
+      in >> json_;
+    } catch (const nlohmann::json::exception& e) {
+      throw InputError(manifest.string() + ": not a reference manifest (" + e.what() + ")");
+    }
+    if (!json_.is_object() || !json_.contains("settings") || !json_.contains("frames_dropped") ||
+        !json_.contains("device"))
+      throw InputError(manifest.string() + ": not a reference manifest");
+  }
+  std::string device() const { return json_["device"].value("name", std::string("?")); }
+  // The suite asked for must be the one saved.
+  void check(const nlohmann::json& settings) const {
+    if (json_["settings"] != settings)
+      throw InputError((fs::path(dir_) / kManifest).string() + ": saved with " +
+                       json_["settings"].dump() + ", not " + settings.dump() +
+                       " (use the same --frames, --width, --height, --spp and --seed)");
+  }
+  FrameSet load(const std::string& label, RenderMode mode, uint32_t seed,
+                const std::vector<int>& frames) const {
+    FrameSet set;
+    for (int f : frames) {
+      const std::string name = referenceFile(label, mode, seed, f);
+      const fs::path path = fs::path(dir_) / name;
+      if (!fs::is_regular_file(path) || !json_["frames_dropped"].contains(name))
+        throw InputError(path.string() +
+                         ": missing from the saved reference (saved with other "
+                         "scenes or modes?)");
+      set.images.push_back(readExr(path.string()));
+      set.dropped.push_back(json_["frames_dropped"][name].get<uint64_t>());
+    }
+    return set;
+  }
+
+ private:
+  std::string dir_;
+  nlohmann::json json_;
+};
 
 // How far past its tolerance a comparison is (above 1: it disagrees); ranks the worst.
 double badness(const Row& r, const Tolerance& tol) {
@@ -195,6 +258,12 @@ int runPortability(const PortabilityOptions& o) {
     scenes.push_back(std::move(s));
   }
 
+  std::unique_ptr<StoredReference> stored;
+  if (!o.referenceDir.empty()) stored = std::make_unique<StoredReference>(o.referenceDir);
+  const bool save = !o.saveReferenceDir.empty();
+  const nlohmann::json settings = suiteSettings(frames, o.width, o.height, o.spp, o.seed);
+  if (stored) stored->check(settings);
+
   const auto all = enumerateDevices();
   if (all.empty()) throw NoDeviceError();
   std::vector<const DeviceEntry*> devices;
@@ -211,7 +280,11 @@ int runPortability(const PortabilityOptions& o) {
   base.quiet = true;
   validateRenderOptions(base);
 
-  const bool compare = devices.size() > 1;
+  // Against saved frames every device is compared; else every device but the first.
+  const size_t firstCompared = stored ? 0 : 1;
+  const bool compare = devices.size() > firstCompared;
+  nlohmann::json savedDropped = nlohmann::json::object();
+  if (save) fs::create_directories(o.saveReferenceDir);
   std::vector<Row> rows;
   double worstBadness =
       -1.0;  // the comparison furthest past its tolerance gets its difference written
@@ -226,21 +299,36 @@ int runPortability(const PortabilityOptions& o) {
       RenderOptions ro = base;
       ro.scene = s.path;
       ro.mode = mode;
-      const FrameSet ref = renderSet(s, *devices[0], ro, frames, o.quiet);
+      auto reference = [&](uint32_t seed) {
+        if (stored) return stored->load(s.label, mode, seed, frames);
+        RenderOptions r = ro;
+        r.seed = seed;
+        FrameSet set = renderSet(s, *devices[0], r, frames, o.quiet);
+        for (size_t fi = 0; save && fi < frames.size(); ++fi) {
+          const std::string name = referenceFile(s.label, mode, seed, frames[fi]);
+          writeExr((fs::path(o.saveReferenceDir) / name).string(), set.images[fi],
+                   ExrPixels::Float);
+          savedDropped[name] = set.dropped[fi];
+        }
+        return set;
+      };
+      const FrameSet ref = reference(o.seed);
       width = ref.images.front().width;
       height = ref.images.front().height;
-      if (!compare) continue;
-      // The noise floor: the reference device again with other seeds.
+      if (!compare && !save) continue;
+      // The noise floor: the reference again with other seeds.
       std::vector<std::vector<Image>> others;
-      for (uint32_t k = 1; k <= kFloorSeeds; ++k) {
-        RenderOptions other = ro;
-        other.seed = o.seed + k;
-        others.push_back(renderSet(s, *devices[0], other, frames, o.quiet).images);
-      }
+      for (uint32_t k = 1; k <= kFloorSeeds; ++k) others.push_back(reference(o.seed + k).images);
+      if (!compare) continue;
       const std::vector<NoiseFloor> floors = measureNoiseFloors(ref.images, others);
-      for (size_t di = 1; di < devices.size(); ++di) {
+      for (size_t di = firstCompared; di < devices.size(); ++di) {
         const FrameSet dev = renderSet(s, *devices[di], ro, frames, o.quiet);
         for (size_t fi = 0; fi < frames.size(); ++fi) {
+          if (dev.images[fi].width != width || dev.images[fi].height != height)
+            throw InputError("the reference frames are " + std::to_string(width) + "x" +
+                             std::to_string(height) + ", the device's " +
+                             std::to_string(dev.images[fi].width) + "x" +
+                             std::to_string(dev.images[fi].height));
           Row r;
           r.scene = si;
           r.mode = mode;
@@ -261,6 +349,15 @@ int runPortability(const PortabilityOptions& o) {
         }
       }
     }
+  }
+  if (save) {
+    const DeviceEntry& d = *devices[0];
+    const nlohmann::json manifest = {
+        {"settings", settings},
+        {"device",
+         {{"name", d.name}, {"platform", d.platformName}, {"driver_version", d.driverVersion}}},
+        {"frames_dropped", savedDropped}};
+    writeFileAtomic((fs::path(o.saveReferenceDir) / kManifest).string(), manifest.dump(2) + "\n");
   }
 
   std::string worstPng;
@@ -295,8 +392,10 @@ int runPortability(const PortabilityOptions& o) {
                       {"name", devices[i]->name},
                       {"platform", devices[i]->platformName},
                       {"driver_version", devices[i]->driverVersion},
-                      {"reference", i == 0}});
+                      {"reference", i == 0 && !stored}});
     j["devices"] = devs;
+    if (stored) j["reference"] = {{"saved_in", o.referenceDir}, {"device", stored->device()}};
+    if (save) j["saved_reference"] = o.saveReferenceDir;
     nlohmann::ordered_json sc = nlohmann::ordered_json::array();
     for (const auto& s : scenes) sc.push_back({{"label", s.label}, {"path", s.path}});
     j["scenes"] = sc;
@@ -349,8 +448,12 @@ int runPortability(const PortabilityOptions& o) {
   std::cout << "devices:";
   for (size_t i = 0; i < devices.size(); ++i)
     std::cout << (i ? ", " : " ") << "[" << devices[i]->index << "] " << devices[i]->name
-              << (i == 0 ? " (reference)" : "");
+              << (i == 0 && !stored ? " (reference)" : "");
   std::cout << "\n";
+  if (stored)
+    std::cout << "reference: frames saved in " << o.referenceDir << " on " << stored->device()
+              << "\n";
+  if (save) std::cout << "saved the reference frames to " << o.saveReferenceDir << "\n";
   if (!compare) {
     std::cout
         << "nothing to compare: only one device; rendered the suite on it (" << scenes.size()
@@ -359,7 +462,7 @@ int runPortability(const PortabilityOptions& o) {
     return kExitOk;
   }
   std::cout << "suite: " << width << "x" << height << ", " << o.spp << " spp, seed " << o.seed
-            << "; floor = reference device at seeds " << o.seed + 1 << "-" << o.seed + kFloorSeeds
+            << "; floor = reference at seeds " << o.seed + 1 << "-" << o.seed + kFloorSeeds
             << "; * = without the worst 1% of pixels\n"
             << "a device disagrees when relMSE* > " << o.tolerance.relMseFactor
             << " x floor*, when its mean luminance is " << o.tolerance.lumSigmas

@@ -1,6 +1,7 @@
 // `pathreuse portability`: renders a fixed suite (a few frames of each demo scene and of each
 // given scene, every mode, small size, fixed seed) on several OpenCL devices and compares every
-// device's frames with the first device's, within a statistical tolerance (compare.h).
+// device's frames with the first device's, or with a reference saved on another machine, within
+// a statistical tolerance (compare.h).
 #pragma once
 
 #include <cstdint>
@@ -25,6 +26,10 @@ struct PortabilityOptions {
   bool json = false;
   std::string outDir = "out/portability";
   bool quiet = false;
+  // The reference frames (seed and noise-floor seeds) as float EXRs and a manifest, so that a
+  // device on another machine can be compared with them (--save-reference / --reference).
+  std::string saveReferenceDir;
+  std::string referenceDir;  // non-empty: every device is compared with these frames
 };
 
 // "A", "A-B" and comma-separated lists of them ("0-2,24"), sorted, without repeats. Throws

@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Packs what tools/gpu-check.sh needs on a machine with a GPU but no package registry: the
+# built programs (stripped), the shared libraries they load except the C library (from ldd),
+# and the portability suite's reference frames rendered here, on the CPU.
+# Usage: tools/gpu-bundle.sh DIR [--device SPEC]   (after tools/build.sh; SPEC default pocl)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+dir="${1:?usage: tools/gpu-bundle.sh DIR [--device SPEC]}"
+device=pocl
+[ "${2:-}" = --device ] && device="${3:?--device needs a SPEC}"
+rm -rf "$dir"
+mkdir -p "$dir/bin" "$dir/lib" "$dir/libstdcxx"
+progs=(build/pathreuse build/exr_compare build/*_test)
+for p in "${progs[@]}"; do
+  [ -x "$p" ] || continue
+  strip -o "$dir/bin/$(basename "$p")" "$p"
+done
+# Every library but glibc's own; libstdc++ and libgcc_s apart, used only where the machine's are
+# older than the build's (gpu-check.sh decides).
+ldd "${progs[@]}" 2>/dev/null | awk '$3 ~ /^\// {print $3}' | sort -u | while read -r lib; do
+  case "$(basename "$lib")" in
+    libc.so.*|libm.so.*|libpthread.so.*|libdl.so.*|librt.so.*|ld-linux*) ;;
+    libstdc++.so.*|libgcc_s.so.*) cp -L "$lib" "$dir/libstdcxx/" ;;
+    *) cp -L "$lib" "$dir/lib/" ;;
+  esac
+done
+build/pathreuse portability --quiet --device "$device" --save-reference "$dir/reference" \
+  --out "$dir/reference-worst" >/dev/null
+rm -rf "$dir/reference-worst"
+pwd >"$dir/source_dir"  # where the tests look for the binary and the sources
+du -sh "$dir"

@@ -1,0 +1,73 @@
+#!/usr/bin/env bash
+# The checks for a machine with a GPU and no package registry, in one call (a few minutes):
+# lists the OpenCL devices, runs the test suite on the GPU, compares the GPU's portability
+# suite with the reference frames rendered on the CPU, and times the demo on the GPU.
+# Everything goes to OUT. The programs come from a bundle made by tools/gpu-bundle.sh on the
+# build machine and carried along (default: .gpu in the repository root).
+# Usage: tools/gpu-check.sh OUT [BUNDLE] [DEVICE]   (DEVICE: a --device spec, default gpu)
+set -uo pipefail
+cd "$(dirname "$0")/.."
+out="${1:?usage: tools/gpu-check.sh OUT [BUNDLE] [DEVICE]}"
+bundle="$(cd "${2:-.gpu}" && pwd)"
+device="${3:-gpu}"
+mkdir -p "$out"
+out="$(cd "$out" && pwd)"
+summary="$out/summary.txt"
+: >"$summary"
+say() { echo "$*" | tee -a "$summary"; }
+
+export LD_LIBRARY_PATH="$bundle/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+# The build's libstdc++ only where the machine's is older than the one it was built with.
+if ! "$bundle/bin/pathreuse" --version >/dev/null 2>&1; then
+  export LD_LIBRARY_PATH="$bundle/libstdcxx:$LD_LIBRARY_PATH"
+fi
+"$bundle/bin/pathreuse" --version >/dev/null || { say "gpu-check: the bundled pathreuse does not start"; exit 1; }
+
+# NVIDIA's OpenCL: its ICD file, else a folder with a one-line .icd naming its library.
+if [ -z "${OCL_ICD_VENDORS:-}" ] && ! grep -qs nvidia /etc/OpenCL/vendors/*.icd; then
+  lib=$(ldconfig -p 2>/dev/null | awk '/libnvidia-opencl\.so\.1/ {print $NF; exit}')
+  [ -n "$lib" ] || lib=$(find / -xdev -name 'libnvidia-opencl.so.1*' 2>/dev/null | head -n 1)
+  if [ -n "$lib" ]; then
+    mkdir -p /tmp/pathreuse-icd
+    cp /etc/OpenCL/vendors/*.icd /tmp/pathreuse-icd/ 2>/dev/null
+    echo "$lib" >/tmp/pathreuse-icd/nvidia.icd
+    export OCL_ICD_VENDORS=/tmp/pathreuse-icd
+    say "gpu-check: NVIDIA OpenCL from $lib"
+  fi
+fi
+"$bundle/bin/pathreuse" devices >"$out/devices.txt" 2>&1
+cat "$out/devices.txt" >>"$summary"
+export PATHREUSE_CACHE_DIR=/tmp/pathreuse-cache
+
+# The tests find the binary and the sources where they were built: make those paths hold.
+src=$(cat "$bundle/source_dir")
+if [ "$src" != "$PWD" ] && [ ! -e "$src" ]; then mkdir -p "$(dirname "$src")" && ln -s "$PWD" "$src"; fi
+if [ ! -x "$src/build/pathreuse" ]; then mkdir -p "$src/build" && cp "$bundle"/bin/* "$src/build/"; fi
+
+rm -f /tmp/gpu-check-rc
+say "== tests on --device $device"
+tests=("$src"/build/*_test)
+export PATHREUSE_TEST_DEVICE="$device"
+printf '%s\n' "${tests[@]}" | xargs -P 4 -I{} sh -c \
+  'timeout 240 "{}" --gtest_brief=1 >"/tmp/$(basename "{}").log" 2>&1; echo "$? $(basename "{}")" >>/tmp/gpu-check-rc'
+for t in "${tests[@]}"; do
+  n=$(basename "$t")
+  { echo "### $n"; cat "/tmp/$n.log"; } >>"$out/tests.log"
+done
+failed=$(awk '$1 != 0 {print $2 " (exit " $1 ")"}' /tmp/gpu-check-rc)
+say "test programs: ${#tests[@]}, failed: ${failed:-none}"
+grep -h "FAILED  \]\|SKIPPED \]" "$out/tests.log" | sort -u | head -n 40 >>"$summary"
+
+say "== portability: --device $device against the CPU's reference frames"
+"$src/build/pathreuse" portability --quiet --device "$device" --reference "$bundle/reference" \
+  --out /tmp/pathreuse-portability >"$out/portability.txt" 2>&1
+say "portability exit code: $?"
+tail -n 2 "$out/portability.txt" >>"$summary"
+
+say "== demo timing on --device $device (320x240, 4 spp, frames 0-23)"
+for mode in pathtrace reuse; do
+  "$src/build/pathreuse" render scenes/cornell-dynamic.gltf --device "$device" --mode "$mode" \
+    --width 320 --height 240 --spp 4 --frames 0-23 --quiet --out "/tmp/pathreuse-demo/$mode-%04d.exr" \
+    --stats "$out/stats-$mode.jsonl" 2>>"$summary"
+  say "$mode: exit $?, median frame wall seconds $(python3 -c 'import json,sys,statistics; print(statistics.median(json.loads(l)["wall_s"] for l in open(sys.argv[1])))' "$out/stats-$mode.jsonl" 2>/dev/null)"
+done
