@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Runs every rendering kernel of every mode on tiny frames under Oclgrind (an OpenCL device
 # simulator, Debian package oclgrind) with its out-of-bounds, API and data-race checks. Any
-# report, or a render that fails, fails the check. Usage: tools/oclgrind-check.sh [BUILD_DIR]
+# report, or a render that fails, fails the check. Its uninitialised-value check is left out:
+# Oclgrind 21.10 stops on LLVM's `freeze` and crashes inside that plugin on these kernels.
+# Usage: tools/oclgrind-check.sh [BUILD_DIR]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build="${1:-build}"
@@ -22,8 +24,7 @@ run() {
       --width 16 --height 12 --spp 1 --out "$work/$name/f_%04d.exr" 2>"$work/$name.err"; then
     echo "oclgrind-check: $name: render failed: $(head -c 2000 "$work/$name.err")"
     fail=1
-  fi
-  if [ -s "$log" ]; then
+  elif [ -s "$log" ]; then
     echo "oclgrind-check: $name: Oclgrind reported:"
     head -n 40 "$log"
     fail=1
