@@ -23,7 +23,9 @@ __kernel void pt_generate(CameraParams cam, uint seed, uint frame, uint sample,
   s.alive = 1u;
   s.rng_dim = rng.dim;
   s.flags = PR_PATH_SPECULAR;
-  s.pad0 = s.pad1 = s.pad2 = 0u;
+  s.prev_x = cam.px;
+  s.prev_y = cam.py;
+  s.prev_z = cam.pz;
   states[i] = s;
   radiance[i] = (float4)(0.0f, 0.0f, 0.0f, 0.0f);
 }

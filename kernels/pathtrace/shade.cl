@@ -31,7 +31,7 @@ __kernel void pt_shade(PR_SCENE_PARAMS, __global PathState* states, __global con
   if (mat->flags & PR_MAT_EMISSIVE) {
     const float3 le = surface_emission(&s, &h);
     float w = 1.0f;
-    if (!(p.flags & PR_PATH_SPECULAR)) w = power_heuristic(p.last_pdf, emitter_pdf(&s, &h, d, hit.t));
+    if (!(p.flags & PR_PATH_SPECULAR)) w = power_heuristic(p.last_pdf, emitter_pdf(&s, &h, make_float3(p.prev_x, p.prev_y, p.prev_z)));
     const float3 add = tp * le * w;
     radiance[i] += (float4)(add.x, add.y, add.z, 0.0f);
   }
@@ -80,6 +80,9 @@ __kernel void pt_shade(PR_SCENE_PARAMS, __global PathState* states, __global con
           }
         }
         p.ray = spawn_ray(h.p, f.ng, wi, PR_INF_F);
+        p.prev_x = h.p.x;
+        p.prev_y = h.p.y;
+        p.prev_z = h.p.z;
         p.last_pdf = pdf;
         p.flags = delta ? PR_PATH_SPECULAR : 0u;
       }

@@ -233,7 +233,7 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
       const int is_delta = bsdf_is_delta(&fh.bsdf);
       // An emitter met by the sample from x: its MIS share against next-event estimation at x.
       if (chain == 0u && (s.sd.materials[h.material].flags & PR_MAT_EMISSIVE))
-        L += t2 * surface_emission(&s, &h) * power_heuristic(pdf, emitter_pdf(&s, &h, d, hit.t));
+        L += t2 * surface_emission(&s, &h) * power_heuristic(pdf, emitter_pdf(&s, &h, x.p));
       if (chain == 0u && !is_delta) {
         // Strategy L at x counts these paths, apart from E's share.
         if (rp.mis_threshold > 0.0f && !delta)

@@ -85,12 +85,12 @@ PR_INLINE float3 surface_emission(const SceneData* s, const SurfaceHit* h) {
   return material_emission(&s->sd, h);
 }
 
-// The pdf that next-event estimation would have had for reaching emitter point h from a
-// point at distance dist along unit direction d.
-PR_INLINE float emitter_pdf(const SceneData* s, const SurfaceHit* h, float3 d, float dist) {
-  const float area = triangle_area_world(h, &s->sd);
-  return light_pdf_triangle(material_emission_factor(&s->sd, h->material), area,
-                            s->lights.total_power, dist, fabs(dot(d, h->ng)));
+// The pdf that next-event estimation at point `ref` would have had for reaching emitter point h.
+PR_INLINE float emitter_pdf(const SceneData* s, const SurfaceHit* h, float3 ref) {
+  float3 v0, e1, e2;
+  triangle_world(&s->sd, h->prim, h->inst, &v0, &e1, &e2);
+  return light_pdf_triangle(material_emission_factor(&s->sd, h->material), s->lights.total_power,
+                            ref, h->p, v0, e1, e2);
 }
 
 // Next-event estimation at a non-delta surface: picks a light by power and a point on it.

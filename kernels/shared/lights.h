@@ -67,6 +67,87 @@ PR_INLINE u32 light_select(PR_GLOBAL const float* cdf, u32 count, float u) {
   return lo;
 }
 
+// Emitter triangles are sampled uniformly in the solid angle they subtend from the receiving
+// point (Arvo 1995) where that solid angle lies between these bounds (pbrt-v4's): below, the
+// triangle is small or far, area sampling is about as good, and the angle sum that gives the
+// solid angle loses its digits; above, the triangle nearly surrounds the point.
+#define PR_MIN_SPHERICAL_SOLID_ANGLE 3e-4f
+#define PR_MAX_SPHERICAL_SOLID_ANGLE 6.22f
+
+// The angle between unit vectors, accurate near 0 and pi.
+PR_INLINE float angle_between(float3 a, float3 b) {
+  if (dot(a, b) < 0.0f) return PR_PI - 2.0f * asin(fmin(1.0f, 0.5f * length(a + b)));
+  return 2.0f * asin(fmin(1.0f, 0.5f * length(b - a)));
+}
+
+// The triangle (v0, v0 + e1, v0 + e2) as seen from p: unit directions to its vertices and the
+// angle at its first vertex. Returns the solid angle it subtends, 0 when it is degenerate.
+typedef struct {
+  float3 a, b, c;
+  float alpha;
+} SphericalTriangle;
+
+PR_INLINE float spherical_triangle(float3 p, float3 v0, float3 e1, float3 e2,
+                                   SphericalTriangle* t) {
+  const float3 da = v0 - p, db = da + e1, dc = da + e2;
+  const float la = length(da), lb = length(db), lc = length(dc);
+  if (!(la > 0.0f && lb > 0.0f && lc > 0.0f)) return 0.0f;
+  t->a = da / la;
+  t->b = db / lb;
+  t->c = dc / lc;
+  float3 n_ab = cross(t->a, t->b), n_bc = cross(t->b, t->c), n_ca = cross(t->c, t->a);
+  const float l_ab = length(n_ab), l_bc = length(n_bc), l_ca = length(n_ca);
+  if (!(l_ab > 0.0f && l_bc > 0.0f && l_ca > 0.0f)) return 0.0f;
+  n_ab = n_ab / l_ab;
+  n_bc = n_bc / l_bc;
+  n_ca = n_ca / l_ca;
+  t->alpha = angle_between(n_ab, -n_ca);
+  const float beta = angle_between(n_bc, -n_ab), gamma = angle_between(n_ca, -n_bc);
+  const float omega = t->alpha + beta + gamma - PR_PI;
+  return omega > 0.0f && isfinite_f(omega) ? omega : 0.0f;
+}
+
+// Whether light sampling from a point uses the solid angle (else the area) for this triangle.
+PR_INLINE int use_solid_angle(float omega) {
+  return omega >= PR_MIN_SPHERICAL_SOLID_ANGLE && omega <= PR_MAX_SPHERICAL_SOLID_ANGLE;
+}
+
+// The component of v orthogonal to unit w, normalised.
+PR_INLINE float3 orthogonal_part(float3 v, float3 w) {
+  return normalize(v - w * dot(v, w));
+}
+
+// A direction uniform in the spherical triangle of solid angle omega (Arvo 1995): u1 picks the
+// sub-triangle (a, b, c') of area u1 * omega, u2 a point on the arc from b to c'.
+PR_INLINE float3 sample_spherical_triangle(const SphericalTriangle* t, float omega, float u1,
+                                           float u2) {
+  const float sub = u1 * omega - t->alpha;
+  const float s = sin(sub), c = cos(sub);
+  const float cos_alpha = cos(t->alpha), sin_alpha = sin(t->alpha);
+  const float u = c - cos_alpha, v = s + sin_alpha * dot(t->a, t->b);
+  const float den = (v * s + u * c) * sin_alpha;
+  const float q = den != 0.0f ? clamp(((v * c - u * s) * cos_alpha - v) / den, -1.0f, 1.0f) : 1.0f;
+  const float3 cp = t->a * q + orthogonal_part(t->c, t->a) * sqrt(fmax(0.0f, 1.0f - q * q));
+  const float z = 1.0f - u2 * (1.0f - dot(cp, t->b));
+  return t->b * z + orthogonal_part(cp, t->b) * sqrt(fmax(0.0f, 1.0f - z * z));
+}
+
+// Barycentrics (b1 for v0 + e1, b2 for v0 + e2) where the ray p + t w meets the triangle's
+// plane, kept inside the triangle against round-off.
+PR_INLINE float2 triangle_barycentrics_along(float3 p, float3 w, float3 v0, float3 e1, float3 e2) {
+  const float3 s1 = cross(w, e2);
+  const float det = dot(s1, e1);
+  if (det == 0.0f) return make_float2(0.0f, 0.0f);
+  const float3 s = p - v0, s2 = cross(s, e1);
+  float b1 = clamp(dot(s, s1) / det, 0.0f, 1.0f), b2 = clamp(dot(w, s2) / det, 0.0f, 1.0f);
+  if (b1 + b2 > 1.0f) {
+    const float sum = b1 + b2;
+    b1 /= sum;
+    b2 /= sum;
+  }
+  return make_float2(b1, b2);
+}
+
 // Samples a point on light `l` (selected with probability `pmf`) as seen from `ref`. Emissive
 // triangles emit on both faces, as in Blender and Cycles. Returns 0 when the sample carries no
 // light. For triangles, (*b1, *b2) are the barycentrics of the point, for emission textures.
@@ -77,13 +158,19 @@ PR_INLINE int light_sample(const Light* l, float pmf, float3 ref, float u1, floa
   *b1 = 0.0f;
   *b2 = 0.0f;
   if (l->type == PR_LIGHT_TRIANGLE) {
-    const float2 b = sample_triangle(u1, u2);
+    const float3 v0 = make_float3(l->p0x, l->p0y, l->p0z);
     const float3 e1 = make_float3(l->e1x, l->e1y, l->e1z), e2 = make_float3(l->e2x, l->e2y, l->e2z);
     const float3 cr = cross(e1, e2);
     const float cl = length(cr);
     if (cl <= 0.0f) return 0;
     s->normal = cr / cl;
-    s->pos = make_float3(l->p0x, l->p0y, l->p0z) + e1 * b.x + e2 * b.y;
+    SphericalTriangle st;
+    const float omega = spherical_triangle(ref, v0, e1, e2, &st);
+    const int solid = use_solid_angle(omega);
+    const float2 b = solid ? triangle_barycentrics_along(
+                                 ref, sample_spherical_triangle(&st, omega, u1, u2), v0, e1, e2)
+                           : sample_triangle(u1, u2);
+    s->pos = v0 + e1 * b.x + e2 * b.y;
     const float3 d = s->pos - ref;
     const float d2 = dot(d, d);
     if (d2 <= 0.0f) return 0;
@@ -91,7 +178,7 @@ PR_INLINE int light_sample(const Light* l, float pmf, float3 ref, float u1, floa
     s->wi = d / s->dist;
     const float cos_l = fabs(dot(s->wi, s->normal));
     if (cos_l <= 1e-7f) return 0;
-    s->pdf = pmf * d2 / (cos_l * l->area);
+    s->pdf = solid ? pmf / omega : pmf * d2 / (cos_l * l->area);
     *b1 = b.x;
     *b2 = b.y;
     return 1;
@@ -119,13 +206,23 @@ PR_INLINE int light_sample(const Light* l, float pmf, float3 ref, float u1, floa
   return att > 0.0f;
 }
 
-// Solid-angle pdf with which light sampling would pick the point `pos` of an emissive triangle
-// with emission `le` and world area `area`, seen from a point at `dist` with |cos| = cos_l.
-PR_INLINE float light_pdf_triangle(float3 le, float area, float total_power, float dist,
-                                   float cos_l) {
-  if (total_power <= 0.0f || cos_l <= 1e-7f || area <= 0.0f) return 0.0f;
+// Solid-angle pdf with which light sampling from `ref` would pick the point `pos` of the
+// emissive triangle (v0, v0 + e1, v0 + e2) with emission `le`: the same choice between solid
+// angle and area as light_sample makes.
+PR_INLINE float light_pdf_triangle(float3 le, float total_power, float3 ref, float3 pos, float3 v0,
+                                   float3 e1, float3 e2) {
+  const float3 cr = cross(e1, e2);
+  const float area = 0.5f * length(cr);
+  if (total_power <= 0.0f || !(area > 0.0f)) return 0.0f;
   const float pmf = emitter_power(le, area) / total_power;
-  return pmf * dist * dist / (cos_l * area);
+  const float3 d = pos - ref;
+  const float d2 = dot(d, d);
+  if (!(d2 > 0.0f)) return 0.0f;
+  const float cos_l = fabs(dot(d, cr)) / (sqrt(d2) * 2.0f * area);
+  if (cos_l <= 1e-7f) return 0.0f;
+  SphericalTriangle st;
+  const float omega = spherical_triangle(ref, v0, e1, e2, &st);
+  return use_solid_angle(omega) ? pmf / omega : pmf * d2 / (cos_l * area);
 }
 
 // The light table as kernels see it (built from PR_LIGHT_PARAMS).

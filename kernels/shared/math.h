@@ -29,6 +29,7 @@ PR_NAMESPACE_BEGIN
 
 // float overloads, so host arithmetic matches the device's single precision.
 using std::acos;
+using std::asin;
 using std::atan2;
 using std::cos;
 using std::exp;

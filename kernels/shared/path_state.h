@@ -16,7 +16,7 @@ typedef struct {
   u32 alive;
   u32 rng_dim;  // next random dimension of this sample
   u32 flags;    // PR_PATH_*
-  u32 pad0, pad1, pad2;
+  float prev_x, prev_y, prev_z;  // the vertex `ray` leaves (for the emitter pdf of its hit)
 } PathState;
 
 #define PR_PATH_SPECULAR 1u  // the last bounce was delta (or the ray is the camera ray)

@@ -75,18 +75,22 @@ PR_INLINE SurfaceHit surface_at(const ShadingData* sd, u32 prim, u32 inst, float
   return s;
 }
 
-PR_INLINE float triangle_area_world(const SurfaceHit* s, const ShadingData* sd) {
-  const ShadingTriangle tri = sd->triangles[s->prim];
+// The world-space corners of a surface's triangle: v0 and the edges to v1 and v2.
+PR_INLINE void triangle_world(const ShadingData* sd, u32 prim, u32 inst, float3* v0, float3* e1,
+                              float3* e2) {
+  const ShadingTriangle tri = sd->triangles[prim];
   const ShadingVertex a = sd->vertices[tri.v0], b = sd->vertices[tri.v1], c = sd->vertices[tri.v2];
   float3 pa = make_float3(a.px, a.py, a.pz), pb = make_float3(b.px, b.py, b.pz),
          pc = make_float3(c.px, c.py, c.pz);
-  if (s->inst != PR_INVALID_INDEX) {
-    PR_GLOBAL const ShadingInstance* in = sd->instances + s->inst;
+  if (inst != PR_INVALID_INDEX) {
+    PR_GLOBAL const ShadingInstance* in = sd->instances + inst;
     pa = xform_point12(in->object_to_world, pa);
     pb = xform_point12(in->object_to_world, pb);
     pc = xform_point12(in->object_to_world, pc);
   }
-  return 0.5f * length(cross(pb - pa, pc - pa));
+  *v0 = pa;
+  *e1 = pb - pa;
+  *e2 = pc - pa;
 }
 
 PR_INLINE float srgb_to_linear(float c) {
