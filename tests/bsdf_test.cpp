@@ -69,14 +69,17 @@ Estimate albedoByEval(const BsdfParams& m, float3 wo, int n, uint32_t seed) {
 }
 
 TEST(Rng, PureFunctionOfKeyAndUniform) {
-  Rng a = rng_make(1, PR_RNG_CAMERA, 2, 3, 4), b = rng_make(1, PR_RNG_CAMERA, 2, 3, 4);
-  for (int i = 0; i < 100; ++i) EXPECT_EQ(rng_next_u32(&a), rng_next_u32(&b));
-  // Any key word changes the stream.
-  const Rng base = rng_make(1, PR_RNG_CAMERA, 2, 3, 4);
-  for (Rng other : {rng_make(9, PR_RNG_CAMERA, 2, 3, 4), rng_make(1, PR_RNG_LIGHT, 2, 3, 4),
-                    rng_make(1, PR_RNG_CAMERA, 7, 3, 4), rng_make(1, PR_RNG_CAMERA, 2, 8, 4),
-                    rng_make(1, PR_RNG_CAMERA, 2, 3, 5)}) {
-    EXPECT_NE(rng_u32_at(&base, 0), rng_u32_at(&other, 0));
+  for (uint32_t kind : {PR_RNG_CAMERA, PR_RNG_LIGHT}) {  // Sobol and hashed streams
+    Rng a = rng_make(1, kind, 2, 3, 4), b = rng_make(1, kind, 2, 3, 4);
+    for (int i = 0; i < 100; ++i) EXPECT_EQ(rng_next(&a), rng_next(&b));
+    // Any key word changes the stream.
+    Rng base = rng_make(1, kind, 2, 3, 4);
+    const float first = rng_next(&base);
+    for (Rng other :
+         {rng_make(9, kind, 2, 3, 4), rng_make(1, PR_RNG_TEST, 2, 3, 4), rng_make(1, kind, 7, 3, 4),
+          rng_make(1, kind, 2, 8, 4), rng_make(1, kind, 2, 3, 5)}) {
+      EXPECT_NE(first, rng_next(&other));
+    }
   }
   // Uniform in [0, 1): mean 1/2, variance 1/12, never 1.
   double s = 0, s2 = 0;

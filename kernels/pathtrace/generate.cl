@@ -11,9 +11,9 @@ __kernel void pt_generate(CameraParams cam, uint seed, uint frame, uint sample,
   const uint i = (uint)get_global_id(0);
   if (i >= count) return;
   Rng rng = rng_make(seed, PR_RNG_CAMERA, frame, i, sample);
-  const float jx = rng_next(&rng), jy = rng_next(&rng);
+  const float2 j = rng_next2(&rng);
   const uint x = i % cam.width, y = i / cam.width;
-  const float3 d = camera_direction(&cam, (float)x + jx, (float)y + jy);
+  const float3 d = camera_direction(&cam, (float)x + j.x, (float)y + j.y);
   PathState s;
   s.ray = make_ray(camera_position(&cam), d, 0.0f, PR_INF_F);
   s.tp_r = s.tp_g = s.tp_b = 1.0f;

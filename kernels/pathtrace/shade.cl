@@ -52,14 +52,15 @@ __kernel void pt_shade(PR_SCENE_PARAMS, __global PathState* states, __global con
         shadows[i].valid = 1u;
       }
     } else {
-      rng.dim += 3u;  // keep the dimension layout independent of the material
+      rng_skip(&rng, PR_NEXT_EVENT_DRAWS);  // the same dimensions whatever the material
     }
-    const float u0 = rng_next(&rng), u1 = rng_next(&rng), u2 = rng_next(&rng);
+    const float u0 = rng_next(&rng);
+    const float2 u12 = rng_next2(&rng);
     float3 wil, weight;
     float pdf;
     int delta;
     const float3 wol = to_local(wo, f.t, f.b, f.n);
-    if (!bsdf_sample(&f.bsdf, wol, u0, u1, u2, PR_RADIANCE, &wil, &weight, &pdf, &delta)) {
+    if (!bsdf_sample(&f.bsdf, wol, u0, u12.x, u12.y, PR_RADIANCE, &wil, &weight, &pdf, &delta)) {
       p.alive = 0u;
     } else {
       const float3 wi = to_world(wil, f.t, f.b, f.n);

@@ -186,9 +186,8 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
   const EyeVertex e = eye[i];
   if (e.prim == PR_INVALID_INDEX) return;
   const SceneData s = PR_SCENE();
-  // Its own stream of dimensions, after those eye_hit used.
-  Rng rng = rng_make(rp.seed, PR_RNG_CAMERA, rp.frame, i, sample);
-  rng.dim = 0x10000u;
+  // Its own stream, apart from eye_hit's.
+  Rng rng = rng_make(rp.seed, PR_RNG_CONNECT, rp.frame, i, sample);
   const uint j = i * rp.spp + sample;
   SurfaceHit x = surface_at(&s.sd, e.prim, e.inst, e.b1, e.b2);
   float3 wo = make_float3(e.wx, e.wy, e.wz);
@@ -207,18 +206,19 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
         if (!trace_occluded(&s, shadow)) L += tp * c;
       }
     } else {
-      rng.dim += 3u;
+      rng_skip(&rng, PR_NEXT_EVENT_DRAWS);
     }
     L += connect_light_paths(&s, &rp, &x, &f, wo, tp, depth, j, headers, vertices, &connect_rays,
                              &clamped);
     // The completeness extension: one BSDF direction, kept only through delta surfaces.
-    const float u0 = rng_next(&rng), u1 = rng_next(&rng), u2 = rng_next(&rng);
+    const float u0 = rng_next(&rng);
+    const float2 u12 = rng_next2(&rng);
     if (depth + 1u >= rp.max_depth) break;
     float3 wil, weight;
     float pdf;
     int delta;
     const float3 wol = to_local(wo, f.t, f.b, f.n);
-    if (!bsdf_sample(&f.bsdf, wol, u0, u1, u2, PR_RADIANCE, &wil, &weight, &pdf, &delta)) break;
+    if (!bsdf_sample(&f.bsdf, wol, u0, u12.x, u12.y, PR_RADIANCE, &wil, &weight, &pdf, &delta)) break;
     float3 d = normalize(to_world(wil, f.t, f.b, f.n));
     if (dot(d, f.ng) * dot(wo, f.ng) <= 0.0f) break;
     float3 t2 = tp * weight;
@@ -254,9 +254,10 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
         break;
       }
       if (depth >= rp.max_depth) break;
-      const float w0 = rng_next(&rng), w1 = rng_next(&rng), w2 = rng_next(&rng);
+      const float w0 = rng_next(&rng);
+      const float2 w12 = rng_next2(&rng);
       const float3 hl = to_local(-d, fh.t, fh.b, fh.n);
-      if (!bsdf_sample(&fh.bsdf, hl, w0, w1, w2, PR_RADIANCE, &wil, &weight, &pdf, &delta)) break;
+      if (!bsdf_sample(&fh.bsdf, hl, w0, w12.x, w12.y, PR_RADIANCE, &wil, &weight, &pdf, &delta)) break;
       d = normalize(to_world(wil, fh.t, fh.b, fh.n));
       t2 = t2 * weight;
       ray = spawn_ray(h.p, fh.ng, d, PR_INF_F);

@@ -11,9 +11,9 @@ __kernel void eye_hit(PR_SCENE_PARAMS, ReuseParams rp, CameraParams cam, uint sa
   if (i >= rp.pixel_count) return;
   const SceneData s = PR_SCENE();
   Rng rng = rng_make(rp.seed, PR_RNG_CAMERA, rp.frame, i, sample);
-  const float jx = rng_next(&rng), jy = rng_next(&rng);
+  const float2 j = rng_next2(&rng);
   const uint x = i % cam.width, y = i / cam.width;
-  float3 d = camera_direction(&cam, (float)x + jx, (float)y + jy);
+  float3 d = camera_direction(&cam, (float)x + j.x, (float)y + j.y);
   Ray ray = make_ray(camera_position(&cam), d, 0.0f, PR_INF_F);
   float3 tp = make_float3(1.0f, 1.0f, 1.0f), L = make_float3(0.0f, 0.0f, 0.0f);
   EyeVertex e;
@@ -48,12 +48,13 @@ __kernel void eye_hit(PR_SCENE_PARAMS, ReuseParams rp, CameraParams cam, uint sa
       e.b2 = hit.v;
       break;
     }
-    const float u0 = rng_next(&rng), u1 = rng_next(&rng), u2 = rng_next(&rng);
+    const float u0 = rng_next(&rng);
+    const float2 u12 = rng_next2(&rng);
     float3 wil, weight;
     float pdf;
     int delta;
     const float3 wol = to_local(wo, f.t, f.b, f.n);
-    if (!bsdf_sample(&f.bsdf, wol, u0, u1, u2, PR_RADIANCE, &wil, &weight, &pdf, &delta)) break;
+    if (!bsdf_sample(&f.bsdf, wol, u0, u12.x, u12.y, PR_RADIANCE, &wil, &weight, &pdf, &delta)) break;
     d = normalize(to_world(wil, f.t, f.b, f.n));
     tp = tp * weight;
     ray = spawn_ray(h.p, f.ng, d, PR_INF_F);

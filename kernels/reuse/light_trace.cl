@@ -20,8 +20,11 @@ __kernel void light_trace(PR_SCENE_PARAMS, ReuseParams rp, __global const float*
   h.escape_x = h.escape_y = h.escape_z = 0.0f;
   __global LightVertex* out = vertices + (size_t)slot * rp.stride;
   Rng rng = rng_make(rp.seed, PR_RNG_LIGHT, 0u, slot, h.generation);
-  const float us = rng_next(&rng), u1 = rng_next(&rng), u2 = rng_next(&rng), u3 = rng_next(&rng),
-              u4 = rng_next(&rng), u5 = rng_next(&rng);
+  const float us = rng_next(&rng);
+  const float2 u12 = rng_next2(&rng);
+  const float u3 = rng_next(&rng);
+  const float2 u45 = rng_next2(&rng);
+  const float u1 = u12.x, u2 = u12.y, u4 = u45.x, u5 = u45.y;
   uint rays = 0u, ssg = 0u, dsg = 0u;
   if (s.lights.count == 0u || !(rp.trace_total > 0.0f)) {
     headers[slot] = h;
@@ -136,7 +139,9 @@ __kernel void light_trace(PR_SCENE_PARAMS, ReuseParams rp, __global const float*
       break;
     }
     // Scatter, in the frame of the stored (decoded) normals.
-    const float u0 = rng_next(&rng), v1 = rng_next(&rng), v2 = rng_next(&rng), rr = rng_next(&rng);
+    const float u0 = rng_next(&rng);
+    const float2 v12 = rng_next2(&rng);
+    const float rr = rng_next(&rng), v1 = v12.x, v2 = v12.y;
     SurfaceHit q = sh;
     q.ng = oct_decode(v.ng_oct);
     q.ns = oct_decode(v.ns_oct);

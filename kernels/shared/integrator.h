@@ -98,9 +98,13 @@ PR_INLINE float emitter_pdf(const SceneData* s, const SurfaceHit* h, float3 ref)
 // throughput), or 0 when the sample carries nothing. With use_mis, area lights are weighted
 // against BSDF sampling (the path tracer); without, the estimate stands alone (path reuse,
 // where BSDF-sampled hits on emitters are not counted).
+#define PR_NEXT_EVENT_DRAWS 2u  // rng_skip this many where next_event is not called
+
 PR_INLINE int next_event(const SceneData* s, const SurfaceHit* h, const ShadingFrame* f, float3 wo,
                          int use_mis, Rng* rng, Ray* shadow, float3* contribution) {
-  const float us = rng_next(rng), u1 = rng_next(rng), u2 = rng_next(rng);
+  const float us = rng_next(rng);
+  const float2 ul = rng_next2(rng);
+  const float u1 = ul.x, u2 = ul.y;
   if (s->lights.count == 0u || s->lights.total_power <= 0.0f) return 0;
   const u32 idx = light_select(s->lights.cdf, s->lights.count, us);
   const Light l = s->lights.lights[idx];

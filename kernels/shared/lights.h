@@ -68,23 +68,20 @@ PR_INLINE u32 light_select(PR_GLOBAL const float* cdf, u32 count, float u) {
 }
 
 // Emitter triangles are sampled uniformly in the solid angle they subtend from the receiving
-// point (Arvo 1995) where that solid angle lies between these bounds (pbrt-v4's): below, the
-// triangle is small or far, area sampling is about as good, and the angle sum that gives the
-// solid angle loses its digits; above, the triangle nearly surrounds the point.
-#define PR_MIN_SPHERICAL_SOLID_ANGLE 3e-4f
+// point (Arvo 1995) where that solid angle lies between these bounds. Below, the triangle is
+// small or far and area sampling is about as good; and Arvo's construction in single precision
+// moves points (measured against double precision, worst of 16,000 random triangles per band)
+// by up to 140% of the triangle's size near 1e-3 sr, 13% near 3e-3, 7% near 0.02, 1.6% near
+// 0.03 and under 1% from 0.056 sr up. Above, the triangle nearly surrounds the point.
+#define PR_MIN_SPHERICAL_SOLID_ANGLE 0.05f
 #define PR_MAX_SPHERICAL_SOLID_ANGLE 6.22f
 
-// The angle between unit vectors, accurate near 0 and pi.
-PR_INLINE float angle_between(float3 a, float3 b) {
-  if (dot(a, b) < 0.0f) return PR_PI - 2.0f * asin(fmin(1.0f, 0.5f * length(a + b)));
-  return 2.0f * asin(fmin(1.0f, 0.5f * length(b - a)));
-}
-
 // The triangle (v0, v0 + e1, v0 + e2) as seen from p: unit directions to its vertices and the
-// angle at its first vertex. Returns the solid angle it subtends, 0 when it is degenerate.
+// cosine and sine of the spherical triangle's angle at a. Returns the solid angle it subtends
+// (Van Oosterom and Strackee 1983: no cancellation for small triangles), 0 when degenerate.
 typedef struct {
   float3 a, b, c;
-  float alpha;
+  float cos_alpha, sin_alpha;
 } SphericalTriangle;
 
 PR_INLINE float spherical_triangle(float3 p, float3 v0, float3 e1, float3 e2,
@@ -95,15 +92,16 @@ PR_INLINE float spherical_triangle(float3 p, float3 v0, float3 e1, float3 e2,
   t->a = da / la;
   t->b = db / lb;
   t->c = dc / lc;
-  float3 n_ab = cross(t->a, t->b), n_bc = cross(t->b, t->c), n_ca = cross(t->c, t->a);
-  const float l_ab = length(n_ab), l_bc = length(n_bc), l_ca = length(n_ca);
-  if (!(l_ab > 0.0f && l_bc > 0.0f && l_ca > 0.0f)) return 0.0f;
-  n_ab = n_ab / l_ab;
-  n_bc = n_bc / l_bc;
-  n_ca = n_ca / l_ca;
-  t->alpha = angle_between(n_ab, -n_ca);
-  const float beta = angle_between(n_bc, -n_ab), gamma = angle_between(n_ca, -n_bc);
-  const float omega = t->alpha + beta + gamma - PR_PI;
+  const float3 n_ab = cross(t->a, t->b), n_ac = cross(t->a, t->c);
+  const float triple = fabs(dot(t->a, cross(t->b, t->c)));
+  const float l_ab = length(n_ab), l_ac = length(n_ac);
+  if (!(l_ab > 0.0f && l_ac > 0.0f && triple > 0.0f)) return 0.0f;
+  // The angle at a is the one between the planes through (a, b) and (a, c); the cross product
+  // of their normals is a times the triple product.
+  t->cos_alpha = clamp(dot(n_ab, n_ac) / (l_ab * l_ac), -1.0f, 1.0f);
+  t->sin_alpha = fmin(triple / (l_ab * l_ac), 1.0f);
+  const float omega =
+      2.0f * atan2(triple, 1.0f + dot(t->a, t->b) + dot(t->b, t->c) + dot(t->c, t->a));
   return omega > 0.0f && isfinite_f(omega) ? omega : 0.0f;
 }
 
@@ -121,15 +119,22 @@ PR_INLINE float3 orthogonal_part(float3 v, float3 w) {
 // sub-triangle (a, b, c') of area u1 * omega, u2 a point on the arc from b to c'.
 PR_INLINE float3 sample_spherical_triangle(const SphericalTriangle* t, float omega, float u1,
                                            float u2) {
-  const float sub = u1 * omega - t->alpha;
-  const float s = sin(sub), c = cos(sub);
-  const float cos_alpha = cos(t->alpha), sin_alpha = sin(t->alpha);
+  // s, c: sine and cosine of (u1 omega - alpha).
+  const float cos_alpha = t->cos_alpha, sin_alpha = t->sin_alpha;
+  float cu;
+  const float su = pr_sincos(u1 * omega, &cu);
+  const float s = su * cos_alpha - cu * sin_alpha, c = cu * cos_alpha + su * sin_alpha;
   const float u = c - cos_alpha, v = s + sin_alpha * dot(t->a, t->b);
   const float den = (v * s + u * c) * sin_alpha;
   const float q = den != 0.0f ? clamp(((v * c - u * s) * cos_alpha - v) / den, -1.0f, 1.0f) : 1.0f;
   const float3 cp = t->a * q + orthogonal_part(t->c, t->a) * sqrt(fmax(0.0f, 1.0f - q * q));
-  const float z = 1.0f - u2 * (1.0f - dot(cp, t->b));
-  return t->b * z + orthogonal_part(cp, t->b) * sqrt(fmax(0.0f, 1.0f - z * z));
+  // 1 - cos(arc b c') from the chord, and 1 - z^2 = (1 - z)(1 + z): no cancellation when the
+  // triangle is small.
+  const float3 chord = cp - t->b;
+  const float one_minus_z = u2 * 0.5f * dot(chord, chord);
+  const float z = 1.0f - one_minus_z;
+  return t->b * z +
+         orthogonal_part(cp, t->b) * sqrt(fmax(0.0f, one_minus_z * (2.0f - one_minus_z)));
 }
 
 // Barycentrics (b1 for v0 + e1, b2 for v0 + e2) where the ray p + t w meets the triangle's

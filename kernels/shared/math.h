@@ -129,6 +129,14 @@ PR_NAMESPACE_BEGIN
 
 #ifdef PR_DEVICE_CODE
 PR_INLINE int isfinite_f(float v) { return isfinite(v) ? 1 : 0; }
+PR_INLINE float pr_sincos(float x, float* c) {
+  return sincos(x, c);
+}
+#else
+inline float pr_sincos(float x, float* c) {
+  *c = std::cos(x);
+  return std::sin(x);
+}
 #endif
 
 PR_INLINE float3 pr_load3(PR_GLOBAL const float* p) { return make_float3(p[0], p[1], p[2]); }

@@ -5,13 +5,16 @@
 #pragma once
 
 #include "shared/common.h"
+#include "shared/math.h"
 
 PR_NAMESPACE_BEGIN
 
-// The state is only a key and a dimension counter; it lives in registers, never in buffers.
+// The state is only a key, a dimension counter and whether it draws low-discrepancy samples;
+// it lives in registers, never in buffers.
 typedef struct {
   u32 k0, k1, k2;
   u32 dim;
+  u32 sobol;
 } Rng;
 
 // A 4-in, 4-out integer permutation (the "pcg4d" hash of Jarzynski and Olano, JCGT 2020).
@@ -47,7 +50,14 @@ PR_INLINE u32 pr_hash_u32(u32 x) {
 // Stream kinds, folded into the key so camera and light streams never coincide.
 #define PR_RNG_CAMERA 0x43414d31u
 #define PR_RNG_LIGHT 0x4c495431u
+#define PR_RNG_CONNECT 0x434f4e31u  // camera samples' draws in `connect`, apart from eye_hit's
 #define PR_RNG_TEST 0x54455354u
+#define PR_RNG_TEST_SOBOL 0x54455353u
+
+// Camera streams are keyed by (pixel, sample index): their first PR_SOBOL_DIMS dimensions are
+// Owen-scrambled Sobol points over the frame's samples of the pixel, hashed numbers beyond
+// (deep bounces gain little from stratification). Other streams draw hashed numbers.
+#define PR_SOBOL_DIMS 64u
 
 PR_INLINE Rng rng_make(u32 seed, u32 kind, u32 frame, u32 stream, u32 index) {
   Rng r;
@@ -55,6 +65,7 @@ PR_INLINE Rng rng_make(u32 seed, u32 kind, u32 frame, u32 stream, u32 index) {
   r.k1 = stream;
   r.k2 = index;
   r.dim = 0u;
+  r.sobol = kind == PR_RNG_CAMERA || kind == PR_RNG_CONNECT || kind == PR_RNG_TEST_SOBOL;
   return r;
 }
 
@@ -65,9 +76,75 @@ PR_INLINE u32 rng_u32_at(const Rng* r, u32 dim) {
   return x ^ w;
 }
 
-PR_INLINE u32 rng_next_u32(Rng* r) { return rng_u32_at(r, r->dim++); }
+PR_INLINE u32 pr_reverse_bits(u32 x) {
+  x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
+  x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
+  x = ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
+  x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8);
+  return (x >> 16) | (x << 16);
+}
 
-// A float in [0, 1): the top 24 bits, so 1.0 is never returned.
-PR_INLINE float rng_next(Rng* r) { return (float)(rng_next_u32(r) >> 8) * (1.0f / 16777216.0f); }
+// Owen scrambling of the bits of x, each flipped by a hash of the bits above it (Burley 2020:
+// the Laine-Karras permutation applied to the reversed bits).
+PR_INLINE u32 pr_owen_scramble(u32 x, u32 seed) {
+  x = pr_reverse_bits(x);
+  x += seed;
+  x ^= x * 0x6c50b47cu;
+  x ^= x * 0xb82f1e52u;
+  x ^= x * 0xc7afe638u;
+  x ^= x * 0x8d22f6e6u;
+  return pr_reverse_bits(x);
+}
+
+// The first two dimensions of the Sobol sequence, as 32-bit fractions: van der Corput, and the
+// dimension whose direction numbers follow v_k = v_(k-1) ^ (v_(k-1) >> 1) (polynomial x + 1).
+PR_INLINE u32 pr_sobol0(u32 index) {
+  return pr_reverse_bits(index);
+}
+PR_INLINE u32 pr_sobol1(u32 index) {
+  u32 r = 0u;
+  for (u32 v = 0x80000000u; index != 0u; index >>= 1, v ^= v >> 1)
+    if (index & 1u) r ^= v;
+  return r;
+}
+
+// Component c of the 2-D point of pair `pair` for sample `index`: Sobol with the index shuffled
+// and each axis scrambled by hashes of (key, pixel, pair), so that every pair is stratified over
+// the pixel's samples and pairs are independent of one another (padding, as pbrt-v4's
+// PaddedSobolSampler). Any 2^k samples whose indices differ in their low k bits (the first 2^k
+// of a frame) form a (0, k, 2)-net.
+PR_INLINE u32 pr_sobol_pair(const Rng* r, u32 pair, u32 c) {
+  const u32 h = pr_hash_u32(r->k0 ^ pr_hash_u32(r->k1 ^ pr_hash_u32(pair)));
+  const u32 index = pr_owen_scramble(r->k2, h);
+  const u32 v = c == 0u ? pr_sobol0(index) : pr_sobol1(index);
+  return pr_owen_scramble(v, pr_hash_u32(h ^ (0x9e3779b9u * (c + 1u))));
+}
+
+PR_INLINE float pr_u32_to_unit(u32 v) {
+  return (float)(v >> 8) * (1.0f / 16777216.0f);
+}
+
+// Every draw takes one pair of dimensions, so that a 2-D draw (a point on a light, a BSDF
+// direction, the pixel jitter) is one stratified pair. A float in [0, 1): 1.0 is never returned.
+PR_INLINE float rng_next(Rng* r) {
+  const u32 d = r->dim;
+  r->dim += 2u;
+  return pr_u32_to_unit(r->sobol && d < PR_SOBOL_DIMS ? pr_sobol_pair(r, d >> 1, 0u)
+                                                      : rng_u32_at(r, d));
+}
+
+PR_INLINE float2 rng_next2(Rng* r) {
+  const u32 d = r->dim;
+  r->dim += 2u;
+  if (r->sobol && d < PR_SOBOL_DIMS)
+    return make_float2(pr_u32_to_unit(pr_sobol_pair(r, d >> 1, 0u)),
+                       pr_u32_to_unit(pr_sobol_pair(r, d >> 1, 1u)));
+  return make_float2(pr_u32_to_unit(rng_u32_at(r, d)), pr_u32_to_unit(rng_u32_at(r, d + 1u)));
+}
+
+// Skips `draws` draws (to keep the layout of dimensions the same whichever way a path goes).
+PR_INLINE void rng_skip(Rng* r, u32 draws) {
+  r->dim += 2u * draws;
+}
 
 PR_NAMESPACE_END

@@ -100,14 +100,15 @@ PR_INLINE void shared_check_case(u32 i, PR_GLOBAL const float* cdf, u32 cdf_coun
   LightSample ls;
   float b1 = 0.0f, b2 = 0.0f;
   const float l1 = rng_next(&rng), l2 = rng_next(&rng);
-  r[33] = (float)light_sample(&l, 0.5f, p, l1, l2, &ls, &b1, &b2);
-  if (r[33] != 0.0f) {
+  const int got = light_sample(&l, 0.5f, p, l1, l2, &ls, &b1, &b2);
+  r[33] = (float)got;
+  if (got) {
     check_put3(r, 34, ls.pos);
     check_put3(r, 37, ls.wi);
     r[40] = ls.pdf;
     check_put3(r, 41, ls.normal);
+    r[44] = power_heuristic(ls.pdf, pdf_c);
   }
-  r[44] = power_heuristic(ls.pdf * (r[33] != 0.0f ? 1.0f : 0.0f), pdf_c);
   r[45] = b1;
   r[46] = b2;
   r[47] = (float)light_select(cdf, cdf_count, 1.0f - us);
