@@ -76,6 +76,18 @@ PR_INLINE u32 rng_u32_at(const Rng* r, u32 dim) {
   return x ^ w;
 }
 
+#if defined(PR_DEVICE_CODE) && defined(PR_BITREVERSE_TABLE)
+// Oclgrind 21.10 cannot run llvm.bitreverse, which LLVM makes of the shifts below (and which is
+// one instruction on GPUs): tools/oclgrind-check.sh builds with -DPR_BITREVERSE_TABLE.
+#define PR_R2(n) n, n + 2 * 64, n + 1 * 64, n + 3 * 64
+#define PR_R4(n) PR_R2(n), PR_R2(n + 2 * 16), PR_R2(n + 1 * 16), PR_R2(n + 3 * 16)
+#define PR_R6(n) PR_R4(n), PR_R4(n + 2 * 4), PR_R4(n + 1 * 4), PR_R4(n + 3 * 4)
+__constant uchar pr_reversed_byte[256] = {PR_R6(0), PR_R6(2), PR_R6(1), PR_R6(3)};
+PR_INLINE u32 pr_reverse_bits(u32 x) {
+  return ((u32)pr_reversed_byte[x & 255u] << 24) | ((u32)pr_reversed_byte[(x >> 8) & 255u] << 16) |
+         ((u32)pr_reversed_byte[(x >> 16) & 255u] << 8) | (u32)pr_reversed_byte[x >> 24];
+}
+#else
 PR_INLINE u32 pr_reverse_bits(u32 x) {
   x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
   x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
@@ -83,6 +95,7 @@ PR_INLINE u32 pr_reverse_bits(u32 x) {
   x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8);
   return (x >> 16) | (x << 16);
 }
+#endif
 
 // Owen scrambling of the bits of x, each flipped by a hash of the bits above it (Burley 2020:
 // the Laine-Karras permutation applied to the reversed bits).
