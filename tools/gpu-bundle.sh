@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Packs what tools/gpu-check.sh needs on a machine with a GPU but no package registry: the
 # built programs (stripped), the shared libraries they load except the C library (from ldd),
-# and the portability suite's reference frames rendered here, on the CPU.
+# the portability suite's reference frames rendered here, on the CPU, and ../shared/scenes.
 # Usage: tools/gpu-bundle.sh DIR [--device SPEC]   (after tools/build.sh; SPEC default pocl)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -28,4 +28,6 @@ build/pathreuse portability --quiet --device "$device" --save-reference "$dir/re
   --out "$dir/reference-worst" >/dev/null
 rm -rf "$dir/reference-worst"
 pwd >"$dir/source_dir"  # where the tests look for the binary and the sources
+# The third-party test scenes (../shared/scenes), when they are beside the checkout.
+[ -d ../shared/scenes ] && cp -r ../shared/scenes "$dir/shared-scenes"
 du -sh "$dir"

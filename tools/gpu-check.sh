@@ -42,6 +42,9 @@ export PATHREUSE_CACHE_DIR=/tmp/pathreuse-cache
 # The tests find the binary and the sources where they were built: make those paths hold.
 src=$(cat "$bundle/source_dir")
 if [ "$src" != "$PWD" ] && [ ! -e "$src" ]; then mkdir -p "$(dirname "$src")" && ln -s "$PWD" "$src"; fi
+if [ -d "$bundle/shared-scenes" ] && [ ! -e "$(dirname "$src")/shared/scenes" ]; then
+  mkdir -p "$(dirname "$src")/shared" && ln -s "$bundle/shared-scenes" "$(dirname "$src")/shared/scenes"
+fi
 if [ ! -x "$src/build/pathreuse" ]; then mkdir -p "$src/build" && cp "$bundle"/bin/* "$src/build/"; fi
 
 rm -f /tmp/gpu-check-rc
