@@ -71,14 +71,14 @@ __kernel void pt_shade(PR_SCENE_PARAMS, __global PathState* states, __global con
         p.alive = 0u;
       } else {
         tp = tp * weight;
-        const float rr = rng_next(&rng);
-        if (p.depth >= 3u) {
-          const float q = fmin(max3(tp), 0.95f);
-          if (rr >= q) {
+        // Russian roulette (pbrt-v4's rule): from the third vertex, a path whose throughput
+        // fell below 1 survives with that probability; brighter paths always go on.
+        const float rr = rng_next(&rng), q = max3(tp);
+        if (p.depth >= 3u && q < 1.0f) {
+          if (rr >= q)
             p.alive = 0u;
-          } else {
+          else
             tp = tp / q;
-          }
         }
         p.ray = spawn_ray(h.p, f.ng, wi, PR_INF_F);
         p.prev_x = h.p.x;

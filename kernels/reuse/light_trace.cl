@@ -100,6 +100,7 @@ __kernel void light_trace(PR_SCENE_PARAMS, ReuseParams rp, __global const float*
   out[0] = v;
   uint count = 1u;
   Ray ray = light_segment_ray(p0, v.ng_oct, prim0, dir);
+  const float tp0 = max3(tp);  // Russian roulette weighs the throughput against this
 
   for (uint k = 1u; k < rp.stride; ++k) {
     Hit hit;
@@ -157,8 +158,9 @@ __kernel void light_trace(PR_SCENE_PARAMS, ReuseParams rp, __global const float*
     const float side = dot(wi, f.ng) * dot(wo, f.ng);
     if ((reflect && side <= 0.0f) || (!reflect && side >= 0.0f)) break;
     float3 w = weight * shading_normal_correction(wo, wi, f.n, f.ng);
-    const float qk = fmin(max3(w), 0.95f);
-    if (k >= 2u) {
+    // Russian roulette (pbrt-v4's rule) on the throughput relative to what left the light.
+    const float qk = max3(tp * w) / tp0;
+    if (k >= 2u && qk < 1.0f) {
       if (rr >= qk) break;
       w = w / qk;
     }
