@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <random>
 #include <set>
@@ -307,9 +308,17 @@ TEST(PortabilityCli, SavedReferenceIsComparedWithEveryDevice) {
   ASSERT_EQ(j["results"].size(), 8u);
   EXPECT_FALSE(j["devices"][0]["reference"].get<bool>());
   for (const auto& e : j["results"]) EXPECT_TRUE(e["identical"].get<bool>()) << e.dump();
-  // Another suite than the one saved, or no manifest: one line, exit 2.
+  // Another suite than the one saved, no manifest, a manifest of the wrong shape: one line,
+  // exit 2.
+  const std::string broken = test::tempDir("port-broken");
+  nlohmann::json manifest = nlohmann::json::parse(std::ifstream(ref + "/reference.json"));
+  for (auto& v : manifest["frames_dropped"]) v = "none";
+  std::ofstream(broken + "/reference.json") << manifest.dump();
+  for (const auto& e : std::filesystem::directory_iterator(ref))
+    if (e.path().extension() == ".exr") std::filesystem::copy(e.path(), broken);
   for (const std::string& bad :
        {" --spp 3 --reference '" + ref + "'", " --reference '" + test::tempDir("port-empty") + "'",
+        " --reference '" + broken + "'",
         " --reference '" + ref + "' --save-reference '" + ref + "'"}) {
     r = test::runPathreuse("portability --quiet --frames 0-1 --width 32 --spp 2" + bad,
                            kTwoDrivers);

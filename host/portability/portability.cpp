@@ -136,11 +136,17 @@ class StoredReference {
     } catch (const nlohmann::json::exception& e) {
       throw InputError(manifest.string() + ": not a reference manifest (" + e.what() + ")");
     }
-    if (!json_.is_object() || !json_.contains("settings") || !json_.contains("frames_dropped") ||
-        !json_.contains("device"))
-      throw InputError(manifest.string() + ": not a reference manifest");
+    bool ok = json_.is_object() && json_.contains("settings") && json_["settings"].is_object() &&
+              json_.contains("device") && json_["device"].is_object() &&
+              json_.contains("frames_dropped") && json_["frames_dropped"].is_object();
+    if (ok)
+      for (const auto& v : json_["frames_dropped"]) ok = ok && v.is_number_unsigned();
+    if (!ok) throw InputError(manifest.string() + ": not a reference manifest");
   }
-  std::string device() const { return json_["device"].value("name", std::string("?")); }
+  std::string device() const {
+    const auto& d = json_["device"];
+    return d.contains("name") && d["name"].is_string() ? d["name"].get<std::string>() : "?";
+  }
   // The suite asked for must be the one saved.
   void check(const nlohmann::json& settings) const {
     if (json_["settings"] != settings)
