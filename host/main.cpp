@@ -1,5 +1,5 @@
 // pathreuse: command-line entry. Parses arguments with CLI11, runs one subcommand, and turns
-// every exception into one line on stderr and an exit code (DESIGN.md section 1).
+// every exception into one line on stderr and an exit code (docs/design.md section 1).
 #include <cstdio>
 #include <exception>
 #include <iostream>

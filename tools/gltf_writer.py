@@ -1,5 +1,5 @@
 """Shared code of the scene generators: triangle meshes, a glTF 2.0 writer and a
-validator that re-reads what was written (see DESIGN.md section 3 for the conventions).
+validator that re-reads what was written (see docs/design.md section 3 for the conventions).
 
 Standard library only. Output is deterministic: every float that reaches the file goes
 through float32 first, so the bytes do not depend on the last bit of the C library's

@@ -1,4 +1,4 @@
-// The host side of the scene's acceleration structures (DESIGN.md section 3): the SSG's BVH,
+// The host side of the scene's acceleration structures (docs/design.md section 3): the SSG's BVH,
 // built once over world-space static triangles, and the DSG's two levels: one object-space BVH
 // per dynamic mesh, built once, and a top-level BVH over this frame's instances.
 // Triangles come as plain arrays: positions and 3 indices per triangle.

@@ -39,7 +39,7 @@ struct RenderOptions {
   // Camera samples keyed by frame 0 on every frame (the scene still moves with the frame):
   // the same noise pattern each frame, to measure how much flicker fresh noise adds.
   bool fixedNoise = false;
-  // Path reuse (DESIGN.md section 5).
+  // Path reuse (docs/design.md section 5).
   int lightPaths = 0;          // slots; 0: chosen from the image size
   int pathsPerPixel = 4;       // C: light paths each pixel sample connects to
   float clamp = 0.0f;          // clamp on the geometry term; 0 = off

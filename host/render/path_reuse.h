@@ -1,4 +1,4 @@
-// The paper's method (--mode reuse), made exact (DESIGN.md sections 4 and 5): light sub-paths
+// The paper's method (--mode reuse), made exact (docs/design.md sections 4 and 5): light sub-paths
 // live in a path-record arena across frames; each frame `invalidate` finds the ones the moving
 // objects disturb, `light_trace` traces those again, and per sample `eye_hit` finds the first
 // non-delta surface and `connect` joins it to the stored light vertices. --mode retrace runs

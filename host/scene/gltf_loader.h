@@ -1,5 +1,5 @@
 // Loading a glTF 2.0 file (.gltf with external or data: buffers, or .glb) into a Scene, with
-// the static/dynamic split of DESIGN.md section 3. Broken input never crashes: every index,
+// the static/dynamic split of docs/design.md section 3. Broken input never crashes: every index,
 // range and reference is checked and the first problem becomes one pr::InputError line
 // "FILE: what is wrong (which object)".
 #pragma once

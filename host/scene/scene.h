@@ -1,4 +1,4 @@
-// The scene as the renderer sees it (DESIGN.md section 3): the static scene graph (SSG)
+// The scene as the renderer sees it (docs/design.md section 3): the static scene graph (SSG)
 // flattened into one world-space triangle list, the dynamic scene graph (DSG) as object-space
 // meshes plus instances whose transforms are evaluated per frame, materials, textures,
 // punctual lights, cameras, and the node hierarchy with its animations.

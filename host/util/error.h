@@ -1,4 +1,4 @@
-// Error types and the exit codes they map to (DESIGN.md section 1).
+// Error types and the exit codes they map to (docs/design.md section 1).
 #pragma once
 
 #include <stdexcept>

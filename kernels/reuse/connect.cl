@@ -1,7 +1,7 @@
 // connect: one work-item per pixel (one pass per sample index). At the pixel sample's eye
 // vertex x: next-event estimation (MIS-weighted against the BSDF sample's emitter hit, as in the
 // path tracer), and connections to every stored non-delta vertex k >= 1 of
-// the C light paths interleaved to this sample (DESIGN.md section 5). Then, for completeness
+// the C light paths interleaved to this sample (docs/design.md section 5). Then, for completeness
 // with mirrors and glass, one BSDF direction from x: if it meets a delta surface, the delta
 // chain is followed and its end is treated like x (emission, next-event estimation,
 // connections), up to the maximum depth. If it meets a non-delta surface Y, that surface is

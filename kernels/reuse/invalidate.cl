@@ -1,5 +1,5 @@
 // invalidate: one work-item per slot. A stored path stays valid only if tracing it again now
-// would give the same vertices (DESIGN.md section 5): it is invalid when (c) its light moved,
+// would give the same vertices (docs/design.md section 5): it is invalid when (c) its light moved,
 // (b) a vertex lies on a DSG instance that moved, or (a) a segment, or the final escaping ray,
 // now meets DSG geometry before its stored end. Only the DSG is tested. Reads the headers, the
 // vertices, the instances' moved flags and the light table; clears `valid` of invalid slots,

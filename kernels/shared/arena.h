@@ -1,4 +1,4 @@
-// The path-record arena (DESIGN.md section 4; the paper's PATH structure): a fixed number of
+// The path-record arena (docs/design.md section 4; the paper's PATH structure): a fixed number of
 // light-path slots, each with a PathHeader and up to `stride` LightVertex records at
 // slot * stride + k. Vertex 0 lies on the light. Normals are stored octahedron-encoded, and the
 // light tracer spawns its rays from the decoded normals, so that invalidation can rebuild every

@@ -1,4 +1,4 @@
-// Ray queries against the scene's two acceleration structures (DESIGN.md section 3), in the C
+// Ray queries against the scene's two acceleration structures (docs/design.md section 3), in the C
 // subset that compiles as OpenCL C and as C++: the host's CPU reference runs this very code.
 //
 //   SSG: one BVH over all static triangles, in world space.

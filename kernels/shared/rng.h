@@ -1,7 +1,7 @@
 // Counter-based random numbers: every value is a pure function of its key, never of thread
 // order, so any sample can be replayed. Camera samples are keyed by (seed, frame, pixel,
 // sample); light paths by (seed, slot, generation) with frame fixed to a constant, so that
-// re-tracing a slot with the same generation reproduces it exactly (DESIGN.md section 4).
+// re-tracing a slot with the same generation reproduces it exactly (docs/design.md section 4).
 #pragma once
 
 #include "shared/common.h"
