@@ -90,6 +90,13 @@ int main(int argc, char** argv) {
                    "pathtrace: unidirectional path tracing (the baseline)")
       ->check(CLI::IsMember({"reuse", "retrace", "pathtrace"}))
       ->capture_default_str();
+  std::string lightSamplerText = "bvh";
+  render
+      ->add_option("--light-sampler", lightSamplerText,
+                   "How a shaded point chooses the light it samples: bvh (by the light it can "
+                   "get from each, through a light BVH) or power (by power alone)")
+      ->check(CLI::IsMember({"bvh", "power"}))
+      ->capture_default_str();
   render->add_option("--light-paths", ro.lightPaths,
                      "Light-path slots kept in the arena (reuse/retrace; default: one per pixel)");
   render
@@ -205,6 +212,7 @@ int main(int argc, char** argv) {
       ro.mode = modeText == "pathtrace" ? pr::RenderMode::PathTrace
                 : modeText == "retrace" ? pr::RenderMode::Retrace
                                         : pr::RenderMode::Reuse;
+      ro.lightSamplerPower = lightSamplerText == "power";
       return pr::runRender(ro);
     }
     if (*portability) {

@@ -1,6 +1,6 @@
-// The shared helpers (sampling, BSDFs, octahedral normals, ray offsets, light choice) give the
-// same values on the device as the CPU reference, in every work-item. A compiler that mishandles
-// some lanes of a vectorised work-group (Intel's CPU runtime did, for helpers kept out of line
+// The shared helpers (sampling, BSDFs, octahedral normals, ray offsets, light choice by power and
+// by the light BVH) give the same values on the device as the CPU reference, in every
+// work-item. A compiler that mishandles some lanes of a vectorised work-group (Intel's CPU runtime did, for helpers kept out of line
 // that pass float3 values) fails here with the lanes named.
 #include <gtest/gtest.h>
 
@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "cl/context.h"
+#include "render/light_bvh.h"
 #include "support/test_env.h"
 #include "test/shared_check.h"
 
@@ -25,6 +26,24 @@ std::vector<float> powerTable() {
     cdf.push_back(sum);
   }
   return cdf;
+}
+
+// A light BVH over small triangles and point lights around the check's points.
+LightBvh lightTree() {
+  std::vector<dev::Light> lights;
+  for (uint32_t k = 0; k < 61; ++k) {
+    auto u = [&](uint32_t j) { return float(dev::pr_hash_u32(k * 7u + j) >> 8) * (1.0f / 16777216.0f); };
+    dev::Light l{};
+    l.type = k % 5 == 4 ? PR_LIGHT_POINT : PR_LIGHT_TRIANGLE;
+    l.p0x = 8.0f * u(0) - 4.0f, l.p0y = 8.0f * u(1) - 4.0f, l.p0z = 8.0f * u(2) - 4.0f;
+    l.e1x = u(3) - 0.5f, l.e1y = 0.3f, l.e1z = u(4) - 0.5f;
+    l.e2x = 0.2f, l.e2y = u(5) - 0.5f, l.e2z = u(6);
+    l.power = 0.1f + 3.0f * u(6);
+    lights.push_back(l);
+  }
+  LightBvh bvh;
+  bvh.build(&lights, uint32_t(lights.size()));
+  return bvh;
 }
 
 // Rounding differs between compilers (fused multiply-adds, sqrt and sin within their OpenCL
@@ -47,6 +66,14 @@ TEST(SharedHelpers, DeviceEqualsTheCpuReferenceInEveryLane) {
   k.setArg(1, kCases);
   k.setArg(2, table);
   k.setArg(3, uint32_t(cdf.size()));
+  const LightBvh tree = lightTree();
+  const auto& nodes = tree.nodes();
+  cl::Buffer nodeBuffer =
+      ctx.allocate("light BVH", nodes.size() * sizeof(dev::LightNode), CL_MEM_READ_ONLY);
+  ctx.queue().enqueueWriteBuffer(nodeBuffer, CL_TRUE, 0, nodes.size() * sizeof(dev::LightNode),
+                                 nodes.data());
+  k.setArg(4, nodeBuffer);
+  k.setArg(5, uint32_t(nodes.size()));
   ctx.launch1D(k, kCases, "shared_check");
   std::vector<float> device(size_t(kCases) * PR_CHECK_STRIDE);
   ctx.queue().enqueueReadBuffer(out, CL_TRUE, 0, device.size() * sizeof(float), device.data());
@@ -56,7 +83,8 @@ TEST(SharedHelpers, DeviceEqualsTheCpuReferenceInEveryLane) {
   std::ostringstream first;
   for (uint32_t i = 0; i < kCases; ++i) {
     float host[PR_CHECK_STRIDE];
-    dev::shared_check_case(i, cdf.data(), uint32_t(cdf.size()), host);
+    dev::shared_check_case(i, cdf.data(), uint32_t(cdf.size()), nodes.data(),
+                           uint32_t(nodes.size()), host);
     const float* d = &device[size_t(i) * PR_CHECK_STRIDE];
     for (uint32_t j = 0; j < PR_CHECK_STRIDE; ++j) {
       if (close(d[j], host[j])) continue;

@@ -5,10 +5,15 @@ high-spp reference, on the scenes where emitter sampling and stratification matt
   python3 tools/bench_sampling.py                       # the table, this build's kernels
   python3 tools/bench_sampling.py --baseline-kernels DIR  # and side by side with other kernels
 
-For each case the reference is rendered once (cached in --cache, keyed by its settings and
-the kernels it was rendered with) at --ref-factor x the spp; each configuration then renders
---seeds seeds, interleaved, and the table gives the median relMSE (eps 0.01, as exr_compare),
-the median kernel seconds per frame, and their product. --baseline-kernels points
+For each case the reference is rendered once (cached in --cache, keyed by the scene's name
+and file contents, its settings and the kernels it was rendered with) at --ref-factor x the
+spp; each configuration then renders --seeds seeds, interleaved, and the table gives the
+median relMSE (eps 0.01, as exr_compare), the median kernel seconds per frame, and their
+product. A case may render in several variants against the one reference (the many-lights
+atrium, tools/gen_atrium.py --light lanterns: --light-sampler bvh and power, one row each,
+the reference with the default sampler); a line below the table gives the ratio of their
+relMSE. A render that fails (e.g. an option this build lacks) gives a row saying so.
+--baseline-kernels points
 PATHREUSE_KERNEL_DIR at another kernels/ folder (e.g. `git archive` of an older commit), so
 both run in the same binary on the same machine in the same run. Standard library only.
 """
@@ -17,6 +22,7 @@ import argparse
 import hashlib
 import json
 import os
+import shutil
 import statistics
 import subprocess
 import sys
@@ -28,18 +34,26 @@ import benchlib  # noqa: E402
 
 REPO = benchlib.REPO
 
-# (name, scene, width, height, render options)
+# (name, scene, width, height, render options[, variants]); variants: [(short name, more
+# render options), ...], each a row of the table (labelled by its options) rendered against
+# the one reference (rendered with the case's options alone); a line after the table gives
+# the relMSE of the second variant over the first
+SAMPLERS = [("bvh", ["--light-sampler", "bvh"]), ("power", ["--light-sampler", "power"])]
 CASES = [
     ("atrium direct (--max-depth 2)", "atrium", 320, 180, ["--force-diffuse", "--max-depth", "2"]),
     ("atrium full (--max-depth 64)", "atrium", 320, 180, ["--force-diffuse", "--max-depth", "64"]),
     ("cornell-nvpro (--max-depth 64)", "cornell-nvpro", 320, 240, ["--force-diffuse", "--max-depth", "64"]),
     ("cornell-dynamic (default depth)", "cornell-dynamic", 320, 240, []),
+    ("atrium lanterns direct (--max-depth 2)", "atrium-lanterns", 320, 180,
+     ["--force-diffuse", "--max-depth", "2"], SAMPLERS),
 ]
 
 
 def scene_path(name, python):
     if name == "atrium":
         return benchlib.ensure_atrium(benchlib.ATRIUM, python)
+    if name == "atrium-lanterns":
+        return benchlib.ensure_atrium(benchlib.ATRIUM_LANTERNS, python, light="lanterns")
     if name == "cornell-nvpro":
         return REPO.parent / "shared" / "scenes" / "cornell-nvpro" / "cornellBox.gltf"
     return REPO / "scenes" / f"{name}.gltf"
@@ -52,9 +66,33 @@ def render(exe, scene, w, h, spp, seed, opts, out_exr, stats, kernels=None):
     cmd = [str(exe), "render", str(scene), "--mode", "pathtrace", "--frames", "0", "--width", str(w),
            "--height", str(h), "--spp", str(spp), "--seed", str(seed), "--quiet", "--exr-float",
            "--out", str(out_exr).replace("0000", "%04d"), "--stats", str(stats)] + opts
-    subprocess.run(cmd, check=True, env=env)
+    run = subprocess.run(cmd, env=env, stderr=subprocess.PIPE, text=True)
+    if run.returncode:
+        sys.stderr.write(run.stderr)
+        lines = run.stderr.strip().splitlines()
+        raise RenderFailed(lines[-1] if lines else f"exit status {run.returncode}")
     rec = json.loads(Path(stats).read_text().splitlines()[-1])
     return benchlib.kernel_s(rec)
+
+
+class RenderFailed(Exception):
+    pass
+
+
+def scene_digest(scene):
+    """SHA-1 of a glTF and the files it refers to (buffers, images), so that a regenerated
+    scene gets new references."""
+    scene = Path(scene)
+    h = hashlib.sha1(scene.read_bytes())
+    if scene.suffix.lower() == ".gltf":
+        doc = json.loads(scene.read_text(encoding="utf-8"))
+        for item in doc.get("buffers", []) + doc.get("images", []):
+            uri = item.get("uri", "")
+            if uri and not uri.startswith("data:"):
+                f = scene.parent / uri
+                h.update(uri.encode())
+                h.update(f.read_bytes() if f.is_file() else b"missing")
+    return h.hexdigest()[:16]
 
 
 def relmse(compare, a, ref):
@@ -90,34 +128,68 @@ def main():
     if args.baseline_kernels:
         configs.insert(0, ("baseline", Path(args.baseline_kernels).resolve()))
     chosen = [int(c) - 1 for c in args.cases.split(",")] if args.cases else range(len(CASES))
+    # generated scenes first, so that the generator's lines do not land inside the table
+    scenes = {CASES[ci][1]: scene_path(CASES[ci][1], args.python) for ci in chosen}
     print("\n".join(benchlib.machine_lines(exe)))
     print(f"- spp {args.spp}, reference {args.spp * args.ref_factor} spp, {args.seeds} seeds, "
           f"relMSE eps 0.01, kernel seconds per frame\n")
     print("| case | kernels | relMSE | kernel s | relMSE x s |\n| --- | --- | ---: | ---: | ---: |")
     tmp = Path(tempfile.mkdtemp(prefix="bench-sampling-"))
+    notes = []
     for ci in chosen:
-        name, scene, w, h, opts = CASES[ci]
-        sp = scene_path(scene, args.python)
+        name, scene, w, h, opts = CASES[ci][:5]
+        variants = CASES[ci][5] if len(CASES[ci]) > 5 else [(None, [])]
+        sp = scenes[scene]
         if not Path(sp).is_file():
             print(f"| {name} | skipped: {sp} not found | | | |")
             continue
         ref_spp = args.spp * args.ref_factor
-        key = hashlib.sha1(json.dumps([str(sp), w, h, ref_spp, opts, kernels_key(REPO / "kernels")]).encode()).hexdigest()[:16]
+        key = hashlib.sha1(json.dumps([scene, str(sp), scene_digest(sp), w, h, ref_spp, opts,
+                                       kernels_key(REPO / "kernels")]).encode()).hexdigest()[:16]
         ref = cache / f"ref_{key}_0000.exr"
         if not ref.is_file():
             print(f"rendering the reference of {name} ({ref_spp} spp) ...", file=sys.stderr, flush=True)
-            render(exe, sp, w, h, ref_spp, 1000, opts, ref, tmp / "ref.jsonl")
-        results = {label: ([], []) for label, _ in configs}
+            try:
+                render(exe, sp, w, h, ref_spp, 1000, opts, tmp / "ref_0000.exr", tmp / "ref.jsonl")
+            except RenderFailed as e:
+                print(f"| {name} | reference failed: {e} | | | |", flush=True)
+                continue
+            shutil.move(str(tmp / "ref_0000.exr"), str(ref))   # only a finished one is cached
+        rows = [(label, vlabel, kd, vopts) for vlabel, vopts in variants for label, kd in configs]
+        results = {(label, vlabel): ([], [], []) for label, vlabel, _, _ in rows}
         for seed in range(1, args.seeds + 1):
-            for label, kd in configs:
+            for label, vlabel, kd, vopts in rows:
+                e, t, failed = results[(label, vlabel)]
+                if failed:
+                    continue
                 img = tmp / f"img_0000.exr"
-                ks = render(exe, sp, w, h, args.spp, seed, opts, img, tmp / "s.jsonl", kd)
-                results[label][0].append(relmse(compare, img, ref))
-                results[label][1].append(ks)
-        for label, _ in configs:
-            e, t = results[label]
+                try:
+                    ks = render(exe, sp, w, h, args.spp, seed, opts + vopts, img, tmp / "s.jsonl", kd)
+                except RenderFailed as err:
+                    failed.append(str(err))
+                    continue
+                e.append(relmse(compare, img, ref))
+                t.append(ks)
+        med = {}
+        for label, vlabel, _, _ in rows:
+            e, t, failed = results[(label, vlabel)]
+            row = label if vlabel is None else f"{label}, {' '.join(dict(variants)[vlabel])}"
+            if failed:
+                print(f"| {name} | {row} | failed: {failed[0]} | | |", flush=True)
+                continue
             me, mt = statistics.median(e), statistics.median(t)
-            print(f"| {name} | {label} | {me:.5f} | {mt:.3f} | {me * mt:.5f} |", flush=True)
+            med[(label, vlabel)] = me
+            print(f"| {name} | {row} | {me:.5f} | {mt:.3f} | {me * mt:.5f} |", flush=True)
+        if len(variants) > 1:
+            (a, _), (b, _) = variants[:2]
+            for label, _ in configs:
+                if (label, a) in med and (label, b) in med and med[(label, a)] > 0:
+                    r = f"{med[(label, b)] / med[(label, a)]:.3f}"
+                else:
+                    r = "n/a (a render failed)"
+                notes.append(f"- {name}, {label}: relMSE {b} / {a} = {r}")
+    if notes:
+        print("\n" + "\n".join(notes), flush=True)
 
 
 if __name__ == "__main__":

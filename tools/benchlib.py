@@ -1,5 +1,6 @@
-"""Helpers shared by the benchmark scripts (bench_reuse.py, evaluate.py): statistics of the
-renderer's per-frame stats, the machine description for a report, and the large atrium.
+"""Helpers shared by the benchmark scripts (bench_reuse.py, evaluate.py, bench_sampling.py):
+statistics of the renderer's per-frame stats, the machine description for a report, and the
+large atrium (its sky-lit default and its night, many-lights variant).
 Standard library only, so that any Python 3 can import it."""
 
 import os
@@ -12,6 +13,8 @@ from pathlib import Path
 
 REPO = Path(__file__).resolve().parent.parent
 ATRIUM = Path("/tmp/pathreuse-atrium/atrium.gltf")
+# the night variant lit by ~460 small emissive lanterns (gen_atrium.py --light lanterns)
+ATRIUM_LANTERNS = Path("/tmp/pathreuse-atrium-lanterns/atrium.gltf")
 
 
 def median(xs):
@@ -45,14 +48,17 @@ def fmt_rng(xs, f="{:.3f}"):
     return f"{f.format(median(xs))} [{f.format(min(xs))}-{f.format(max(xs))}]"
 
 
-def ensure_atrium(path, python=None):
-    """Generates the atrium (size 1, ~300k triangles) at `path` when it is absent."""
+def ensure_atrium(path, python=None, light="sky"):
+    """Generates the atrium (size 1, ~300k triangles) at `path` when it is absent; `light` is
+    gen_atrium.py's --light (sky, sun or lanterns). Give each variant its own path (ATRIUM,
+    ATRIUM_LANTERNS): a file already there is used as it is."""
     path = Path(path)
     if not path.is_file():
         print(f"generating {path} ...", flush=True)
         path.parent.mkdir(parents=True, exist_ok=True)
         subprocess.run([python or sys.executable, str(REPO / "tools" / "gen_atrium.py"), "--size", "1",
-                        "--out", str(path)], check=True)
+                        "--out", str(path)] + (["--light", light] if light != "sky" else []),
+                       check=True)
     return path
 
 

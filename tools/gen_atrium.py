@@ -1,18 +1,35 @@
 #!/usr/bin/env python3
 """Generates a large atrium test scene (not committed): a courtyard surrounded by two
 storeys of columns and arches, galleries, outer walls, curtains, an opening in the roof
-lit by an emissive sky quad (or a directional sun), and three moving objects.
+lit by an emissive sky quad (or a directional sun, or at night by several hundred small
+lanterns), and three moving objects.
 
   python3 tools/gen_atrium.py --size 1 --out /tmp/atrium/atrium.gltf   # ~300k triangles
   python3 tools/gen_atrium.py --size 0.1 --out /tmp/atrium-small.gltf  # quick test scene
+  python3 tools/gen_atrium.py --light lanterns --out /tmp/atrium-lanterns/atrium.gltf
 
---size scales the tessellation (triangles grow about linearly with it); the layout and the
-cameras do not change. Writes PATH.gltf and PATH.bin, validates them, prints one line.
+--size scales the tessellation (triangles grow about linearly with it); the layout, the
+cameras and the lanterns do not change. --light picks the lighting:
+
+  sky       an emissive quad over the opening in the roof (the default)
+  sun       a KHR_lights_punctual directional light through the opening
+  lanterns  night, a many-lights scene: 460 small emissive lantern bodies (boxes and
+            low-poly spheres, 4 to 35 cm; 6936 emissive triangles) in every bay of both
+            storeys (under each arch, hanging from the gallery ceilings, sconces on the
+            outer walls and on the arcades' courtyard faces, candles on the gallery
+            floors), on the courtyard floor and on six strings of bulbs across the
+            courtyard; warm white, amber, red, green, blue, cool white and pink, emission
+            strengths spread over two orders of magnitude (a fixed pseudo-random sequence,
+            so the file is the same every time); 6 point lights and a spot light, and the
+            swinging lantern's glass glows (an emitter on a moving instance). No sky.
+
+Writes PATH.gltf and PATH.bin, validates them, prints one line.
 """
 
 import argparse
 import math
 import os
+import random
 import sys
 import time
 
@@ -217,6 +234,7 @@ def ball_pose(t):
     return (x, BALL_R, BALL_Z), gw.quat_axis_angle((0, 0, 1), -x / BALL_R)
 
 
+COURTYARD_EYE = (7.0, 1.7, 2.8)                 # the courtyard camera
 LANTERN_PIVOT, LANTERN_ROD = (0.0, STOREYS[0][2], COL_Z + 1.6), 1.8
 
 
@@ -261,9 +279,230 @@ def lantern_meshes(c):
     return metal, glass
 
 
+# ---------------------------------------------------------------- night: many lanterns
+
+# emission colours (factor in [0, 1]) and how often each is drawn
+LANTERN_COLOURS = (("warm", (1.0, 0.78, 0.5), 5), ("amber", (1.0, 0.55, 0.15), 4),
+                   ("red", (1.0, 0.14, 0.08), 2), ("green", (0.25, 1.0, 0.3), 2),
+                   ("blue", (0.2, 0.4, 1.0), 2), ("cool", (0.8, 0.9, 1.0), 1),
+                   ("pink", (1.0, 0.35, 0.75), 1))
+# emission strength levels: STRENGTH_LO x 10^(k / 4), k = 0..8, i.e. a factor of 100
+STRENGTH_LO, STRENGTH_LEVELS = 0.5, 9
+LANTERN_GLASS_STRENGTH = 4.0    # the swinging lantern's glass in the lanterns variant
+
+
+def scaled(mesh, sx, sy, sz):
+    """A copy of mesh scaled along the axes (normals by the inverse transpose)."""
+    m = gw.Mesh()
+    m.idx = list(mesh.idx)
+    for i in range(0, len(mesh.pos), 3):
+        m.pos += (mesh.pos[i] * sx, mesh.pos[i + 1] * sy, mesh.pos[i + 2] * sz)
+        m.nrm += gw.normalize((mesh.nrm[i] / sx, mesh.nrm[i + 1] / sy, mesh.nrm[i + 2] / sz))
+    return m
+
+
+def rod(a, b, r):
+    """Thin square rod (a 4-sided open prism) from point a to point b."""
+    d = gw.sub(b, a)
+    n = math.sqrt(gw.dot(d, d))
+    prism = gw.lathe([(0.0, r, 0), (n, r, 0)], 4)
+    axis = gw.cross((0.0, 1.0, 0.0), d)
+    s = math.sqrt(gw.dot(axis, axis))
+    if s < 1e-9:
+        rot = None if d[1] > 0 else gw.quat_axis_angle((1, 0, 0), math.pi)
+    else:
+        rot = gw.quat_axis_angle(axis, math.atan2(s, d[1]))
+    return gw.Mesh().add(prism, rotation=rot, translation=a)
+
+
+class Lanterns:
+    """Collects the emitters (one Mesh per colour and strength level) and the iron that
+    holds them; every emitter draws its colour and level from one fixed sequence."""
+
+    def __init__(self):
+        self.rng = random.Random(1)
+        self.emitters = {}          # (colour index, level) -> Mesh
+        self.iron = gw.Mesh()
+        self.count = 0
+        self._bag = [i for i, (_, _, w) in enumerate(LANTERN_COLOURS) for _ in range(w)]
+
+    def add(self, mesh, centre, lo=0, hi=STRENGTH_LEVELS - 1, rotation=None):
+        key = (self.rng.choice(self._bag), self.rng.randint(lo, hi))
+        self.emitters.setdefault(key, gw.Mesh()).add(mesh, rotation=rotation,
+                                                     translation=centre)
+        self.count += 1
+
+    def hanging(self, x, top, z, drop, body):
+        """A body hanging `drop` below (x, top, z) on a rod, with a small iron cap."""
+        half = body_half_height(body)
+        cy = top - drop - half
+        self.iron.add(rod((x, cy + half, z), (x, top, z), 0.008))
+        self.iron.add(gw.box((x - 0.04, cy + half, z - 0.04),
+                             (x + 0.04, cy + half + 0.02, z + 0.04)))
+        return (x, cy, z)
+
+
+def span_box(a, b, pad):
+    """Axis-aligned box spanning points a and b, widened by pad in x and z."""
+    return gw.box((min(a[0], b[0]) - pad, min(a[1], b[1]), min(a[2], b[2]) - pad),
+                  (max(a[0], b[0]) + pad, max(a[1], b[1]), max(a[2], b[2]) + pad))
+
+
+def body_half_height(m):
+    ys = m.pos[1::3]
+    return (max(ys) - min(ys)) / 2
+
+
+def sphere_body(r, stretch=1.0):
+    return scaled(gw.uv_sphere(1.0, 6, 3), r, r * stretch, r)
+
+
+def box_body(w, h):
+    return gw.box((-w / 2, -h / 2, -w / 2), (w / 2, h / 2, w / 2))
+
+
+def near_pendulum(x, z, level):
+    """Whether (x, z) on that storey is in the swinging lantern's way."""
+    return level == 0 and abs(x) < 0.7 and abs(z - LANTERN_PIVOT[2]) < 1.2
+
+
+def build_lanterns():
+    """Returns the Lanterns of the night variant: every bay of both storeys, the columns'
+    courtyard faces, the courtyard floor and strings of bulbs across the courtyard."""
+    L = Lanterns()
+    rng = L.rng
+    gallery = OUT_Z - COL_Z                    # depth of the galleries (3 m on every side)
+
+    def world(bx, bz, yaw, lx, ly, lz):
+        c, s = math.cos(yaw), math.sin(yaw)
+        return (bx + lx * c + lz * s, ly, bz - lx * s + lz * c)
+
+    for level, (floor_y, col_top, arcade_top) in enumerate(STOREYS):
+        crown = col_top + ABACUS_H + ARCH_R
+        for bx, bz, yaw in bays():
+            # under the crown of the arch
+            body = sphere_body(rng.uniform(0.07, 0.11), rng.choice((1.0, 1.4)))
+            x, _, z = world(bx, bz, yaw, 0.0, 0.0, 0.0)
+            L.add(body, L.hanging(x, crown, z, rng.uniform(0.15, 0.35), body), lo=3)
+            # two hanging from the gallery ceiling
+            for lx in (-0.5, 0.5):
+                x, _, z = world(bx, bz, yaw, lx, 0.0, -gallery / 2)
+                if near_pendulum(x, z, level):
+                    continue
+                if rng.random() < 0.5:
+                    body = sphere_body(rng.uniform(0.06, 0.12), rng.choice((1.0, 1.5)))
+                else:
+                    body = box_body(rng.uniform(0.1, 0.2), rng.uniform(0.15, 0.3))
+                L.add(body, L.hanging(x, arcade_top, z, rng.uniform(0.3, 1.0), body), lo=2)
+            # sconce on the outer wall facing the bay
+            w, h = rng.uniform(0.08, 0.14), rng.uniform(0.12, 0.2)
+            x, y, z = world(bx, bz, yaw, 0.0, floor_y + 2.3, -gallery + 0.04 + w / 2)
+            L.add(box_body(w, h), (x, y, z), lo=2, hi=6)
+            ax, _, az = world(bx, bz, yaw, 0.0, 0.0, -gallery)
+            L.iron.add(span_box((ax, y - h / 2 - 0.03, az), (x, y - h / 2, z), 0.02))
+            # candles on the gallery floor against the outer wall
+            for lx in (-0.6, 0.6):
+                w, h = rng.uniform(0.04, 0.08), rng.uniform(0.06, 0.2)
+                x, _, z = world(bx, bz, yaw, lx + rng.uniform(-0.2, 0.2), 0.0, -gallery + 0.25)
+                L.add(box_body(w, h), (x, floor_y + h / 2, z), hi=5)
+        # sconces on the arcade's courtyard face above every column
+        for cx, cz in column_positions():
+            if abs(cz) == COL_Z:
+                nx, nz = 0.0, -math.copysign(1.0, cz)
+            else:
+                nx, nz = -math.copysign(1.0, cx), 0.0
+            if abs(cx) == COL_X and abs(cz) == COL_Z:   # corner pier: on its diagonal
+                nx, nz = -math.copysign(1.0, cx), -math.copysign(1.0, cz)
+            y = col_top + ABACUS_H + 0.45
+            face, d = ARCADE_D / 2, ARCADE_D / 2 + 0.08
+            body = sphere_body(rng.uniform(0.05, 0.08), 1.3)
+            L.add(body, (cx + nx * d, y, cz + nz * d), lo=1, hi=7)
+            L.iron.add(span_box((cx + nx * face, y - 0.1, cz + nz * face),
+                                (cx + nx * d, y - 0.08, cz + nz * d), 0.015))
+
+    # strings of bulbs across the courtyard below the upper arcades, sagging 1.2 m
+    top_y, sag, bulbs = STOREYS[1][2] - 0.3, 1.2, 13
+    bulb = scaled(gw.uv_sphere(1.0, 4, 2), 0.035, 0.035, 0.035)   # an octahedron
+    for k in range(6):
+        x = -IN_X + 2 * IN_X * (k + 0.5) / 6
+        pts = []
+        for i in range(bulbs + 2):
+            t = i / (bulbs + 1)
+            pts.append((x, top_y - sag * 4 * t * (1 - t), -IN_Z + 2 * IN_Z * t))
+        for a, b in zip(pts, pts[1:]):
+            L.iron.add(rod(a, b, 0.004))
+        for p in pts[1:-1]:
+            L.add(bulb, (p[0], p[1] - 0.039, p[2]), lo=0, hi=6)
+
+    # the courtyard floor: lanterns round its edge and a cluster of candles, clear of the
+    # rolling ball's track and of the courtyard camera
+    edge = []
+    for i in range(15):
+        x = -IN_X + 0.4 + (2 * IN_X - 0.8) * i / 14
+        edge += [(x, -IN_Z + 0.4), (x, IN_Z - 0.4)]
+    for j in range(6):
+        z = -IN_Z + 0.9 + (2 * IN_Z - 1.8) * j / 5
+        edge += [(-IN_X + 0.4, z), (IN_X - 0.4, z)]
+    cam = COURTYARD_EYE
+    for x, z in edge:
+        if math.hypot(x - cam[0], z - cam[2]) < 0.9:
+            continue
+        w, h = rng.uniform(0.12, 0.2), rng.uniform(0.2, 0.32)
+        L.add(box_body(w, h), (x, h / 2, z), lo=1, hi=7)
+    for i in range(9):
+        a = 2 * math.pi * i / 9
+        r = 0.5 + 0.15 * (i % 2)
+        w, h = rng.uniform(0.04, 0.07), rng.uniform(0.06, 0.25)
+        L.add(box_body(w, h), (r * math.cos(a), h / 2, -1.9 + r * math.sin(a)), hi=4)
+    return L
+
+
+def add_lanterns(g, roots):
+    """The night lighting: the lanterns (one static node), point lights and a spot."""
+    L = build_lanterns()
+    prims = [(L.iron, g.material("lantern_iron", (0.06, 0.06, 0.06), metallic=1.0,
+                                 roughness=0.5))]
+    for (ci, lv) in sorted(L.emitters):
+        name, col, _ = LANTERN_COLOURS[ci]
+        strength = STRENGTH_LO * 10 ** (lv / 4)
+        mat = g.material("lantern_%s_%d" % (name, lv), tuple(0.5 * c for c in col),
+                         roughness=0.6, emissive=col, strength=gw.f32(strength))
+        prims.append((L.emitters[(ci, lv)], mat))
+    roots.append(g.node("lanterns", mesh=g.mesh("lanterns", prims)))
+
+    # warm point lights in the corners of the galleries, a spot from the upper gallery
+    # onto the courtyard
+    for i, (pos, col, cd) in enumerate((
+            ((-9.5, 4.6, -5.5), (1.0, 0.75, 0.45), 3.0), ((9.5, 4.6, -5.5), (1.0, 0.75, 0.45), 3.0),
+            ((-9.5, 4.6, 5.5), (1.0, 0.6, 0.3), 3.0), ((9.5, 4.6, 5.5), (1.0, 0.6, 0.3), 3.0),
+            ((-9.5, 9.6, 0.0), (0.7, 0.8, 1.0), 4.0), ((9.5, 9.6, 0.0), (0.7, 0.8, 1.0), 4.0))):
+        light = punctual_light(g, "lamp_%d" % i, "point", col, cd)
+        roots.append(g.node("lamp_%d" % i, translation=pos,
+                            extensions={"KHR_lights_punctual": {"light": light}}))
+    spot_pos, spot_at = (0.0, STOREYS[1][2] - 0.2, -IN_Z + 0.15), (0.0, 0.0, 0.8)
+    spot = punctual_light(g, "spot", "spot", (1.0, 0.95, 0.85), 40.0, cone=(0.25, 0.35))
+    roots.append(g.node("spot", translation=spot_pos,
+                        rotation=gw.quat_look(gw.sub(spot_at, spot_pos)),
+                        extensions={"KHR_lights_punctual": {"light": spot}}))
+    return L.count
+
+
+def punctual_light(g, name, kind, color, intensity, cone=None):
+    """A KHR_lights_punctual point or spot light (intensity in candela); returns its index.
+    cone: (inner, outer) angles in radians of a spot."""
+    g.extensions.add("KHR_lights_punctual")
+    ext = g.doc.setdefault("extensions", {}).setdefault("KHR_lights_punctual", {"lights": []})
+    light = {"name": name, "type": kind, "color": list(color), "intensity": intensity}
+    if kind == "spot":
+        light["spot"] = {"innerConeAngle": cone[0], "outerConeAngle": cone[1]}
+    ext["lights"].append(light)
+    return len(ext["lights"]) - 1
+
+
 def build(size, light):
     c = counts(size)
-    g = gw.Gltf("pathreuse tools/gen_atrium.py --size %g" % size)
+    g = gw.Gltf("pathreuse tools/gen_atrium.py --size %g" % size
+                + (" --light lanterns" if light == "lanterns" else ""))
     mats = {
         "stone": g.material("stone", (0.62, 0.58, 0.5), roughness=0.9),
         "dark_stone": g.material("dark_stone", (0.32, 0.3, 0.27), roughness=0.8),
@@ -272,6 +511,7 @@ def build(size, light):
         "cloth_green": g.material("cloth_green", (0.1, 0.35, 0.12), double_sided=True),
         "cloth_blue": g.material("cloth_blue", (0.1, 0.15, 0.45), double_sided=True),
     }
+    emitters = 0
     static = build_static(c)
     roots = [g.node("atrium", mesh=g.mesh("atrium", [(static[k], mats[k]) for k in mats]))]
 
@@ -282,6 +522,8 @@ def build(size, light):
         if quad.nrm[1::3] != [-1.0] * quad.vertex_count:
             raise gw.Invalid("sky quad does not face down")
         roots.append(g.node("sky", mesh=g.mesh("sky", [(quad, sky)])))
+    elif light == "lanterns":
+        emitters = add_lanterns(g, roots)
     else:
         sun = g.directional_light("sun", (1.0, 0.95, 0.85), 5.0)
         roots.append(g.node("sun", rotation=gw.quat_look((0.35, -1.0, 0.25)),
@@ -295,7 +537,11 @@ def build(size, light):
                   translation=ball_pose(0)[0], rotation=ball_pose(0)[1],
                   extras={"dynamic": True})
     metal = g.material("lantern_metal", (0.2, 0.2, 0.2), metallic=1.0, roughness=0.4)
-    glass = g.material("lantern_glass", (0.9, 0.8, 0.5), roughness=0.5)
+    if light == "lanterns":                    # the swinging lantern is lit too
+        glass = g.material("lantern_glass", (0.9, 0.8, 0.5), roughness=0.5,
+                           emissive=(1.0, 0.75, 0.4), strength=LANTERN_GLASS_STRENGTH)
+    else:
+        glass = g.material("lantern_glass", (0.9, 0.8, 0.5), roughness=0.5)
     lm, lg = lantern_meshes(c)
     lantern = g.node("lantern", mesh=g.mesh("lantern", [(lm, metal), (lg, glass)]),
                      extras={"dynamic": True})
@@ -315,12 +561,12 @@ def build(size, light):
     # cameras: in the corner arch of the upper gallery looking across the courtyard, and
     # one standing in the courtyard
     cams = [("gallery_corner", (-COL_X + BAY / 2, STOREYS[1][0] + 1.7, COL_Z), (4.0, 2.0, -3.0)),
-            ("courtyard", (7.0, 1.7, 2.8), (-8.0, 4.0, -2.0))]
+            ("courtyard", COURTYARD_EYE, (-8.0, 4.0, -2.0))]
     for name, eye, at in cams:
         cam = g.camera(name, 0.9, 16.0 / 9.0, 0.05, 200.0)
         roots.append(g.node(name, camera=cam, translation=eye,
                             rotation=gw.quat_look(gw.sub(at, eye))))
-    return g, roots
+    return g, roots, emitters
 
 
 def main():
@@ -328,14 +574,15 @@ def main():
     ap.add_argument("--size", type=float, default=1.0,
                     help="tessellation scale; 1 gives about 300k triangles (default 1)")
     ap.add_argument("--out", required=True, help="output .gltf (a .bin is written beside it)")
-    ap.add_argument("--light", choices=("sky", "sun"), default="sky",
-                    help="emissive sky quad over the opening, or a KHR_lights_punctual sun")
+    ap.add_argument("--light", choices=("sky", "sun", "lanterns"), default="sky",
+                    help="emissive sky quad over the opening (default), a KHR_lights_punctual "
+                    "sun, or night lit by several hundred small emissive lanterns")
     args = ap.parse_args()
     if not args.size > 0:
         ap.error("--size must be positive")
     start = time.time()
     try:
-        g, roots = build(args.size, args.light)
+        g, roots, emitters = build(args.size, args.light)
         os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
         g.write(args.out, roots, embedded=False)
         s = gw.validate(args.out)
@@ -347,8 +594,9 @@ def main():
     except (gw.Invalid, OSError, KeyError, ValueError) as e:
         print("gen_atrium: %s" % e, file=sys.stderr)
         return 1
-    print("%s: %d triangles (%d static, %d dynamic = %.2f%%), %d bytes, %.1f s"
-          % (args.out, s["triangles"], s["static"], s["dynamic"], 100 * frac, s["bytes"],
+    lit = ", %d lanterns" % emitters if emitters else ""
+    print("%s: %d triangles (%d static, %d dynamic = %.2f%%)%s, %d bytes, %.1f s"
+          % (args.out, s["triangles"], s["static"], s["dynamic"], 100 * frac, lit, s["bytes"],
              time.time() - start))
     return 0
 

@@ -19,10 +19,6 @@ void toRows(const glm::mat4& m, float out[12]) {
     for (int c = 0; c < 4; ++c) out[r * 4 + c] = m[c][r];
 }
 
-float luminanceOf(const glm::vec3& c) {
-  return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z;
-}
-
 dev::Light triangleLight(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c,
                          const glm::vec3& le, uint32_t prim, uint32_t inst, uint32_t material) {
   dev::Light l{};
@@ -35,7 +31,7 @@ dev::Light triangleLight(const glm::vec3& a, const glm::vec3& b, const glm::vec3
   l.prim = prim;
   l.le_r = le.x, l.le_g = le.y, l.le_b = le.z;
   l.area = 0.5f * glm::length(glm::cross(e1, e2));
-  l.power = luminanceOf(le) * 3.14159265f * l.area;
+  l.power = dev::light_power(&l, 0.0f);
   l.material = material;
   return l;
 }
@@ -130,7 +126,9 @@ GpuScene::GpuScene(Context& ctx, const Scene& scene, const GpuSceneOptions& opti
   for (const Material& m : scene.materials)
     if (m.alphaMode != AlphaMode::Opaque) hasAlpha_ = true;
 
-  // Static emitters, once.
+  // Static emitters, once; the light of each emissive triangle, for the pdf of a BSDF ray
+  // that hits it.
+  primLight_.assign(next, PR_INVALID_INDEX);
   for (size_t i = 0; i < sm.triangleCount(); ++i) {
     const uint32_t mat = sm.materials[i];
     const glm::vec3 le = scene.materials[mat].emission();
@@ -138,9 +136,20 @@ GpuScene::GpuScene(Context& ctx, const Scene& scene, const GpuSceneOptions& opti
     const glm::vec3 a = sm.positions[sm.indices[3 * i]], b = sm.positions[sm.indices[3 * i + 1]],
                     c = sm.positions[sm.indices[3 * i + 2]];
     dev::Light l = triangleLight(a, b, c, le, static_cast<uint32_t>(i), PR_INVALID_INDEX, mat);
-    if (l.area > 0.0f && std::isfinite(l.power) && l.power > 0.0f) staticEmitters_.push_back(l);
+    if (l.area > 0.0f && std::isfinite(l.power) && l.power > 0.0f) {
+      primLight_[i] = static_cast<uint32_t>(staticEmitters_.size());
+      staticEmitters_.push_back(l);
+    }
+  }
+  for (size_t mi = 0; mi < scene.dynamicMeshes.size(); ++mi) {
+    const TriangleMesh& m = scene.dynamicMeshes[mi];
+    uint32_t rank = 0;
+    for (uint32_t k = 0; k < m.triangleCount(); ++k)
+      if (scene.materials[m.materials[k]].isEmissive()) primLight_[meshFirstTriangle_[mi] + k] = rank++;
   }
   for (uint32_t i = 0; i < scene.instances.size(); ++i) {
+    instanceFirstLight_.push_back(
+        static_cast<uint32_t>(staticEmitters_.size() + dynamicEmitters_.size()));
     const TriangleMesh& m = scene.dynamicMeshes[scene.instances[i].mesh];
     for (uint32_t k = 0; k < m.triangleCount(); ++k)
       if (scene.materials[m.materials[k]].isEmissive()) {
@@ -148,6 +157,8 @@ GpuScene::GpuScene(Context& ctx, const Scene& scene, const GpuSceneOptions& opti
         lightsAnimated_ = true;
       }
   }
+  primLightBuffer_ = upload("light of each emissive triangle", primLight_.data(),
+                            primLight_.size() * sizeof(uint32_t), &shadingBytes_);
   for (const auto& l : scene.lights)
     if (l.dynamic) lightsAnimated_ = true;
   const Bounds b = scene.bounds;
@@ -251,6 +262,7 @@ void GpuScene::setTime(double t) {
     toRows(glm::inverse(m), s.world_to_object);
     s.first_triangle = meshFirstTriangle_[scene_.instances[i].mesh];
     s.mesh = scene_.instances[i].mesh;
+    s.first_light = instanceFirstLight_[i];
     const bool moved = firstFrame_ || std::memcmp(&m, &lastTransforms_[i], sizeof m) != 0;
     s.moved = moved ? 1u : 0u;
     anyMoved_ = anyMoved_ || moved;
@@ -302,7 +314,13 @@ std::vector<dev::Light> GpuScene::lightsAt(double t) const {
     if (!(l.area > 0.0f) || !std::isfinite(l.power)) l.power = 0.0f, l.area = 0.0f;
     lights.push_back(l);
   }
-  for (size_t i = 0; i < scene_.lights.size(); ++i) {
+  // Directional lights last: the light BVH holds the lights before them.
+  std::vector<size_t> punctual;
+  for (int directional = 0; directional < 2; ++directional)
+    for (size_t i = 0; i < scene_.lights.size(); ++i)
+      if ((scene_.lights[i].type == LightType::Directional) == (directional == 1))
+        punctual.push_back(i);
+  for (size_t i : punctual) {
     const PunctualLight p = scene_.lightAt(i, t);
     dev::Light l{};
     const glm::vec3 c = p.color * p.intensity;
@@ -312,23 +330,20 @@ std::vector<dev::Light> GpuScene::lightsAt(double t) const {
     l.e1x = d.x, l.e1y = d.y, l.e1z = d.z;
     l.inst = PR_INVALID_INDEX;
     l.prim = PR_INVALID_INDEX;
-    const float lum = luminanceOf(c);
     switch (p.type) {
       case LightType::Point:
         l.type = PR_LIGHT_POINT;
-        l.power = 4.0f * 3.14159265f * lum;
         break;
       case LightType::Spot:
         l.type = PR_LIGHT_SPOT;
         l.cos_inner = std::cos(p.innerConeAngle);
         l.cos_outer = std::cos(p.outerConeAngle);
-        l.power = 2.0f * 3.14159265f * (1.0f - 0.5f * (l.cos_inner + l.cos_outer)) * lum;
         break;
       case LightType::Directional:
         l.type = PR_LIGHT_DIRECTIONAL;
-        l.power = 3.14159265f * sceneRadius_ * sceneRadius_ * lum;
         break;
     }
+    l.power = dev::light_power(&l, sceneRadius_);
     if (!std::isfinite(l.power) || !(l.power > 0.0f)) l.power = 0.0f;
     lights.push_back(l);
   }
@@ -341,6 +356,24 @@ void GpuScene::buildLights(double t) {
     next[i].moved = (lights_.size() != next.size() || !sameGeometry(lights_[i], next[i])) ? 1u : 0u;
   lights_ = std::move(next);
   totalPower_ = runningSums(lights_, &cdf_);
+  if (!lightBvhBuilt_) {
+    treeLights_ = 0;
+    while (treeLights_ < lights_.size() && lights_[treeLights_].type != PR_LIGHT_DIRECTIONAL)
+      ++treeLights_;
+    lightBvh_.build(&lights_, treeLights_);
+    lightBvhBuilt_ = true;
+  } else {
+    lightBvh_.refit(&lights_);
+  }
+  const std::vector<dev::LightNode>& nodes = lightBvh_.nodes();
+  if (nodes.size() > lightNodeCapacity_) {
+    if (lightNodeCapacity_) ctx_.release(lightNodeCapacity_ * sizeof(dev::LightNode));
+    lightNodeCapacity_ = nodes.size();
+    lightNodeBuffer_ = ctx_.allocate("light BVH", nodes.size() * sizeof(dev::LightNode),
+                                     CL_MEM_READ_ONLY);
+  }
+  CL_CHECK(ctx_.queue().enqueueWriteBuffer(lightNodeBuffer_, CL_TRUE, 0,
+                                           nodes.size() * sizeof(dev::LightNode), nodes.data()));
 
   const size_t count = std::max<size_t>(lights_.size(), 1);
   if (count > lightCapacity_) {
@@ -375,14 +408,24 @@ cl_uint GpuScene::setKernelArgs(cl::Kernel& kernel, cl_uint first) {
   CL_CHECK(kernel.setArg(a++, texels_));
   CL_CHECK(kernel.setArg(a++, lightBuffer_));
   CL_CHECK(kernel.setArg(a++, cdfBuffer_));
+  CL_CHECK(kernel.setArg(a++, lightNodeBuffer_));
+  CL_CHECK(kernel.setArg(a++, primLightBuffer_));
   CL_CHECK(kernel.setArg(a++, static_cast<cl_uint>(lights_.size())));
+  CL_CHECK(kernel.setArg(a++, static_cast<cl_uint>(treeLights_)));
   CL_CHECK(kernel.setArg(a++, totalPower_));
   return a;
 }
 
+std::string GpuScene::buildOptions() const {
+  std::string o = hasAlpha_ ? "-DPR_HAS_ALPHA=1 " : "";
+  if (options_.lightSampler == LightSampler::Power) o += "-DPR_LIGHT_SAMPLER_POWER=1 ";
+  if (!o.empty()) o.pop_back();
+  return o;
+}
+
 uint64_t GpuScene::deviceBytes() const {
   return deviceAccel_.staticBytes() + deviceAccel_.meshBytes() + deviceAccel_.frameBytes() +
-         shadingBytes_ + instanceBytes_ + lightBytes_;
+         shadingBytes_ + instanceBytes_ + lightBytes_ + lightNodeCapacity_ * sizeof(dev::LightNode);
 }
 
 }  // namespace pr

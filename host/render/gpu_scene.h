@@ -3,11 +3,13 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "accel/device_accel.h"
 #include "accel/scene_accel.h"
 #include "cl/context.h"
+#include "render/light_bvh.h"
 #include "scene/scene.h"
 #include "shared/camera.h"
 #include "shared/geometry.h"
@@ -16,10 +18,15 @@
 
 namespace pr {
 
+// How a receiving point chooses the light it samples: the light BVH, or by power alone (the
+// comparison the light BVH is measured against).
+enum class LightSampler { Bvh, Power };
+
 struct GpuSceneOptions {
   // Every non-delta material becomes pure Lambert with its base colour (pbrt's --force-diffuse):
   // a diagnostic with exactly known albedo, used by the furnace tests.
   bool forceDiffuse = false;
+  LightSampler lightSampler = LightSampler::Bvh;
 };
 
 // Host-side conversions, exposed for tests.
@@ -39,9 +46,11 @@ class GpuScene {
   dev::CameraParams camera(int cameraIndex, double t, int width, int height) const;
 
   // Kernel arguments from `first` on, in this order: PR_SCENE_GEOM_PARAMS (7),
-  // PR_SHADING_PARAMS (6), PR_LIGHT_PARAMS (4). Returns the next free index.
+  // PR_SHADING_PARAMS (6), PR_LIGHT_PARAMS (7). Returns the next free index.
   cl_uint setKernelArgs(cl::Kernel& kernel, cl_uint first);
-  static constexpr cl_uint kArgCount = 17;
+  static constexpr cl_uint kArgCount = 20;
+  // Build options every kernel that takes the scene is compiled with.
+  std::string buildOptions() const;
   // The light-tracing selection table: running sums of every light's power at time 0, fixed for
   // the whole animation so that a light path depends only on its key and the scene at its frame.
   const cl::Buffer& traceCdf() const { return traceCdfBuffer_; }
@@ -54,6 +63,7 @@ class GpuScene {
   uint32_t lightCount() const { return static_cast<uint32_t>(lights_.size()); }
   float totalLightPower() const { return totalPower_; }
   const std::vector<dev::Light>& lights() const { return lights_; }
+  const LightBvh& lightBvh() const { return lightBvh_; }
   const std::vector<dev::ShadingInstance>& instances() const { return instances_; }
   bool anyInstanceMoved() const { return anyMoved_; }
   bool lightsChanged() const { return lightsChanged_; }
@@ -92,6 +102,11 @@ class GpuScene {
   };
   std::vector<dev::Light> staticEmitters_;
   std::vector<DynamicEmitter> dynamicEmitters_;
+  std::vector<uint32_t> instanceFirstLight_;  // light of each instance's first emitter
+  std::vector<uint32_t> primLight_;           // per shading triangle, see LightData.prim_light
+  LightBvh lightBvh_;
+  bool lightBvhBuilt_ = false;
+  uint32_t treeLights_ = 0;  // lights in the tree: all but the directional ones, which are last
   std::vector<dev::Light> lights_;
   std::vector<float> cdf_;
   float totalPower_ = 0.0f;
@@ -104,7 +119,8 @@ class GpuScene {
   bool lightsAnimated_ = false;
 
   cl::Buffer vertices_, triangles_, shadingInstances_, materials_, textures_, texels_;
-  cl::Buffer lightBuffer_, cdfBuffer_;
+  cl::Buffer lightBuffer_, cdfBuffer_, lightNodeBuffer_, primLightBuffer_;
+  size_t lightNodeCapacity_ = 0;
   uint64_t shadingBytes_ = 0, instanceBytes_ = 0, lightBytes_ = 0;
   size_t lightCapacity_ = 0, instanceCapacity_ = 0;
 };

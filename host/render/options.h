@@ -34,6 +34,7 @@ struct RenderOptions {
   float exposure = 0.0f;
   bool quiet = false;
   bool forceDiffuse = false;
+  bool lightSamplerPower = false;  // choose lights by power alone, not with the light BVH
   std::string statsFile;
   bool resume = false;  // skip frames whose complete EXR exists; append to the stats file
   // Camera samples keyed by frame 0 on every frame (the scene still moves with the frame):

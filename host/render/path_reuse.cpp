@@ -16,7 +16,7 @@ PathReuse::PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseS
     throw InputError("--paths-per-pixel: must be 1 to 64");
   slots_ = settings_.lightPaths ? settings_.lightPaths : film.pixels();
   stride_ = static_cast<uint32_t>(settings_.maxDepth - 1);
-  const std::string opts = sceneBuildOptions(scene);
+  const std::string opts = scene.buildOptions();
   invalidate_ = ctx.kernel("reuse/invalidate.cl", "invalidate", opts);
   lightTrace_ = ctx.kernel("reuse/light_trace.cl", "light_trace", opts);
   eyeHit_ = ctx.kernel("reuse/eye_hit.cl", "eye_hit", opts);

@@ -7,14 +7,10 @@
 
 namespace pr {
 
-std::string sceneBuildOptions(const GpuScene& scene) {
-  return scene.hasAlphaMaterials() ? "-DPR_HAS_ALPHA=1" : "";
-}
-
 PathTracer::PathTracer(Context& ctx, GpuScene& scene, Film& film,
                        const PathTracerSettings& settings)
     : ctx_(ctx), scene_(scene), film_(film), settings_(settings) {
-  const std::string opts = sceneBuildOptions(scene);
+  const std::string opts = scene.buildOptions();
   generate_ = ctx.kernel("pathtrace/generate.cl", "pt_generate", opts);
   extend_ = ctx.kernel("pathtrace/extend.cl", "pt_extend", opts);
   shade_ = ctx.kernel("pathtrace/shade.cl", "pt_shade", opts);

@@ -33,7 +33,4 @@ class PathTracer : public Integrator {
   uint64_t bytes_ = 0;
 };
 
-// The -D options every program that includes shared/integrator.h is built with.
-std::string sceneBuildOptions(const GpuScene& scene);
-
 }  // namespace pr

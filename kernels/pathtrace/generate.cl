@@ -26,6 +26,8 @@ __kernel void pt_generate(CameraParams cam, uint seed, uint frame, uint sample,
   s.prev_x = cam.px;
   s.prev_y = cam.py;
   s.prev_z = cam.pz;
+  s.prev_nx = s.prev_ny = s.prev_nz = 0.0f;
+  s.pad = 0u;
   states[i] = s;
   radiance[i] = (float4)(0.0f, 0.0f, 0.0f, 0.0f);
 }

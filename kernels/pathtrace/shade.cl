@@ -31,7 +31,9 @@ __kernel void pt_shade(PR_SCENE_PARAMS, __global PathState* states, __global con
   if (mat->flags & PR_MAT_EMISSIVE) {
     const float3 le = surface_emission(&s, &h);
     float w = 1.0f;
-    if (!(p.flags & PR_PATH_SPECULAR)) w = power_heuristic(p.last_pdf, emitter_pdf(&s, &h, make_float3(p.prev_x, p.prev_y, p.prev_z)));
+    if (!(p.flags & PR_PATH_SPECULAR))
+      w = power_heuristic(p.last_pdf, emitter_pdf(&s, &h, make_float3(p.prev_x, p.prev_y, p.prev_z),
+                                                  make_float3(p.prev_nx, p.prev_ny, p.prev_nz)));
     const float3 add = tp * le * w;
     radiance[i] += (float4)(add.x, add.y, add.z, 0.0f);
   }
@@ -84,6 +86,9 @@ __kernel void pt_shade(PR_SCENE_PARAMS, __global PathState* states, __global con
         p.prev_x = h.p.x;
         p.prev_y = h.p.y;
         p.prev_z = h.p.z;
+        p.prev_nx = f.n.x;
+        p.prev_ny = f.n.y;
+        p.prev_nz = f.n.z;
         p.last_pdf = pdf;
         p.flags = delta ? PR_PATH_SPECULAR : 0u;
       }

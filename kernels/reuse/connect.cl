@@ -29,11 +29,8 @@ PR_INLINE float mis_weight_l(float r, float threshold) {
 // not connect to vertex 0 (spot and directional lights).
 PR_INLINE float light_emit_pdf(const SceneData* s, u32 light, PR_GLOBAL const LightVertex* v0,
                                float3 dir) {
-  const u32 type = s->lights.lights[light].type;
-  // Triangles: a face with probability 1/2, then cosine-weighted about it.
-  if (type == PR_LIGHT_TRIANGLE) return fabs(dot(oct_decode(v0->ng_oct), dir)) * (0.5f * PR_INV_PI);
-  if (type == PR_LIGHT_POINT) return 0.25f * PR_INV_PI;
-  return 0.0f;
+  const Light l = s->lights.lights[light];
+  return light_pdf_emit_dir(&l, oct_decode(v0->ng_oct), dir);
 }
 
 // Strategy L: connections from surface x (eye depth `depth`, throughput tp) to the light paths
@@ -233,7 +230,7 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
       const int is_delta = bsdf_is_delta(&fh.bsdf);
       // An emitter met by the sample from x: its MIS share against next-event estimation at x.
       if (chain == 0u && (s.sd.materials[h.material].flags & PR_MAT_EMISSIVE))
-        L += t2 * surface_emission(&s, &h) * power_heuristic(pdf, emitter_pdf(&s, &h, x.p));
+        L += t2 * surface_emission(&s, &h) * power_heuristic(pdf, emitter_pdf(&s, &h, x.p, f.n));
       if (chain == 0u && !is_delta) {
         // Strategy L at x counts these paths, apart from E's share.
         if (rp.mis_threshold > 0.0f && !delta)

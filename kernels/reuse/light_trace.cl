@@ -35,48 +35,43 @@ __kernel void light_trace(PR_SCENE_PARAMS, ReuseParams rp, __global const float*
   const Light L = s.lights.lights[li];
   h.light = li;
 
-  // Vertex 0 on the light, and the first direction.
+  // Vertex 0 on the light, and the first direction (shared/lights.h).
   float3 p0, n0 = make_float3(0.0f, 0.0f, 1.0f), dir;
   float3 tp = make_float3(0.0f, 0.0f, 0.0f);
   uint prim0 = PR_INVALID_INDEX, inst0 = PR_INVALID_INDEX;
   float b1 = 0.0f, b2 = 0.0f;
-  const float3 axis = make_float3(L.e1x, L.e1y, L.e1z);
   if (L.type == PR_LIGHT_TRIANGLE) {
     const float2 b = sample_triangle(u1, u2);
     b1 = b.x;
     b2 = b.y;
     const SurfaceHit e = surface_at(&s.sd, L.prim, L.inst, b1, b2);
     p0 = e.p;
-    // Both faces emit: pick one, then a cosine-weighted direction about it (pdf cos / (2 pi)).
+    // Both faces emit: one is chosen, in the quantised form the arena keeps, so that connect
+    // evaluates the pdf of this very direction.
     n0 = oct_decode(oct_encode(u3 < 0.5f ? e.ng : -e.ng));
-    float3 t, bt;
-    orthonormal_basis(n0, &t, &bt);
-    dir = normalize(to_world(sample_cosine_hemisphere(u4, u5), t, bt, n0));
-    tp = material_emission(&s.sd, &e) * (2.0f * PR_PI * L.area / pmf);
+    const float pdf_dir = light_sample_emit_dir(&L, n0, u4, u5, &dir);
+    // Le cos / (pmf / area x pdf_dir), with pdf_dir = cos / (2 pi).
+    tp = pdf_dir > 0.0f ? material_emission(&s.sd, &e) * (2.0f * PR_PI * L.area / pmf)
+                        : make_float3(0.0f, 0.0f, 0.0f);
     prim0 = L.prim;
     inst0 = L.inst;
-  } else if (L.type == PR_LIGHT_POINT) {
-    p0 = make_float3(L.p0x, L.p0y, L.p0z);
-    dir = sample_uniform_sphere(u1, u2);
-    tp = make_float3(L.le_r, L.le_g, L.le_b) * (4.0f * PR_PI / pmf);
-  } else if (L.type == PR_LIGHT_SPOT) {
-    p0 = make_float3(L.p0x, L.p0y, L.p0z);
+  } else if (L.type == PR_LIGHT_DIRECTIONAL) {
+    // Parallel rays from a disk that covers the scene's bounding sphere.
+    light_sample_emit_dir(&L, n0, u4, u5, &dir);
     float3 t, bt;
-    orthonormal_basis(axis, &t, &bt);
-    const float3 lc = sample_uniform_cone(u1, u2, L.cos_outer);
-    dir = normalize(to_world(lc, t, bt, axis));
-    const float pdf = 1.0f / (2.0f * PR_PI * (1.0f - L.cos_outer));
-    tp = make_float3(L.le_r, L.le_g, L.le_b) *
-         (spot_attenuation(lc.z, L.cos_inner, L.cos_outer) / (pmf * pdf));
-  } else {
-    // Directional: parallel rays from a disk that covers the scene's bounding sphere.
-    dir = axis;
-    float3 t, bt;
-    orthonormal_basis(axis, &t, &bt);
+    orthonormal_basis(dir, &t, &bt);
     const float3 d = sample_cosine_hemisphere(u1, u2);  // its xy is uniform on the unit disk
     const float r = rp.scene_radius;
-    p0 = make_float3(rp.cx, rp.cy, rp.cz) - axis * (1.01f * r) + (t * d.x + bt * d.y) * r;
+    p0 = make_float3(rp.cx, rp.cy, rp.cz) - dir * (1.01f * r) + (t * d.x + bt * d.y) * r;
     tp = make_float3(L.le_r, L.le_g, L.le_b) * (PR_PI * r * r / pmf);
+  } else {
+    p0 = make_float3(L.p0x, L.p0y, L.p0z);
+    const float pdf_dir = light_sample_emit_dir(&L, n0, u4, u5, &dir);
+    const float att = L.type == PR_LIGHT_SPOT
+                          ? spot_attenuation(dot(dir, make_float3(L.e1x, L.e1y, L.e1z)),
+                                             L.cos_inner, L.cos_outer)
+                          : 1.0f;
+    tp = make_float3(L.le_r, L.le_g, L.le_b) * (att / (pmf * pdf_dir));
   }
   if (!(pmf > 0.0f) || !(max3(tp) > 0.0f) || !(max3(tp) < PR_INF_F)) {
     headers[slot] = h;

@@ -28,7 +28,7 @@ typedef struct {
   u32 first_triangle;  // the instance's mesh's first triangle in the shading triangle array
   u32 mesh;
   u32 moved;           // transform changed since the previous frame (for invalidation)
-  u32 pad0;
+  u32 first_light;     // the light of the instance's first emissive triangle
 } ShadingInstance;
 
 PR_NAMESPACE_END

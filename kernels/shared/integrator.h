@@ -85,19 +85,28 @@ PR_INLINE float3 surface_emission(const SceneData* s, const SurfaceHit* h) {
   return material_emission(&s->sd, h);
 }
 
-// The pdf that next-event estimation at point `ref` would have had for reaching emitter point h.
-PR_INLINE float emitter_pdf(const SceneData* s, const SurfaceHit* h, float3 ref) {
-  float3 v0, e1, e2;
-  triangle_world(&s->sd, h->prim, h->inst, &v0, &e1, &e2);
-  return light_pdf_triangle(material_emission_factor(&s->sd, h->material), s->lights.total_power,
-                            ref, h->p, v0, e1, e2);
+// The light that the emissive triangle of hit h is in the light table.
+PR_INLINE u32 emitter_light(const SceneData* s, const SurfaceHit* h) {
+  const u32 k = s->lights.prim_light[h->prim];
+  if (k == PR_INVALID_INDEX || h->inst == PR_INVALID_INDEX) return k;
+  return s->sd.instances[h->inst].first_light + k;
 }
 
-// Next-event estimation at a non-delta surface: picks a light by power and a point on it.
-// Returns 1 with the shadow ray and the unoccluded contribution (to be multiplied by the path
-// throughput), or 0 when the sample carries nothing. With use_mis, area lights are weighted
-// against BSDF sampling (the path tracer); without, the estimate stands alone (path reuse,
-// where BSDF-sampled hits on emitters are not counted).
+// The pdf that next-event estimation at `ref`, with shading normal n_ref, would have had for
+// reaching the emitter point h.
+PR_INLINE float emitter_pdf(const SceneData* s, const SurfaceHit* h, float3 ref, float3 n_ref) {
+  const float pmf = light_choice_pmf(&s->lights, emitter_light(s, h), ref, n_ref);
+  if (!(pmf > 0.0f)) return 0.0f;
+  float3 v0, e1, e2;
+  triangle_world(&s->sd, h->prim, h->inst, &v0, &e1, &e2);
+  return light_pdf_triangle(pmf, ref, h->p, v0, e1, e2);
+}
+
+// Next-event estimation at a non-delta surface: chooses a light for this point and a point on
+// it. Returns 1 with the shadow ray and the unoccluded contribution (to be multiplied by the
+// path throughput), or 0 when the sample carries nothing. With use_mis, area lights are
+// weighted against BSDF sampling (the path tracer); without, the estimate stands alone (path
+// reuse, where BSDF-sampled hits on emitters are not counted).
 #define PR_NEXT_EVENT_DRAWS 2u  // rng_skip this many where next_event is not called
 
 PR_INLINE int next_event(const SceneData* s, const SurfaceHit* h, const ShadingFrame* f, float3 wo,
@@ -105,10 +114,10 @@ PR_INLINE int next_event(const SceneData* s, const SurfaceHit* h, const ShadingF
   const float us = rng_next(rng);
   const float2 ul = rng_next2(rng);
   const float u1 = ul.x, u2 = ul.y;
-  if (s->lights.count == 0u || s->lights.total_power <= 0.0f) return 0;
-  const u32 idx = light_select(s->lights.cdf, s->lights.count, us);
+  float pmf;
+  const u32 idx = light_choose(&s->lights, h->p, f->n, us, &pmf);
+  if (idx == PR_INVALID_INDEX || !(pmf > 0.0f)) return 0;
   const Light l = s->lights.lights[idx];
-  const float pmf = l.power / s->lights.total_power;
   LightSample ls;
   float b1, b2;
   if (!light_sample(&l, pmf, h->p, u1, u2, &ls, &b1, &b2)) return 0;

@@ -21,6 +21,7 @@
   S(TextureInfo)              \
   S(CameraParams)             \
   S(Light)                    \
+  S(LightNode)                \
   S(ShadingVertex)            \
   S(ShadingTriangle)          \
   S(ShadingInstance)          \
@@ -86,6 +87,12 @@
   F(PathState, rng_dim)               \
   F(PathState, flags)                 \
   F(PathState, prev_x)                \
+  F(PathState, prev_nx)               \
+  F(PathState, pad)                   \
+  F(LightNode, power)                 \
+  F(LightNode, index)                 \
+  F(LightNode, cos_o)                 \
+  F(LightNode, parent)                \
   F(ShadowRay, c_r)                   \
   F(ShadowRay, valid)                 \
   F(PathHeader, end)                  \
@@ -102,6 +109,7 @@
   F(EyeVertex, depth)                 \
   F(EyeVertex, b2)                    \
   F(Light, moved)                     \
+  F(Light, leaf)                      \
   F(ReuseParams, clamp)               \
   F(ReuseParams, cx)                  \
   F(ReuseParams, pad1)

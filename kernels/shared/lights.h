@@ -1,10 +1,10 @@
 // Lights: emissive triangles (world space, rebuilt by the host whenever a dynamic emitter moves)
-// and KHR_lights_punctual lights. Selection is proportional to power: the probability of a
-// light is light_power(light) / total_power, and an emissive triangle's power is computed from
-// its material's emission factor and world area, so that the pdf of a triangle hit by a BSDF
-// ray (for MIS) needs no table lookup.
+// and KHR_lights_punctual lights. A receiving point chooses a light with the light BVH
+// (shared/light_bvh.h), or by power alone with PR_LIGHT_SAMPLER_POWER; light paths, whose
+// origin knows no receiver, choose by power (docs/design.md section 6).
 #pragma once
 
+#include "shared/light_bvh.h"
 #include "shared/math.h"
 #include "shared/sampling.h"
 
@@ -26,10 +26,11 @@ typedef struct {
   float le_r, le_g, le_b;  // radiance factor (triangle), intensity in cd (point, spot), or lux
   float area;              // world area (triangle)
   float cos_inner, cos_outer;  // spot cone
-  float power;                 // selection weight, the same formula as light_power()
+  float power;                 // selection weight by power: emitter_power() for triangles
   u32 material;
   u32 moved;  // changed since the previous frame (for invalidation)
-  float pad1, pad2, pad3;
+  u32 leaf;   // the light's node in the light BVH; PR_INVALID_INDEX for directional lights
+  float pad2, pad3;
 } Light;
 
 // The selection weight of an emissive triangle: luminance(Le) * pi * area.
@@ -211,15 +212,61 @@ PR_INLINE int light_sample(const Light* l, float pmf, float3 ref, float u1, floa
   return att > 0.0f;
 }
 
+// The selection weight of a light by power: the luminance of the flux it emits (a directional
+// light's through the disk of radius scene_radius that covers the scene). The host builds the
+// power tables and the light BVH from it.
+PR_INLINE float light_power(const Light* l, float scene_radius) {
+  const float lum = luminance(make_float3(l->le_r, l->le_g, l->le_b));
+  if (l->type == PR_LIGHT_TRIANGLE) return emitter_power(make_float3(l->le_r, l->le_g, l->le_b), l->area);
+  if (l->type == PR_LIGHT_POINT) return 4.0f * PR_PI * lum;
+  if (l->type == PR_LIGHT_SPOT)
+    return 2.0f * PR_PI * (1.0f - 0.5f * (l->cos_inner + l->cos_outer)) * lum;
+  return PR_PI * scene_radius * scene_radius * lum;
+}
+
+// The direction in which a light path leaves vertex 0 of light l, and its solid-angle pdf:
+// triangles cosine-weighted about the face n0 already chosen (each face with probability 1/2:
+// pdf cos / (2 pi)); point lights uniform on the sphere; spot lights uniform in the outer cone;
+// directional lights along their direction (a delta: pdf 1).
+PR_INLINE float light_sample_emit_dir(const Light* l, float3 n0, float u1, float u2, float3* dir) {
+  const float3 axis = make_float3(l->e1x, l->e1y, l->e1z);
+  float3 t, b;
+  if (l->type == PR_LIGHT_TRIANGLE) {
+    orthonormal_basis(n0, &t, &b);
+    const float3 wl = sample_cosine_hemisphere(u1, u2);
+    *dir = normalize(to_world(wl, t, b, n0));
+    return wl.z * (0.5f * PR_INV_PI);
+  }
+  if (l->type == PR_LIGHT_POINT) {
+    *dir = sample_uniform_sphere(u1, u2);
+    return 0.25f * PR_INV_PI;
+  }
+  if (l->type == PR_LIGHT_SPOT) {
+    orthonormal_basis(axis, &t, &b);
+    *dir = normalize(to_world(sample_uniform_cone(u1, u2, l->cos_outer), t, b, axis));
+    return 1.0f / (2.0f * PR_PI * (1.0f - l->cos_outer));
+  }
+  *dir = axis;
+  return 1.0f;
+}
+
+// The solid-angle pdf with which a light path leaves vertex 0 of a triangle or point light along
+// dir, whichever face of the triangle (normal n0 or -n0) it chose. Spot and directional lights:
+// 0, no other strategy reaches their vertex 0.
+PR_INLINE float light_pdf_emit_dir(const Light* l, float3 n0, float3 dir) {
+  if (l->type == PR_LIGHT_TRIANGLE) return fabs(dot(n0, dir)) * (0.5f * PR_INV_PI);
+  if (l->type == PR_LIGHT_POINT) return 0.25f * PR_INV_PI;
+  return 0.0f;
+}
+
 // Solid-angle pdf with which light sampling from `ref` would pick the point `pos` of the
-// emissive triangle (v0, v0 + e1, v0 + e2) with emission `le`: the same choice between solid
-// angle and area as light_sample makes.
-PR_INLINE float light_pdf_triangle(float3 le, float total_power, float3 ref, float3 pos, float3 v0,
-                                   float3 e1, float3 e2) {
+// emissive triangle (v0, v0 + e1, v0 + e2), chosen with probability pmf: the same choice
+// between solid angle and area as light_sample makes.
+PR_INLINE float light_pdf_triangle(float pmf, float3 ref, float3 pos, float3 v0, float3 e1,
+                                   float3 e2) {
   const float3 cr = cross(e1, e2);
   const float area = 0.5f * length(cr);
-  if (total_power <= 0.0f || !(area > 0.0f)) return 0.0f;
-  const float pmf = emitter_power(le, area) / total_power;
+  if (!(pmf > 0.0f) || !(area > 0.0f)) return 0.0f;
   const float3 d = pos - ref;
   const float d2 = dot(d, d);
   if (!(d2 > 0.0f)) return 0.0f;
@@ -234,26 +281,76 @@ PR_INLINE float light_pdf_triangle(float3 le, float total_power, float3 ref, flo
 typedef struct {
   PR_GLOBAL const Light* lights;
   PR_GLOBAL const float* cdf;  // running sum of power; cdf[count - 1] == total_power
+  PR_GLOBAL const LightNode* nodes;  // the light BVH over lights [0, tree_count)
+  // Per shading triangle: its light (SSG), or its rank among its mesh's emissive triangles (DSG,
+  // added to the instance's first_light); PR_INVALID_INDEX where it is no light.
+  PR_GLOBAL const u32* prim_light;
   u32 count;
+  u32 tree_count;  // directional lights come after the tree's
   float total_power;
 } LightData;
+
+// Chooses a light for the receiver at p with shading normal n (zero: none) with u; *pmf is the
+// probability of the choice. A directional light is chosen by its share of the power, the
+// tree as a whole by the share of the others. PR_INVALID_INDEX where no light can reach p.
+PR_INLINE u32 light_choose(const LightData* d, float3 p, float3 n, float u, float* pmf) {
+  *pmf = 0.0f;
+  if (d->count == 0u || !(d->total_power > 0.0f)) return PR_INVALID_INDEX;
+  const u32 i = light_select(d->cdf, d->count, u);
+#ifndef PR_LIGHT_SAMPLER_POWER
+  if (i < d->tree_count) {
+    const float share = d->cdf[d->tree_count - 1u] / d->total_power;
+    float tree_pmf;
+    const u32 j =
+        light_bvh_sample(d->nodes, p, n, fmin(u / share, PR_ONE_MINUS_EPSILON), &tree_pmf);
+    *pmf = share * tree_pmf;
+    return j;
+  }
+#else
+  (void)p;
+  (void)n;
+#endif
+  *pmf = d->lights[i].power / d->total_power;
+  return i;
+}
+
+// The probability that light_choose picks `light` for the receiver (p, n).
+PR_INLINE float light_choice_pmf(const LightData* d, u32 light, float3 p, float3 n) {
+  if (light >= d->count || !(d->total_power > 0.0f)) return 0.0f;
+#ifndef PR_LIGHT_SAMPLER_POWER
+  if (light < d->tree_count)
+    return d->cdf[d->tree_count - 1u] / d->total_power *
+           light_bvh_pmf(d->nodes, d->lights[light].leaf, p, n);
+#else
+  (void)p;
+  (void)n;
+#endif
+  return d->lights[light].power / d->total_power;
+}
 
 PR_NAMESPACE_END
 
 #ifdef PR_DEVICE_CODE
-#define PR_LIGHT_PARAMS                                                                  \
-  __global const Light *pr_lights, __global const float *pr_light_cdf, uint pr_light_count, \
-      float pr_total_power
-PR_INLINE LightData pr_light_data(__global const Light* l, __global const float* cdf, uint count,
-                                  float total) {
+#define PR_LIGHT_PARAMS                                                                        \
+  __global const Light *pr_lights, __global const float *pr_light_cdf,                         \
+      __global const LightNode *pr_light_nodes, __global const uint *pr_prim_light,            \
+      uint pr_light_count, uint pr_light_tree_count, float pr_total_power
+PR_INLINE LightData pr_light_data(__global const Light* l, __global const float* cdf,
+                                  __global const LightNode* nodes, __global const uint* prim_light,
+                                  uint count, uint tree_count, float total) {
   LightData d;
   d.lights = l;
   d.cdf = cdf;
+  d.nodes = nodes;
+  d.prim_light = prim_light;
   d.count = count;
+  d.tree_count = tree_count;
   d.total_power = total;
   return d;
 }
-#define PR_LIGHTS() pr_light_data(pr_lights, pr_light_cdf, pr_light_count, pr_total_power)
+#define PR_LIGHTS()                                                                      \
+  pr_light_data(pr_lights, pr_light_cdf, pr_light_nodes, pr_prim_light, pr_light_count, \
+                pr_light_tree_count, pr_total_power)
 #endif
 
 PR_STATIC_ASSERT(sizeof(pr::dev::Light) == 96, "Light layout");

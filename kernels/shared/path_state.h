@@ -6,7 +6,7 @@
 
 PR_NAMESPACE_BEGIN
 
-// 80 bytes.
+// 96 bytes.
 typedef struct {
   Ray ray;
   float tp_r, tp_g, tp_b;
@@ -16,7 +16,9 @@ typedef struct {
   u32 alive;
   u32 rng_dim;  // next random dimension of this sample
   u32 flags;    // PR_PATH_*
-  float prev_x, prev_y, prev_z;  // the vertex `ray` leaves (for the emitter pdf of its hit)
+  float prev_x, prev_y, prev_z;     // the vertex `ray` leaves and its shading normal (for the
+  float prev_nx, prev_ny, prev_nz;  // emitter pdf of its hit)
+  u32 pad;
 } PathState;
 
 #define PR_PATH_SPECULAR 1u  // the last bounce was delta (or the ray is the camera ray)
@@ -30,7 +32,7 @@ typedef struct {
 
 PR_NAMESPACE_END
 
-PR_STATIC_ASSERT(sizeof(pr::dev::PathState) == 80, "PathState layout");
+PR_STATIC_ASSERT(sizeof(pr::dev::PathState) == 96, "PathState layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::PathState, depth) == 48, "PathState layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::PathState, flags) == 64, "PathState layout");
 PR_STATIC_ASSERT(sizeof(pr::dev::ShadowRay) == 48, "ShadowRay layout");

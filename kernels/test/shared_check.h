@@ -12,7 +12,7 @@
 
 PR_NAMESPACE_BEGIN
 
-#define PR_CHECK_STRIDE 48
+#define PR_CHECK_STRIDE 52
 
 PR_INLINE void check_put3(float* r, u32 at, float3 v) {
   r[at] = v.x;
@@ -27,7 +27,8 @@ PR_INLINE float3 check_unit(Rng* rng) {
   return dot(v, v) > 1e-6f ? normalize(v) : make_float3(0.0f, 0.0f, 1.0f);
 }
 
-PR_INLINE void shared_check_case(u32 i, PR_GLOBAL const float* cdf, u32 cdf_count, float* r) {
+PR_INLINE void shared_check_case(u32 i, PR_GLOBAL const float* cdf, u32 cdf_count,
+                                  PR_GLOBAL const LightNode* nodes, u32 node_count, float* r) {
   for (u32 k = 0u; k < PR_CHECK_STRIDE; ++k) r[k] = 0.0f;
   Rng rng = rng_make(7u, PR_RNG_TEST, 0u, i, 0u);
 
@@ -112,6 +113,16 @@ PR_INLINE void shared_check_case(u32 i, PR_GLOBAL const float* cdf, u32 cdf_coun
   r[45] = b1;
   r[46] = b2;
   r[47] = (float)light_select(cdf, cdf_count, 1.0f - us);
+
+  // The light BVH: a node's importance, a choice and its pmf, and the pmf of reaching a node.
+  const u32 node = i % node_count;
+  const float3 nr = (i & 3u) == 3u ? make_float3(0.0f, 0.0f, 0.0f) : n;
+  const float3 pl = make_float3(2.0f * p.x, 0.08f * p.y - 4.0f, 4.0f * n.z);  // among the lights
+  r[48] = light_node_importance(nodes + node, pl, nr);
+  float pmf = 0.0f;
+  r[49] = (float)light_bvh_sample(nodes, pl, nr, l1, &pmf);
+  r[50] = pmf;
+  r[51] = light_bvh_pmf(nodes, node, pl, nr);
 }
 
 PR_NAMESPACE_END
