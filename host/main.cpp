@@ -90,12 +90,13 @@ int main(int argc, char** argv) {
                    "pathtrace: unidirectional path tracing (the baseline)")
       ->check(CLI::IsMember({"reuse", "retrace", "pathtrace"}))
       ->capture_default_str();
-  std::string lightSamplerText = "bvh";
+  std::string lightSamplerText = "auto";
   render
       ->add_option("--light-sampler", lightSamplerText,
                    "How a shaded point chooses the light it samples: bvh (by the light it can "
-                   "get from each, through a light BVH) or power (by power alone)")
-      ->check(CLI::IsMember({"bvh", "power"}))
+                   "get from each, through a light BVH), power (by power alone) or auto (bvh "
+                   "where the scene has more than 16 lights)")
+      ->check(CLI::IsMember({"auto", "bvh", "power"}))
       ->capture_default_str();
   render->add_option("--light-paths", ro.lightPaths,
                      "Light-path slots kept in the arena (reuse/retrace; default: one per pixel)");
@@ -212,7 +213,9 @@ int main(int argc, char** argv) {
       ro.mode = modeText == "pathtrace" ? pr::RenderMode::PathTrace
                 : modeText == "retrace" ? pr::RenderMode::Retrace
                                         : pr::RenderMode::Reuse;
-      ro.lightSamplerPower = lightSamplerText == "power";
+      ro.lightSampler = lightSamplerText == "bvh"     ? pr::LightSampler::Bvh
+                        : lightSamplerText == "power" ? pr::LightSampler::Power
+                                                      : pr::LightSampler::Auto;
       return pr::runRender(ro);
     }
     if (*portability) {

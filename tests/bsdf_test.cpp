@@ -5,6 +5,7 @@
 #include <cmath>
 #include <random>
 #include <set>
+#include <vector>
 
 #include "shared/bsdf.h"
 #include "shared/rng.h"
@@ -162,6 +163,78 @@ TEST(Bsdf, PdfIntegratesToAtMostOne) {
     EXPECT_LE(s / n, 1.02) << roughness;
     EXPECT_GT(s / n, 0.85) << roughness;
   }
+}
+
+// Chi-square test of the directions bsdf_sample draws against the density bsdf_eval reports (as
+// pbrt-v4's bsdfs_test does): the sphere cut into cells equal in solid angle (z bands x phi
+// sectors), each cell's expected count from integrating the pdf over it. Returns the tail
+// probability; `tilt` multiplies the reported pdf by (1 + tilt z), a mutation that must fail.
+double bsdfChiSquarePValue(const BsdfParams& m, float3 wo, int n, uint32_t seed, float tilt = 0.0f) {
+  constexpr int kZ = 16, kPhi = 32, kSub = 24;
+  auto cellOf = [&](float3 w) {
+    const int iz = std::min(kZ - 1, std::max(0, int((w.z + 1.0f) * 0.5f * kZ)));
+    double phi = std::atan2(double(w.y), double(w.x));
+    if (phi < 0) phi += 2 * M_PI;
+    const int ip = std::min(kPhi - 1, int(phi / (2 * M_PI) * kPhi));
+    return iz * kPhi + ip;
+  };
+  std::vector<double> expected(kZ * kPhi, 0.0), observed(kZ * kPhi, 0.0);
+  // Midpoint rule in (z, phi): dz dphi is the solid angle.
+  const double dz = 2.0 / (kZ * kSub), dphi = 2 * M_PI / (kPhi * kSub);
+  for (int iz = 0; iz < kZ * kSub; ++iz)
+    for (int ip = 0; ip < kPhi * kSub; ++ip) {
+      const double z = -1.0 + (iz + 0.5) * dz, phi = (ip + 0.5) * dphi;
+      const double r = std::sqrt(std::fmax(0.0, 1.0 - z * z));
+      const float3 wi = make_float3(float(r * std::cos(phi)), float(r * std::sin(phi)), float(z));
+      float pdf;
+      bsdf_eval(&m, wo, wi, &pdf);
+      expected[(iz / kSub) * kPhi + ip / kSub] += pdf * (1.0 + tilt * z) * dz * dphi * n;
+    }
+  Rng r = rng_make(seed, PR_RNG_TEST, 0, 5, 6);
+  for (int i = 0; i < n; ++i) {
+    float3 wi, w;
+    float pdf;
+    int delta;
+    const float u0 = rng_next(&r), u1 = rng_next(&r), u2 = rng_next(&r);
+    if (bsdf_sample(&m, wo, u0, u1, u2, PR_RADIANCE, &wi, &w, &pdf, &delta))
+      observed[cellOf(wi)] += 1.0;
+  }
+  double chi = 0.0, poolO = 0.0, poolE = 0.0;
+  int dof = -1;
+  for (size_t c = 0; c < expected.size(); ++c) {
+    if (expected[c] < 5.0) {
+      poolO += observed[c], poolE += expected[c];
+      continue;
+    }
+    chi += (observed[c] - expected[c]) * (observed[c] - expected[c]) / expected[c];
+    ++dof;
+  }
+  if (poolE >= 5.0) {
+    chi += (poolO - poolE) * (poolO - poolE) / poolE;
+    ++dof;
+  } else if (poolO > 20.0) {
+    return 0.0;
+  }
+  const double z = (std::cbrt(chi / dof) - (1.0 - 2.0 / (9.0 * dof))) / std::sqrt(2.0 / (9.0 * dof));
+  return 0.5 * std::erfc(z / std::sqrt(2.0));
+}
+
+TEST(Bsdf, SampledDirectionsFollowThePdfChiSquare) {
+  BsdfParams lambert = microfacet(make_float3(0.7f, 0.5f, 0.3f), 0.0f, 1.0f);
+  lambert.kind = PR_BSDF_LAMBERT;
+  const BsdfParams cases[] = {lambert, microfacet(make_float3(0.7f, 0.7f, 0.7f), 0.0f, 0.6f),
+                              microfacet(make_float3(0.9f, 0.6f, 0.3f), 1.0f, 0.5f),
+                              microfacet(make_float3(0.5f, 0.5f, 0.5f), 0.5f, 0.8f)};
+  int k = 0;
+  for (const BsdfParams& m : cases)
+    for (float cos_o : {0.9f, 0.4f}) {
+      const float3 wo = dirFromCos(cos_o, 0.4f);
+      EXPECT_GT(bsdfChiSquarePValue(m, wo, 200000, 10u + k), 1e-4)
+          << "case " << k << " cos_o " << cos_o;
+      ++k;
+    }
+  // The test has the power to see a wrong pdf: a 10% tilt fails it.
+  EXPECT_LT(bsdfChiSquarePValue(cases[1], dirFromCos(0.9f, 0.4f), 200000, 30u, 0.1f), 1e-6);
 }
 
 TEST(Bsdf, Reciprocity) {

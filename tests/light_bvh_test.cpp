@@ -194,12 +194,15 @@ void expectNested(const LightBvh& bvh) {
       const dev::LightNode& k = nodes[c];
       ASSERT_EQ(k.parent, i);
       if (!(k.power > 0.0f)) continue;
-      EXPECT_LE(n.lo_x, k.lo_x);
-      EXPECT_LE(n.lo_y, k.lo_y);
-      EXPECT_LE(n.lo_z, k.lo_z);
-      EXPECT_GE(n.hi_x, k.hi_x);
-      EXPECT_GE(n.hi_y, k.hi_y);
-      EXPECT_GE(n.hi_z, k.hi_z);
+      const LightBounds &bn = bvh.bounds(i), &bk = bvh.bounds(c);
+      for (int a = 0; a < 3; ++a) {
+        EXPECT_LE(bn.lo[a], bk.lo[a]);
+        EXPECT_GE(bn.hi[a], bk.hi[a]);
+      }
+      // The device's sphere is the box's.
+      const glm::vec3 half = 0.5f * (bk.hi - bk.lo);
+      EXPECT_FLOAT_EQ(k.r2, glm::dot(half, half));
+      EXPECT_FLOAT_EQ(k.cx, 0.5f * (bk.lo.x + bk.hi.x));
       const double angle = angleBetween(glm::dvec3(n.axis_x, n.axis_y, n.axis_z),
                                         glm::dvec3(k.axis_x, k.axis_y, k.axis_z));
       const double thetaN = std::acos(std::clamp(double(n.cos_o), -1.0, 1.0));

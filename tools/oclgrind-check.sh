@@ -40,4 +40,12 @@ for mode in pathtrace reuse retrace; do
   run "cornell-dynamic-$mode" scenes/cornell-dynamic.gltf --frames 0-2 --mode "$mode"
 done
 run "cornell-orbit-reuse" scenes/cornell-orbit.gltf --frames 0-1 --mode reuse
+# The light BVH's kernels (the demo scenes have too few lights for --light-sampler auto to take
+# it), on the many-lights atrium too: a deep tree, point and spot lights, a moving emitter.
+run "cornell-dynamic-pathtrace-lightbvh" scenes/cornell-dynamic.gltf --frames 0-1 --mode pathtrace \
+  --light-sampler bvh
+python3 tools/gen_atrium.py --size 0.02 --light lanterns --out "$work/lanterns/atrium.gltf" >/dev/null
+for mode in pathtrace reuse; do
+  run "lanterns-$mode" "$work/lanterns/atrium.gltf" --frames 0-1 --mode "$mode" --light-sampler bvh
+done
 exit $fail

@@ -159,8 +159,15 @@ GpuScene::GpuScene(Context& ctx, const Scene& scene, const GpuSceneOptions& opti
   }
   primLightBuffer_ = upload("light of each emissive triangle", primLight_.data(),
                             primLight_.size() * sizeof(uint32_t), &shadingBytes_);
-  for (const auto& l : scene.lights)
+  size_t treeLights = staticEmitters_.size() + dynamicEmitters_.size();
+  for (const auto& l : scene.lights) {
     if (l.dynamic) lightsAnimated_ = true;
+    if (l.type != LightType::Directional) ++treeLights;
+  }
+  // With few lights, choosing by power was as good on every scene measured and costs less
+  // (docs/design.md section 6).
+  useLightBvh_ = options_.lightSampler == LightSampler::Bvh ||
+                 (options_.lightSampler == LightSampler::Auto && treeLights > kAutoLightBvhMin);
   const Bounds b = scene.bounds;
   if (!b.empty()) {
     sceneRadius_ = std::max(1e-3f, 0.5f * glm::length(b.extent()));
@@ -418,7 +425,7 @@ cl_uint GpuScene::setKernelArgs(cl::Kernel& kernel, cl_uint first) {
 
 std::string GpuScene::buildOptions() const {
   std::string o = hasAlpha_ ? "-DPR_HAS_ALPHA=1 " : "";
-  if (options_.lightSampler == LightSampler::Power) o += "-DPR_LIGHT_SAMPLER_POWER=1 ";
+  if (!useLightBvh_) o += "-DPR_LIGHT_SAMPLER_POWER=1 ";
   if (!o.empty()) o.pop_back();
   return o;
 }

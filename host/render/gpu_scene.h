@@ -10,6 +10,7 @@
 #include "accel/scene_accel.h"
 #include "cl/context.h"
 #include "render/light_bvh.h"
+#include "render/options.h"
 #include "scene/scene.h"
 #include "shared/camera.h"
 #include "shared/geometry.h"
@@ -18,15 +19,11 @@
 
 namespace pr {
 
-// How a receiving point chooses the light it samples: the light BVH, or by power alone (the
-// comparison the light BVH is measured against).
-enum class LightSampler { Bvh, Power };
-
 struct GpuSceneOptions {
   // Every non-delta material becomes pure Lambert with its base colour (pbrt's --force-diffuse):
   // a diagnostic with exactly known albedo, used by the furnace tests.
   bool forceDiffuse = false;
-  LightSampler lightSampler = LightSampler::Bvh;
+  LightSampler lightSampler = LightSampler::Auto;
 };
 
 // Host-side conversions, exposed for tests.
@@ -64,6 +61,8 @@ class GpuScene {
   float totalLightPower() const { return totalPower_; }
   const std::vector<dev::Light>& lights() const { return lights_; }
   const LightBvh& lightBvh() const { return lightBvh_; }
+  // Whether shaded points choose lights with the light BVH (else by power).
+  bool usesLightBvh() const { return useLightBvh_; }
   const std::vector<dev::ShadingInstance>& instances() const { return instances_; }
   bool anyInstanceMoved() const { return anyMoved_; }
   bool lightsChanged() const { return lightsChanged_; }
@@ -106,6 +105,7 @@ class GpuScene {
   std::vector<uint32_t> primLight_;           // per shading triangle, see LightData.prim_light
   LightBvh lightBvh_;
   bool lightBvhBuilt_ = false;
+  bool useLightBvh_ = true;
   uint32_t treeLights_ = 0;  // lights in the tree: all but the directional ones, which are last
   std::vector<dev::Light> lights_;
   std::vector<float> cdf_;

@@ -114,8 +114,10 @@ LightBounds unionOf(const LightBounds& a, const LightBounds& b) {
 
 void LightBvh::store(uint32_t node, const LightBounds& b) {
   dev::LightNode& n = nodes_[node];
-  n.lo_x = b.lo.x, n.lo_y = b.lo.y, n.lo_z = b.lo.z;
-  n.hi_x = b.hi.x, n.hi_y = b.hi.y, n.hi_z = b.hi.z;
+  const glm::vec3 c = 0.5f * (b.lo + b.hi), half = 0.5f * (b.hi - b.lo);
+  n.cx = c.x, n.cy = c.y, n.cz = c.z;
+  n.r2 = glm::dot(half, half);
+  n.radius = std::sqrt(n.r2);
   n.power = b.power;
   n.axis_x = b.axis.x, n.axis_y = b.axis.y, n.axis_z = b.axis.z;
   n.cos_o = b.thetaO >= float(kPi) ? -1.0f : float(std::cos(double(b.thetaO)));

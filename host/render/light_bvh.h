@@ -37,6 +37,8 @@ class LightBvh {
   void refit(std::vector<dev::Light>* lights);
 
   const std::vector<dev::LightNode>& nodes() const { return nodes_; }
+  // The box and cone of node i, as built or refitted.
+  const LightBounds& bounds(size_t i) const { return nodeBounds_[i]; }
   uint32_t lightCount() const { return count_; }
 
  private:

@@ -8,6 +8,11 @@ namespace pr {
 
 enum class RenderMode { Reuse, Retrace, PathTrace };
 
+// How a shaded point chooses the light it samples: through the light BVH, by power alone, or
+// (auto) the light BVH where the scene has more lights than kAutoLightBvhMin.
+enum class LightSampler { Auto, Bvh, Power };
+constexpr int kAutoLightBvhMin = 16;
+
 const char* renderModeName(RenderMode m);
 
 struct FrameRange {
@@ -34,7 +39,7 @@ struct RenderOptions {
   float exposure = 0.0f;
   bool quiet = false;
   bool forceDiffuse = false;
-  bool lightSamplerPower = false;  // choose lights by power alone, not with the light BVH
+  LightSampler lightSampler = LightSampler::Auto;
   std::string statsFile;
   bool resume = false;  // skip frames whose complete EXR exists; append to the stats file
   // Camera samples keyed by frame 0 on every frame (the scene still moves with the frame):

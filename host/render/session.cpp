@@ -71,7 +71,7 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
   chooseSize(options, scene.cameraAt(camera_, 0.0), &width_, &height_);
   GpuSceneOptions sceneOptions;
   sceneOptions.forceDiffuse = options.forceDiffuse;
-  sceneOptions.lightSampler = options.lightSamplerPower ? LightSampler::Power : LightSampler::Bvh;
+  sceneOptions.lightSampler = options.lightSampler;
   gpu_ = std::make_unique<GpuScene>(ctx_, scene, sceneOptions);
   film_ = std::make_unique<Film>(ctx_, width_, height_);
   const RenderOptions& o = options_;

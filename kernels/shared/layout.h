@@ -92,6 +92,7 @@
   F(LightNode, power)                 \
   F(LightNode, index)                 \
   F(LightNode, cos_o)                 \
+  F(LightNode, r2)                    \
   F(LightNode, parent)                \
   F(ShadowRay, c_r)                   \
   F(ShadowRay, valid)                 \

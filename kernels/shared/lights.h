@@ -296,19 +296,22 @@ typedef struct {
 PR_INLINE u32 light_choose(const LightData* d, float3 p, float3 n, float u, float* pmf) {
   *pmf = 0.0f;
   if (d->count == 0u || !(d->total_power > 0.0f)) return PR_INVALID_INDEX;
-  const u32 i = light_select(d->cdf, d->count, u);
 #ifndef PR_LIGHT_SAMPLER_POWER
-  if (i < d->tree_count) {
-    const float share = d->cdf[d->tree_count - 1u] / d->total_power;
+  const float share = d->tree_count > 0u ? d->cdf[d->tree_count - 1u] / d->total_power : 0.0f;
+  if (u < share) {
     float tree_pmf;
     const u32 j =
         light_bvh_sample(d->nodes, p, n, fmin(u / share, PR_ONE_MINUS_EPSILON), &tree_pmf);
     *pmf = share * tree_pmf;
     return j;
   }
+  // A directional light (the rounding of u * total at the boundary aside).
+  const u32 found = light_select(d->cdf, d->count, u);
+  const u32 i = found < d->tree_count ? d->tree_count : found;
 #else
   (void)p;
   (void)n;
+  const u32 i = light_select(d->cdf, d->count, u);
 #endif
   *pmf = d->lights[i].power / d->total_power;
   return i;

@@ -91,6 +91,7 @@ inline float3 cross(float3 a, float3 b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
 inline float length(float3 a) { return std::sqrt(dot(a, a)); }
+inline float rsqrt(float x) { return 1.0f / std::sqrt(x); }
 inline float3 normalize(float3 a) {
   const float l = length(a);
   return l > 0.0f ? a / l : a;
