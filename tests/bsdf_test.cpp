@@ -9,6 +9,7 @@
 
 #include "shared/bsdf.h"
 #include "shared/rng.h"
+#include "support/chi_square.h"
 #include "support/test_env.h"
 
 namespace pr {
@@ -199,24 +200,7 @@ double bsdfChiSquarePValue(const BsdfParams& m, float3 wo, int n, uint32_t seed,
     if (bsdf_sample(&m, wo, u0, u1, u2, PR_RADIANCE, &wi, &w, &pdf, &delta))
       observed[cellOf(wi)] += 1.0;
   }
-  double chi = 0.0, poolO = 0.0, poolE = 0.0;
-  int dof = -1;
-  for (size_t c = 0; c < expected.size(); ++c) {
-    if (expected[c] < 5.0) {
-      poolO += observed[c], poolE += expected[c];
-      continue;
-    }
-    chi += (observed[c] - expected[c]) * (observed[c] - expected[c]) / expected[c];
-    ++dof;
-  }
-  if (poolE >= 5.0) {
-    chi += (poolO - poolE) * (poolO - poolE) / poolE;
-    ++dof;
-  } else if (poolO > 20.0) {
-    return 0.0;
-  }
-  const double z = (std::cbrt(chi / dof) - (1.0 - 2.0 / (9.0 * dof))) / std::sqrt(2.0 / (9.0 * dof));
-  return 0.5 * std::erfc(z / std::sqrt(2.0));
+  return test::chiSquarePValue(observed, expected);
 }
 
 TEST(Bsdf, SampledDirectionsFollowThePdfChiSquare) {

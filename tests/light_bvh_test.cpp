@@ -12,6 +12,7 @@
 #include "render/light_bvh.h"
 #include "shared/lights.h"
 #include "shared/rng.h"
+#include "support/chi_square.h"
 
 namespace pr {
 namespace {
@@ -84,10 +85,6 @@ std::vector<Receiver> randomReceivers(uint32_t seed, int count) {
   return r;
 }
 
-double chiSquareTail(double x, int k) {
-  const double z = (std::cbrt(x / k) - (1.0 - 2.0 / (9.0 * k))) / std::sqrt(2.0 / (9.0 * k));
-  return 0.5 * std::erfc(z / std::sqrt(2.0));
-}
 
 // Chi-square tail probability of n choices from (p, normal) against light_bvh_pmf.
 double choicePValue(const LightBvh& bvh, const std::vector<dev::Light>& lights, const Receiver& r,
@@ -106,24 +103,7 @@ double choicePValue(const LightBvh& bvh, const std::vector<dev::Light>& lights, 
     const float expect = dev::light_bvh_pmf(nodes.data(), lights[l].leaf, r.p, r.n);
     if (!(std::fabs(pmf - expect) <= 1e-4f * expect)) ++*mismatches;
   }
-  // Cells with few expected choices pooled into one.
-  double chi = 0.0, poolCount = 0.0, poolExpected = 0.0;
-  int dof = -1;
-  for (size_t i = 0; i < lights.size(); ++i) {
-    if (expected[i] < 5.0) {
-      poolCount += count[i], poolExpected += expected[i];
-      continue;
-    }
-    chi += (count[i] - expected[i]) * (count[i] - expected[i]) / expected[i];
-    ++dof;
-  }
-  if (poolExpected >= 5.0) {
-    chi += (poolCount - poolExpected) * (poolCount - poolExpected) / poolExpected;
-    ++dof;
-  } else if (poolCount > 20.0) {
-    return 0.0;  // lights the pmf calls (nearly) impossible were chosen
-  }
-  return dof > 0 ? chiSquareTail(chi, dof) : 1.0;
+  return test::chiSquarePValue(count, expected);
 }
 
 TEST(LightBvh, ChoicesFollowTheReportedPmf) {

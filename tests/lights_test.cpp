@@ -10,6 +10,7 @@
 #include "shared/lights.h"
 #include "shared/rng.h"
 #include "shared/types.h"
+#include "support/chi_square.h"
 
 namespace pr {
 namespace {
@@ -92,18 +93,36 @@ std::vector<double> cellProbabilities(const Tri& t, float3 p, bool solid) {
   return prob;
 }
 
-// Upper tail probability of chi-square with k degrees of freedom (Wilson-Hilferty).
-double chiSquareTail(double x, int k) {
-  const double z = (std::cbrt(x / k) - (1.0 - 2.0 / (9.0 * k))) / std::sqrt(2.0 / (9.0 * k));
-  return 0.5 * std::erfc(z / std::sqrt(2.0));
+
+// Cell probabilities of the density light_pdf_triangle reports from p (shading normal n),
+// integrated over the triangle on a fine grid (solid angle = area x cos / d^2).
+std::vector<double> cellProbabilitiesOfPdf(const Tri& t, float3 p, float3 n) {
+  constexpr int kFine = 192;
+  std::vector<double> prob(kCells, 0.0);
+  const float3 cr = dev::cross(t.e1, t.e2);
+  const double subArea = 0.5 * dev::length(cr) / (double(kFine) * kFine);
+  const float3 nl = dev::normalize(cr);
+  for (int j = 0; j < kFine; ++j)
+    for (int i = 0; i + j < kFine; ++i)
+      for (int upper = 0; upper < 2 && (upper == 0 || i + j < kFine - 1); ++upper) {
+        const double off = upper ? 2.0 / 3.0 : 1.0 / 3.0;
+        const double b1 = (i + off) / kFine, b2 = (j + off) / kFine;
+        const float3 x = at(t, b1, b2), d = x - p;
+        const double d2 = dev::dot(d, d), cosL = std::fabs(dev::dot(d, nl)) / std::sqrt(d2);
+        const float pdf = dev::light_pdf_triangle(1.0f, p, n, x, t.v0, t.e1, t.e2);
+        prob[cellOf(b1, b2)] += pdf * subArea * cosL / d2;
+      }
+  return prob;
 }
 
-// Draws `n` points with light_sample from p and returns the chi-square tail probability of
-// their cells against the cells' probabilities by solid angle (solid) or by area.
+// Draws `n` points with light_sample from p (shading normal nRef) and returns the chi-square
+// tail probability of their cells against `prob`, by default the cells' probabilities by
+// solid angle (solid) or by area.
 double samplingPValue(const Tri& t, float3 p, bool expectSolid, int n, uint32_t seed,
-                      bool forceArea = false) {
+                      bool forceArea = false, float3 nRef = make_float3(0, 0, 0),
+                      const std::vector<double>* expected = nullptr) {
   const dev::Light l = triangleLight(t);
-  const std::vector<double> prob = cellProbabilities(t, p, expectSolid);
+  const std::vector<double> prob = expected ? *expected : cellProbabilities(t, p, expectSolid);
   std::vector<double> count(kCells, 0.0);
   dev::Rng rng = dev::rng_make(seed, PR_RNG_TEST, 0u, 0u, 0u);
   for (int s = 0; s < n; ++s) {
@@ -113,20 +132,14 @@ double samplingPValue(const Tri& t, float3 p, bool expectSolid, int n, uint32_t 
     if (forceArea) {
       const auto b = dev::sample_triangle(u1, u2);
       b1 = b.x, b2 = b.y;
-    } else if (!dev::light_sample(&l, 1.0f, p, u1, u2, &ls, &b1, &b2)) {
+    } else if (!dev::light_sample(&l, 1.0f, p, nRef, u1, u2, &ls, &b1, &b2)) {
       continue;
     }
     count[cellOf(b1, b2)] += 1.0;
   }
-  double chi = 0.0;
-  int dof = -1;
-  for (int c = 0; c < kCells; ++c) {
-    const double e = prob[c] * n;
-    if (e < 5.0) continue;  // too few expected for the statistic
-    chi += (count[c] - e) * (count[c] - e) / e;
-    ++dof;
-  }
-  return chiSquareTail(chi, dof);
+  std::vector<double> expectedCounts(kCells);
+  for (int c = 0; c < kCells; ++c) expectedCounts[c] = prob[c] * n;
+  return test::chiSquarePValue(count, expectedCounts);
 }
 
 float omegaOf(const Tri& t, float3 p) {
@@ -172,22 +185,44 @@ TEST(SphericalTriangle, SmallOrFarTrianglesAreSampledByArea) {
   EXPECT_GT(samplingPValue(kBig, far, false, 100000, 13), 1e-4);
 }
 
-// MIS needs the pdf of a point reached another way: it must be the density light_sample drew
-// it with, in both regimes.
-TEST(SphericalTriangle, PdfOfAPointEqualsThePdfOfDrawingIt) {
-  const dev::Light l = triangleLight(kBig);
-  for (const float3 p : {make_float3(0.1f, 0.2f, 0.3f), make_float3(1.2f, 1.15f, 0.3f),
-                         make_float3(0.0f, 200.0f, 0.0f)}) {
-    dev::Rng rng = dev::rng_make(5u, PR_RNG_TEST, 0u, 2u, 0u);
-    for (int s = 0; s < 2000; ++s) {
-      const float u1 = dev::rng_next(&rng), u2 = dev::rng_next(&rng);
-      dev::LightSample ls;
-      float b1, b2;
-      if (!dev::light_sample(&l, 0.25f, p, u1, u2, &ls, &b1, &b2)) continue;
-      const float pdf = dev::light_pdf_triangle(0.25f, p, ls.pos, kBig.v0, kBig.e1, kBig.e2);
-      ASSERT_NEAR(pdf, ls.pdf, 1e-3f * ls.pdf) << "sample " << s << " from y " << p.y;
+// With the receiver's normal, directions follow the cosine-warped density (pbrt-v4's bilinear
+// warp): checked against the pdf light_pdf_triangle reports for a point, which must also
+// integrate to 1 over the triangle; a receiver facing the triangle and one at a grazing angle.
+TEST(SphericalTriangle, CosineWarpedSamplesFollowTheReportedPdf) {
+  const float3 p = make_float3(0.1f, 0.2f, 0.3f);
+  for (const float3 n : {make_float3(0, 1, 0), dev::normalize(make_float3(1.0f, 0.15f, 0.2f))}) {
+    const std::vector<double> prob = cellProbabilitiesOfPdf(kBig, p, n);
+    double total = 0.0;
+    for (double v : prob) total += v;
+    EXPECT_NEAR(total, 1.0, 2e-3) << "the pdf does not integrate to 1 for n.x " << n.x;
+    EXPECT_GT(samplingPValue(kBig, p, true, 200000, 14, false, n, &prob), 1e-4) << n.x;
+    // Not the unwarped density: the grazing receiver tells them apart.
+    if (n.x > 0.5f) {
+      const std::vector<double> flat = cellProbabilities(kBig, p, true);
+      EXPECT_LT(samplingPValue(kBig, p, true, 200000, 15, false, n, &flat), 1e-6);
     }
   }
+}
+
+// MIS needs the pdf of a point reached another way: it must be the density light_sample drew
+// it with, in both regimes, with and without the cosine warp.
+TEST(SphericalTriangle, PdfOfAPointEqualsThePdfOfDrawingIt) {
+  const dev::Light l = triangleLight(kBig);
+  for (const float3 n : {make_float3(0, 0, 0), make_float3(0, 1, 0),
+                         dev::normalize(make_float3(1.0f, 0.15f, 0.2f))})
+    for (const float3 p : {make_float3(0.1f, 0.2f, 0.3f), make_float3(1.2f, 1.15f, 0.3f),
+                           make_float3(0.0f, 200.0f, 0.0f)}) {
+      dev::Rng rng = dev::rng_make(5u, PR_RNG_TEST, 0u, 2u, 0u);
+      for (int s = 0; s < 2000; ++s) {
+        const float u1 = dev::rng_next(&rng), u2 = dev::rng_next(&rng);
+        dev::LightSample ls;
+        float b1, b2;
+        if (!dev::light_sample(&l, 0.25f, p, n, u1, u2, &ls, &b1, &b2)) continue;
+        const float pdf =
+            dev::light_pdf_triangle(0.25f, p, n, ls.pos, kBig.v0, kBig.e1, kBig.e2);
+        ASSERT_NEAR(pdf, ls.pdf, 2e-3f * ls.pdf) << "sample " << s << " from y " << p.y;
+      }
+    }
 }
 
 }  // namespace

@@ -99,7 +99,7 @@ PR_INLINE float emitter_pdf(const SceneData* s, const SurfaceHit* h, float3 ref,
   if (!(pmf > 0.0f)) return 0.0f;
   float3 v0, e1, e2;
   triangle_world(&s->sd, h->prim, h->inst, &v0, &e1, &e2);
-  return light_pdf_triangle(pmf, ref, h->p, v0, e1, e2);
+  return light_pdf_triangle(pmf, ref, n_ref, h->p, v0, e1, e2);
 }
 
 // Next-event estimation at a non-delta surface: chooses a light for this point and a point on
@@ -120,7 +120,7 @@ PR_INLINE int next_event(const SceneData* s, const SurfaceHit* h, const ShadingF
   const Light l = s->lights.lights[idx];
   LightSample ls;
   float b1, b2;
-  if (!light_sample(&l, pmf, h->p, u1, u2, &ls, &b1, &b2)) return 0;
+  if (!light_sample(&l, pmf, h->p, f->n, u1, u2, &ls, &b1, &b2)) return 0;
   if (dot(ls.wi, f->ng) <= 0.0f) return 0;  // below the geometric surface
   float3 le = ls.le;
   if (l.type == PR_LIGHT_TRIANGLE) {

@@ -138,6 +138,44 @@ PR_INLINE float3 sample_spherical_triangle(const SphericalTriangle* t, float ome
          orthogonal_part(cp, t->b) * sqrt(fmax(0.0f, one_minus_z * (2.0f - one_minus_z)));
 }
 
+// Where sample_spherical_triangle put direction w (unit, inside the triangle): the inverse of
+// Arvo's construction. c' is where the great circle through b and w meets the arc from a to c;
+// u1 is the share of the solid angle in (a, b, c'), u2 the share of the arc b c' up to w (in
+// 1 - cos, from the chords).
+PR_INLINE float2 invert_spherical_triangle(const SphericalTriangle* t, float omega, float3 w) {
+  const float3 cb = w - t->b;
+  float3 cp = cross(cross(t->b, w), cross(t->a, t->c));
+  const float lp = length(cp);
+  if (!(lp > 0.0f)) return make_float2(0.0f, 0.0f);  // w on b: u1 does not matter
+  cp = cp / lp;
+  if (dot(cp, t->a + t->c) < 0.0f) cp = -cp;
+  const float triple = fabs(dot(t->a, cross(t->b, cp)));
+  const float part =
+      2.0f * atan2(triple, 1.0f + dot(t->a, t->b) + dot(t->b, cp) + dot(cp, t->a));
+  const float3 cc = cp - t->b;
+  const float den = dot(cc, cc);
+  return make_float2(clamp(part / omega, 0.0f, 1.0f),
+                     den > 0.0f ? clamp(dot(cb, cb) / den, 0.0f, 1.0f) : 0.0f);
+}
+
+// The receiver's cosine at the triangle's corners, as weights of a bilinear warp of the unit
+// square that sample_spherical_triangle maps onto the triangle: (0, 0) and (1, 0) go to b,
+// (0, 1) to a, (1, 1) to c (pbrt-v4's warp). With them, directions follow the solid angle
+// times roughly the cosine at the receiver. Floors at 0.01 keep every direction possible.
+typedef struct {
+  float w00, w10, w01, w11;
+} CosineWarp;
+
+PR_INLINE CosineWarp cosine_warp(const SphericalTriangle* t, float3 n) {
+  CosineWarp c;
+  c.w00 = c.w10 = fmax(0.01f, dot(n, t->b));
+  c.w01 = fmax(0.01f, dot(n, t->a));
+  c.w11 = fmax(0.01f, dot(n, t->c));
+  return c;
+}
+
+PR_INLINE int has_normal(float3 n) { return n.x != 0.0f || n.y != 0.0f || n.z != 0.0f; }
+
 // Barycentrics (b1 for v0 + e1, b2 for v0 + e2) where the ray p + t w meets the triangle's
 // plane, kept inside the triangle against round-off.
 PR_INLINE float2 triangle_barycentrics_along(float3 p, float3 w, float3 v0, float3 e1, float3 e2) {
@@ -154,10 +192,11 @@ PR_INLINE float2 triangle_barycentrics_along(float3 p, float3 w, float3 v0, floa
   return make_float2(b1, b2);
 }
 
-// Samples a point on light `l` (selected with probability `pmf`) as seen from `ref`. Emissive
-// triangles emit on both faces, as in Blender and Cycles. Returns 0 when the sample carries no
-// light. For triangles, (*b1, *b2) are the barycentrics of the point, for emission textures.
-PR_INLINE int light_sample(const Light* l, float pmf, float3 ref, float u1, float u2,
+// Samples a point on light `l` (selected with probability `pmf`) as seen from `ref`, whose
+// shading normal is n_ref (zero: none, no cosine warp). Emissive triangles emit on both faces,
+// as in Blender and Cycles. Returns 0 when the sample carries no light. For triangles,
+// (*b1, *b2) are the barycentrics of the point, for emission textures.
+PR_INLINE int light_sample(const Light* l, float pmf, float3 ref, float3 n_ref, float u1, float u2,
                            LightSample* s, float* b1, float* b2) {
   s->delta = l->type != PR_LIGHT_TRIANGLE;
   s->le = make_float3(l->le_r, l->le_g, l->le_b);
@@ -173,6 +212,14 @@ PR_INLINE int light_sample(const Light* l, float pmf, float3 ref, float u1, floa
     SphericalTriangle st;
     const float omega = spherical_triangle(ref, v0, e1, e2, &st);
     const int solid = use_solid_angle(omega);
+    float warp_pdf = 1.0f;
+    if (solid && has_normal(n_ref)) {
+      const CosineWarp cw = cosine_warp(&st, n_ref);
+      const float2 uw = sample_bilinear(u1, u2, cw.w00, cw.w10, cw.w01, cw.w11);
+      warp_pdf = bilinear_pdf(uw, cw.w00, cw.w10, cw.w01, cw.w11);
+      u1 = uw.x;
+      u2 = uw.y;
+    }
     const float2 b = solid ? triangle_barycentrics_along(
                                  ref, sample_spherical_triangle(&st, omega, u1, u2), v0, e1, e2)
                            : sample_triangle(u1, u2);
@@ -184,7 +231,7 @@ PR_INLINE int light_sample(const Light* l, float pmf, float3 ref, float u1, floa
     s->wi = d / s->dist;
     const float cos_l = fabs(dot(s->wi, s->normal));
     if (cos_l <= 1e-7f) return 0;
-    s->pdf = solid ? pmf / omega : pmf * d2 / (cos_l * l->area);
+    s->pdf = solid ? pmf * warp_pdf / omega : pmf * d2 / (cos_l * l->area);
     *b1 = b.x;
     *b2 = b.y;
     return 1;
@@ -259,11 +306,11 @@ PR_INLINE float light_pdf_emit_dir(const Light* l, float3 n0, float3 dir) {
   return 0.0f;
 }
 
-// Solid-angle pdf with which light sampling from `ref` would pick the point `pos` of the
-// emissive triangle (v0, v0 + e1, v0 + e2), chosen with probability pmf: the same choice
-// between solid angle and area as light_sample makes.
-PR_INLINE float light_pdf_triangle(float pmf, float3 ref, float3 pos, float3 v0, float3 e1,
-                                   float3 e2) {
+// Solid-angle pdf with which light sampling from `ref` (shading normal n_ref) would pick the
+// point `pos` of the emissive triangle (v0, v0 + e1, v0 + e2), chosen with probability pmf: the
+// same choices (solid angle or area, cosine warp) as light_sample makes.
+PR_INLINE float light_pdf_triangle(float pmf, float3 ref, float3 n_ref, float3 pos, float3 v0,
+                                   float3 e1, float3 e2) {
   const float3 cr = cross(e1, e2);
   const float area = 0.5f * length(cr);
   if (!(pmf > 0.0f) || !(area > 0.0f)) return 0.0f;
@@ -274,7 +321,11 @@ PR_INLINE float light_pdf_triangle(float pmf, float3 ref, float3 pos, float3 v0,
   if (cos_l <= 1e-7f) return 0.0f;
   SphericalTriangle st;
   const float omega = spherical_triangle(ref, v0, e1, e2, &st);
-  return use_solid_angle(omega) ? pmf / omega : pmf * d2 / (cos_l * area);
+  if (!use_solid_angle(omega)) return pmf * d2 / (cos_l * area);
+  if (!has_normal(n_ref)) return pmf / omega;
+  const CosineWarp cw = cosine_warp(&st, n_ref);
+  const float2 u = invert_spherical_triangle(&st, omega, d * (1.0f / sqrt(d2)));
+  return pmf * bilinear_pdf(u, cw.w00, cw.w10, cw.w01, cw.w11) / omega;
 }
 
 // The light table as kernels see it (built from PR_LIGHT_PARAMS).

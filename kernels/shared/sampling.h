@@ -41,6 +41,30 @@ PR_INLINE float3 sample_uniform_cone(float u1, float u2, float cos_max) {
   return make_float3(sin_t * cos(phi), sin_t * sin(phi), cos_t);
 }
 
+// x in [0, 1) with density proportional to (1 - x) a + x b (a, b >= 0, not both 0): the root of
+// the CDF's quadratic in a form without cancellation.
+PR_INLINE float sample_linear(float u, float a, float b) {
+  if (u == 0.0f && a == 0.0f) return 0.0f;
+  const float x = u * (a + b) / (a + sqrt(fmax(0.0f, (1.0f - u) * a * a + u * b * b)));
+  return fmin(x, 0.99999994f);
+}
+
+// A point of [0, 1)^2 with density proportional to the bilinear interpolation of the corner
+// values w00 (at (0, 0)), w10, w01 and w11; and that density.
+PR_INLINE float2 sample_bilinear(float u1, float u2, float w00, float w10, float w01, float w11) {
+  const float y = sample_linear(u2, w00 + w10, w01 + w11);
+  const float x = sample_linear(u1, w00 + (w01 - w00) * y, w10 + (w11 - w10) * y);
+  return make_float2(x, y);
+}
+PR_INLINE float bilinear_pdf(float2 p, float w00, float w10, float w01, float w11) {
+  const float sum = w00 + w10 + w01 + w11;
+  if (!(sum > 0.0f)) return 1.0f;
+  return 4.0f *
+         ((1.0f - p.x) * (1.0f - p.y) * w00 + p.x * (1.0f - p.y) * w10 + (1.0f - p.x) * p.y * w01 +
+          p.x * p.y * w11) /
+         sum;
+}
+
 // Barycentrics (b1, b2) of a uniform point on a triangle (the square-root parameterisation).
 PR_INLINE float2 sample_triangle(float u1, float u2) {
   const float s = sqrt(u1);

@@ -101,7 +101,7 @@ PR_INLINE void shared_check_case(u32 i, PR_GLOBAL const float* cdf, u32 cdf_coun
   LightSample ls;
   float b1 = 0.0f, b2 = 0.0f;
   const float l1 = rng_next(&rng), l2 = rng_next(&rng);
-  const int got = light_sample(&l, 0.5f, p, l1, l2, &ls, &b1, &b2);
+  const int got = light_sample(&l, 0.5f, p, n, l1, l2, &ls, &b1, &b2);
   r[33] = (float)got;
   if (got) {
     check_put3(r, 34, ls.pos);
