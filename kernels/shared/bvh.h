@@ -129,6 +129,7 @@ PR_INLINE int intersect_triangle(PR_GLOBAL const BvhTriangle* tri, float3 o, flo
 PR_INLINE int bvh_traverse(PR_GLOBAL const BvhNode* nodes, PR_GLOBAL const BvhTriangle* tris,
                            u32 root, BvhRay* r, Hit* hit, u32 inst, int any_hit) {
   u32 stack[PR_BVH_STACK_SIZE];
+  float stack_t[PR_BVH_STACK_SIZE];
   int sp = 0;
   int found = 0;
   u32 node = root;
@@ -155,8 +156,9 @@ PR_INLINE int bvh_traverse(PR_GLOBAL const BvhNode* nodes, PR_GLOBAL const BvhTr
       const float tl = bvh_box_entry(nodes + left, r);
       const float tr = bvh_box_entry(nodes + right, r);
       if (tl != PR_INF_F && tr != PR_INF_F) {
-        // Nearer child first; the other waits on the stack.
+        // Nearer child first; the other waits on the stack with its entry distance.
         const int right_first = tr < tl;
+        stack_t[sp] = right_first ? tl : tr;
         stack[sp++] = right_first ? left : right;
         node = right_first ? right : left;
         continue;
@@ -170,10 +172,13 @@ PR_INLINE int bvh_traverse(PR_GLOBAL const BvhNode* nodes, PR_GLOBAL const BvhTr
         continue;
       }
     }
-    if (sp == 0) break;
-    node = stack[--sp];
+    // A waiting node that starts beyond the nearest hit found since it was pushed is skipped.
+    do {
+      if (sp == 0) return found;
+      --sp;
+    } while (stack_t[sp] > r->tmax);
+    node = stack[sp];
   }
-  return found;
 }
 
 PR_INLINE float3 xform_point(PR_GLOBAL const float* m, float3 p) {
@@ -197,6 +202,7 @@ PR_INLINE BvhRay instance_ray(PR_GLOBAL const BvhInstance* inst, const BvhRay* w
 PR_INLINE int tlas_traverse(const SceneGeom* g, BvhRay* r, Hit* hit, int any_hit) {
   if (g->instance_count == 0) return 0;
   u32 stack[PR_BVH_STACK_SIZE];
+  float stack_t[PR_BVH_STACK_SIZE];
   int sp = 0;
   int found = 0;
   u32 node = 0;
@@ -222,6 +228,7 @@ PR_INLINE int tlas_traverse(const SceneGeom* g, BvhRay* r, Hit* hit, int any_hit
       const float tr = bvh_box_entry(nodes + right, r);
       if (tl != PR_INF_F && tr != PR_INF_F) {
         const int right_first = tr < tl;
+        stack_t[sp] = right_first ? tl : tr;
         stack[sp++] = right_first ? left : right;
         node = right_first ? right : left;
         continue;
@@ -235,10 +242,13 @@ PR_INLINE int tlas_traverse(const SceneGeom* g, BvhRay* r, Hit* hit, int any_hit
         continue;
       }
     }
-    if (sp == 0) break;
-    node = stack[--sp];
+    // A waiting node that starts beyond the nearest hit found since it was pushed is skipped.
+    do {
+      if (sp == 0) return found;
+      --sp;
+    } while (stack_t[sp] > r->tmax);
+    node = stack[sp];
   }
-  return found;
 }
 
 PR_INLINE Hit hit_none(void) {
