@@ -16,6 +16,13 @@ relMSE. A render that fails (e.g. an option this build lacks) gives a row saying
 --baseline-kernels points
 PATHREUSE_KERNEL_DIR at another kernels/ folder (e.g. `git archive` of an older commit), so
 both run in the same binary on the same machine in the same run. Standard library only.
+
+--cycles adds, for the cases whose light transport Blender can match (--force-diffuse scenes
+without punctual lights: cases 1-3), a row rendered by Blender Cycles (Debian's `blender`,
+tools/cycles_peer.py: Lambert + emission, box filter, bounces = --max-depth - 2, 2 threads)
+with the same spp and seeds against the same reference. Its time column is the wall time of
+Blender's render call (scene sync and Embree BVH build included), ours the kernel seconds;
+the "wall s" column gives our wall time per frame for a like-for-like view.
 """
 
 import argparse
@@ -39,6 +46,7 @@ REPO = benchlib.REPO
 # the one reference (rendered with the case's options alone); a line after the table gives
 # the relMSE of the second variant over the first
 SAMPLERS = [("bvh", ["--light-sampler", "bvh"]), ("power", ["--light-sampler", "power"])]
+CYCLES_CASES = {0, 1, 2}  # --force-diffuse, no punctual lights: the same transport in Cycles
 CASES = [
     ("atrium direct (--max-depth 2)", "atrium", 320, 180, ["--force-diffuse", "--max-depth", "2"]),
     ("atrium full (--max-depth 64)", "atrium", 320, 180, ["--force-diffuse", "--max-depth", "64"]),
@@ -72,7 +80,20 @@ def render(exe, scene, w, h, spp, seed, opts, out_exr, stats, kernels=None):
         lines = run.stderr.strip().splitlines()
         raise RenderFailed(lines[-1] if lines else f"exit status {run.returncode}")
     rec = json.loads(Path(stats).read_text().splitlines()[-1])
-    return benchlib.kernel_s(rec)
+    return benchlib.kernel_s(rec), float(rec.get("wall_s", 0.0))
+
+
+def render_cycles(scene, w, h, spp, seed, opts, out_exr):
+    """Blender Cycles through tools/cycles_peer.py; returns the render call's seconds."""
+    depth = int(opts[opts.index("--max-depth") + 1]) if "--max-depth" in opts else 8
+    cmd = ["blender", "-b", "--factory-startup", "--python", str(REPO / "tools" / "cycles_peer.py"),
+           "--", str(scene), str(out_exr), "--width", str(w), "--height", str(h), "--spp", str(spp),
+           "--max-depth", str(depth), "--seed", str(seed)]
+    run = subprocess.run(cmd, capture_output=True, text=True)
+    lines = [l for l in run.stdout.splitlines() if l.startswith('{"render_s"')]
+    if run.returncode or not lines or not Path(out_exr).is_file():
+        raise RenderFailed((run.stderr.strip().splitlines() or ["blender failed"])[-1])
+    return json.loads(lines[-1])["render_s"]
 
 
 class RenderFailed(Exception):
@@ -119,6 +140,7 @@ def main():
     ap.add_argument("--cases", help="comma-separated case numbers (1-based) to run")
     ap.add_argument("--cache", default="/tmp/pathreuse-bench-sampling")
     ap.add_argument("--python", default="/usr/bin/python3", help="python for gen_atrium.py")
+    ap.add_argument("--cycles", action="store_true", help="add Blender Cycles rows (cases 1-3)")
     args = ap.parse_args()
     exe = Path(args.build) / "pathreuse"
     compare = Path(args.build) / "exr_compare"
@@ -133,7 +155,8 @@ def main():
     print("\n".join(benchlib.machine_lines(exe)))
     print(f"- spp {args.spp}, reference {args.spp * args.ref_factor} spp, {args.seeds} seeds, "
           f"relMSE eps 0.01, kernel seconds per frame\n")
-    print("| case | kernels | relMSE | kernel s | relMSE x s |\n| --- | --- | ---: | ---: | ---: |")
+    print("| case | kernels | relMSE | kernel s | relMSE x s | wall s |\n"
+          "| --- | --- | ---: | ---: | ---: | ---: |")
     tmp = Path(tempfile.mkdtemp(prefix="bench-sampling-"))
     notes = []
     for ci in chosen:
@@ -141,7 +164,7 @@ def main():
         variants = CASES[ci][5] if len(CASES[ci]) > 5 else [(None, [])]
         sp = scenes[scene]
         if not Path(sp).is_file():
-            print(f"| {name} | skipped: {sp} not found | | | |")
+            print(f"| {name} | skipped: {sp} not found | | | | |")
             continue
         ref_spp = args.spp * args.ref_factor
         key = hashlib.sha1(json.dumps([scene, str(sp), scene_digest(sp), w, h, ref_spp, opts,
@@ -152,34 +175,43 @@ def main():
             try:
                 render(exe, sp, w, h, ref_spp, 1000, opts, tmp / "ref_0000.exr", tmp / "ref.jsonl")
             except RenderFailed as e:
-                print(f"| {name} | reference failed: {e} | | | |", flush=True)
+                print(f"| {name} | reference failed: {e} | | | | |", flush=True)
                 continue
             shutil.move(str(tmp / "ref_0000.exr"), str(ref))   # only a finished one is cached
         rows = [(label, vlabel, kd, vopts) for vlabel, vopts in variants for label, kd in configs]
-        results = {(label, vlabel): ([], [], []) for label, vlabel, _, _ in rows}
+        if args.cycles and ci in CYCLES_CASES:
+            rows.append(("Blender Cycles 3.4 (CPU, 2 threads; time: render call)", None, "cycles", []))
+        results = {(label, vlabel): ([], [], [], []) for label, vlabel, _, _ in rows}
         for seed in range(1, args.seeds + 1):
             for label, vlabel, kd, vopts in rows:
-                e, t, failed = results[(label, vlabel)]
+                e, t, failed, walls = results[(label, vlabel)]
                 if failed:
                     continue
                 img = tmp / f"img_0000.exr"
                 try:
-                    ks = render(exe, sp, w, h, args.spp, seed, opts + vopts, img, tmp / "s.jsonl", kd)
+                    if kd == "cycles":
+                        ks, wall = render_cycles(sp, w, h, args.spp, seed, opts, img), None
+                    else:
+                        ks, wall = render(exe, sp, w, h, args.spp, seed, opts + vopts, img,
+                                          tmp / "s.jsonl", kd)
                 except RenderFailed as err:
                     failed.append(str(err))
                     continue
                 e.append(relmse(compare, img, ref))
                 t.append(ks)
+                if wall is not None:
+                    walls.append(wall)
         med = {}
         for label, vlabel, _, _ in rows:
-            e, t, failed = results[(label, vlabel)]
+            e, t, failed, walls = results[(label, vlabel)]
             row = label if vlabel is None else f"{label}, {' '.join(dict(variants)[vlabel])}"
             if failed:
-                print(f"| {name} | {row} | failed: {failed[0]} | | |", flush=True)
+                print(f"| {name} | {row} | failed: {failed[0]} | | | |", flush=True)
                 continue
             me, mt = statistics.median(e), statistics.median(t)
+            mw = f"{statistics.median(walls):.3f}" if walls else ""
             med[(label, vlabel)] = me
-            print(f"| {name} | {row} | {me:.5f} | {mt:.3f} | {me * mt:.5f} |", flush=True)
+            print(f"| {name} | {row} | {me:.5f} | {mt:.3f} | {me * mt:.5f} | {mw} |", flush=True)
         if len(variants) > 1:
             (a, _), (b, _) = variants[:2]
             for label, _ in configs:
