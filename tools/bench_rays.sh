@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Ray-throughput benchmark (issue 4): builds ray_bench if needed, generates the large atrium,
+# Ray-throughput benchmark: builds ray_bench if needed, generates the large atrium,
 # runs the benchmark on cornell-nvpro and the atrium on PoCL capped to 2 threads, and writes
 # docs/ray-benchmark.md. The Embree column appears when libembree-dev was installed before
 # cmake ran (apt-get install -y libembree-dev).
@@ -49,7 +49,7 @@ done
 {
   echo "# Ray-throughput benchmark"
   echo
-  echo "Written by \`tools/bench_rays.sh\` (issue 4). Closest hit for camera and diffuse bounce rays,"
+  echo "Written by \`tools/bench_rays.sh\`. Closest hit for camera and diffuse bounce rays,"
   echo "any hit for shadow rays, on the SSG + DSG as the renderer builds them (frame time 0),"
   echo "640 x 480 camera rays through pixel centres of the scene's first camera; camera rays that"
   echo "miss are dropped from all sets. Our rate: kernel time from OpenCL profiling events,"

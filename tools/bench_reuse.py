@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Benchmark of light-path reuse (issue 5): reuse against retrace (and pathtrace for
+"""Benchmark of light-path reuse: reuse against retrace (and pathtrace for
 reference) on the demo animation and the large atrium, plus a small (C, N_L) sweep on the
 demo. Writes a markdown report.
 
@@ -29,7 +29,7 @@ from benchlib import (ATRIUM, REPO, ensure_atrium, fmt_rng, frame_breakdown, ker
 DEMO = REPO / "scenes" / "cornell-dynamic.gltf"
 MODES = ("reuse", "retrace", "pathtrace")
 PAPER_RATIO = 0.7   # "up to 30%" less time (paper, abstract and section 5)
-GOAL_RATIO = 0.5    # issue 5: reuse at most half the time of retrace
+GOAL_RATIO = 0.5    # the goal: reuse at most half the time of retrace
 
 
 def die(msg):
@@ -245,7 +245,7 @@ def render_report(args, argv, exe, scenes, results, sweep, loads, elapsed):
     now = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     cmd = "python3 tools/bench_reuse.py" + "".join(f" {a}" for a in argv)
     L = ["# Path-reuse benchmark: reuse against retrace", "",
-         "Written by `tools/bench_reuse.py` (issue 5). `--mode reuse` keeps light paths across "
+         "Written by `tools/bench_reuse.py`. `--mode reuse` keeps light paths across "
          "frames and re-traces only the slots that moving objects disturb; `--mode retrace` runs "
          "the same kernels but re-traces every slot every frame and gives identical images; "
          "`--mode pathtrace` is the unidirectional baseline. All three use the same settings; "

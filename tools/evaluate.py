@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Evaluation of pathreuse against the paper's claims (issue 6): time per frame of reuse,
+"""Evaluation of pathreuse against the paper's claims: time per frame of reuse,
 retrace and pathtrace (the paper's Figure 9), error against a high-sample reference, temporal
 flicker, equal-time and equal-error comparisons. Writes results.md, results.json and PNG plots.
 
@@ -758,7 +758,7 @@ def write_report(path, args, argv, scenes, res, gl, names, elapsed, loads, mp4s)
     now = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     cmd = "/usr/bin/python3 tools/evaluate.py" + "".join(f" {a}" for a in argv)
     L = ["# Evaluation: reuse, retrace and pathtrace against the paper's claims", "",
-         "Written by `tools/evaluate.py` (issue 6). The paper claims (a) about 30% less "
+         "Written by `tools/evaluate.py`. The paper claims (a) about 30% less "
          "computation than path tracing over an animation (its Figure 9) and (b) less temporal "
          "flicker at the same computing time (its Figures 6-8). This page measures both on our "
          "scenes.", "",

@@ -1,5 +1,5 @@
 // ray_bench: ray throughput of the SSG + DSG traversal (kernels/shared/bvh.h) on an OpenCL
-// device, with BVH build times and device memory (issue 4).
+// device, with BVH build times and device memory.
 //
 //   ray_bench SCENE.gltf [--frame-time T] [--width W --height H] [--repeats N] [--device SPEC]
 //             [--json FILE]
