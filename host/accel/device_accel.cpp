@@ -1,5 +1,7 @@
 #include "accel/device_accel.h"
 
+#include "cl/kernel_args.h"
+
 #include <algorithm>
 #include <vector>
 
@@ -49,17 +51,13 @@ void DeviceAccel::uploadFrame(Context& ctx, const DynamicAccel& dsg) {
   instanceCount_ = uint32_t(dsg.instances().size());
 }
 
-void DeviceAccel::setKernelArgs(Context& ctx, cl::Kernel& kernel, cl_uint first) {
+cl_uint DeviceAccel::setKernelArgs(Context& ctx, cl::Kernel& kernel, cl_uint first) {
   if (staticNodes_.bytes == 0) throw RuntimeError("DeviceAccel: static geometry not uploaded");
   for (Slot* s : {&tlasNodes_, &instances_, &meshNodes_, &meshTris_})
     if (s->bytes == 0) upload(ctx, *s, "dynamic geometry placeholder", nullptr, 0, false);
-  CL_CHECK(kernel.setArg(first + 0, staticNodes_.buffer));
-  CL_CHECK(kernel.setArg(first + 1, staticTris_.buffer));
-  CL_CHECK(kernel.setArg(first + 2, tlasNodes_.buffer));
-  CL_CHECK(kernel.setArg(first + 3, instances_.buffer));
-  CL_CHECK(kernel.setArg(first + 4, meshNodes_.buffer));
-  CL_CHECK(kernel.setArg(first + 5, meshTris_.buffer));
-  CL_CHECK(kernel.setArg(first + 6, cl_uint(instanceCount_)));
+  return pr::setKernelArgs(kernel, first, staticNodes_.buffer, staticTris_.buffer,
+                           tlasNodes_.buffer, instances_.buffer, meshNodes_.buffer,
+                           meshTris_.buffer, cl_uint(instanceCount_));
 }
 
 }  // namespace pr::accel

@@ -17,9 +17,10 @@ class DeviceAccel {
   // This frame's TLAS and instance records; buffers grow as needed and are reused.
   void uploadFrame(Context& ctx, const DynamicAccel& dsg);
 
-  // Sets the 7 arguments of PR_SCENE_GEOM_PARAMS from argument `first` on. Needs uploadStatic;
-  // missing DSG parts are bound as small placeholder buffers with instance count 0.
-  void setKernelArgs(Context& ctx, cl::Kernel& kernel, cl_uint first);
+  // Sets the arguments of PR_SCENE_GEOM_PARAMS from argument `first` on; returns the index after
+  // them. Needs uploadStatic; missing DSG parts are bound as small placeholder buffers with
+  // instance count 0.
+  cl_uint setKernelArgs(Context& ctx, cl::Kernel& kernel, cl_uint first);
 
   uint32_t instanceCount() const { return instanceCount_; }
   // Device bytes held: static part, meshes, per-frame part.

@@ -1,12 +1,12 @@
 #include "render/gpu_scene.h"
 
-#include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <cstring>
 
 #include <glm/gtc/matrix_inverse.hpp>
 
+#include "cl/kernel_args.h"
 #include "util/error.h"
 
 namespace pr {
@@ -109,7 +109,6 @@ dev::CameraParams toCameraParams(const CameraPose& pose, int width, int height) 
 
 GpuScene::GpuScene(Context& ctx, const Scene& scene, const GpuSceneOptions& options)
     : ctx_(ctx), scene_(scene), options_(options) {
-  const auto t0 = std::chrono::steady_clock::now();
   const TriangleMesh& sm = scene.staticMesh;
   staticTriangles_ = static_cast<uint32_t>(sm.triangleCount());
   ssg_.build(sm.positions, sm.indices);
@@ -120,7 +119,6 @@ GpuScene::GpuScene(Context& ctx, const Scene& scene, const GpuSceneOptions& opti
     dsg_.addMesh(m.positions, m.indices, next);
     next += static_cast<uint32_t>(m.triangleCount());
   }
-  bvhSeconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   deviceAccel_.uploadStatic(ctx_, ssg_);
   deviceAccel_.uploadMeshes(ctx_, dsg_);
   for (const Material& m : scene.materials)
@@ -291,7 +289,6 @@ void GpuScene::setTime(double t) {
   if (n > 0)
     CL_CHECK(ctx_.queue().enqueueWriteBuffer(shadingInstances_, CL_TRUE, 0,
                                              n * sizeof(dev::ShadingInstance), instances_.data()));
-  lightsChanged_ = firstFrame_ || (lightsAnimated_ && anyMoved_);
   if (firstFrame_ || lightsAnimated_) {
     buildLights(t);
   } else if (!lights_.empty() && lights_.front().moved) {
@@ -405,22 +402,12 @@ dev::CameraParams GpuScene::camera(int cameraIndex, double t, int width, int hei
 }
 
 cl_uint GpuScene::setKernelArgs(cl::Kernel& kernel, cl_uint first) {
-  deviceAccel_.setKernelArgs(ctx_, kernel, first);
-  cl_uint a = first + 7;
-  CL_CHECK(kernel.setArg(a++, vertices_));
-  CL_CHECK(kernel.setArg(a++, triangles_));
-  CL_CHECK(kernel.setArg(a++, shadingInstances_));
-  CL_CHECK(kernel.setArg(a++, materials_));
-  CL_CHECK(kernel.setArg(a++, textures_));
-  CL_CHECK(kernel.setArg(a++, texels_));
-  CL_CHECK(kernel.setArg(a++, lightBuffer_));
-  CL_CHECK(kernel.setArg(a++, cdfBuffer_));
-  CL_CHECK(kernel.setArg(a++, lightNodeBuffer_));
-  CL_CHECK(kernel.setArg(a++, primLightBuffer_));
-  CL_CHECK(kernel.setArg(a++, static_cast<cl_uint>(lights_.size())));
-  CL_CHECK(kernel.setArg(a++, static_cast<cl_uint>(treeLights_)));
-  CL_CHECK(kernel.setArg(a++, totalPower_));
-  return a;
+  const cl_uint shading = deviceAccel_.setKernelArgs(ctx_, kernel, first);
+  const cl_uint lights = pr::setKernelArgs(kernel, shading, vertices_, triangles_,
+                                           shadingInstances_, materials_, textures_, texels_);
+  return pr::setKernelArgs(kernel, lights, lightBuffer_, cdfBuffer_, lightNodeBuffer_,
+                           primLightBuffer_, static_cast<cl_uint>(lights_.size()),
+                           static_cast<cl_uint>(treeLights_), totalPower_);
 }
 
 std::string GpuScene::buildOptions() const {

@@ -42,10 +42,9 @@ class GpuScene {
   // The camera at time t for an image of width x height.
   dev::CameraParams camera(int cameraIndex, double t, int width, int height) const;
 
-  // Kernel arguments from `first` on, in this order: PR_SCENE_GEOM_PARAMS (7),
-  // PR_SHADING_PARAMS (6), PR_LIGHT_PARAMS (7). Returns the next free index.
+  // Kernel arguments from `first` on, in this order: PR_SCENE_GEOM_PARAMS, PR_SHADING_PARAMS,
+  // PR_LIGHT_PARAMS. Returns the next free index.
   cl_uint setKernelArgs(cl::Kernel& kernel, cl_uint first);
-  static constexpr cl_uint kArgCount = 20;
   // Build options every kernel that takes the scene is compiled with.
   std::string buildOptions() const;
   // The light-tracing selection table: running sums of every light's power at time 0, fixed for
@@ -57,18 +56,14 @@ class GpuScene {
   glm::vec3 sceneCentre() const { return sceneCentre_; }
 
   const Scene& scene() const { return scene_; }
-  uint32_t lightCount() const { return static_cast<uint32_t>(lights_.size()); }
-  float totalLightPower() const { return totalPower_; }
   const std::vector<dev::Light>& lights() const { return lights_; }
   const LightBvh& lightBvh() const { return lightBvh_; }
   // Whether shaded points choose lights with the light BVH (else by power).
   bool usesLightBvh() const { return useLightBvh_; }
   const std::vector<dev::ShadingInstance>& instances() const { return instances_; }
   bool anyInstanceMoved() const { return anyMoved_; }
-  bool lightsChanged() const { return lightsChanged_; }
   bool hasAlphaMaterials() const { return hasAlpha_; }
   uint64_t deviceBytes() const;
-  double bvhBuildSeconds() const { return bvhSeconds_; }
   const accel::StaticAccel& staticAccel() const { return ssg_; }
   const accel::DynamicAccel& dynamicAccel() const { return dsg_; }
 
@@ -84,7 +79,6 @@ class GpuScene {
   accel::StaticAccel ssg_;
   accel::DynamicAccel dsg_;
   accel::DeviceAccel deviceAccel_;
-  double bvhSeconds_ = 0.0;
 
   uint32_t staticTriangles_ = 0;
   std::vector<uint32_t> meshFirstTriangle_;  // per dynamic mesh, in the shading triangle array
@@ -115,7 +109,6 @@ class GpuScene {
   cl::Buffer traceCdfBuffer_;
   float sceneRadius_ = 1.0f;
   glm::vec3 sceneCentre_{0.0f};
-  bool lightsChanged_ = true;
   bool lightsAnimated_ = false;
 
   cl::Buffer vertices_, triangles_, shadingInstances_, materials_, textures_, texels_;

@@ -2,6 +2,7 @@
 
 #include <numeric>
 
+#include "cl/kernel_args.h"
 #include "render/path_tracer.h"
 #include "shared/reuse.h"
 #include "util/error.h"
@@ -57,22 +58,13 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
   rp.trace_total = scene_.traceTotalPower();
   rp.scene_radius = scene_.sceneRadius();
   rp.cx = scene_.sceneCentre().x, rp.cy = scene_.sceneCentre().y, rp.cz = scene_.sceneCentre().z;
-  const cl_uint a = GpuScene::kArgCount;
 
   // 1. Which slots must be traced again.
   cl_uint toTrace = slots_;
   const cl::Buffer* list = &allSlots_;
   if (!settings_.retraceAll && !first_) {
-    bool anyLightMoved = false;
-    for (const auto& l : scene_.lights()) anyLightMoved = anyLightMoved || l.moved;
-    scene_.setKernelArgs(invalidate_, 0);
-    CL_CHECK(invalidate_.setArg(a + 0, rp));
-    CL_CHECK(invalidate_.setArg(a + 1, cl_uint(scene_.anyInstanceMoved() ? 1 : 0)));
-    CL_CHECK(invalidate_.setArg(a + 2, headers_));
-    CL_CHECK(invalidate_.setArg(a + 3, vertices_));
-    CL_CHECK(invalidate_.setArg(a + 4, list_));
-    CL_CHECK(invalidate_.setArg(a + 5, counters_));
-    (void)anyLightMoved;
+    setKernelArgs(invalidate_, scene_.setKernelArgs(invalidate_, 0), rp,
+                  cl_uint(scene_.anyInstanceMoved() ? 1 : 0), headers_, vertices_, list_, counters_);
     ctx_.launch1D(invalidate_, slots_, "invalidate", &timer);
     CL_CHECK(ctx_.queue().enqueueReadBuffer(counters_, CL_TRUE, PR_C_LIST * 4, 4, &toTrace));
     list = &list_;
@@ -81,35 +73,21 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
 
   // 2. Trace them.
   if (toTrace > 0) {
-    scene_.setKernelArgs(lightTrace_, 0);
-    CL_CHECK(lightTrace_.setArg(a + 0, rp));
-    CL_CHECK(lightTrace_.setArg(a + 1, scene_.traceCdf()));
-    CL_CHECK(lightTrace_.setArg(a + 2, headers_));
-    CL_CHECK(lightTrace_.setArg(a + 3, vertices_));
-    CL_CHECK(lightTrace_.setArg(a + 4, *list));
-    CL_CHECK(lightTrace_.setArg(a + 5, toTrace));
-    CL_CHECK(lightTrace_.setArg(a + 6, counters_));
+    setKernelArgs(lightTrace_, scene_.setKernelArgs(lightTrace_, 0), rp, scene_.traceCdf(),
+                  headers_, vertices_, *list, toTrace, counters_);
     ctx_.launch1D(lightTrace_, toTrace, "light_trace", &timer);
   }
 
   // 3. Per sample: first hits, then connections, then the film.
-  scene_.setKernelArgs(eyeHit_, 0);
-  CL_CHECK(eyeHit_.setArg(a + 0, rp));
-  CL_CHECK(eyeHit_.setArg(a + 1, camera));
-  CL_CHECK(eyeHit_.setArg(a + 3, eye_));
-  CL_CHECK(eyeHit_.setArg(a + 4, radiance_));
-  CL_CHECK(eyeHit_.setArg(a + 5, counters_));
-  scene_.setKernelArgs(connect_, 0);
-  CL_CHECK(connect_.setArg(a + 0, rp));
-  CL_CHECK(connect_.setArg(a + 2, eye_));
-  CL_CHECK(connect_.setArg(a + 3, headers_));
-  CL_CHECK(connect_.setArg(a + 4, vertices_));
-  CL_CHECK(connect_.setArg(a + 5, radiance_));
-  CL_CHECK(connect_.setArg(a + 6, counters_));
+  // `sample` changes per pass.
+  const cl_uint eyeSample = setKernelArgs(eyeHit_, scene_.setKernelArgs(eyeHit_, 0), rp, camera);
+  setKernelArgs(eyeHit_, eyeSample + 1, eye_, radiance_, counters_);
+  const cl_uint connectSample = setKernelArgs(connect_, scene_.setKernelArgs(connect_, 0), rp);
+  setKernelArgs(connect_, connectSample + 1, eye_, headers_, vertices_, radiance_, counters_);
   const cl_uint n = film_.pixels();
   for (int s = 0; s < settings_.spp; ++s) {
-    CL_CHECK(eyeHit_.setArg(a + 2, cl_uint(s)));
-    CL_CHECK(connect_.setArg(a + 1, cl_uint(s)));
+    CL_CHECK(eyeHit_.setArg(eyeSample, cl_uint(s)));
+    CL_CHECK(connect_.setArg(connectSample, cl_uint(s)));
     ctx_.launch1D(eyeHit_, n, "eye_hit", &timer);
     ctx_.launch1D(connect_, n, "connect", &timer);
     film_.accumulate(radiance_, n, &timer);

@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include "cl/kernel_args.h"
 #include "shared/path_state.h"
 #include "util/interrupt.h"
 
@@ -34,35 +35,17 @@ void PathTracer::renderFrame(int frame, const dev::CameraParams& camera, FrameSt
   const cl_uint n = film_.pixels();
   const cl_uint rngFrame = settings_.fixedNoise ? 0 : cl_uint(frame);
   ctx_.zero(rays_, 16);
-  const cl_uint first = GpuScene::kArgCount;
-  scene_.setKernelArgs(extend_, 0);
-  scene_.setKernelArgs(shade_, 0);
-  scene_.setKernelArgs(shadow_, 0);
-  CL_CHECK(extend_.setArg(first + 0, states_));
-  CL_CHECK(extend_.setArg(first + 1, hits_));
-  CL_CHECK(extend_.setArg(first + 2, rays_));
-  CL_CHECK(extend_.setArg(first + 3, n));
-  CL_CHECK(shade_.setArg(first + 0, states_));
-  CL_CHECK(shade_.setArg(first + 1, hits_));
-  CL_CHECK(shade_.setArg(first + 2, radiance_));
-  CL_CHECK(shade_.setArg(first + 3, shadows_));
-  CL_CHECK(shade_.setArg(first + 4, n));
-  CL_CHECK(shade_.setArg(first + 5, settings_.seed));
-  CL_CHECK(shade_.setArg(first + 6, rngFrame));
-  CL_CHECK(shade_.setArg(first + 8, cl_uint(settings_.maxDepth)));
-  CL_CHECK(shadow_.setArg(first + 0, radiance_));
-  CL_CHECK(shadow_.setArg(first + 1, shadows_));
-  CL_CHECK(shadow_.setArg(first + 2, rays_));
-  CL_CHECK(shadow_.setArg(first + 3, n));
-  CL_CHECK(generate_.setArg(0, camera));
-  CL_CHECK(generate_.setArg(1, settings_.seed));
-  CL_CHECK(generate_.setArg(2, rngFrame));
-  CL_CHECK(generate_.setArg(4, states_));
-  CL_CHECK(generate_.setArg(5, radiance_));
-  CL_CHECK(generate_.setArg(6, n));
+  // Each kernel's own arguments follow the scene's (PR_SCENE_PARAMS); `sample` changes per pass.
+  setKernelArgs(extend_, scene_.setKernelArgs(extend_, 0), states_, hits_, rays_, n);
+  const cl_uint shadeSample = setKernelArgs(shade_, scene_.setKernelArgs(shade_, 0), states_, hits_,
+                                            radiance_, shadows_, n, settings_.seed, rngFrame);
+  setKernelArgs(shade_, shadeSample + 1, cl_uint(settings_.maxDepth));
+  setKernelArgs(shadow_, scene_.setKernelArgs(shadow_, 0), radiance_, shadows_, rays_, n);
+  const cl_uint generateSample = setKernelArgs(generate_, 0, camera, settings_.seed, rngFrame);
+  setKernelArgs(generate_, generateSample + 1, states_, radiance_, n);
   for (int s = 0; s < settings_.spp; ++s) {
-    CL_CHECK(generate_.setArg(3, cl_uint(s)));
-    CL_CHECK(shade_.setArg(first + 7, cl_uint(s)));
+    CL_CHECK(generate_.setArg(generateSample, cl_uint(s)));
+    CL_CHECK(shade_.setArg(shadeSample, cl_uint(s)));
     ctx_.launch1D(generate_, n, "generate", &timer);
     for (int d = 0; d < settings_.maxDepth; ++d) {
       ctx_.launch1D(extend_, n, "extend", &timer);
