@@ -1,5 +1,6 @@
 #include "render/gpu_scene.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstring>
@@ -356,28 +357,31 @@ std::vector<dev::Light> GpuScene::lightsAt(double t) const {
 
 void GpuScene::buildLights(double t) {
   std::vector<dev::Light> next = lightsAt(t);
-  for (size_t i = 0; i < next.size(); ++i)
-    next[i].moved = (lights_.size() != next.size() || !sameGeometry(lights_[i], next[i])) ? 1u : 0u;
+  const bool sameTable = lights_.size() == next.size();
+  for (size_t i = 0; i < next.size(); ++i) {
+    next[i].moved = (!sameTable || !sameGeometry(lights_[i], next[i])) ? 1u : 0u;
+    if (sameTable) next[i].leaf = lights_[i].leaf;  // the tree keeps its leaves
+  }
   lights_ = std::move(next);
   totalPower_ = runningSums(lights_, &cdf_);
+  // The light BVH: built and uploaded once (an empty one where lights are chosen by power),
+  // refitted and uploaded again only when a light moved. Its size never changes.
   if (!lightBvhBuilt_) {
     treeLights_ = 0;
     while (treeLights_ < lights_.size() && lights_[treeLights_].type != PR_LIGHT_DIRECTIONAL)
       ++treeLights_;
-    lightBvh_.build(&lights_, treeLights_);
+    lightBvh_.build(&lights_, useLightBvh_ ? treeLights_ : 0u);
     lightBvhBuilt_ = true;
-  } else {
+    lightNodeBytes_ = lightBvh_.nodes().size() * sizeof(dev::LightNode);
+    lightNodeBuffer_ = ctx_.allocate("light BVH", lightNodeBytes_, CL_MEM_READ_ONLY);
+    CL_CHECK(ctx_.queue().enqueueWriteBuffer(lightNodeBuffer_, CL_TRUE, 0, lightNodeBytes_,
+                                             lightBvh_.nodes().data()));
+  } else if (useLightBvh_ && std::any_of(lights_.begin(), lights_.end(),
+                                         [](const dev::Light& l) { return l.moved != 0u; })) {
     lightBvh_.refit(&lights_);
+    CL_CHECK(ctx_.queue().enqueueWriteBuffer(lightNodeBuffer_, CL_TRUE, 0, lightNodeBytes_,
+                                             lightBvh_.nodes().data()));
   }
-  const std::vector<dev::LightNode>& nodes = lightBvh_.nodes();
-  if (nodes.size() > lightNodeCapacity_) {
-    if (lightNodeCapacity_) ctx_.release(lightNodeCapacity_ * sizeof(dev::LightNode));
-    lightNodeCapacity_ = nodes.size();
-    lightNodeBuffer_ = ctx_.allocate("light BVH", nodes.size() * sizeof(dev::LightNode),
-                                     CL_MEM_READ_ONLY);
-  }
-  CL_CHECK(ctx_.queue().enqueueWriteBuffer(lightNodeBuffer_, CL_TRUE, 0,
-                                           nodes.size() * sizeof(dev::LightNode), nodes.data()));
 
   const size_t count = std::max<size_t>(lights_.size(), 1);
   if (count > lightCapacity_) {
@@ -419,7 +423,7 @@ std::string GpuScene::buildOptions() const {
 
 uint64_t GpuScene::deviceBytes() const {
   return deviceAccel_.staticBytes() + deviceAccel_.meshBytes() + deviceAccel_.frameBytes() +
-         shadingBytes_ + instanceBytes_ + lightBytes_ + lightNodeCapacity_ * sizeof(dev::LightNode);
+         shadingBytes_ + instanceBytes_ + lightBytes_ + lightNodeBytes_;
 }
 
 }  // namespace pr

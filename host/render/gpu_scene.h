@@ -57,9 +57,6 @@ class GpuScene {
 
   const Scene& scene() const { return scene_; }
   const std::vector<dev::Light>& lights() const { return lights_; }
-  const LightBvh& lightBvh() const { return lightBvh_; }
-  // Whether shaded points choose lights with the light BVH (else by power).
-  bool usesLightBvh() const { return useLightBvh_; }
   const std::vector<dev::ShadingInstance>& instances() const { return instances_; }
   bool anyInstanceMoved() const { return anyMoved_; }
   bool hasAlphaMaterials() const { return hasAlpha_; }
@@ -113,7 +110,7 @@ class GpuScene {
 
   cl::Buffer vertices_, triangles_, shadingInstances_, materials_, textures_, texels_;
   cl::Buffer lightBuffer_, cdfBuffer_, lightNodeBuffer_, primLightBuffer_;
-  size_t lightNodeCapacity_ = 0;
+  uint64_t lightNodeBytes_ = 0;
   uint64_t shadingBytes_ = 0, instanceBytes_ = 0, lightBytes_ = 0;
   size_t lightCapacity_ = 0, instanceCapacity_ = 0;
 };

@@ -62,7 +62,7 @@ PR_INLINE float light_node_importance(PR_GLOBAL const LightNode* node, float3 p,
     if (cos_p <= node->cos_e) return 0.0f;
   }
   float importance = power * cos_p * inv_d2;
-  if (n.x != 0.0f || n.y != 0.0f || n.z != 0.0f) {
+  if (has_normal(n)) {
     // One-sided: every non-delta BSDF here reflects, so only light above n can be received.
     const float cos_i = clamp(-dot(wi, n), -1.0f, 1.0f);
     if (cos_i < cos_b) {

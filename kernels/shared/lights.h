@@ -26,15 +26,12 @@ typedef struct {
   float le_r, le_g, le_b;  // radiance factor (triangle), intensity in cd (point, spot), or lux
   float area;              // world area (triangle)
   float cos_inner, cos_outer;  // spot cone
-  float power;                 // selection weight by power: emitter_power() for triangles
+  float power;                 // selection weight by power: light_power()
   u32 material;
   u32 moved;  // changed since the previous frame (for invalidation)
   u32 leaf;   // the light's node in the light BVH; PR_INVALID_INDEX for directional lights
   float pad2, pad3;
 } Light;
-
-// The selection weight of an emissive triangle: luminance(Le) * pi * area.
-PR_INLINE float emitter_power(float3 le, float area) { return luminance(le) * PR_PI * area; }
 
 // A sampled point on a light, as seen from a reference point.
 typedef struct {
@@ -174,8 +171,6 @@ PR_INLINE CosineWarp cosine_warp(const SphericalTriangle* t, float3 n) {
   return c;
 }
 
-PR_INLINE int has_normal(float3 n) { return n.x != 0.0f || n.y != 0.0f || n.z != 0.0f; }
-
 // Barycentrics (b1 for v0 + e1, b2 for v0 + e2) where the ray p + t w meets the triangle's
 // plane, kept inside the triangle against round-off.
 PR_INLINE float2 triangle_barycentrics_along(float3 p, float3 w, float3 v0, float3 e1, float3 e2) {
@@ -264,7 +259,7 @@ PR_INLINE int light_sample(const Light* l, float pmf, float3 ref, float3 n_ref, 
 // power tables and the light BVH from it.
 PR_INLINE float light_power(const Light* l, float scene_radius) {
   const float lum = luminance(make_float3(l->le_r, l->le_g, l->le_b));
-  if (l->type == PR_LIGHT_TRIANGLE) return emitter_power(make_float3(l->le_r, l->le_g, l->le_b), l->area);
+  if (l->type == PR_LIGHT_TRIANGLE) return lum * PR_PI * l->area;
   if (l->type == PR_LIGHT_POINT) return 4.0f * PR_PI * lum;
   if (l->type == PR_LIGHT_SPOT)
     return 2.0f * PR_PI * (1.0f - 0.5f * (l->cos_inner + l->cos_outer)) * lum;

@@ -144,6 +144,8 @@ PR_INLINE float3 pr_load3(PR_GLOBAL const float* p) { return make_float3(p[0], p
 PR_INLINE float max3(float3 v) { return fmax(v.x, fmax(v.y, v.z)); }
 PR_INLINE float min3(float3 v) { return fmin(v.x, fmin(v.y, v.z)); }
 PR_INLINE float luminance(float3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+// Whether a normal was given (the zero vector stands for none).
+PR_INLINE int has_normal(float3 n) { return n.x != 0.0f || n.y != 0.0f || n.z != 0.0f; }
 
 // An orthonormal basis around unit n (Duff et al. 2017, branchless).
 PR_INLINE void orthonormal_basis(float3 n, float3* t, float3* b) {
