@@ -98,6 +98,13 @@ int main(int argc, char** argv) {
                    "where the scene has more than 16 lights)")
       ->check(CLI::IsMember({"auto", "bvh", "power"}))
       ->capture_default_str();
+  std::string bvhWidthText = "auto";
+  render
+      ->add_option("--bvh-width", bvhWidthText,
+                   "Children per BVH node: 8 (float8 slab tests, for CPUs), 2 (both children's "
+                   "boxes in one node, for GPUs), 4, or auto (8 on CPUs, 2 on GPUs)")
+      ->check(CLI::IsMember({"auto", "2", "4", "8"}))
+      ->capture_default_str();
   render->add_option("--light-paths", ro.lightPaths,
                      "Light-path slots kept in the arena (reuse/retrace; default: one per pixel)");
   render
@@ -216,6 +223,7 @@ int main(int argc, char** argv) {
       ro.lightSampler = lightSamplerText == "bvh"     ? pr::LightSampler::Bvh
                         : lightSamplerText == "power" ? pr::LightSampler::Power
                                                       : pr::LightSampler::Auto;
+      ro.bvhWidth = bvhWidthText == "auto" ? 0 : std::stoi(bvhWidthText);
       return pr::runRender(ro);
     }
     if (*portability) {

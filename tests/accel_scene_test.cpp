@@ -1,14 +1,18 @@
 // The renderer's own BVHs of real scenes against a brute-force loop over every triangle: the
-// SSG of cornell-nvpro and the SSG + DSG of animated scenes at several frames.
+// SSG of cornell-nvpro and the SSG + DSG of animated scenes at several frames, traversed by the
+// CPU reference and on the device in every BVH layout.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <random>
 
 #include "accel/scene_accel.h"
 #include "render/gpu_scene.h"
 #include "scene/gltf_loader.h"
 #include "shared/bvh.h"
+#include "support/render_helpers.h"
+#include "support/trace_rays.h"
 #include "support/test_env.h"
 
 namespace pr {
@@ -33,10 +37,27 @@ void bruteForce(const std::vector<BvhTriangle>& tris, dev::float3 o, dev::float3
   }
 }
 
+// The same nearest hit: same triangle and t within 1e-5, or two triangles at the very same
+// distance (coincident faces), which may legitimately swap.
+bool sameHit(const Hit& got, const Hit& want) {
+  const bool same = got.prim == want.prim && got.inst == want.inst &&
+                    (want.prim == PR_INVALID_INDEX || std::fabs(got.t - want.t) <= 1e-5f * want.t);
+  const bool tie = got.prim != PR_INVALID_INDEX && want.prim != PR_INVALID_INDEX &&
+                   std::fabs(got.t - want.t) <= 1e-6f * want.t;
+  return same || tie;
+}
+
 void expectSceneMatchesBruteForce(const std::string& path, const std::vector<double>& times, size_t rays) {
   const Scene scene = loadScene(path);
   Context& ctx = test::testContext();
   GpuScene gpu(ctx, scene);
+  // The same scene in every layout a device may get, traced on the test device.
+  std::vector<std::unique_ptr<GpuScene>> layouts;
+  for (int width : {2, 4, 8}) {
+    GpuSceneOptions o;
+    o.bvhWidth = width;
+    layouts.push_back(std::make_unique<GpuScene>(ctx, scene, o));
+  }
   // SSG triangles, numbered as the renderer numbers them.
   std::vector<BvhTriangle> ssg;
   const TriangleMesh& sm = scene.staticMesh;
@@ -63,16 +84,13 @@ void expectSceneMatchesBruteForce(const std::string& path, const std::vector<dou
   int hits = 0, failures = 0, dynamicHits = 0;
   for (double t : times) {
     gpu.setTime(t);
+    for (auto& l : layouts) l->setTime(t);
+    std::vector<Ray> traced;
+    std::vector<Hit> wanted;
     const accel::StaticAccel& sa = gpu.staticAccel();
     const accel::DynamicAccel& da = gpu.dynamicAccel();
-    dev::SceneGeom g{};
-    g.static_nodes = sa.nodes().data();
-    g.static_tris = sa.triangles().data();
-    g.tlas_nodes = da.tlasNodes().data();
-    g.instances = da.instances().data();
-    g.mesh_nodes = da.meshNodes().data();
-    g.mesh_tris = da.meshTriangles().data();
-    g.instance_count = static_cast<uint32_t>(da.instances().size());
+    const accel::HostGeom hg(sa, &da);
+    const dev::SceneGeom g = hg.geom();
     const CameraPose cam = scene.cameraAt(0, t);
     for (size_t r = 0; r < rays; ++r) {
       // Half from the camera through the view, half between random points of the bounds.
@@ -98,17 +116,25 @@ void expectSceneMatchesBruteForce(const std::string& path, const std::vector<dou
         const dev::BvhRay local = dev::instance_ray(&rec, &world);
         bruteForce(meshes[rec.mesh], local.o, local.d, 0.0f, rec.instance_id, &want);
       }
-      const bool same = got.prim == want.prim && got.inst == want.inst &&
-                        (want.prim == PR_INVALID_INDEX || std::fabs(got.t - want.t) <= 1e-5f * want.t);
-      // Two triangles at the very same distance (coincident faces) may legitimately swap.
-      const bool tie = !same && got.prim != PR_INVALID_INDEX && want.prim != PR_INVALID_INDEX &&
-                       std::fabs(got.t - want.t) <= 1e-6f * want.t;
       hits += want.prim != PR_INVALID_INDEX;
       dynamicHits += want.inst != PR_INVALID_INDEX;
-      if (!same && !tie && ++failures <= 5)
+      if (!sameHit(got, want) && ++failures <= 5)
         ADD_FAILURE() << path << " t=" << t << " ray " << r << ": got prim " << got.prim << " inst " << got.inst
                       << " t " << got.t << ", want prim " << want.prim << " inst " << want.inst << " t "
                       << want.t;
+      traced.push_back(ray);
+      wanted.push_back(want);
+    }
+    for (auto& l : layouts) {
+      const std::vector<Hit> got = test::traceRays(l->deviceAccel(), traced, 0).hits;
+      int wrong = 0;
+      for (size_t i = 0; i < got.size(); ++i) {
+        if (sameHit(got[i], wanted[i]) || ++wrong > 5) continue;
+        ADD_FAILURE() << path << " t=" << t << " width " << l->bvhWidth() << " ray " << i << ": got prim "
+                      << got[i].prim << " inst " << got[i].inst << " t " << got[i].t << ", want prim "
+                      << wanted[i].prim << " inst " << wanted[i].inst << " t " << wanted[i].t;
+      }
+      EXPECT_EQ(wrong, 0) << "width " << l->bvhWidth();
     }
   }
   EXPECT_EQ(failures, 0);
@@ -126,6 +152,25 @@ TEST(SceneAccel, CornellNvproMatchesBruteForce) {
 
 TEST(SceneAccel, AnimatedDemoMatchesBruteForceAtSeveralFrames) {
   expectSceneMatchesBruteForce(test::sourcePath("scenes/cornell-dynamic.gltf"), {0.0, 1.3, 2.6, 4.9}, 2000);
+}
+
+TEST(SceneAccel, OrbitDemoMatchesBruteForceAtSeveralFrames) {
+  expectSceneMatchesBruteForce(test::sourcePath("scenes/cornell-orbit.gltf"), {0.0, 2.1, 4.0}, 2000);
+}
+
+// Every layout renders the demo's frames bit for bit the same (its rays never fall exactly
+// between two triangles at the same distance).
+TEST(SceneAccel, EveryBvhWidthRendersTheDemoAlike) {
+  const std::string scene = test::sourcePath("scenes/cornell-dynamic.gltf");
+  const std::string args = "--mode reuse --width 48 --height 36 --spp 2";
+  const std::string ref = test::renderFrames(scene, "0-1", args + " --bvh-width 8", "bvh8");
+  for (const char* width : {"2", "4"}) {
+    const std::string dir = test::renderFrames(scene, "0-1", args + " --bvh-width " + width,
+                                               std::string("bvh") + width);
+    for (int f = 0; f <= 1; ++f)
+      EXPECT_TRUE(test::frameImage(dir, f).rgba == test::frameImage(ref, f).rgba)
+          << "width " << width << " frame " << f;
+  }
 }
 
 TEST(SceneAccel, BoxAnimatedMatchesBruteForceAtSeveralFrames) {

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <random>
 #include <string>
 #include <vector>
@@ -17,6 +18,7 @@
 #include "accel/scene_accel.h"
 #include "shared/bvh.h"
 #include "support/test_env.h"
+#include "support/trace_rays.h"
 
 namespace pr {
 namespace {
@@ -113,20 +115,6 @@ Hit bruteForce(const std::vector<BvhTriangle>& tris, Ray ray, uint32_t inst = PR
   return best;
 }
 
-SceneGeom cpuGeom(const StaticAccel& s, const DynamicAccel* d) {
-  SceneGeom g{};
-  g.static_nodes = s.nodes().data();
-  g.static_tris = s.triangles().data();
-  if (d) {
-    g.tlas_nodes = d->tlasNodes().data();
-    g.instances = d->instances().data();
-    g.mesh_nodes = d->meshNodes().data();
-    g.mesh_tris = d->meshTriangles().data();
-    g.instance_count = uint32_t(d->instances().size());
-  }
-  return g;
-}
-
 bool relClose(float a, float b, float rel) { return std::fabs(a - b) <= rel * std::fmax(std::fabs(a), std::fabs(b)); }
 
 // Compares closest hits; failures are counted and the first few described.
@@ -148,16 +136,16 @@ struct HitChecker {
 // Builder
 
 // Every node's box holds its children's boxes / its triangles; every triangle is in one leaf.
-void checkStructure(const std::vector<dev::BvhNode>& nodes, const std::vector<BvhTriangle>& tris) {
+void checkStructure(const std::vector<BinaryNode>& nodes, const std::vector<BvhTriangle>& tris) {
   ASSERT_FALSE(nodes.empty());
   EXPECT_LE(bvhDepth(nodes), PR_BVH_STACK_SIZE);
   std::vector<int> seen(tris.size(), 0);
-  auto inside = [](const dev::BvhNode& outer, const dev::BvhNode& inner) {
+  auto inside = [](const BinaryNode& outer, const BinaryNode& inner) {
     return outer.lo_x <= inner.lo_x && outer.lo_y <= inner.lo_y && outer.lo_z <= inner.lo_z &&
            outer.hi_x >= inner.hi_x && outer.hi_y >= inner.hi_y && outer.hi_z >= inner.hi_z;
   };
   for (uint32_t i = 0; i < nodes.size(); ++i) {
-    const dev::BvhNode& n = nodes[i];
+    const BinaryNode& n = nodes[i];
     if (n.meta & PR_BVH_LEAF_BIT) {
       const uint32_t count = n.meta & ~PR_BVH_LEAF_BIT;
       EXPECT_LE(count, 4u);
@@ -182,6 +170,118 @@ void checkStructure(const std::vector<dev::BvhNode>& nodes, const std::vector<Bv
   for (size_t k = 0; k < seen.size(); ++k) ASSERT_EQ(seen[k], 1) << "triangle slot " << k;
 }
 
+// Exponentially spaced triangles make SAH peel one off at a time: a chain far deeper than the
+// stack unless the depth cap steps in.
+Soup exponentialSoup(size_t n) {
+  Soup s;
+  float x = 1.0f;
+  for (size_t t = 0; t < n; ++t, x *= 1.5f) {
+    const float w = x * 0.01f;
+    for (const glm::vec3 p : {glm::vec3(x, 0, 0), glm::vec3(x + w, 0, w), glm::vec3(x, w, w)}) {
+      s.positions.push_back(p);
+      s.indices.push_back(uint32_t(s.positions.size() - 1));
+    }
+  }
+  return s;
+}
+
+float wideBoundOf(const WideBvh& w, uint32_t node, int b, int i) {
+  float f;
+  std::memcpy(&f, &w.words[wideBound(w.width, node, b, i)], 4);
+  return f;
+}
+
+// The wide tree: every child box holds what lies below it, every leaf is one packet referenced
+// once, every triangle sits in exactly one packet lane, unused slots and lanes are inert, and
+// no path needs more stack than the traversal has.
+void checkWide(const TriangleBvh& t) {
+  const WideBvh& w = t.wide;
+  ASSERT_GT(w.nodeCount(), 0u);
+  EXPECT_LE(w.stackNeed, PR_BVH_STACK_SIZE);
+  ASSERT_EQ(t.packets.size(), w.leaves.size());
+  std::vector<int> packetSeen(t.packets.size(), 0), nodeSeen(w.nodeCount(), 0);
+  std::vector<int> primSeen(t.triangles.size() + 1, 0);
+  uint32_t primMax = 0;
+  for (const auto& tri : t.triangles) primMax = std::max(primMax, tri.prim);
+  primSeen.assign(size_t(primMax) + 1, 0);
+  // Box of a subtree's triangles, from its packets.
+  std::function<Aabb(uint32_t)> content = [&](uint32_t ref) {
+    Aabb box;
+    if (ref & PR_BVH_LEAF_BIT) {
+      const dev::BvhTriPacket& p = t.packets[ref & ~PR_BVH_LEAF_BIT];
+      for (int l = 0; l < PR_BVH_PACKET; ++l) {
+        if (p.prim[l] == PR_INVALID_INDEX) {
+          EXPECT_EQ(p.e1x[l] * p.e2y[l] - p.e1y[l] * p.e2x[l], 0.0f);
+          continue;
+        }
+        const glm::vec3 v0(p.v0x[l], p.v0y[l], p.v0z[l]);
+        box.grow(v0);
+        box.grow(v0 + glm::vec3(p.e1x[l], p.e1y[l], p.e1z[l]));
+        box.grow(v0 + glm::vec3(p.e2x[l], p.e2y[l], p.e2z[l]));
+      }
+      return box;
+    }
+    for (int i = 0; i < w.width; ++i) {
+      const uint32_t c = w.words[wideChild(w.width, ref, i)];
+      if (c == PR_INVALID_INDEX) {
+        EXPECT_EQ(wideBoundOf(w, ref, 0, i), INFINITY);
+        EXPECT_EQ(wideBoundOf(w, ref, 1, i), -INFINITY);
+        continue;
+      }
+      const Aabb inner = content(c);
+      const float eps = 1e-6f * (1.0f + glm::length(inner.hi) + glm::length(inner.lo));
+      for (int a = 0; a < 3; ++a) {
+        EXPECT_LE(wideBoundOf(w, ref, 2 * a, i), inner.lo[a] + eps) << "node " << ref << " child " << i;
+        EXPECT_GE(wideBoundOf(w, ref, 2 * a + 1, i), inner.hi[a] - eps) << "node " << ref << " child " << i;
+      }
+      box.grow(inner);
+      if (c & PR_BVH_LEAF_BIT) {
+        ++packetSeen[c & ~PR_BVH_LEAF_BIT];
+        const dev::BvhTriPacket& p = t.packets[c & ~PR_BVH_LEAF_BIT];
+        for (int l = 0; l < PR_BVH_PACKET; ++l)
+          if (p.prim[l] != PR_INVALID_INDEX) ++primSeen[p.prim[l]];
+      } else {
+        EXPECT_GT(c, ref) << "children follow their parent";
+        ++nodeSeen[c];
+      }
+    }
+    return box;
+  };
+  content(0);
+  for (size_t k = 1; k < nodeSeen.size(); ++k) EXPECT_EQ(nodeSeen[k], 1) << "node " << k;
+  for (size_t k = 0; k < packetSeen.size(); ++k) EXPECT_EQ(packetSeen[k], 1) << "packet " << k;
+  for (const auto& tri : t.triangles) EXPECT_EQ(primSeen[tri.prim], 1) << "prim " << tri.prim;
+}
+
+TEST(BvhBuild, WideTreesOfEveryWidth) {
+  for (int width : {2, 4, 8}) {
+    for (size_t n : {0, 1, 3, 5, 100, 3000}) {
+      SCOPED_TRACE("width " + std::to_string(width) + ", n = " + std::to_string(n));
+      const Soup s = randomSoup(n, 0.1f, 21 + uint32_t(n));
+      BuildOptions o;
+      o.width = width;
+      const TriangleBvh t = buildTriangleBvh(s.positions, s.indices, 7, o, "soup");
+      EXPECT_EQ(t.wide.width, width);
+      checkWide(t);
+      if (n > 100) {
+        // The collapse opens children until `width` are gathered: no node of one child, and
+        // more than 3 children on average once nodes may hold 4 or more.
+        const double children = double(t.wide.nodeCount() - 1 + t.packets.size());
+        const double fill = children / double(t.wide.nodeCount());
+        EXPECT_GE(fill, width == 2 ? 1.99 : 3.0) << fill;
+      }
+    }
+  }
+  // The deepest chain SAH can make still fits the stack at every width (the depth cap is
+  // lowered until it does).
+  const Soup deep = exponentialSoup(150);
+  for (int width : {2, 4, 8}) {
+    BuildOptions o;
+    o.width = width;
+    checkWide(buildTriangleBvh(deep.positions, deep.indices, 0, o, "deep"));
+  }
+}
+
 TEST(BvhBuild, StructureOfRandomSoups) {
   for (size_t n : {0, 1, 2, 5, 100, 3000}) {
     SCOPED_TRACE("n = " + std::to_string(n));
@@ -202,13 +302,16 @@ TEST(BvhBuild, ThreadedBuildEqualsSerialBuild) {
   serial.threads = false;
   const TriangleBvh a = buildTriangleBvh(s.positions, s.indices, 0, serial, "serial");
   const TriangleBvh b = buildTriangleBvh(s.positions, s.indices, 0, BuildOptions{}, "threaded");
-  ASSERT_EQ(a.nodes.size(), b.nodes.size());
-  EXPECT_EQ(std::memcmp(a.nodes.data(), b.nodes.data(), a.nodes.size() * sizeof(dev::BvhNode)), 0);
+  ASSERT_EQ(a.binary.size(), b.binary.size());
+  EXPECT_EQ(std::memcmp(a.binary.data(), b.binary.data(), a.binary.size() * sizeof(BinaryNode)), 0);
+  EXPECT_EQ(a.wide.words, b.wide.words);
+  ASSERT_EQ(a.packets.size(), b.packets.size());
+  EXPECT_EQ(std::memcmp(a.packets.data(), b.packets.data(), a.packets.size() * sizeof(dev::BvhTriPacket)), 0);
   ASSERT_EQ(a.triangles.size(), b.triangles.size());
   EXPECT_EQ(std::memcmp(a.triangles.data(), b.triangles.data(), a.triangles.size() * sizeof(BvhTriangle)), 0);
   EXPECT_EQ(a.stats.depth, b.stats.depth);
   EXPECT_EQ(a.stats.leaves, b.stats.leaves);
-  checkStructure(b.nodes, b.triangles);
+  checkStructure(b.binary, b.triangles);
 }
 
 TEST(BvhBuild, RejectsBadInput) {
@@ -219,21 +322,6 @@ TEST(BvhBuild, RejectsBadInput) {
   BuildOptions o;
   o.maxDepth = PR_BVH_STACK_SIZE + 1;
   EXPECT_THROW(buildBvh({}, o), RuntimeError);
-}
-
-// Exponentially spaced triangles make SAH peel one off at a time: a chain far deeper than the
-// stack unless the depth cap steps in.
-Soup exponentialSoup(size_t n) {
-  Soup s;
-  float x = 1.0f;
-  for (size_t t = 0; t < n; ++t, x *= 1.5f) {
-    const float w = x * 0.01f;
-    for (const glm::vec3 p : {glm::vec3(x, 0, 0), glm::vec3(x + w, 0, w), glm::vec3(x, w, w)}) {
-      s.positions.push_back(p);
-      s.indices.push_back(uint32_t(s.positions.size() - 1));
-    }
-  }
-  return s;
 }
 
 TEST(BvhBuild, DepthNeverExceedsTheStack) {
@@ -249,7 +337,8 @@ TEST(BvhBuild, DepthNeverExceedsTheStack) {
   a.build(s.positions, s.indices, o);
   EXPECT_LE(a.stats().depth, 10);
   checkStructure(a.nodes(), a.triangles());
-  const SceneGeom g = cpuGeom(a, nullptr);
+  const HostGeom hg(a, nullptr);
+    const SceneGeom g = hg.geom();
   const auto tris = packSoup(s);
   HitChecker c;
   const auto rays = randomRays(500, triangleCentres(s), 9);
@@ -267,7 +356,8 @@ TEST(BvhBuild, DepthNeverExceedsTheStack) {
 void expectStaticMatchesBruteForce(const Soup& s, size_t rayCount, uint32_t seed, bool exactPrim) {
   StaticAccel a;
   a.build(s.positions, s.indices);
-  const SceneGeom g = cpuGeom(a, nullptr);
+  const HostGeom hg(a, nullptr);
+    const SceneGeom g = hg.geom();
   const auto tris = packSoup(s);
   const auto rays = randomRays(rayCount, triangleCentres(s), seed);
   HitChecker c;
@@ -358,7 +448,8 @@ TEST(StaticTraversal, DegenerateSoups) {
 TEST(StaticTraversal, EmptySceneHitsNothing) {
   StaticAccel a;
   a.build({}, {});
-  const SceneGeom g = cpuGeom(a, nullptr);
+  const HostGeom hg(a, nullptr);
+    const SceneGeom g = hg.geom();
   Hit h;
   EXPECT_EQ(dev::intersect_scene(&g, makeRay({0, 0, 0}, {0, 0, 1}, 0.0f, PR_INF_F), &h), 0);
   EXPECT_EQ(h.prim, PR_INVALID_INDEX);
@@ -377,7 +468,8 @@ TEST(StaticTraversal, AxisAlignedRaysAndFaces) {
     }
   StaticAccel a;
   a.build(s.positions, s.indices);
-  const SceneGeom g = cpuGeom(a, nullptr);
+  const HostGeom hg(a, nullptr);
+    const SceneGeom g = hg.geom();
   const auto tris = packSoup(s);
   HitChecker c;
   std::mt19937 rng(3);
@@ -400,6 +492,7 @@ TEST(StaticTraversal, AxisAlignedRaysAndFaces) {
 // DSG
 
 struct DynamicScene {
+  explicit DynamicScene(int width = PR_BVH_WIDTH) : accel(width) {}
   std::vector<Soup> meshes;
   DynamicAccel accel;
   std::vector<InstanceInput> instances;
@@ -486,10 +579,11 @@ TEST(DynamicTraversal, MatchesBruteForceOverFrames) {
   for (int frame = 0; frame < 4; ++frame) {
     SCOPED_TRACE("frame " + std::to_string(frame));
     setFrame(d, frame);
-    EXPECT_LE(bvhDepth(d.accel.tlasNodes()), PR_BVH_STACK_SIZE);
+    EXPECT_LE(d.accel.tlas().stackNeed, PR_BVH_STACK_SIZE);
     // Meshes 0, 1, 3 are hittable; mesh 2 is empty, and frame 2 has one singular instance.
     EXPECT_EQ(d.accel.instances().size(), frame == 2 ? 6u : 7u);
-    const SceneGeom g = cpuGeom(empty, &d.accel);
+    const HostGeom hg(empty, &d.accel);
+    const SceneGeom g = hg.geom();
     const auto world = worldTriangles(d);
     const auto rays = randomRays(2000, instanceCentres(d), 50 + uint32_t(frame));
     HitChecker c;
@@ -544,7 +638,8 @@ TEST(SceneTraversal, NearerOfStaticAndDynamic) {
   const auto packed = packMeshes(d);
   for (int frame = 0; frame < 2; ++frame) {
     setFrame(d, frame);
-    const SceneGeom g = cpuGeom(a, &d.accel);
+    const HostGeom hg(a, &d.accel);
+    const SceneGeom g = hg.geom();
     auto aim = instanceCentres(d);
     for (const auto& c : triangleCentres(s)) aim.push_back(c);
     const auto rays = randomRays(2000, aim, 90 + uint32_t(frame));
@@ -579,7 +674,8 @@ TEST(SelfIntersection, RaysLeavingASurfaceNeverHitIt) {
     DynamicScene d;
     makeDynamic(d, 30);
     setFrame(d, 1);
-    const SceneGeom g = cpuGeom(a, &d.accel);
+    const HostGeom hg(a, &d.accel);
+    const SceneGeom g = hg.geom();
     std::mt19937 rng(99);
     std::uniform_real_distribution<float> u01(0.0f, 1.0f);
     int selfHits = 0;
@@ -630,7 +726,8 @@ TEST(SelfIntersection, ShadowSegmentsBetweenFacingSurfaces) {
   s.indices = {0, 1, 2, 0, 2, 3, 4, 6, 5, 4, 7, 6};
   StaticAccel a;
   a.build(s.positions, s.indices);
-  const SceneGeom g = cpuGeom(a, nullptr);
+  const HostGeom hg(a, nullptr);
+    const SceneGeom g = hg.geom();
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> u01(0.0f, 1.0f);
   auto point = [&](size_t t, glm::vec3* n) {
@@ -654,37 +751,6 @@ TEST(SelfIntersection, ShadowSegmentsBetweenFacingSurfaces) {
 // ---------------------------------------------------------------------------------------------
 // The device runs the same code
 
-struct DeviceTrace {
-  std::vector<Hit> hits;
-  std::vector<cl_uint> occluded;
-};
-
-DeviceTrace traceOnDevice(DeviceAccel& dacc, const std::vector<Ray>& rays, cl_uint mode) {
-  Context& ctx = test::testContext();
-  static cl::Program program = ctx.buildProgram("test/trace.cl").program;
-  cl_int err = CL_SUCCESS;
-  cl::Kernel k(program, "trace_rays", &err);
-  CL_CHECK(err);
-  const cl_uint n = cl_uint(rays.size());
-  cl::Buffer rb = ctx.allocate("rays", n * sizeof(Ray)), hb = ctx.allocate("hits", n * sizeof(Hit)),
-             ob = ctx.allocate("occluded", n * sizeof(cl_uint));
-  CL_CHECK(ctx.queue().enqueueWriteBuffer(rb, CL_TRUE, 0, n * sizeof(Ray), rays.data()));
-  CL_CHECK(k.setArg(0, rb));
-  CL_CHECK(k.setArg(1, hb));
-  CL_CHECK(k.setArg(2, ob));
-  CL_CHECK(k.setArg(3, n));
-  CL_CHECK(k.setArg(4, mode));
-  dacc.setKernelArgs(ctx, k, 5);
-  ctx.launch1D(k, n, "trace_rays");
-  DeviceTrace out;
-  out.hits.resize(n);
-  out.occluded.resize(n);
-  CL_CHECK(ctx.queue().enqueueReadBuffer(hb, CL_TRUE, 0, n * sizeof(Hit), out.hits.data()));
-  CL_CHECK(ctx.queue().enqueueReadBuffer(ob, CL_TRUE, 0, n * sizeof(cl_uint), out.occluded.data()));
-  ctx.release(n * (sizeof(Ray) + sizeof(Hit) + sizeof(cl_uint)));
-  return out;
-}
-
 // A hit this close to a triangle's edge may fall on either side with another rounding.
 bool nearEdge(const Hit& h) {
   return h.prim != PR_INVALID_INDEX && (h.u < 1e-4f || h.v < 1e-4f || 1.0f - h.u - h.v < 1e-4f);
@@ -692,7 +758,7 @@ bool nearEdge(const Hit& h) {
 
 void compareDevice(const SceneGeom& g, DeviceAccel& dacc, const std::vector<Ray>& rays, cl_uint mode,
                    const std::string& what) {
-  const DeviceTrace dt = traceOnDevice(dacc, rays, mode);
+  const test::TracedRays dt = test::traceRays(dacc, rays, mode);
   HitChecker c;
   int edgeCases = 0;
   for (size_t i = 0; i < rays.size(); ++i) {
@@ -720,35 +786,48 @@ void compareDevice(const SceneGeom& g, DeviceAccel& dacc, const std::vector<Ray>
   EXPECT_GT(c.hits, int(rays.size() / 5)) << what;
 }
 
-TEST(DeviceTraversal, MatchesCpuReference) {
+// Every layout a device may get: the same nearest hits (t within 1e-5, same triangle away from
+// edges) and the same occlusion answers as the CPU reference (PR_BVH_WIDTH wide), over frames
+// of a two-level scene with a singular instance, with and without the DSG.
+TEST(DeviceTraversal, EveryWidthMatchesCpuReference) {
   Context& ctx = test::testContext();
-  const Soup s = randomSoup(10000, 0.05f, 123);
-  StaticAccel a;
-  a.build(s.positions, s.indices);
-  DynamicScene d;
-  makeDynamic(d, 200);
-  DeviceAccel dacc;
-  dacc.uploadStatic(ctx, a);
-  {
-    // No DSG at all: placeholders, instance count 0.
-    DynamicAccel none;
-    const SceneGeom g = cpuGeom(a, nullptr);
-    compareDevice(g, dacc, randomRays(4000, triangleCentres(s), 1), 1, "static only");
+  const Soup s = randomSoup(8000, 0.05f, 123);
+  StaticAccel ref;
+  ref.build(s.positions, s.indices);
+  DynamicScene dref;
+  makeDynamic(dref, 200);
+  for (int width : {2, 4, 8}) {
+    SCOPED_TRACE("width " + std::to_string(width));
+    BuildOptions o;
+    o.width = width;
+    StaticAccel a;
+    a.build(s.positions, s.indices, o);
+    DynamicScene d(width);
+    makeDynamic(d, 200);
+    DeviceAccel dacc(width);
+    dacc.uploadStatic(ctx, a);
+    {
+      // No DSG at all: placeholders, instance count 0.
+      const HostGeom hg(ref, nullptr);
+      compareDevice(hg.geom(), dacc, randomRays(3000, triangleCentres(s), 1), 1, "static only");
+    }
+    dacc.uploadMeshes(ctx, d.accel);
+    for (int frame = 0; frame < 3; ++frame) {
+      SCOPED_TRACE("frame " + std::to_string(frame));
+      setFrame(d, frame);
+      setFrame(dref, frame);
+      dacc.uploadFrame(ctx, d.accel);
+      const HostGeom hg(ref, &dref.accel);
+      auto aim = instanceCentres(d);
+      const auto sc = triangleCentres(s);
+      aim.insert(aim.end(), sc.begin(), sc.begin() + 2000);
+      const auto rays = randomRays(3000, aim, 300 + uint32_t(frame));
+      for (cl_uint mode : {0u, 1u, 2u}) compareDevice(hg.geom(), dacc, rays, mode, "mode " + std::to_string(mode));
+    }
   }
-  dacc.uploadMeshes(ctx, d.accel);
-  for (int frame = 0; frame < 3; ++frame) {
-    SCOPED_TRACE("frame " + std::to_string(frame));
-    setFrame(d, frame);
-    dacc.uploadFrame(ctx, d.accel);
-    const SceneGeom g = cpuGeom(a, &d.accel);
-    auto aim = instanceCentres(d);
-    aim.resize(aim.size() + 2000);
-    const auto sc = triangleCentres(s);
-    std::copy(sc.begin(), sc.begin() + 2000, aim.end() - 2000);
-    const auto rays = randomRays(4000, aim, 300 + uint32_t(frame));
-    compareDevice(g, dacc, rays, 0, "scene");
-    compareDevice(g, dacc, rays, 2, "dynamic");
-  }
+  // A device compiled for one width refuses BVHs of another.
+  DeviceAccel four(4);
+  EXPECT_THROW(four.uploadStatic(ctx, ref), RuntimeError);
 }
 
 }  // namespace

@@ -44,6 +44,11 @@ run "cornell-orbit-reuse" scenes/cornell-orbit.gltf --frames 0-1 --mode reuse
 # it), on the many-lights atrium too: a deep tree, point and spot lights, a moving emitter.
 run "cornell-dynamic-pathtrace-lightbvh" scenes/cornell-dynamic.gltf --frames 0-1 --mode pathtrace \
   --light-sampler bvh
+# The other BVH layouts (8 is what a CPU gets by default): 2, a GPU's, and 4.
+for width in 2 4; do
+  run "cornell-dynamic-reuse-bvh$width" scenes/cornell-dynamic.gltf --frames 0-1 --mode reuse \
+    --bvh-width "$width"
+done
 python3 tools/gen_atrium.py --size 0.02 --light lanterns --out "$work/lanterns/atrium.gltf" >/dev/null
 for mode in pathtrace reuse; do
   run "lanterns-$mode" "$work/lanterns/atrium.gltf" --frames 0-1 --mode "$mode" --light-sampler bvh

@@ -181,14 +181,14 @@ BenchScene synthetic(int levels, int instances) {
 
 // --- BVH statistics ---
 
-float halfArea(const dev::BvhNode& n) {
+float halfArea(const accel::BinaryNode& n) {
   const float x = n.hi_x - n.lo_x, y = n.hi_y - n.lo_y, z = n.hi_z - n.lo_z;
   return x * y + y * z + z * x;
 }
 
 // SAH cost of the tree below `root` with the builder's costs (traversal 1, triangle 1), in
 // units of one triangle test per ray that hits the root box.
-double sahCost(const std::vector<dev::BvhNode>& nodes, uint32_t root) {
+double sahCost(const std::vector<accel::BinaryNode>& nodes, uint32_t root) {
   const double rootArea = halfArea(nodes[root]);
   if (!(rootArea > 0.0)) return 0.0;
   double cost = 0.0;
@@ -196,7 +196,7 @@ double sahCost(const std::vector<dev::BvhNode>& nodes, uint32_t root) {
   while (!stack.empty()) {
     const uint32_t i = stack.back();
     stack.pop_back();
-    const dev::BvhNode& n = nodes[i];
+    const accel::BinaryNode& n = nodes[i];
     const double a = halfArea(n) / rootArea;
     if (n.meta & PR_BVH_LEAF_BIT) {
       cost += a * double(n.meta & ~PR_BVH_LEAF_BIT);
@@ -228,7 +228,7 @@ struct Rates {
 class DeviceTracer {
  public:
   DeviceTracer(Context& ctx, accel::DeviceAccel& acc) : ctx_(ctx) {
-    ProgramBuild pb = ctx.buildProgram("test/trace.cl");
+    ProgramBuild pb = ctx.buildProgram("test/trace.cl", "-DPR_BVH_WIDTH=" + std::to_string(acc.width()));
     cl_int err = CL_SUCCESS;
     closest_ = cl::Kernel(pb.program, "trace_closest", &err);
     CL_CHECK(err);
@@ -547,6 +547,8 @@ int main(int argc, char** argv) {
   app.add_option("--levels", levels, "Synthetic scene: sphere-flake levels (3: about 236k triangles)");
   app.add_option("--instances", instances, "Synthetic scene: dynamic instances of a 2k-triangle sphere");
   app.add_option("--embree-threads", embreeThreads, "Threads of the Embree reference")->check(CLI::PositiveNumber);
+  app.add_option("--bvh-width", build.width, "Children per BVH node (2, 4 or 8)")
+      ->check(CLI::IsMember({2, 4, 8}));
   app.add_option("--leaf-size", build.maxLeafSize, "BVH builder: largest leaf (tuning experiments)");
   app.add_option("--traversal-cost", build.traversalCost, "BVH builder: SAH node cost per triangle test");
   app.add_flag("--no-embree", noEmbree, "Skip the Embree reference");
@@ -570,7 +572,7 @@ int main(int argc, char** argv) {
     t0 = now();
     ssg.build(s.positions, s.indices, build);
     const double ssgSeconds = now() - t0;
-    accel::DynamicAccel dsg;
+    accel::DynamicAccel dsg(build.width);
     t0 = now();
     for (const DynMesh& m : s.meshes) dsg.addMesh(m.positions, m.indices, m.primBase, build);
     const double meshSeconds = now() - t0;
@@ -581,9 +583,9 @@ int main(int argc, char** argv) {
       tlasTimes.push_back(now() - t0);
     }
     const double tlasSeconds = median(tlasTimes);
-    uint32_t meshNodes = uint32_t(dsg.meshNodes().size());
+    uint32_t meshNodes = dsg.meshNodeCount();
 
-    accel::DeviceAccel dacc;
+    accel::DeviceAccel dacc(build.width);
     dacc.uploadStatic(ctx, ssg);
     dacc.uploadMeshes(ctx, dsg);
     dacc.uploadFrame(ctx, dsg);

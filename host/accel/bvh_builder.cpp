@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstring>
 #include <cmath>
 #include <numeric>
 #include <exception>
@@ -31,8 +32,8 @@ float Aabb::halfArea() const {
   return e.x * e.y + e.y * e.z + e.z * e.x;
 }
 
-dev::BvhNode makeNode(const Aabb& b, uint32_t index, uint32_t meta) {
-  dev::BvhNode n{};
+BinaryNode makeNode(const Aabb& b, uint32_t index, uint32_t meta) {
+  BinaryNode n{};
   if (!b.empty()) {
     n.lo_x = b.lo.x, n.lo_y = b.lo.y, n.lo_z = b.lo.z;
     n.hi_x = b.hi.x, n.hi_y = b.hi.y, n.hi_z = b.hi.z;
@@ -63,7 +64,7 @@ class Builder {
     build(0, begin, end, depth);
   }
 
-  std::vector<dev::BvhNode> nodes_;
+  std::vector<BinaryNode> nodes_;
   BvhStats stats_;
 
  private:
@@ -100,7 +101,7 @@ class Builder {
         if (bestAxis < 0 || cost < bestCost) bestCost = cost, bestAxis = a, bestBin = bin;
       }
       const float area = bounds.halfArea();
-      const float leafCost = float(n);
+      const float leafCost = blocks(n);
       const float splitCost = area > 0.0f ? o_.traversalCost + bestCost / area : leafCost;
       if (n <= o_.maxLeafSize && leafCost <= splitCost) return makeLeaf(node, bounds, begin, n, depth);
       if (bestAxis >= 0) {
@@ -147,7 +148,7 @@ class Builder {
       worker.join();
       if (failure) std::rethrow_exception(failure);
       right = uint32_t(nodes_.size());
-      for (dev::BvhNode c : sub.nodes_) {
+      for (BinaryNode c : sub.nodes_) {
         if (!(c.meta & PR_BVH_LEAF_BIT)) c.index += right;
         nodes_.push_back(c);
       }
@@ -161,6 +162,9 @@ class Builder {
     }
     nodes_[node] = makeNode(bounds, right, uint32_t(axis));
   }
+
+  // Intersection tests for n primitives in packets of leafPacket.
+  float blocks(uint32_t n) const { return float((n + o_.leafPacket - 1) / o_.leafPacket); }
 
   int binOf(float c, float lo, float scale) const {
     const int b = int((c - lo) * scale);
@@ -185,7 +189,7 @@ class Builder {
     for (int i = o_.bins - 1; i > 0; --i) {
       acc.grow(bins_[size_t(i)].box);
       count += bins_[size_t(i)].count;
-      rightCost_[size_t(i)] = count > 0 ? acc.halfArea() * float(count) : 0.0f;
+      rightCost_[size_t(i)] = count > 0 ? acc.halfArea() * blocks(count) : 0.0f;
     }
     float best = std::numeric_limits<float>::infinity();
     *bestBin = 0;
@@ -196,7 +200,7 @@ class Builder {
       acc.grow(bins_[size_t(i)].box);
       count += bins_[size_t(i)].count;
       if (count == 0 || count == total) continue;
-      const float cost = acc.halfArea() * float(count) + rightCost_[size_t(i) + 1];
+      const float cost = acc.halfArea() * blocks(count) + rightCost_[size_t(i) + 1];
       if (cost < best) best = cost, *bestBin = i;
     }
     return best;
@@ -223,7 +227,8 @@ class Builder {
 
 Bvh buildBvh(const std::vector<Aabb>& boxes, const BuildOptions& options) {
   if (options.maxDepth > PR_BVH_STACK_SIZE || options.maxDepth < 1 || options.bins < 2 ||
-      options.maxLeafSize < 1 || boxes.size() >= PR_BVH_LEAF_BIT)
+      options.maxLeafSize < 1 || options.leafPacket < 1 || boxes.size() >= PR_BVH_LEAF_BIT ||
+      !(options.width == 2 || options.width == 4 || options.width == 8))
     throw RuntimeError("BVH build: bad options (maxDepth " + std::to_string(options.maxDepth) +
                        ", stack " + std::to_string(PR_BVH_STACK_SIZE) + ")");
   const auto t0 = std::chrono::steady_clock::now();
@@ -252,14 +257,14 @@ Bvh buildBvh(const std::vector<Aabb>& boxes, const BuildOptions& options) {
   return bvh;
 }
 
-int bvhDepth(const std::vector<dev::BvhNode>& nodes, uint32_t root) {
+int bvhDepth(const std::vector<BinaryNode>& nodes, uint32_t root) {
   if (root >= nodes.size()) throw RuntimeError("BVH: root node out of range");
   int deepest = 0;
   std::vector<std::pair<uint32_t, int>> stack{{root, 0}};
   while (!stack.empty()) {
     const auto [i, d] = stack.back();
     stack.pop_back();
-    const dev::BvhNode& n = nodes[i];
+    const BinaryNode& n = nodes[i];
     if (n.meta & PR_BVH_LEAF_BIT) {
       deepest = std::max(deepest, d);
       continue;
@@ -270,6 +275,134 @@ int bvhDepth(const std::vector<dev::BvhNode>& nodes, uint32_t root) {
     stack.push_back({n.index, d + 1});
   }
   return deepest;
+}
+
+namespace {
+
+class Collapser {
+ public:
+  Collapser(const std::vector<BinaryNode>& nodes, int width) : nodes_(nodes), w_(width) {}
+
+  WideBvh run() {
+    out_.width = w_;
+    const BinaryNode& root = nodes_[0];
+    std::vector<uint32_t> kids;
+    if (!(root.meta & PR_BVH_LEAF_BIT)) {
+      emit(0);
+    } else {
+      const uint32_t node = allocate();
+      if ((root.meta & ~PR_BVH_LEAF_BIT) > 0) setChild(node, 0, 0);
+    }
+    out_.stackNeed = need(0);
+    return std::move(out_);
+  }
+
+ private:
+  static bool isLeaf(const BinaryNode& n) { return (n.meta & PR_BVH_LEAF_BIT) != 0; }
+  static float area(const BinaryNode& n) {
+    const float x = n.hi_x - n.lo_x, y = n.hi_y - n.lo_y, z = n.hi_z - n.lo_z;
+    return x * y + y * z + z * x;
+  }
+
+  uint32_t allocate() {
+    const uint32_t node = out_.nodeCount();
+    out_.words.resize(out_.words.size() + 7 * size_t(w_));
+    const float inf = std::numeric_limits<float>::infinity();
+    for (int i = 0; i < w_; ++i) {
+      for (int b = 0; b < 6; ++b) store(wideBound(w_, node, b, i), (b & 1) ? -inf : inf);
+      out_.words[wideChild(w_, node, i)] = PR_INVALID_INDEX;
+    }
+    return node;
+  }
+
+  void store(size_t word, float f) { std::memcpy(&out_.words[word], &f, 4); }
+
+  // Slot i of wide node `node` becomes binary node b (a leaf reference or a new wide node).
+  void setChild(uint32_t node, int i, uint32_t b) {
+    const BinaryNode& n = nodes_[b];
+    const float bounds[6] = {n.lo_x, n.hi_x, n.lo_y, n.hi_y, n.lo_z, n.hi_z};
+    for (int k = 0; k < 6; ++k) store(wideBound(w_, node, k, i), bounds[k]);
+    uint32_t ref;
+    if (isLeaf(n)) {
+      ref = PR_BVH_LEAF_BIT | uint32_t(out_.leaves.size());
+      out_.leaves.push_back(n);
+    } else {
+      ref = emit(b);
+    }
+    out_.words[wideChild(w_, node, i)] = ref;  // (emit may have grown words)
+  }
+
+  // A wide node for interior binary node b; returns its index.
+  uint32_t emit(uint32_t b) {
+    std::vector<uint32_t> kids{b + 1, nodes_[b].index};
+    while (int(kids.size()) < w_) {
+      int open = -1;
+      for (size_t k = 0; k < kids.size(); ++k) {
+        const BinaryNode& n = nodes_[kids[k]];
+        if (!isLeaf(n) && (open < 0 || area(n) > area(nodes_[kids[size_t(open)]]))) open = int(k);
+      }
+      if (open < 0) break;
+      const uint32_t c = kids[size_t(open)];
+      kids[size_t(open)] = c + 1;
+      kids.insert(kids.begin() + open + 1, nodes_[c].index);
+    }
+    const uint32_t node = allocate();
+    for (size_t k = 0; k < kids.size(); ++k) setChild(node, int(k), kids[k]);
+    return node;
+  }
+
+  // Most entries on the stack below wide node `node`: its entered children go on the stack,
+  // all but the one descended into stay.
+  int need(uint32_t node) const {
+    int k = 0, deepest = 0;
+    for (int i = 0; i < w_; ++i) {
+      const uint32_t ref = out_.words[wideChild(w_, node, i)];
+      if (ref == PR_INVALID_INDEX) continue;
+      ++k;
+      if (!(ref & PR_BVH_LEAF_BIT)) deepest = std::max(deepest, need(ref));
+    }
+    return k == 0 ? 0 : std::max(k, k - 1 + deepest);
+  }
+
+  const std::vector<BinaryNode>& nodes_;
+  const int w_;
+  WideBvh out_;
+};
+
+}  // namespace
+
+WideBvh collapseBvh(const std::vector<BinaryNode>& nodes, int width) {
+  if (nodes.empty() || !(width == 2 || width == 4 || width == 8))
+    throw RuntimeError("BVH collapse: no nodes or width " + std::to_string(width));
+  return Collapser(nodes, width).run();
+}
+
+WideBvh buildWideBvh(const std::vector<Aabb>& boxes, const BuildOptions& options, Bvh* binary) {
+  BuildOptions o = options;
+  for (;;) {
+    *binary = buildBvh(boxes, o);
+    WideBvh wide = collapseBvh(binary->nodes, o.width);
+    if (wide.stackNeed <= PR_BVH_STACK_SIZE) return wide;
+    // Each binary level can add at most width - 1 entries.
+    const int over = wide.stackNeed - PR_BVH_STACK_SIZE;
+    const int lower = std::max(1, (over + o.width - 2) / (o.width - 1));
+    if (o.maxDepth <= 1)
+      throw RuntimeError("BVH build: the tree needs " + std::to_string(wide.stackNeed) +
+                         " traversal stack entries (at most " + std::to_string(PR_BVH_STACK_SIZE) + ")");
+    o.maxDepth = std::max(1, o.maxDepth - lower);
+  }
+}
+
+void rebaseWide(std::vector<uint32_t>& words, int width, uint32_t nodeBase, uint32_t leafBase) {
+  const size_t stride = 7 * size_t(width);
+  for (size_t n = 0; n < words.size() / stride; ++n) {
+    for (int i = 0; i < width; ++i) {
+      uint32_t& ref = words[n * stride + 6 * size_t(width) + size_t(i)];
+      if (ref == PR_INVALID_INDEX) continue;
+      ref = (ref & PR_BVH_LEAF_BIT) ? PR_BVH_LEAF_BIT | ((ref & ~PR_BVH_LEAF_BIT) + leafBase)
+                                    : ref + nodeBase;
+    }
+  }
 }
 
 }  // namespace pr::accel

@@ -1,9 +1,11 @@
-// Binned-SAH BVH construction over axis-aligned boxes, flattened depth-first into the 32-byte
-// BvhNode layout of kernels/shared/types.h. Used for the SSG, for each DSG mesh and for the
-// per-frame top-level BVH over instances.
+// Binned-SAH BVH construction over axis-aligned boxes: a binary tree flattened depth-first,
+// then collapsed into the wide BvhNode layout of kernels/shared/types.h that the device
+// traverses (collapseBvh). Used for the SSG, for each DSG mesh and for the per-frame top-level
+// BVH over instances.
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <vector>
 
@@ -29,10 +31,14 @@ struct BuildOptions {
   int bins = 16;
   uint32_t maxLeafSize = 4;    // leaves never hold more; SAH may stop earlier
   float traversalCost = 1.0f;  // relative to one primitive test
-  // Deepest leaf allowed (root = depth 0). Traversal pushes one entry per level, so this must
-  // not exceed PR_BVH_STACK_SIZE; deeper SAH splits give way to median splits.
+  // Primitives tested at once in a leaf (PR_BVH_PACKET for triangles): a leaf of n costs
+  // ceil(n / leafPacket) tests.
+  uint32_t leafPacket = 1;
+  // Deepest leaf allowed (root = depth 0); deeper SAH splits give way to median splits.
+  // buildWideBvh lowers it where the collapsed tree would not fit the traversal stack.
   int maxDepth = 64;
-  bool threads = true;  // top splits on std::threads (same tree either way)
+  int width = PR_BVH_WIDTH;  // children per node of the collapsed tree: 2, 4 or 8
+  bool threads = true;       // top splits on std::threads (same tree either way)
 };
 
 struct BvhStats {
@@ -41,8 +47,19 @@ struct BvhStats {
   double seconds = 0.0;
 };
 
+// A node of the binary tree, 32 bytes. Nodes are stored depth-first: an interior node's left
+// child is the next node (self + 1) and `index` is its right child; a leaf has PR_BVH_LEAF_BIT
+// set in `meta`, its primitive count in the low bits (0 for an empty BVH) and `index` is its
+// first primitive in `order`. Interior nodes keep the split axis in `meta` (informative only).
+struct BinaryNode {
+  float lo_x, lo_y, lo_z;
+  float hi_x, hi_y, hi_z;
+  uint32_t index;
+  uint32_t meta;
+};
+
 struct Bvh {
-  std::vector<dev::BvhNode> nodes;  // root at 0; always at least one node
+  std::vector<BinaryNode> nodes;  // root at 0; always at least one node
   std::vector<uint32_t> order;      // leaf ranges index this; order[i] = input primitive
   BvhStats stats;
 };
@@ -52,9 +69,45 @@ struct Bvh {
 Bvh buildBvh(const std::vector<Aabb>& boxes, const BuildOptions& options = {});
 
 // Deepest leaf below nodes[root] (root = 0), walking the flattened tree; checks structure.
-int bvhDepth(const std::vector<dev::BvhNode>& nodes, uint32_t root = 0);
+int bvhDepth(const std::vector<BinaryNode>& nodes, uint32_t root = 0);
 
 // Node whose box is `b` (an empty box is stored as all zeros).
-dev::BvhNode makeNode(const Aabb& b, uint32_t index, uint32_t meta);
+BinaryNode makeNode(const Aabb& b, uint32_t index, uint32_t meta);
+
+// A BVH of `width`-wide nodes in the device's layout, as 32-bit words (28 * width bytes per
+// node, see BvhNode in kernels/shared/types.h), root at node 0. Leaf references are
+// PR_BVH_LEAF_BIT | k for the k-th entry of `leaves`, the binary tree's leaves in the order
+// the collapse met them (their index / count say which primitives they hold).
+struct WideBvh {
+  int width = PR_BVH_WIDTH;
+  std::vector<uint32_t> words;
+  std::vector<BinaryNode> leaves;
+  int stackNeed = 0;  // the most traversal stack entries a ray can need
+  uint32_t nodeCount() const { return uint32_t(words.size() / (7 * size_t(width))); }
+  uint64_t bytes() const { return uint64_t(words.size()) * 4u; }
+};
+
+// Word offsets inside wide node `node`: bound `b` (0..5 = lo_x, hi_x, lo_y, hi_y, lo_z, hi_z)
+// of child i, and the reference of child i.
+inline size_t wideBound(int width, uint32_t node, int b, int i) {
+  return size_t(node) * 7 * size_t(width) + size_t(b * width + i);
+}
+inline size_t wideChild(int width, uint32_t node, int i) {
+  return size_t(node) * 7 * size_t(width) + size_t(6 * width + i);
+}
+
+// Collapses a binary tree into `width`-wide nodes: each wide node takes the children of a
+// binary node and opens its largest-area interior child until it has `width` (as Embree and
+// tinybvh collapse). A tree that is one leaf becomes a root with that one child (none when the
+// leaf is empty). Unused slots hold PR_INVALID_INDEX and an inverted box.
+WideBvh collapseBvh(const std::vector<BinaryNode>& nodes, int width);
+
+// buildBvh, then collapseBvh, lowering options.maxDepth until no ray can need more than
+// PR_BVH_STACK_SIZE stack entries. *binary receives the binary tree the result came from.
+WideBvh buildWideBvh(const std::vector<Aabb>& boxes, const BuildOptions& options, Bvh* binary);
+
+// Rebases a wide BVH's references for concatenation: node references += nodeBase, leaf
+// references += leafBase.
+void rebaseWide(std::vector<uint32_t>& words, int width, uint32_t nodeBase, uint32_t leafBase);
 
 }  // namespace pr::accel

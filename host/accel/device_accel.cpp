@@ -3,6 +3,7 @@
 #include "cl/kernel_args.h"
 
 #include <algorithm>
+#include <string>
 #include <vector>
 
 #include "cl/error.h"
@@ -29,23 +30,28 @@ static uint64_t byteSize(const std::vector<T>& v) {
 }
 
 void DeviceAccel::uploadStatic(Context& ctx, const StaticAccel& ssg) {
-  upload(ctx, staticNodes_, "static BVH nodes", ssg.nodes().data(), byteSize(ssg.nodes()), false);
-  upload(ctx, staticTris_, "static BVH triangles", ssg.triangles().data(),
-         byteSize(ssg.triangles()), false);
+  if (ssg.wide().width != width_)
+    throw RuntimeError("DeviceAccel: static BVH is " + std::to_string(ssg.wide().width) +
+                       " wide, the kernels take " + std::to_string(width_));
+  upload(ctx, staticNodes_, "static BVH nodes", ssg.wide().words.data(), ssg.wide().bytes(), false);
+  upload(ctx, staticTris_, "static BVH triangles", ssg.packets().data(), byteSize(ssg.packets()),
+         false);
 }
 
 void DeviceAccel::uploadMeshes(Context& ctx, const DynamicAccel& dsg) {
+  if (dsg.width() != width_)
+    throw RuntimeError("DeviceAccel: dynamic BVHs are " + std::to_string(dsg.width()) +
+                       " wide, the kernels take " + std::to_string(width_));
   upload(ctx, meshNodes_, "dynamic mesh BVH nodes", dsg.meshNodes().data(),
          byteSize(dsg.meshNodes()), false);
-  upload(ctx, meshTris_, "dynamic mesh triangles", dsg.meshTriangles().data(),
-         byteSize(dsg.meshTriangles()), false);
+  upload(ctx, meshTris_, "dynamic mesh triangles", dsg.meshPackets().data(),
+         byteSize(dsg.meshPackets()), false);
 }
 
 void DeviceAccel::uploadFrame(Context& ctx, const DynamicAccel& dsg) {
   if (byteSize(dsg.meshNodes()) > meshNodes_.bytes && !dsg.instances().empty())
     throw RuntimeError("DeviceAccel: uploadMeshes must follow the last addMesh");
-  upload(ctx, tlasNodes_, "top-level BVH nodes", dsg.tlasNodes().data(), byteSize(dsg.tlasNodes()),
-         true);
+  upload(ctx, tlasNodes_, "top-level BVH nodes", dsg.tlas().words.data(), dsg.tlas().bytes(), true);
   upload(ctx, instances_, "dynamic instances", dsg.instances().data(), byteSize(dsg.instances()),
          true);
   instanceCount_ = uint32_t(dsg.instances().size());

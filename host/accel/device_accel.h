@@ -11,6 +11,10 @@ namespace pr::accel {
 
 class DeviceAccel {
  public:
+  // For kernels compiled with -DPR_BVH_WIDTH=width: uploads refuse BVHs of another width.
+  explicit DeviceAccel(int width = PR_BVH_WIDTH) : width_(width) {}
+  int width() const { return width_; }
+
   void uploadStatic(Context& ctx, const StaticAccel& ssg);
   // The meshes' BVHs (once, after the last addMesh).
   void uploadMeshes(Context& ctx, const DynamicAccel& dsg);
@@ -38,6 +42,7 @@ class DeviceAccel {
   static void upload(Context& ctx, Slot& slot, const char* name, const void* data, uint64_t bytes,
                      bool grow);
 
+  int width_;
   Slot staticNodes_, staticTris_, meshNodes_, meshTris_, tlasNodes_, instances_;
   uint32_t instanceCount_ = 0;
 };

@@ -1,6 +1,8 @@
 #include "accel/scene_accel.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <string>
 
 #include <glm/common.hpp>
@@ -27,6 +29,19 @@ dev::BvhTriangle packTriangle(const glm::vec3& a, const glm::vec3& b, const glm:
 bool zeroArea(const dev::BvhTriangle& t) {
   const glm::vec3 c = glm::cross(glm::vec3(t.e1x, t.e1y, t.e1z), glm::vec3(t.e2x, t.e2y, t.e2z));
   return c.x == 0.0f && c.y == 0.0f && c.z == 0.0f;
+}
+
+dev::BvhTriPacket packTriangles(const dev::BvhTriangle* first, uint32_t count) {
+  dev::BvhTriPacket p{};
+  for (uint32_t i = 0; i < PR_BVH_PACKET; ++i) p.prim[i] = PR_INVALID_INDEX;
+  for (uint32_t i = 0; i < count && i < PR_BVH_PACKET; ++i) {
+    const dev::BvhTriangle& t = first[i];
+    p.v0x[i] = t.v0x, p.v0y[i] = t.v0y, p.v0z[i] = t.v0z;
+    p.e1x[i] = t.e1x, p.e1y[i] = t.e1y, p.e1z[i] = t.e1z;
+    p.e2x[i] = t.e2x, p.e2y[i] = t.e2y, p.e2z[i] = t.e2z;
+    p.prim[i] = t.prim;
+  }
+  return p;
 }
 
 TriangleBvh buildTriangleBvh(const std::vector<glm::vec3>& positions,
@@ -60,21 +75,32 @@ TriangleBvh buildTriangleBvh(const std::vector<glm::vec3>& positions,
     packed.push_back(tri);
     boxes.push_back(box);
   }
-  Bvh bvh = buildBvh(boxes, options);
+  BuildOptions o = options;
+  o.leafPacket = PR_BVH_PACKET;
+  o.maxLeafSize = std::min<uint32_t>(o.maxLeafSize, PR_BVH_PACKET);  // one packet per leaf
   TriangleBvh out;
-  out.nodes = std::move(bvh.nodes);
+  Bvh bvh;
+  out.wide = buildWideBvh(boxes, o, &bvh);
+  out.binary = std::move(bvh.nodes);
   out.stats = bvh.stats;
   out.triangles.reserve(packed.size());
   for (uint32_t k : bvh.order) {
     out.triangles.push_back(packed[k]);
     out.bounds.grow(boxes[k]);
   }
+  out.packets.reserve(out.wide.leaves.size());
+  for (const BinaryNode& leaf : out.wide.leaves)
+    out.packets.push_back(packTriangles(out.triangles.data() + leaf.index, leaf.meta & ~PR_BVH_LEAF_BIT));
   return out;
 }
 
 void StaticAccel::build(const std::vector<glm::vec3>& positions,
                         const std::vector<uint32_t>& indices, const BuildOptions& options) {
   bvh_ = buildTriangleBvh(positions, indices, 0, options, "static geometry");
+}
+
+DynamicAccel::DynamicAccel(int width) : width_(width) {
+  tlas_ = collapseBvh({makeNode(Aabb{}, 0, PR_BVH_LEAF_BIT)}, width_);
 }
 
 uint32_t DynamicAccel::addMesh(const std::vector<glm::vec3>& positions,
@@ -86,19 +112,20 @@ uint32_t DynamicAccel::addMesh(const std::vector<glm::vec3>& positions,
                                const std::vector<uint32_t>& indices, uint32_t primBase,
                                const BuildOptions& options) {
   const std::string what = "dynamic mesh " + std::to_string(meshes_.size());
-  TriangleBvh bvh = buildTriangleBvh(positions, indices, primBase, options, what.c_str());
+  BuildOptions o = options;
+  o.width = width_;
+  TriangleBvh bvh = buildTriangleBvh(positions, indices, primBase, o, what.c_str());
   Mesh m;
-  m.rootNode = uint32_t(meshNodes_.size());
+  m.rootNode = meshNodeCount();
   m.firstTriangle = uint32_t(meshTris_.size());
   m.triangleCount = uint32_t(bvh.triangles.size());
   m.primBase = primBase;
   m.bounds = bvh.bounds;
   m.stats = bvh.stats;
   // Rebase to absolute indices in the concatenated buffers.
-  for (dev::BvhNode n : bvh.nodes) {
-    n.index += (n.meta & PR_BVH_LEAF_BIT) ? m.firstTriangle : m.rootNode;
-    meshNodes_.push_back(n);
-  }
+  rebaseWide(bvh.wide.words, width_, m.rootNode, uint32_t(meshPackets_.size()));
+  meshNodes_.insert(meshNodes_.end(), bvh.wide.words.begin(), bvh.wide.words.end());
+  meshPackets_.insert(meshPackets_.end(), bvh.packets.begin(), bvh.packets.end());
   meshTris_.insert(meshTris_.end(), bvh.triangles.begin(), bvh.triangles.end());
   nextPrimBase_ = std::max(nextPrimBase_, primBase + m.triangleCount);
   meshes_.push_back(m);
@@ -155,13 +182,15 @@ void DynamicAccel::setInstances(const std::vector<InstanceInput>& instances) {
     inverses.push_back(inv);
   }
   BuildOptions o;
-  o.maxLeafSize = 2;
-  Bvh bvh = buildBvh(boxes, o);
-  tlas_ = std::move(bvh.nodes);
+  o.maxLeafSize = 1;  // leaf k of the wide tree is record k
+  o.width = width_;
+  Bvh bvh;
+  tlas_ = buildWideBvh(boxes, o, &bvh);
   tlasStats_ = bvh.stats;
   records_.clear();
-  records_.reserve(bvh.order.size());
-  for (uint32_t k : bvh.order) {
+  records_.reserve(tlas_.leaves.size());
+  for (const BinaryNode& leaf : tlas_.leaves) {
+    const uint32_t k = bvh.order[leaf.index];
     const uint32_t i = kept[k];
     const Mesh& mesh = meshes_[instances[i].mesh];
     dev::BvhInstance r{};
@@ -172,6 +201,34 @@ void DynamicAccel::setInstances(const std::vector<InstanceInput>& instances) {
     r.mesh = instances[i].mesh;
     r.instance_id = i;
     records_.push_back(r);
+  }
+}
+
+namespace {
+
+std::vector<dev::BvhNode> toNodes(const std::vector<uint32_t>& words, int width) {
+  if (width != PR_BVH_WIDTH)
+    throw RuntimeError("HostGeom: BVH is " + std::to_string(width) + " wide, the CPU reference " +
+                       std::to_string(PR_BVH_WIDTH));
+  std::vector<dev::BvhNode> nodes(words.size() * 4 / sizeof(dev::BvhNode));
+  if (!nodes.empty()) std::memcpy(nodes.data(), words.data(), nodes.size() * sizeof(dev::BvhNode));
+  return nodes;
+}
+
+}  // namespace
+
+HostGeom::HostGeom(const StaticAccel& ssg, const DynamicAccel* dsg) {
+  staticNodes_ = toNodes(ssg.wide().words, ssg.wide().width);
+  geom_.static_nodes = staticNodes_.data();
+  geom_.static_tris = ssg.packets().data();
+  if (dsg) {
+    tlasNodes_ = toNodes(dsg->tlas().words, dsg->width());
+    meshNodes_ = toNodes(dsg->meshNodes(), dsg->width());
+    geom_.tlas_nodes = tlasNodes_.data();
+    geom_.instances = dsg->instances().data();
+    geom_.mesh_nodes = meshNodes_.data();
+    geom_.mesh_tris = dsg->meshPackets().data();
+    geom_.instance_count = uint32_t(dsg->instances().size());
   }
 }
 

@@ -11,6 +11,7 @@
 #include <glm/vec3.hpp>
 
 #include "accel/bvh_builder.h"
+#include "shared/bvh.h"
 #include "shared/types.h"
 
 namespace pr::accel {
@@ -21,14 +22,21 @@ dev::BvhTriangle packTriangle(const glm::vec3& a, const glm::vec3& b, const glm:
 // True when the packed triangle has exactly zero area (cross(e1, e2) == 0).
 bool zeroArea(const dev::BvhTriangle& t);
 
-// A BVH over one triangle soup, flattened: nodes (root at 0, indices relative to this BVH)
-// and the triangles in leaf order, each keeping primBase + its index in the input.
+// A BVH over one triangle soup: wide nodes (root at 0, indices relative to this BVH) whose
+// leaf k is packets[k], each triangle keeping primBase + its index in the input. `binary` and
+// `triangles` (in the binary tree's leaf order) are the tree it was collapsed from, kept on the
+// host for statistics and tests.
 struct TriangleBvh {
-  std::vector<dev::BvhNode> nodes;
+  WideBvh wide;
+  std::vector<dev::BvhTriPacket> packets;
+  std::vector<BinaryNode> binary;
   std::vector<dev::BvhTriangle> triangles;
   Aabb bounds;
   BvhStats stats;
 };
+
+// The packet of triangles [first, first + count) (count <= PR_BVH_PACKET; unused lanes never hit).
+dev::BvhTriPacket packTriangles(const dev::BvhTriangle* first, uint32_t count);
 
 // Triangles whose edge cross product is exactly zero (points, repeated vertices) are left out:
 // they have no surface, and Moller-Trumbore's rounding could report stray hits on them.
@@ -44,13 +52,17 @@ class StaticAccel {
   void build(const std::vector<glm::vec3>& positions, const std::vector<uint32_t>& indices,
              const BuildOptions& options = {});
 
-  const std::vector<dev::BvhNode>& nodes() const { return bvh_.nodes; }
+  // The device's layout: wide nodes and leaf packets.
+  const WideBvh& wide() const { return bvh_.wide; }
+  const std::vector<dev::BvhTriPacket>& packets() const { return bvh_.packets; }
+  // The binary tree it was collapsed from and its triangles in leaf order.
+  const std::vector<BinaryNode>& nodes() const { return bvh_.binary; }
   const std::vector<dev::BvhTriangle>& triangles() const { return bvh_.triangles; }
   const BvhStats& stats() const { return bvh_.stats; }
   const Aabb& bounds() const { return bvh_.bounds; }
 
  private:
-  TriangleBvh bvh_{{makeNode(Aabb{}, 0, PR_BVH_LEAF_BIT)}, {}, {}, {}};
+  TriangleBvh bvh_ = buildTriangleBvh({}, {}, 0, BuildOptions{}, "static geometry");
 };
 
 // One instance of a dynamic mesh this frame.
@@ -63,6 +75,9 @@ struct InstanceInput {
 // primBase + the triangle's index in that mesh.
 class DynamicAccel {
  public:
+  // Nodes `width` wide (PR_BVH_WIDTH: the layout this host's CPU reference traverses).
+  explicit DynamicAccel(int width = PR_BVH_WIDTH);
+
   // Builds the mesh's object-space BVH (once). primBase defaults to the number of triangles of
   // the meshes added before, so prim is the index in the concatenation of all meshes' lists.
   uint32_t addMesh(const std::vector<glm::vec3>& positions, const std::vector<uint32_t>& indices,
@@ -77,11 +92,15 @@ class DynamicAccel {
 
   uint32_t meshCount() const { return uint32_t(meshes_.size()); }
   uint32_t meshTriangleCount() const { return uint32_t(meshTris_.size()); }
-  // All meshes' BVHs concatenated, with absolute child and triangle indices.
-  const std::vector<dev::BvhNode>& meshNodes() const { return meshNodes_; }
+  int width() const { return width_; }
+  // All meshes' wide BVHs concatenated, with absolute node and packet references.
+  const std::vector<uint32_t>& meshNodes() const { return meshNodes_; }
+  const std::vector<dev::BvhTriPacket>& meshPackets() const { return meshPackets_; }
+  // All meshes' triangles in their binary trees' leaf order (host only: tests, statistics).
   const std::vector<dev::BvhTriangle>& meshTriangles() const { return meshTris_; }
-  // This frame's TLAS (root at 0) and instance records in its leaf order.
-  const std::vector<dev::BvhNode>& tlasNodes() const { return tlas_; }
+  uint32_t meshNodeCount() const { return uint32_t(meshNodes_.size() / (7 * size_t(width_))); }
+  // This frame's wide TLAS (root at 0); leaf k is instance record k.
+  const WideBvh& tlas() const { return tlas_; }
   const std::vector<dev::BvhInstance>& instances() const { return records_; }
   const BvhStats& tlasStats() const { return tlasStats_; }
   // World bounds of instance i of the last setInstances (empty when left out).
@@ -93,14 +112,31 @@ class DynamicAccel {
     Aabb bounds;
     BvhStats stats;
   };
+  int width_;
   std::vector<Mesh> meshes_;
   uint32_t nextPrimBase_ = 0;
-  std::vector<dev::BvhNode> meshNodes_;
+  std::vector<uint32_t> meshNodes_;
+  std::vector<dev::BvhTriPacket> meshPackets_;
   std::vector<dev::BvhTriangle> meshTris_;
-  std::vector<dev::BvhNode> tlas_{makeNode(Aabb{}, 0, PR_BVH_LEAF_BIT)};
+  WideBvh tlas_;
   std::vector<dev::BvhInstance> records_;
   std::vector<Aabb> worldBounds_;
   BvhStats tlasStats_;
+};
+
+// The CPU reference's view of both structures (kernels/shared/bvh.h compiled for the host), for
+// tests and tools: the wide nodes copied into BvhNode arrays. Needs BVHs PR_BVH_WIDTH wide;
+// made again after each setInstances.
+class HostGeom {
+ public:
+  explicit HostGeom(const StaticAccel& ssg, const DynamicAccel* dsg = nullptr);
+  HostGeom(const HostGeom&) = delete;
+  HostGeom& operator=(const HostGeom&) = delete;
+  const dev::SceneGeom& geom() const { return geom_; }
+
+ private:
+  std::vector<dev::BvhNode> staticNodes_, tlasNodes_, meshNodes_;
+  dev::SceneGeom geom_{};
 };
 
 }  // namespace pr::accel

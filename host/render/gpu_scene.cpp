@@ -109,10 +109,17 @@ dev::CameraParams toCameraParams(const CameraPose& pose, int width, int height) 
 }
 
 GpuScene::GpuScene(Context& ctx, const Scene& scene, const GpuSceneOptions& options)
-    : ctx_(ctx), scene_(scene), options_(options) {
+    : ctx_(ctx),
+      scene_(scene),
+      options_(options),
+      bvhWidth_(options.bvhWidth ? options.bvhWidth : defaultBvhWidth((ctx.device().type & CL_DEVICE_TYPE_GPU) != 0)),
+      dsg_(bvhWidth_),
+      deviceAccel_(bvhWidth_) {
   const TriangleMesh& sm = scene.staticMesh;
   staticTriangles_ = static_cast<uint32_t>(sm.triangleCount());
-  ssg_.build(sm.positions, sm.indices);
+  accel::BuildOptions build;
+  build.width = bvhWidth_;
+  ssg_.build(sm.positions, sm.indices, build);
   // DSG prims are numbered after the static triangles, so a hit's prim is its shading triangle.
   uint32_t next = staticTriangles_;
   for (const TriangleMesh& m : scene.dynamicMeshes) {
@@ -415,7 +422,8 @@ cl_uint GpuScene::setKernelArgs(cl::Kernel& kernel, cl_uint first) {
 }
 
 std::string GpuScene::buildOptions() const {
-  std::string o = hasAlpha_ ? "-DPR_HAS_ALPHA=1 " : "";
+  std::string o = "-DPR_BVH_WIDTH=" + std::to_string(bvhWidth_) + " ";
+  if (hasAlpha_) o += "-DPR_HAS_ALPHA=1 ";
   if (!useLightBvh_) o += "-DPR_LIGHT_SAMPLER_POWER=1 ";
   if (!o.empty()) o.pop_back();
   return o;

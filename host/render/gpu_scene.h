@@ -24,6 +24,7 @@ struct GpuSceneOptions {
   // a diagnostic with exactly known albedo, used by the furnace tests.
   bool forceDiffuse = false;
   LightSampler lightSampler = LightSampler::Auto;
+  int bvhWidth = 0;  // children per BVH node; 0: defaultBvhWidth of the device
 };
 
 // Host-side conversions, exposed for tests.
@@ -61,8 +62,10 @@ class GpuScene {
   bool anyInstanceMoved() const { return anyMoved_; }
   bool hasAlphaMaterials() const { return hasAlpha_; }
   uint64_t deviceBytes() const;
+  int bvhWidth() const { return bvhWidth_; }
   const accel::StaticAccel& staticAccel() const { return ssg_; }
   const accel::DynamicAccel& dynamicAccel() const { return dsg_; }
+  accel::DeviceAccel& deviceAccel() { return deviceAccel_; }
 
  private:
   void uploadShading();
@@ -73,6 +76,7 @@ class GpuScene {
   Context& ctx_;
   const Scene& scene_;
   GpuSceneOptions options_;
+  int bvhWidth_;  // (before the accels: they are built that wide)
   accel::StaticAccel ssg_;
   accel::DynamicAccel dsg_;
   accel::DeviceAccel deviceAccel_;

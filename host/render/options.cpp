@@ -8,6 +8,8 @@
 
 namespace pr {
 
+int defaultBvhWidth(bool gpu) { return gpu ? 2 : 8; }
+
 const char* renderModeName(RenderMode m) {
   switch (m) {
     case RenderMode::Reuse:

@@ -13,6 +13,10 @@ enum class RenderMode { Reuse, Retrace, PathTrace };
 enum class LightSampler { Auto, Bvh, Power };
 constexpr int kAutoLightBvhMin = 16;
 
+// Children per BVH node for a device (0: auto): CPUs 8 (float8 slab tests), GPUs 2 (a binary
+// node holding both children's boxes). Measured in docs/ray-benchmark.md.
+int defaultBvhWidth(bool gpu);
+
 const char* renderModeName(RenderMode m);
 
 struct FrameRange {
@@ -40,6 +44,7 @@ struct RenderOptions {
   bool quiet = false;
   bool forceDiffuse = false;
   LightSampler lightSampler = LightSampler::Auto;
+  int bvhWidth = 0;  // 0: defaultBvhWidth of the device
   std::string statsFile;
   bool resume = false;  // skip frames whose complete EXR exists; append to the stats file
   // Camera samples keyed by frame 0 on every frame (the scene still moves with the frame):

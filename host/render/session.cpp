@@ -72,6 +72,7 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
   GpuSceneOptions sceneOptions;
   sceneOptions.forceDiffuse = options.forceDiffuse;
   sceneOptions.lightSampler = options.lightSampler;
+  sceneOptions.bvhWidth = options.bvhWidth;
   gpu_ = std::make_unique<GpuScene>(ctx_, scene, sceneOptions);
   film_ = std::make_unique<Film>(ctx_, width_, height_);
   const RenderOptions& o = options_;

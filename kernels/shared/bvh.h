@@ -14,8 +14,9 @@
 // The offset is a few hundred ulps of p's coordinates (a fixed tiny distance near the origin),
 // so it scales with the scene and no scene-dependent epsilon on t is needed.
 //
-// Traversal keeps a fixed stack of PR_BVH_STACK_SIZE entries; it pushes at most one entry per
-// level, and the host builder guarantees every BVH's depth is at most PR_BVH_STACK_SIZE.
+// Nodes are PR_BVH_WIDTH wide (types.h); leaves are packets of up to 4 triangles. Traversal
+// keeps a fixed stack of PR_BVH_STACK_SIZE entries; the host builder checks that no path from
+// the root can need more (it pushes the children a ray enters, less the one it descends into).
 #pragma once
 
 #include "shared/math.h"
@@ -38,19 +39,21 @@ PR_NAMESPACE_BEGIN
 // (OpenCL C 1.2 allows pointers to __global in private structs, not in kernel arguments):
 // see PR_SCENE_GEOM_PARAMS / pr_scene_geom below.
 typedef struct {
-  PR_GLOBAL const BvhNode* static_nodes;     // root at 0; an empty SSG is one empty leaf
-  PR_GLOBAL const BvhTriangle* static_tris;
+  PR_GLOBAL const BvhNode* static_nodes;     // root at 0; an empty SSG is a node with no child
+  PR_GLOBAL const BvhTriPacket* static_tris;
   PR_GLOBAL const BvhNode* tlas_nodes;       // root at 0; read only when instance_count > 0
-  PR_GLOBAL const BvhInstance* instances;    // in TLAS leaf order
+  PR_GLOBAL const BvhInstance* instances;    // indexed by the TLAS's leaves
   PR_GLOBAL const BvhNode* mesh_nodes;       // all meshes' BVHs, absolute indices
-  PR_GLOBAL const BvhTriangle* mesh_tris;
+  PR_GLOBAL const BvhTriPacket* mesh_tris;
   u32 instance_count;
 } SceneGeom;
 
-// A ray prepared for traversal (private, never in a buffer).
+// A ray prepared for traversal (private, never in a buffer). near_* / far_* are the offsets of
+// the slab planes the ray meets first / last in BvhNode.bounds, chosen by the direction's signs.
 typedef struct {
   float3 o, d, inv_d;
   float tmin, tmax;
+  int near_x, near_y, near_z, far_x, far_y, far_z;
 } BvhRay;
 
 PR_INLINE float bvh_safe_inverse(float d) {
@@ -66,11 +69,19 @@ PR_INLINE BvhRay bvh_ray(float3 o, float3 d, float tmin, float tmax) {
   r.inv_d = make_float3(bvh_safe_inverse(d.x), bvh_safe_inverse(d.y), bvh_safe_inverse(d.z));
   r.tmin = tmin;
   r.tmax = tmax;
+  const int w = PR_BVH_WIDTH;
+  const int neg_x = r.inv_d.x < 0.0f, neg_y = r.inv_d.y < 0.0f, neg_z = r.inv_d.z < 0.0f;
+  r.near_x = neg_x ? w : 0;
+  r.far_x = neg_x ? 0 : w;
+  r.near_y = neg_y ? 3 * w : 2 * w;
+  r.far_y = neg_y ? 2 * w : 3 * w;
+  r.near_z = neg_z ? 5 * w : 4 * w;
+  r.far_z = neg_z ? 4 * w : 5 * w;
   return r;
 }
 
-// min/max by comparison: slab distances are never NaN (finite boxes, bvh_safe_inverse), so
-// fmin/fmax's NaN handling is dead weight in the hottest function.
+// min/max by comparison: slab distances are never NaN (finite or inverted-infinite boxes,
+// bvh_safe_inverse), so fmin/fmax's NaN handling is dead weight in the hottest function.
 PR_INLINE float bvh_min(float a, float b) {
   return a < b ? a : b;
 }
@@ -78,17 +89,83 @@ PR_INLINE float bvh_max(float a, float b) {
   return a > b ? a : b;
 }
 
-// Entry distance of the ray into the node's box, or PR_INF_F when it misses it within
-// [tmin, tmax].
-PR_INLINE float bvh_box_entry(PR_GLOBAL const BvhNode* n, const BvhRay* r) {
-  const float x0 = (n->lo_x - r->o.x) * r->inv_d.x, x1 = (n->hi_x - r->o.x) * r->inv_d.x;
-  const float y0 = (n->lo_y - r->o.y) * r->inv_d.y, y1 = (n->hi_y - r->o.y) * r->inv_d.y;
-  const float z0 = (n->lo_z - r->o.z) * r->inv_d.z, z1 = (n->hi_z - r->o.z) * r->inv_d.z;
-  const float tnear = bvh_max(bvh_max(bvh_min(x0, x1), bvh_min(y0, y1)),
-                              bvh_max(bvh_min(z0, z1), r->tmin));
-  const float tfar =
-      bvh_min(bvh_min(bvh_max(x0, x1), bvh_max(y0, y1)), bvh_max(z0, z1)) * PR_BVH_FAR_SCALE;
-  return (tnear <= tfar && tnear <= r->tmax) ? tnear : PR_INF_F;
+#ifdef PR_DEVICE_CODE
+// bvh_bits(m): bit i set where lane i of the comparison mask m is true.
+#if PR_BVH_WIDTH == 2
+typedef float2 bvh_fw;
+typedef int2 bvh_iw;
+#define bvh_loadw(p) vload2(0, p)
+#define bvh_storew(v, p) vstore2(v, 0, p)
+PR_INLINE u32 bvh_bits(int2 m) {
+  const int2 b = m & (int2)(1, 2);
+  return (u32)(b.x | b.y);
+}
+#elif PR_BVH_WIDTH == 4
+typedef float4 bvh_fw;
+typedef int4 bvh_iw;
+#define bvh_loadw(p) vload4(0, p)
+#define bvh_storew(v, p) vstore4(v, 0, p)
+PR_INLINE u32 bvh_bits(int4 m) {
+  const int4 b = m & (int4)(1, 2, 4, 8);
+  const int2 h = b.lo | b.hi;
+  return (u32)(h.x | h.y);
+}
+#elif PR_BVH_WIDTH == 8
+typedef float8 bvh_fw;
+typedef int8 bvh_iw;
+#define bvh_loadw(p) vload8(0, p)
+#define bvh_storew(v, p) vstore8(v, 0, p)
+PR_INLINE u32 bvh_bits(int8 m) {
+  const int8 b = m & (int8)(1, 2, 4, 8, 16, 32, 64, 128);
+  const int4 q = b.lo | b.hi;
+  const int2 h = q.lo | q.hi;
+  return (u32)(h.x | h.y);
+}
+#else
+#error "PR_BVH_WIDTH must be 2, 4 or 8"
+#endif
+#endif
+
+// Entry distance of the ray into each child box of n, and the mask of the children it enters
+// within [tmin, tmax] (bit i: child i; entry[i] is meaningful only there). Far distances are
+// scaled by PR_BVH_FAR_SCALE so rounding never culls a box that holds a hit. The device tests
+// all children at once with one float vector per slab; the host runs the same operations lane
+// by lane (bit for bit the same results).
+PR_INLINE u32 bvh_node_entries(PR_GLOBAL const BvhNode* n, const BvhRay* r, float* entry) {
+  PR_GLOBAL const float* b = n->bounds;
+#ifdef PR_DEVICE_CODE
+  const bvh_fw x0 = (bvh_loadw(b + r->near_x) - r->o.x) * r->inv_d.x;
+  const bvh_fw y0 = (bvh_loadw(b + r->near_y) - r->o.y) * r->inv_d.y;
+  const bvh_fw z0 = (bvh_loadw(b + r->near_z) - r->o.z) * r->inv_d.z;
+  const bvh_fw x1 = (bvh_loadw(b + r->far_x) - r->o.x) * r->inv_d.x;
+  const bvh_fw y1 = (bvh_loadw(b + r->far_y) - r->o.y) * r->inv_d.y;
+  const bvh_fw z1 = (bvh_loadw(b + r->far_z) - r->o.z) * r->inv_d.z;
+  const bvh_fw tmin = (bvh_fw)(r->tmin);
+  // select(b, a, a > b) is a > b ? a : b per lane: bvh_max, as the host computes it.
+  const bvh_fw nxy = select(y0, x0, x0 > y0), nz = select(tmin, z0, z0 > tmin);
+  const bvh_fw tnear = select(nz, nxy, nxy > nz);
+  const bvh_fw fxy = select(y1, x1, x1 < y1);
+  const bvh_fw tfar = select(z1, fxy, fxy < z1) * PR_BVH_FAR_SCALE;
+  const bvh_iw enter = (tnear <= tfar) & (tnear <= r->tmax);
+  if (!any(enter)) return 0u;
+  bvh_storew(tnear, entry);
+  return bvh_bits(enter);
+#else
+  u32 mask = 0u;
+  for (int i = 0; i < PR_BVH_WIDTH; ++i) {
+    const float x0 = (b[r->near_x + i] - r->o.x) * r->inv_d.x;
+    const float y0 = (b[r->near_y + i] - r->o.y) * r->inv_d.y;
+    const float z0 = (b[r->near_z + i] - r->o.z) * r->inv_d.z;
+    const float x1 = (b[r->far_x + i] - r->o.x) * r->inv_d.x;
+    const float y1 = (b[r->far_y + i] - r->o.y) * r->inv_d.y;
+    const float z1 = (b[r->far_z + i] - r->o.z) * r->inv_d.z;
+    const float tnear = bvh_max(bvh_max(x0, y0), bvh_max(z0, r->tmin));
+    const float tfar = bvh_min(bvh_min(x1, y1), z1) * PR_BVH_FAR_SCALE;
+    entry[i] = tnear;
+    if (tnear <= tfar && tnear <= r->tmax) mask |= 1u << i;
+  }
+  return mask;
+#endif
 }
 
 // dot and cross written out: OpenCL's built-ins may fuse or reorder (their error bounds allow
@@ -124,60 +201,133 @@ PR_INLINE int intersect_triangle(PR_GLOBAL const BvhTriangle* tri, float3 o, flo
   return 1;
 }
 
-// Traverses one BVH from `root`. Closest hit (any_hit == 0): shrinks r->tmax to each nearer hit
-// and fills *hit with inst = `inst`. Any hit: returns at the first one, *hit untouched.
-PR_INLINE int bvh_traverse(PR_GLOBAL const BvhNode* nodes, PR_GLOBAL const BvhTriangle* tris,
+// The ray against a leaf's triangles: the lane of the nearest hit in (tmin, tmax) (the lowest
+// lane among equal distances) with its t, u, v, or -1. The device runs intersect_triangle's
+// operations on all lanes at once with float4s; the host runs intersect_triangle lane by lane.
+PR_INLINE int intersect_packet(PR_GLOBAL const BvhTriPacket* p, const BvhRay* r, float* t,
+                               float* u, float* v) {
+#ifdef PR_DEVICE_CODE
+  const float3 d = r->d;
+  const float4 e1x = vload4(0, p->e1x), e1y = vload4(0, p->e1y), e1z = vload4(0, p->e1z);
+  const float4 e2x = vload4(0, p->e2x), e2y = vload4(0, p->e2y), e2z = vload4(0, p->e2z);
+  const float4 px = d.y * e2z - d.z * e2y, py = d.z * e2x - d.x * e2z, pz = d.x * e2y - d.y * e2x;
+  const float4 det = e1x * px + e1y * py + e1z * pz;
+  const float4 inv_det = 1.0f / det;
+  const float4 sx = r->o.x - vload4(0, p->v0x), sy = r->o.y - vload4(0, p->v0y),
+               sz = r->o.z - vload4(0, p->v0z);
+  const float4 uu = (sx * px + sy * py + sz * pz) * inv_det;
+  const float4 qx = sy * e1z - sz * e1y, qy = sz * e1x - sx * e1z, qz = sx * e1y - sy * e1x;
+  const float4 vv = (d.x * qx + d.y * qy + d.z * qz) * inv_det;
+  const float4 tt = (e2x * qx + e2y * qy + e2z * qz) * inv_det;
+  const int4 ok = (det != 0.0f) & (uu >= 0.0f) & (uu <= 1.0f) & (vv >= 0.0f) &
+                  (uu + vv <= 1.0f) & (tt > r->tmin) & (tt < r->tmax);
+  if (!any(ok)) return -1;
+  float ta[4], ua[4], va[4];
+  vstore4(select((float4)(PR_INF_F), tt, ok), 0, ta);
+  vstore4(uu, 0, ua);
+  vstore4(vv, 0, va);
+  int lane = -1;
+  float best = r->tmax;
+  for (int i = 0; i < 4; ++i) {
+    if (ta[i] < best) {
+      best = ta[i];
+      lane = i;
+    }
+  }
+  *t = ta[lane];
+  *u = ua[lane];
+  *v = va[lane];
+  return lane;
+#else
+  int lane = -1;
+  float tmax = r->tmax;
+  for (int i = 0; i < PR_BVH_PACKET; ++i) {
+    BvhTriangle tri;
+    tri.v0x = p->v0x[i], tri.v0y = p->v0y[i], tri.v0z = p->v0z[i];
+    tri.e1x = p->e1x[i], tri.e1y = p->e1y[i], tri.e1z = p->e1z[i];
+    tri.e2x = p->e2x[i], tri.e2y = p->e2y[i], tri.e2z = p->e2z[i];
+    if (intersect_triangle(&tri, r->o, r->d, r->tmin, tmax, t, u, v)) {
+      lane = i;
+      tmax = *t;
+    }
+  }
+  return lane;
+#endif
+}
+
+// Pushes the children of n that the ray enters; closest hit keeps the pushed ones sorted
+// farthest first (equal distances in child order), so the nearest is popped next. Returns
+// whether any was pushed.
+PR_INLINE int bvh_push_children(PR_GLOBAL const BvhNode* n, const BvhRay* r, u32* stack,
+                                float* stack_t, int* sp, int any_hit) {
+  float entry[PR_BVH_WIDTH];
+  u32 mask = bvh_node_entries(n, r, entry);
+  const int base = *sp;
+  int top = base;
+  for (; mask != 0u; mask &= mask - 1u) {
+    const int i = 31 - (int)clz(mask & (0u - mask));  // lowest set bit
+    const float t = entry[i];
+    int j = top++;
+    if (!any_hit) {
+      for (; j > base && stack_t[j - 1] <= t; --j) {
+        stack[j] = stack[j - 1];
+        stack_t[j] = stack_t[j - 1];
+      }
+    }
+    stack[j] = n->child[i];
+    stack_t[j] = t;
+  }
+  *sp = top;
+  return top > base;
+}
+
+// Pops the next entry that starts before tmax (one beyond the nearest hit found since it was
+// pushed is skipped). Returns 0 when the stack is empty.
+PR_INLINE int bvh_pop(const u32* stack, const float* stack_t, int* sp, float tmax, u32* ref) {
+  int s = *sp;
+  do {
+    if (s == 0) {
+      *sp = 0;
+      return 0;
+    }
+    --s;
+  } while (stack_t[s] > tmax);
+  *sp = s;
+  *ref = stack[s];
+  return 1;
+}
+
+// Traverses one BVH from node `root`. Closest hit (any_hit == 0): shrinks r->tmax to each
+// nearer hit and fills *hit with inst = `inst`. Any hit: returns at the first one, *hit untouched.
+PR_INLINE int bvh_traverse(PR_GLOBAL const BvhNode* nodes, PR_GLOBAL const BvhTriPacket* packets,
                            u32 root, BvhRay* r, Hit* hit, u32 inst, int any_hit) {
   u32 stack[PR_BVH_STACK_SIZE];
   float stack_t[PR_BVH_STACK_SIZE];
   int sp = 0;
   int found = 0;
-  u32 node = root;
-  if (bvh_box_entry(nodes + root, r) == PR_INF_F) return 0;
+  u32 ref = root;
   for (;;) {
-    PR_GLOBAL const BvhNode* n = nodes + node;
-    if (n->meta & PR_BVH_LEAF_BIT) {
-      const u32 end = n->index + (n->meta & ~PR_BVH_LEAF_BIT);
-      for (u32 i = n->index; i < end; ++i) {
-        float t, u, v;
-        if (intersect_triangle(tris + i, r->o, r->d, r->tmin, r->tmax, &t, &u, &v)) {
-          if (any_hit) return 1;
-          found = 1;
-          r->tmax = t;
-          hit->t = t;
-          hit->u = u;
-          hit->v = v;
-          hit->prim = tris[i].prim;
-          hit->inst = inst;
-        }
+    if (!(ref & PR_BVH_LEAF_BIT)) {
+      if (bvh_push_children(nodes + ref, r, stack, stack_t, &sp, any_hit)) {
+        ref = stack[--sp];
+        continue;
       }
     } else {
-      const u32 left = node + 1, right = n->index;
-      const float tl = bvh_box_entry(nodes + left, r);
-      const float tr = bvh_box_entry(nodes + right, r);
-      if (tl != PR_INF_F && tr != PR_INF_F) {
-        // Nearer child first; the other waits on the stack with its entry distance.
-        const int right_first = tr < tl;
-        stack_t[sp] = right_first ? tl : tr;
-        stack[sp++] = right_first ? left : right;
-        node = right_first ? right : left;
-        continue;
-      }
-      if (tl != PR_INF_F) {
-        node = left;
-        continue;
-      }
-      if (tr != PR_INF_F) {
-        node = right;
-        continue;
+      PR_GLOBAL const BvhTriPacket* p = packets + (ref & ~PR_BVH_LEAF_BIT);
+      float t, u, v;
+      const int lane = intersect_packet(p, r, &t, &u, &v);
+      if (lane >= 0) {
+        if (any_hit) return 1;
+        found = 1;
+        r->tmax = t;
+        hit->t = t;
+        hit->u = u;
+        hit->v = v;
+        hit->prim = p->prim[lane];
+        hit->inst = inst;
       }
     }
-    // A waiting node that starts beyond the nearest hit found since it was pushed is skipped.
-    do {
-      if (sp == 0) return found;
-      --sp;
-    } while (stack_t[sp] > r->tmax);
-    node = stack[sp];
+    if (!bvh_pop(stack, stack_t, &sp, r->tmax, &ref)) return found;
   }
 }
 
@@ -198,56 +348,32 @@ PR_INLINE BvhRay instance_ray(PR_GLOBAL const BvhInstance* inst, const BvhRay* w
                  xform_vector(inst->world_to_object, world->d), world->tmin, world->tmax);
 }
 
-// Traverses the TLAS; at each instance, the instance's mesh BVH in object space.
+// Traverses the TLAS (leaves are instance records); at each instance, the instance's mesh BVH
+// in object space.
 PR_INLINE int tlas_traverse(const SceneGeom* g, BvhRay* r, Hit* hit, int any_hit) {
   if (g->instance_count == 0) return 0;
   u32 stack[PR_BVH_STACK_SIZE];
   float stack_t[PR_BVH_STACK_SIZE];
   int sp = 0;
   int found = 0;
-  u32 node = 0;
-  PR_GLOBAL const BvhNode* nodes = g->tlas_nodes;
-  if (bvh_box_entry(nodes, r) == PR_INF_F) return 0;
+  u32 ref = 0;
   for (;;) {
-    PR_GLOBAL const BvhNode* n = nodes + node;
-    if (n->meta & PR_BVH_LEAF_BIT) {
-      const u32 end = n->index + (n->meta & ~PR_BVH_LEAF_BIT);
-      for (u32 i = n->index; i < end; ++i) {
-        PR_GLOBAL const BvhInstance* inst = g->instances + i;
-        BvhRay obj = instance_ray(inst, r);  // ("local" is an OpenCL keyword)
-        if (bvh_traverse(g->mesh_nodes, g->mesh_tris, inst->root_node, &obj, hit,
-                         inst->instance_id, any_hit)) {
-          if (any_hit) return 1;
-          found = 1;
-          r->tmax = obj.tmax;
-        }
+    if (!(ref & PR_BVH_LEAF_BIT)) {
+      if (bvh_push_children(g->tlas_nodes + ref, r, stack, stack_t, &sp, any_hit)) {
+        ref = stack[--sp];
+        continue;
       }
     } else {
-      const u32 left = node + 1, right = n->index;
-      const float tl = bvh_box_entry(nodes + left, r);
-      const float tr = bvh_box_entry(nodes + right, r);
-      if (tl != PR_INF_F && tr != PR_INF_F) {
-        const int right_first = tr < tl;
-        stack_t[sp] = right_first ? tl : tr;
-        stack[sp++] = right_first ? left : right;
-        node = right_first ? right : left;
-        continue;
-      }
-      if (tl != PR_INF_F) {
-        node = left;
-        continue;
-      }
-      if (tr != PR_INF_F) {
-        node = right;
-        continue;
+      PR_GLOBAL const BvhInstance* inst = g->instances + (ref & ~PR_BVH_LEAF_BIT);
+      BvhRay obj = instance_ray(inst, r);  // ("local" is an OpenCL keyword)
+      if (bvh_traverse(g->mesh_nodes, g->mesh_tris, inst->root_node, &obj, hit, inst->instance_id,
+                       any_hit)) {
+        if (any_hit) return 1;
+        found = 1;
+        r->tmax = obj.tmax;
       }
     }
-    // A waiting node that starts beyond the nearest hit found since it was pushed is skipped.
-    do {
-      if (sp == 0) return found;
-      --sp;
-    } while (stack_t[sp] > r->tmax);
-    node = stack[sp];
+    if (!bvh_pop(stack, stack_t, &sp, r->tmax, &ref)) return found;
   }
 }
 
@@ -363,13 +489,13 @@ PR_NAMESPACE_END
 // Kernel parameters that carry a SceneGeom, and the struct built from them in the kernel body.
 // The host's DeviceAccel::setKernelArgs sets them in this order.
 #define PR_SCENE_GEOM_PARAMS                                                                    \
-  __global const BvhNode *pr_static_nodes, __global const BvhTriangle *pr_static_tris,          \
+  __global const BvhNode *pr_static_nodes, __global const BvhTriPacket *pr_static_tris,         \
       __global const BvhNode *pr_tlas_nodes, __global const BvhInstance *pr_instances,          \
-      __global const BvhNode *pr_mesh_nodes, __global const BvhTriangle *pr_mesh_tris,          \
+      __global const BvhNode *pr_mesh_nodes, __global const BvhTriPacket *pr_mesh_tris,         \
       uint pr_instance_count
-PR_INLINE SceneGeom pr_scene_geom(__global const BvhNode* sn, __global const BvhTriangle* st,
+PR_INLINE SceneGeom pr_scene_geom(__global const BvhNode* sn, __global const BvhTriPacket* st,
                                   __global const BvhNode* tn, __global const BvhInstance* in,
-                                  __global const BvhNode* mn, __global const BvhTriangle* mt,
+                                  __global const BvhNode* mn, __global const BvhTriPacket* mt,
                                   uint count) {
   SceneGeom g;
   g.static_nodes = sn;

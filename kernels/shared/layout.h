@@ -16,6 +16,7 @@
   S(Hit)                     \
   S(BvhNode)                 \
   S(BvhTriangle)             \
+  S(BvhTriPacket)            \
   S(BvhInstance)              \
   S(Material)                 \
   S(TextureInfo)              \
@@ -42,10 +43,11 @@
   F(Hit, prim)                        \
   F(Hit, inst)                        \
   F(Hit, pad2)                        \
-  F(BvhNode, lo_x)                    \
-  F(BvhNode, hi_x)                    \
-  F(BvhNode, index)                   \
-  F(BvhNode, meta)                    \
+  F(BvhNode, bounds)                  \
+  F(BvhNode, child)                   \
+  F(BvhTriPacket, e1x)                \
+  F(BvhTriPacket, e2z)                \
+  F(BvhTriPacket, prim)               \
   F(BvhTriangle, prim)                \
   F(BvhTriangle, e1x)                 \
   F(BvhTriangle, e2x)                 \

@@ -111,6 +111,8 @@ inline float3 clamp(float3 v, float lo, float hi) {
 inline float mix(float a, float b, float t) { return a + (b - a) * t; }
 inline float3 mix(float3 a, float3 b, float t) { return a + (b - a) * t; }
 inline int isfinite_f(float v) { return std::isfinite(v) ? 1 : 0; }
+// OpenCL's clz: leading zero bits, 32 for 0.
+inline u32 clz(u32 x) { return x ? u32(__builtin_clz(x)) : 32u; }
 
 // float2
 inline float2 operator+(float2 a, float2 b) { return {a.x + b.x, a.y + b.y}; }

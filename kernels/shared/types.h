@@ -24,20 +24,27 @@ typedef struct {
 
 #define PR_INVALID_INDEX 0xffffffffu
 
-// One node of a flattened BVH, 32 bytes. Nodes are stored depth-first: an interior node's left
-// child is the next node (self + 1) and `index` is its right child; a leaf has PR_BVH_LEAF_BIT
-// set in `meta`, its triangle count in the low bits (0 for an empty BVH) and `index` is its
-// first triangle in the BVH's reordered triangle array. Interior nodes keep the split axis in
-// `meta` (informative only).
+// BVH width: children per node. CPUs take 8 (one float8 slab test per node, AVX), GPUs 2 (a
+// binary node holding both children's boxes, as Aila and Laine 2009 lay it out for SIMT); 4 is
+// the third choice. The host builds the layout the device's kernels were compiled for
+// (-DPR_BVH_WIDTH=N); the host's CPU reference traverses the default.
+#ifndef PR_BVH_WIDTH
+#define PR_BVH_WIDTH 8
+#endif
+
+// One node of a flattened wide BVH: the boxes of its children structure-of-arrays, so that a
+// ray tests all of them with one vector per slab. bounds holds lo_x[W], hi_x[W], lo_y[W],
+// hi_y[W], lo_z[W], hi_z[W] (W = PR_BVH_WIDTH). child[i] is a node index, PR_BVH_LEAF_BIT | a
+// triangle packet (an instance record in the top-level BVH), or PR_INVALID_INDEX for an unused
+// slot, whose box is inverted (lo = +inf, hi = -inf) so that no ray enters it.
+// 28 * W bytes: 224 at W = 8.
 typedef struct {
-  float lo_x, lo_y, lo_z;
-  float hi_x, hi_y, hi_z;
-  u32 index;
-  u32 meta;
+  float bounds[6 * PR_BVH_WIDTH];
+  u32 child[PR_BVH_WIDTH];
 } BvhNode;
 
 // A triangle laid out for Moller-Trumbore: v0 and the two edges from it, plus the triangle's id
-// in the scene (what hits report). Three 16-byte rows so a device can load it as float4s. 48 bytes.
+// in the scene (what hits report). 48 bytes.
 typedef struct {
   float v0x, v0y, v0z;
   u32 prim;
@@ -47,9 +54,19 @@ typedef struct {
   u32 pad1;
 } BvhTriangle;
 
+// A BVH leaf: up to PR_BVH_PACKET triangles structure-of-arrays, tested by one ray at once with
+// float4s. Unused lanes have zero edges (never hit) and prim PR_INVALID_INDEX. 160 bytes.
+#define PR_BVH_PACKET 4
+typedef struct {
+  float v0x[PR_BVH_PACKET], v0y[PR_BVH_PACKET], v0z[PR_BVH_PACKET];
+  float e1x[PR_BVH_PACKET], e1y[PR_BVH_PACKET], e1z[PR_BVH_PACKET];
+  float e2x[PR_BVH_PACKET], e2y[PR_BVH_PACKET], e2z[PR_BVH_PACKET];
+  u32 prim[PR_BVH_PACKET];
+} BvhTriPacket;
+
 // One instance of a dynamic mesh in the current frame, in the top-level BVH's leaf order.
 // Matrices are 3x4 row-major: row r is (m[4r], m[4r+1], m[4r+2] | translation m[4r+3]).
-// root_node indexes the concatenated mesh node buffer (child and triangle indices in there are
+// root_node indexes the concatenated mesh node buffer (child and packet indices in there are
 // absolute too); instance_id is what hits report in Hit.inst. 112 bytes.
 typedef struct {
   float world_to_object[12];
@@ -71,9 +88,10 @@ PR_STATIC_ASSERT(offsetof(pr::dev::Ray, tmax) == 28, "Ray layout");
 PR_STATIC_ASSERT(sizeof(pr::dev::Hit) == 32, "Hit layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::Hit, prim) == 12, "Hit layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::Hit, inst) == 16, "Hit layout");
-PR_STATIC_ASSERT(sizeof(pr::dev::BvhNode) == 32, "BvhNode layout");
-PR_STATIC_ASSERT(offsetof(pr::dev::BvhNode, index) == 24, "BvhNode layout");
-PR_STATIC_ASSERT(offsetof(pr::dev::BvhNode, meta) == 28, "BvhNode layout");
+PR_STATIC_ASSERT(sizeof(pr::dev::BvhNode) == 28 * PR_BVH_WIDTH, "BvhNode layout");
+PR_STATIC_ASSERT(offsetof(pr::dev::BvhNode, child) == 24 * PR_BVH_WIDTH, "BvhNode layout");
+PR_STATIC_ASSERT(sizeof(pr::dev::BvhTriPacket) == 40 * PR_BVH_PACKET, "BvhTriPacket layout");
+PR_STATIC_ASSERT(offsetof(pr::dev::BvhTriPacket, prim) == 36 * PR_BVH_PACKET, "BvhTriPacket layout");
 PR_STATIC_ASSERT(sizeof(pr::dev::BvhTriangle) == 48, "BvhTriangle layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::BvhTriangle, prim) == 12, "BvhTriangle layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::BvhTriangle, e1x) == 16, "BvhTriangle layout");
