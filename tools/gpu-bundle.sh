@@ -11,6 +11,13 @@ device=pocl
 rm -rf "$dir"
 mkdir -p "$dir/bin" "$dir/lib" "$dir/libstdcxx"
 progs=(build/pathreuse build/exr_compare build/*_test)
+# The ray benchmark picks the GPU's BVH layout; linked with Embree (44 MB) it would not fit a
+# carry, so it comes only from a build configured with -DCMAKE_DISABLE_FIND_PACKAGE_embree=ON.
+if [ -x build/ray_bench ] && ! ldd build/ray_bench | grep -q embree; then
+  progs+=(build/ray_bench)
+elif [ -x build/ray_bench ]; then
+  echo "gpu-bundle: build/ray_bench links Embree; left out (reconfigure with -DCMAKE_DISABLE_FIND_PACKAGE_embree=ON to carry it)" >&2
+fi
 for p in "${progs[@]}"; do
   [ -x "$p" ] || continue
   strip -o "$dir/bin/$(basename "$p")" "$p"

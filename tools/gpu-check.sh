@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The checks for a machine with a GPU and no package registry, in one call (a few minutes):
 # lists the OpenCL devices, runs the test suite on the GPU, compares the GPU's portability
-# suite with the reference frames rendered on the CPU, and times the demo on the GPU.
+# suite with the reference frames rendered on the CPU, times the demo on the GPU, and (where
+# the bundle has ray_bench) measures ray throughput of each BVH width there.
 # Everything goes to OUT. The programs come from a bundle made by tools/gpu-bundle.sh on the
 # build machine and carried along (default: .gpu in the repository root).
 # Usage: tools/gpu-check.sh OUT [BUNDLE] [DEVICE]   (DEVICE: a --device spec, default gpu)
@@ -74,3 +75,14 @@ for mode in pathtrace reuse; do
     --stats "$out/stats-$mode.jsonl" 2>>"$summary"
   say "$mode: exit $?, median frame wall seconds $(python3 -c 'import json,sys,statistics; print(statistics.median(json.loads(l)["wall_s"] for l in open(sys.argv[1])))' "$out/stats-$mode.jsonl" 2>/dev/null)"
 done
+
+# Which BVH layout suits the GPU: ray throughput at each width (auto gives a GPU width 2).
+if [ -x "$bundle/bin/ray_bench" ]; then
+  scene="$(dirname "$src")/shared/scenes/cornell-nvpro/cornellBox.gltf"
+  [ -f "$scene" ] || scene=scenes/cornell-dynamic.gltf
+  say "== ray throughput on --device $device by BVH width ($(basename "$scene"), Mrays/s camera shadow bounce)"
+  for w in 2 4 8; do
+    "$bundle/bin/ray_bench" "$scene" --device "$device" --repeats 3 --bvh-width "$w" >"$out/rays-w$w.txt" 2>&1
+    say "width $w: exit $?, $(awk '/^(camera|shadow|bounce) /{printf "%s ", $6}' "$out/rays-w$w.txt")"
+  done
+fi
