@@ -103,8 +103,8 @@ for name in ("camera", "shadow", "bounce"):
     print(row)
 ssg, dsg, mem = j["ssg"], j["dsg"], j["device_bytes"]
 print()
-print(f"BVH build: SSG {ssg['triangles']} triangles {ssg['build_ms']:.1f} ms ({ssg['nodes']} nodes, depth {ssg['depth']}, "
-      f"SAH cost {ssg['sah_cost']:.1f}); DSG meshes {dsg['mesh_triangles']} triangles {dsg['mesh_build_ms']:.2f} ms; "
+print(f"BVH build: SSG {ssg['triangles']} triangles {ssg['build_ms']:.1f} ms (binary tree of {ssg['nodes']} nodes, depth {ssg['depth']}, "
+      f"SAH cost {ssg['sah_cost']:.1f}, collapsed into {ssg.get('wide_nodes', 0)} nodes {ssg.get('width', 0)} wide); DSG meshes {dsg['mesh_triangles']} triangles {dsg['mesh_build_ms']:.2f} ms; "
       f"TLAS over {dsg['instances']} instances {dsg['tlas_build_ms']:.3f} ms.")
 print(f"Device memory: SSG {mem['ssg'] / 2**20:.2f} MiB, DSG meshes {mem['dsg_meshes'] / 2**20:.2f} MiB, "
       f"per frame {mem['per_frame'] / 1024:.1f} KiB.", end="")

@@ -593,8 +593,10 @@ int main(int argc, char** argv) {
 
     const auto& st = ssg.stats();
     std::printf("scene: %s (loaded in %.2f s)\n", s.name.c_str(), loadSeconds);
-    std::printf("SSG:  %zu triangles, build %.1f ms, %u nodes, %u leaves, depth %d, SAH cost %.1f\n",
-                s.indices.size() / 3, ssgSeconds * 1e3, st.nodes, st.leaves, st.depth, sahCost(ssg.nodes(), 0));
+    std::printf("SSG:  %zu triangles, build %.1f ms, binary tree of %u nodes, %u leaves, depth %d, SAH cost %.1f; "
+                "%u nodes %d wide, stack need %d\n",
+                s.indices.size() / 3, ssgSeconds * 1e3, st.nodes, st.leaves, st.depth, sahCost(ssg.nodes(), 0),
+                ssg.wide().nodeCount(), ssg.wide().width, ssg.wide().stackNeed);
     std::printf("DSG:  %zu meshes (%zu triangles), mesh BVHs %.2f ms, %u nodes; %zu instances (%zu triangles), "
                 "TLAS %.3f ms, %u nodes, depth %d\n",
                 s.meshes.size(), dynTris, meshSeconds * 1e3, meshNodes, s.instances.size(), instTris,
@@ -695,7 +697,9 @@ int main(int argc, char** argv) {
       j["frame_time"] = frameTime;
       j["image"] = {width, height};
       j["ssg"] = {{"triangles", s.indices.size() / 3}, {"build_ms", ssgSeconds * 1e3}, {"nodes", st.nodes},
-                  {"leaves", st.leaves}, {"depth", st.depth}, {"sah_cost", sahCost(ssg.nodes(), 0)}};
+                  {"leaves", st.leaves}, {"depth", st.depth}, {"sah_cost", sahCost(ssg.nodes(), 0)},
+                  {"wide_nodes", ssg.wide().nodeCount()}, {"width", ssg.wide().width},
+                  {"stack_need", ssg.wide().stackNeed}};
       j["dsg"] = {{"meshes", s.meshes.size()}, {"mesh_triangles", dynTris}, {"mesh_build_ms", meshSeconds * 1e3},
                   {"mesh_nodes", meshNodes}, {"instances", s.instances.size()}, {"instance_triangles", instTris},
                   {"tlas_build_ms", tlasSeconds * 1e3}, {"tlas_nodes", dsg.tlasStats().nodes}};
