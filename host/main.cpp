@@ -123,6 +123,14 @@ int main(int argc, char** argv) {
           "path is shared with a connection from that sample (fewer fireflies near "
           "corners; 0 = off)")
       ->capture_default_str();
+  std::string connectionsText = "all";
+  render
+      ->add_option("--connections", connectionsText,
+                   "Connections to the stored light vertices per eye vertex (reuse/retrace): "
+                   "1 to 4 shadow rays, each to a candidate chosen in proportion to its "
+                   "unshadowed contribution, or all (one shadow ray per candidate)")
+      ->check(CLI::IsMember({"1", "2", "3", "4", "all"}))
+      ->capture_default_str();
   render->add_option("--camera", ro.camera, "Camera index (default: the scene's first)");
   render->add_option("--out", ro.outPattern, "Output EXR path with a frame number conversion")
       ->capture_default_str();
@@ -224,6 +232,7 @@ int main(int argc, char** argv) {
                         : lightSamplerText == "power" ? pr::LightSampler::Power
                                                       : pr::LightSampler::Auto;
       ro.bvhWidth = bvhWidthText == "auto" ? 0 : std::stoi(bvhWidthText);
+      ro.connections = connectionsText == "all" ? 0 : std::stoi(connectionsText);
       return pr::runRender(ro);
     }
     if (*portability) {

@@ -88,6 +88,13 @@ TEST(Reuse, EqualsRetraceWhenObjectsSweepThroughLightBeams) {
   expectReuseEqualsRetrace(sweepScene(), "0-7", 0, 7, "--fps 8");
 }
 
+// Resampled connections choose among the same candidates with the same numbers in both modes.
+TEST(Reuse, EqualsRetraceWithResampledConnections) {
+  expectReuseEqualsRetrace(test::sourcePath("scenes/cornell-dynamic.gltf"), "20-31", 20, 31,
+                           "--connections 2");
+  expectReuseEqualsRetrace(sweepScene(), "0-7", 0, 7, "--fps 8 --connections 1");
+}
+
 // The arena after invalidation and re-tracing equals a full re-trace's, slot by slot.
 TEST(Reuse, ArenaEqualsAFullRetraceSlotBySlot) {
   const Scene scene = loadScene(sweepScene());
@@ -195,6 +202,12 @@ TEST(Reuse, WhiteFurnaceConvergesWithConnectionMisStrategyE) {
   expectFurnace(48, 20, 131072, "--connection-mis 1", "furnace-mis");
 }
 
+// One resampled connection per eye vertex: its weight (sum of the candidates' weights over the
+// kept one's) must be exact, or the furnace's answer moves (a weight 10% off fails here).
+TEST(Reuse, WhiteFurnaceConvergesWithOneResampledConnection) {
+  expectFurnace(64, 40, 65536, "--connections 1", "furnace-ris");
+}
+
 // Reuse and the path tracer estimate the same image: 4x4 region means agree within their
 // statistical error. Light paths are not shared between pixel samples here (one slot per
 // connection), so pixels are independent and per-pixel spread gives the error.
@@ -233,6 +246,39 @@ void expectSameImage(const std::string& scene, const std::string& args, int w, i
 TEST(Reuse, ConvergesToThePathTracerOnADiffuseScene) {
   expectSameImage(test::sourcePath("scenes/cornell-dynamic.gltf"), "--force-diffuse --max-depth 6",
                   48, 36, 32, 2);
+}
+
+// Resampled connections (two per eye vertex) estimate the same image as tracing them all.
+TEST(Reuse, ResampledConnectionsConvergeToThePathTracer) {
+  expectSameImage(test::sourcePath("scenes/cornell-dynamic.gltf"),
+                  "--force-diffuse --max-depth 6 --connections 2", 48, 36, 32, 2);
+}
+
+TEST(Reuse, ResampledConnectionsConvergeOnGlossyAndDeltaMaterials) {
+  expectSameImage(sweepScene(), "--max-depth 6 --connections 1", 48, 36, 32, 2);
+}
+
+// Resampled connections trace one shadow ray per eye vertex (the first hit, and each vertex a
+// delta chain leads to, each found by a bounce ray), whatever the candidates; tracing them all
+// costs one ray per candidate. Both count the same candidates.
+TEST(Reuse, ResampledConnectionsTraceOneRayPerEyeVertex) {
+  const std::string scene = test::sourcePath("scenes/cornell-dynamic.gltf");
+  auto stats = [&](const std::string& mode) {
+    const std::string dir = test::renderFrames(scene, "0", "--mode reuse --width 64 --height 48 "
+                                               "--spp 4 --connections " + mode, "conn-" + mode);
+    const auto lines = test::statsLines(dir);
+    EXPECT_EQ(lines.size(), 1u);
+    return nlohmann::json::parse(lines.at(0));
+  };
+  const auto r = stats("1"), a = stats("all");
+  const double candidates = r["counters"]["connection_candidates"];
+  EXPECT_EQ(candidates, double(a["counters"]["connection_candidates"]));
+  EXPECT_EQ(double(a["rays"]["connection"]), candidates);
+  const double eyeVertices = double(r["rays"]["camera"]) + double(r["rays"]["bounce"]);
+  EXPECT_LE(double(r["rays"]["connection"]), eyeVertices);
+  EXPECT_LT(double(r["rays"]["connection"]), 0.25 * candidates);
+  EXPECT_LE(double(r["counters"]["connections_unoccluded"]), double(r["rays"]["connection"]));
+  EXPECT_GT(double(r["counters"]["connections_unoccluded"]), 0.0);
 }
 
 TEST(Reuse, ConvergesToThePathTracerOnCornellNvpro) {

@@ -45,6 +45,7 @@ run "cornell-orbit-reuse" scenes/cornell-orbit.gltf --frames 0-1 --mode reuse
 run "cornell-dynamic-pathtrace-lightbvh" scenes/cornell-dynamic.gltf --frames 0-1 --mode pathtrace \
   --light-sampler bvh
 # The other BVH layouts (8 is what a CPU gets by default): 2, a GPU's, and 4.
+run "cornell-dynamic-reuse-ris" scenes/cornell-dynamic.gltf --frames 0-1 --mode reuse --connections 2
 for width in 2 4; do
   run "cornell-dynamic-reuse-bvh$width" scenes/cornell-dynamic.gltf --frames 0-1 --mode reuse \
     --bvh-width "$width"

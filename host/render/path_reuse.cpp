@@ -55,6 +55,7 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
   rp.frame = settings_.fixedNoise ? 0u : static_cast<uint32_t>(frame);  // RNG key only
   rp.clamp = settings_.clamp;
   rp.mis_threshold = settings_.misThreshold;
+  rp.resample = settings_.resample;
   rp.trace_total = scene_.traceTotalPower();
   rp.scene_radius = scene_.sceneRadius();
   rp.cx = scene_.sceneCentre().x, rp.cy = scene_.sceneCentre().y, rp.cz = scene_.sceneCentre().z;
@@ -115,6 +116,8 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
   stats->counters["arena_bytes"] = arenaBytes();
   if (settings_.clamp > 0.0f) stats->counters["connections_clamped"] = c[PR_C_CLAMPED];
   if (settings_.misThreshold > 0.0f) stats->counters["connections_mis"] = c[PR_C_MIS_RAYS];
+  stats->counters["connection_candidates"] = c[PR_C_CANDIDATES];
+  stats->counters["connections_unoccluded"] = c[PR_C_CONNECTED];
 }
 
 void PathReuse::readArena(std::vector<dev::PathHeader>* headers,

@@ -24,6 +24,7 @@ struct PathReuseSettings {
   uint32_t pathsPerPixel = 4;
   float clamp = 0.0f;
   float misThreshold = 4.0f;  // connection MIS (kernels/reuse/connect.cl); 0 = off
+  uint32_t resample = 0;      // resampled connections per eye vertex (connect.cl); 0: all
   bool retraceAll = false;    // --mode retrace
   bool fixedNoise = false;    // camera samples keyed by frame 0 on every frame
 };

@@ -88,6 +88,7 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
     r.pathsPerPixel = static_cast<uint32_t>(o.pathsPerPixel);
     r.clamp = o.clamp;
     r.misThreshold = o.connectionMis;
+    r.resample = static_cast<uint32_t>(o.connections);
     r.retraceAll = o.mode == RenderMode::Retrace;
     r.fixedNoise = o.fixedNoise;
     integrator_ = std::make_unique<PathReuse>(ctx_, *gpu_, *film_, r);

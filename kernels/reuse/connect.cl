@@ -17,7 +17,84 @@
 // below the threshold L keeps weight 1. The weights add to 1 for every path, so the estimator
 // stays unbiased. E needs y_{k-1} to be connectable: not a delta surface, nor a spot or
 // directional light's vertex 0 (left to L alone).
+//
+// Resampled connections (rp.resample = 1). Every connection above (both strategies, all the
+// light vertices of the C paths) is a candidate with an unshadowed contribution c_i, found
+// without a ray. One candidate per eye vertex is kept by weighted reservoir sampling with
+// weights luminance(c_i) (resampled importance sampling, Talbot 2005), and only it is traced:
+// it counts c_k * (sum of weights) / weight_k when unoccluded, an unbiased estimate of the sum
+// of all candidates' shadowed contributions, for one shadow ray instead of one per candidate.
+// The reservoir's draws come from a stream of their own, so the path's draws stay in place.
 #include "shared/reuse.h"
+
+// The connections kept so far among an eye vertex's candidates: rp.resample of them, each
+// chosen independently among all (with replacement), sharing the sum of the weights.
+#define PR_MAX_CONNECTIONS 4
+typedef struct {
+  Ray ray[PR_MAX_CONNECTIONS];
+  float c[3 * PR_MAX_CONNECTIONS];  // unshadowed contributions
+  float w[PR_MAX_CONNECTIONS];      // their weights
+  u32 mis[PR_MAX_CONNECTIONS];      // strategy E's
+  float w_sum;                      // all candidates' weights
+  u32 candidates;
+} Reservoir;
+
+PR_INLINE void reservoir_clear(Reservoir* r) {
+  r->w_sum = 0.0f;
+  r->candidates = 0u;
+}
+
+// Counts of the connections an eye sample made.
+typedef struct {
+  uint candidates, rays, mis_rays, unoccluded, clamped;
+} ConnectCounts;
+
+// A connection with unshadowed contribution c along shadow ray `ray`: traced now (no
+// resampling; returns what it adds) or offered to the reservoir (returns 0).
+PR_INLINE float3 connection(const SceneData* s, const ReuseParams* rp, Reservoir* res, Rng* rr,
+                            float3 c, Ray ray, u32 mis, ConnectCounts* n) {
+  ++n->candidates;
+  if (rp->resample > 0u) {
+    const float w = luminance(c);
+    if (w > 0.0f) {
+      res->w_sum += w;
+      ++res->candidates;
+      for (u32 k = 0u; k < rp->resample; ++k) {
+        // The first candidate is kept by every slot (u * w < w).
+        if (rng_next(rr) * res->w_sum < w) {
+          res->ray[k] = ray;
+          res->c[3 * k] = c.x, res->c[3 * k + 1] = c.y, res->c[3 * k + 2] = c.z;
+          res->w[k] = w;
+          res->mis[k] = mis;
+        }
+      }
+    }
+    return make_float3(0.0f, 0.0f, 0.0f);
+  }
+  ++n->rays;
+  n->mis_rays += mis;
+  if (trace_occluded(s, ray)) return make_float3(0.0f, 0.0f, 0.0f);
+  ++n->unoccluded;
+  return c;
+}
+
+// Traces the reservoir's connections; returns their resampled contribution and clears it.
+PR_INLINE float3 reservoir_resolve(const SceneData* s, const ReuseParams* rp, Reservoir* res,
+                                   ConnectCounts* n) {
+  float3 out = make_float3(0.0f, 0.0f, 0.0f);
+  if (res->candidates > 0u) {
+    for (u32 k = 0u; k < rp->resample; ++k) {
+      ++n->rays;
+      n->mis_rays += res->mis[k];
+      if (trace_occluded(s, res->ray[k])) continue;
+      ++n->unoccluded;
+      out += make_float3(res->c[3 * k], res->c[3 * k + 1], res->c[3 * k + 2]) *
+             (res->w_sum / (res->w[k] * (float)rp->resample));
+    }
+  }
+  reservoir_clear(res);
+  return out;
+}
 
 // Weight of strategy L; strategy E's is 1 minus it. r NaN or below the threshold: L alone.
 PR_INLINE float mis_weight_l(float r, float threshold) {
@@ -38,8 +115,8 @@ PR_INLINE float light_emit_pdf(const SceneData* s, u32 light, PR_GLOBAL const Li
 PR_INLINE float3 connect_light_paths(const SceneData* s, const ReuseParams* rp, const SurfaceHit* x,
                                      const ShadingFrame* fx, float3 wo, float3 tp, uint depth,
                                      uint j, __global const PathHeader* headers,
-                                     __global const LightVertex* vertices, uint* rays,
-                                     uint* clamped) {
+                                     __global const LightVertex* vertices, Reservoir* res,
+                                     Rng* rr, ConnectCounts* n) {
   float3 sum = make_float3(0.0f, 0.0f, 0.0f);
   const float3 wol = to_local(wo, fx->t, fx->b, fx->n);
   const float inv_c = 1.0f / (float)rp->paths_per_pixel;
@@ -84,15 +161,13 @@ PR_INLINE float3 connect_light_paths(const SceneData* s, const ReuseParams* rp, 
       float g = fabs(dot(fx->n, dir)) * fabs(dot(fy.n, dir)) / dist2;
       if (rp->clamp > 0.0f && g > rp->clamp) {
         g = rp->clamp;
-        ++*clamped;
+        ++n->clamped;
       }
       const float corr = shading_normal_correction(wy_prev, -dir, fy.n, fy.ng);
       const float3 tpy = make_float3(v[k].tp_r, v[k].tp_g, v[k].tp_b);
       const float3 contrib = tp * f_x * f_y * tpy * (g * corr * inv_c * w);
       if (!(max3(contrib) > 0.0f)) continue;
-      ++*rays;
-      const Ray r = spawn_ray_to(x->p, fx->ng, y.p, fy.ng);
-      if (!trace_occluded(s, r)) sum += contrib;
+      sum += connection(s, rp, res, rr, contrib, spawn_ray_to(x->p, fx->ng, y.p, fy.ng), 0u, n);
     }
   }
   return sum;
@@ -105,8 +180,8 @@ PR_INLINE float3 connect_sampled_vertex(const SceneData* s, const ReuseParams* r
                                         const SurfaceHit* yh, const ShadingFrame* fy, float3 wo,
                                         float3 tp, float pdf_x, uint depth, uint j,
                                         __global const PathHeader* headers,
-                                        __global const LightVertex* vertices, uint* rays,
-                                        uint* mis_rays, uint* clamped) {
+                                        __global const LightVertex* vertices, Reservoir* res,
+                                        Rng* rr, ConnectCounts* n) {
   float3 sum = make_float3(0.0f, 0.0f, 0.0f);
   const float3 dxy = yh->p - xp;
   const float dxy2 = dot(dxy, dxy);
@@ -160,16 +235,14 @@ PR_INLINE float3 connect_sampled_vertex(const SceneData* s, const ReuseParams* r
       float g = fabs(dot(fy->n, dir)) * cos_z / dist2;
       if (rp->clamp > 0.0f && g > rp->clamp) {
         g = rp->clamp;
-        ++*clamped;
+        ++n->clamped;
       }
       const float3 contrib = tp * f_y * f_z * tpz * (g * corr * inv_c * w);
       if (!(max3(contrib) > 0.0f)) continue;
-      ++*rays;
-      ++*mis_rays;
       const Ray r = (k == 0u && v[0].prim == PR_INVALID_INDEX)
                         ? spawn_ray(yh->p, fy->ng, dir, sqrt(dist2) * (1.0f - 1e-4f))
                         : spawn_ray_to(yh->p, fy->ng, zp, zng);
-      if (!trace_occluded(s, r)) sum += contrib;
+      sum += connection(s, rp, res, rr, contrib, r, 1u, n);
     }
   }
   return sum;
@@ -185,14 +258,21 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
   const SceneData s = PR_SCENE();
   // Its own stream, apart from eye_hit's.
   Rng rng = rng_make(rp.seed, PR_RNG_CONNECT, rp.frame, i, sample);
+  Rng rr = rng_make(rp.seed, PR_RNG_RESAMPLE, rp.frame, i, sample);
+  Reservoir res;
+  reservoir_clear(&res);
+  ConnectCounts n;
+  n.candidates = n.rays = n.mis_rays = n.unoccluded = n.clamped = 0u;
   const uint j = i * rp.spp + sample;
   SurfaceHit x = surface_at(&s.sd, e.prim, e.inst, e.b1, e.b2);
   float3 wo = make_float3(e.wx, e.wy, e.wz);
   float3 tp = make_float3(e.tp_r, e.tp_g, e.tp_b);
   uint depth = e.depth;
   float3 L = make_float3(0.0f, 0.0f, 0.0f);
-  uint shadow_rays = 0u, connect_rays = 0u, mis_rays = 0u, bounce_rays = 0u, clamped = 0u;
+  uint shadow_rays = 0u, bounce_rays = 0u;
   for (;;) {
+    // The previous eye vertex's kept connection (each vertex of a delta chain has its own).
+    L += reservoir_resolve(&s, &rp, &res, &n);
     const ShadingFrame f = shading_frame(&s, &x, wo);
     if (depth + 1u <= rp.max_depth) {
       Ray shadow;
@@ -205,8 +285,7 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
     } else {
       rng_skip(&rng, PR_NEXT_EVENT_DRAWS);
     }
-    L += connect_light_paths(&s, &rp, &x, &f, wo, tp, depth, j, headers, vertices, &connect_rays,
-                             &clamped);
+    L += connect_light_paths(&s, &rp, &x, &f, wo, tp, depth, j, headers, vertices, &res, &rr, &n);
     // The completeness extension: one BSDF direction, kept only through delta surfaces.
     const float u0 = rng_next(&rng);
     const float2 u12 = rng_next2(&rng);
@@ -235,7 +314,7 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
         // Strategy L at x counts these paths, apart from E's share.
         if (rp.mis_threshold > 0.0f && !delta)
           L += connect_sampled_vertex(&s, &rp, x.p, &h, &fh, -d, t2, pdf, depth + 1u, j, headers,
-                                      vertices, &connect_rays, &mis_rays, &clamped);
+                                      vertices, &res, &rr, &n);
         break;
       }
       ++depth;
@@ -261,10 +340,13 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
     }
     if (!found || !(max3(tp) < PR_INF_F)) break;
   }
+  L += reservoir_resolve(&s, &rp, &res, &n);
   radiance[i] += (float4)(L.x, L.y, L.z, 0.0f);
   if (shadow_rays) atomic_add(counters + PR_C_SHADOW_RAYS, shadow_rays);
-  if (connect_rays) atomic_add(counters + PR_C_CONNECT_RAYS, connect_rays);
+  if (n.rays) atomic_add(counters + PR_C_CONNECT_RAYS, n.rays);
   if (bounce_rays) atomic_add(counters + PR_C_BOUNCE_RAYS, bounce_rays);
-  if (mis_rays) atomic_add(counters + PR_C_MIS_RAYS, mis_rays);
-  if (clamped) atomic_add(counters + PR_C_CLAMPED, clamped);
+  if (n.mis_rays) atomic_add(counters + PR_C_MIS_RAYS, n.mis_rays);
+  if (n.clamped) atomic_add(counters + PR_C_CLAMPED, n.clamped);
+  if (n.candidates) atomic_add(counters + PR_C_CANDIDATES, n.candidates);
+  if (n.unoccluded) atomic_add(counters + PR_C_CONNECTED, n.unoccluded);
 }

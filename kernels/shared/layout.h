@@ -115,4 +115,4 @@
   F(Light, leaf)                      \
   F(ReuseParams, clamp)               \
   F(ReuseParams, cx)                  \
-  F(ReuseParams, pad1)
+  F(ReuseParams, resample)

@@ -23,7 +23,7 @@ typedef struct {
   float scene_radius;
   float mis_threshold;  // connection MIS: strategy E runs where p_E / p_L >= this; 0 = off
   float cx, cy, cz;  // scene centre
-  float pad1;
+  u32 resample;      // connections per eye vertex chosen by RIS (1-4); 0 = every candidate
 } ReuseParams;
 
 // Counters the kernels add to (one atomic add per work-item and counter).
@@ -38,7 +38,9 @@ typedef struct {
 #define PR_C_DSG_VERTICES 8
 #define PR_C_CLAMPED 9       // connections whose geometry term was clamped
 #define PR_C_MIS_RAYS 10     // connection rays of strategy E (a subset of PR_C_CONNECT_RAYS)
-#define PR_C_COUNT 11
+#define PR_C_CANDIDATES 11   // connections evaluated (each would cost a ray without resampling)
+#define PR_C_CONNECTED 12    // connection rays found unoccluded
+#define PR_C_COUNT 13
 
 // The ray of the segment leaving a stored vertex in direction dir: from the exact point for
 // punctual lights (prim == PR_INVALID_INDEX), else offset off the surface along the decoded
