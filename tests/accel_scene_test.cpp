@@ -47,7 +47,8 @@ bool sameHit(const Hit& got, const Hit& want) {
   return same || tie;
 }
 
-void expectSceneMatchesBruteForce(const std::string& path, const std::vector<double>& times, size_t rays) {
+void expectSceneMatchesBruteForce(const std::string& path, const std::vector<double>& times,
+                                  size_t rays) {
   const Scene scene = loadScene(path);
   Context& ctx = test::testContext();
   GpuScene gpu(ctx, scene);
@@ -62,8 +63,9 @@ void expectSceneMatchesBruteForce(const std::string& path, const std::vector<dou
   std::vector<BvhTriangle> ssg;
   const TriangleMesh& sm = scene.staticMesh;
   for (uint32_t i = 0; i < sm.triangleCount(); ++i) {
-    const auto t = accel::packTriangle(sm.positions[sm.indices[3 * i]], sm.positions[sm.indices[3 * i + 1]],
-                                       sm.positions[sm.indices[3 * i + 2]], i);
+    const auto t =
+        accel::packTriangle(sm.positions[sm.indices[3 * i]], sm.positions[sm.indices[3 * i + 1]],
+                            sm.positions[sm.indices[3 * i + 2]], i);
     if (!zeroArea(t)) ssg.push_back(t);
   }
   // Each dynamic mesh in object space; DSG prims follow the SSG's.
@@ -72,8 +74,9 @@ void expectSceneMatchesBruteForce(const std::string& path, const std::vector<dou
   for (const TriangleMesh& m : scene.dynamicMeshes) {
     meshes.emplace_back();
     for (uint32_t i = 0; i < m.triangleCount(); ++i) {
-      const auto t = accel::packTriangle(m.positions[m.indices[3 * i]], m.positions[m.indices[3 * i + 1]],
-                                         m.positions[m.indices[3 * i + 2]], next + i);
+      const auto t =
+          accel::packTriangle(m.positions[m.indices[3 * i]], m.positions[m.indices[3 * i + 1]],
+                              m.positions[m.indices[3 * i + 2]], next + i);
       if (!zeroArea(t)) meshes.back().push_back(t);
     }
     next += static_cast<uint32_t>(m.triangleCount());
@@ -119,9 +122,9 @@ void expectSceneMatchesBruteForce(const std::string& path, const std::vector<dou
       hits += want.prim != PR_INVALID_INDEX;
       dynamicHits += want.inst != PR_INVALID_INDEX;
       if (!sameHit(got, want) && ++failures <= 5)
-        ADD_FAILURE() << path << " t=" << t << " ray " << r << ": got prim " << got.prim << " inst " << got.inst
-                      << " t " << got.t << ", want prim " << want.prim << " inst " << want.inst << " t "
-                      << want.t;
+        ADD_FAILURE() << path << " t=" << t << " ray " << r << ": got prim " << got.prim << " inst "
+                      << got.inst << " t " << got.t << ", want prim " << want.prim << " inst "
+                      << want.inst << " t " << want.t;
       traced.push_back(ray);
       wanted.push_back(want);
     }
@@ -130,9 +133,10 @@ void expectSceneMatchesBruteForce(const std::string& path, const std::vector<dou
       int wrong = 0;
       for (size_t i = 0; i < got.size(); ++i) {
         if (sameHit(got[i], wanted[i]) || ++wrong > 5) continue;
-        ADD_FAILURE() << path << " t=" << t << " width " << l->bvhWidth() << " ray " << i << ": got prim "
-                      << got[i].prim << " inst " << got[i].inst << " t " << got[i].t << ", want prim "
-                      << wanted[i].prim << " inst " << wanted[i].inst << " t " << wanted[i].t;
+        ADD_FAILURE() << path << " t=" << t << " width " << l->bvhWidth() << " ray " << i
+                      << ": got prim " << got[i].prim << " inst " << got[i].inst << " t "
+                      << got[i].t << ", want prim " << wanted[i].prim << " inst " << wanted[i].inst
+                      << " t " << wanted[i].t;
       }
       EXPECT_EQ(wrong, 0) << "width " << l->bvhWidth();
     }
@@ -151,11 +155,13 @@ TEST(SceneAccel, CornellNvproMatchesBruteForce) {
 }
 
 TEST(SceneAccel, AnimatedDemoMatchesBruteForceAtSeveralFrames) {
-  expectSceneMatchesBruteForce(test::sourcePath("scenes/cornell-dynamic.gltf"), {0.0, 1.3, 2.6, 4.9}, 2000);
+  expectSceneMatchesBruteForce(test::sourcePath("scenes/cornell-dynamic.gltf"),
+                               {0.0, 1.3, 2.6, 4.9}, 2000);
 }
 
 TEST(SceneAccel, OrbitDemoMatchesBruteForceAtSeveralFrames) {
-  expectSceneMatchesBruteForce(test::sourcePath("scenes/cornell-orbit.gltf"), {0.0, 2.1, 4.0}, 2000);
+  expectSceneMatchesBruteForce(test::sourcePath("scenes/cornell-orbit.gltf"), {0.0, 2.1, 4.0},
+                               2000);
 }
 
 // Every layout renders the demo's frames bit for bit the same (its rays never fall exactly

@@ -86,14 +86,16 @@ std::vector<Ray> randomRays(size_t n, const std::vector<glm::vec3>& aim, uint32_
 
 std::vector<glm::vec3> triangleCentres(const Soup& s) {
   std::vector<glm::vec3> c;
-  for (size_t t = 0; t < s.size(); ++t) c.push_back((s.vertex(t, 0) + s.vertex(t, 1) + s.vertex(t, 2)) / 3.0f);
+  for (size_t t = 0; t < s.size(); ++t)
+    c.push_back((s.vertex(t, 0) + s.vertex(t, 1) + s.vertex(t, 2)) / 3.0f);
   return c;
 }
 
 std::vector<BvhTriangle> packSoup(const Soup& s, uint32_t primBase = 0) {
   std::vector<BvhTriangle> out;
   for (size_t t = 0; t < s.size(); ++t) {
-    const BvhTriangle tri = packTriangle(s.vertex(t, 0), s.vertex(t, 1), s.vertex(t, 2), primBase + uint32_t(t));
+    const BvhTriangle tri =
+        packTriangle(s.vertex(t, 0), s.vertex(t, 1), s.vertex(t, 2), primBase + uint32_t(t));
     if (!zeroArea(tri)) out.push_back(tri);
   }
   return out;
@@ -115,13 +117,16 @@ Hit bruteForce(const std::vector<BvhTriangle>& tris, Ray ray, uint32_t inst = PR
   return best;
 }
 
-bool relClose(float a, float b, float rel) { return std::fabs(a - b) <= rel * std::fmax(std::fabs(a), std::fabs(b)); }
+bool relClose(float a, float b, float rel) {
+  return std::fabs(a - b) <= rel * std::fmax(std::fabs(a), std::fabs(b));
+}
 
 // Compares closest hits; failures are counted and the first few described.
 struct HitChecker {
   int failures = 0;
   int hits = 0;
-  void check(const Hit& got, const Hit& want, size_t ray, const std::string& what, float rel = 1e-5f) {
+  void check(const Hit& got, const Hit& want, size_t ray, const std::string& what,
+             float rel = 1e-5f) {
     const bool ok = got.prim == want.prim && got.inst == want.inst &&
                     (want.prim == PR_INVALID_INDEX || relClose(got.t, want.t, rel));
     hits += want.prim != PR_INVALID_INDEX;
@@ -231,8 +236,10 @@ void checkWide(const TriangleBvh& t) {
       const Aabb inner = content(c);
       const float eps = 1e-6f * (1.0f + glm::length(inner.hi) + glm::length(inner.lo));
       for (int a = 0; a < 3; ++a) {
-        EXPECT_LE(wideBoundOf(w, ref, 2 * a, i), inner.lo[a] + eps) << "node " << ref << " child " << i;
-        EXPECT_GE(wideBoundOf(w, ref, 2 * a + 1, i), inner.hi[a] - eps) << "node " << ref << " child " << i;
+        EXPECT_LE(wideBoundOf(w, ref, 2 * a, i), inner.lo[a] + eps)
+            << "node " << ref << " child " << i;
+        EXPECT_GE(wideBoundOf(w, ref, 2 * a + 1, i), inner.hi[a] - eps)
+            << "node " << ref << " child " << i;
       }
       box.grow(inner);
       if (c & PR_BVH_LEAF_BIT) {
@@ -306,9 +313,13 @@ TEST(BvhBuild, ThreadedBuildEqualsSerialBuild) {
   EXPECT_EQ(std::memcmp(a.binary.data(), b.binary.data(), a.binary.size() * sizeof(BinaryNode)), 0);
   EXPECT_EQ(a.wide.words, b.wide.words);
   ASSERT_EQ(a.packets.size(), b.packets.size());
-  EXPECT_EQ(std::memcmp(a.packets.data(), b.packets.data(), a.packets.size() * sizeof(dev::BvhTriPacket)), 0);
+  EXPECT_EQ(
+      std::memcmp(a.packets.data(), b.packets.data(), a.packets.size() * sizeof(dev::BvhTriPacket)),
+      0);
   ASSERT_EQ(a.triangles.size(), b.triangles.size());
-  EXPECT_EQ(std::memcmp(a.triangles.data(), b.triangles.data(), a.triangles.size() * sizeof(BvhTriangle)), 0);
+  EXPECT_EQ(
+      std::memcmp(a.triangles.data(), b.triangles.data(), a.triangles.size() * sizeof(BvhTriangle)),
+      0);
   EXPECT_EQ(a.stats.depth, b.stats.depth);
   EXPECT_EQ(a.stats.leaves, b.stats.leaves);
   checkStructure(b.binary, b.triangles);
@@ -338,7 +349,7 @@ TEST(BvhBuild, DepthNeverExceedsTheStack) {
   EXPECT_LE(a.stats().depth, 10);
   checkStructure(a.nodes(), a.triangles());
   const HostGeom hg(a, nullptr);
-    const SceneGeom g = hg.geom();
+  const SceneGeom g = hg.geom();
   const auto tris = packSoup(s);
   HitChecker c;
   const auto rays = randomRays(500, triangleCentres(s), 9);
@@ -357,7 +368,7 @@ void expectStaticMatchesBruteForce(const Soup& s, size_t rayCount, uint32_t seed
   StaticAccel a;
   a.build(s.positions, s.indices);
   const HostGeom hg(a, nullptr);
-    const SceneGeom g = hg.geom();
+  const SceneGeom g = hg.geom();
   const auto tris = packSoup(s);
   const auto rays = randomRays(rayCount, triangleCentres(s), seed);
   HitChecker c;
@@ -366,7 +377,8 @@ void expectStaticMatchesBruteForce(const Soup& s, size_t rayCount, uint32_t seed
     const int any = dev::intersect_static(&g, rays[i], &h);
     const Hit want = bruteForce(tris, rays[i]);
     EXPECT_EQ(any, want.prim != PR_INVALID_INDEX);
-    if (!exactPrim && h.prim != want.prim && h.prim != PR_INVALID_INDEX && want.prim != PR_INVALID_INDEX) {
+    if (!exactPrim && h.prim != want.prim && h.prim != PR_INVALID_INDEX &&
+        want.prim != PR_INVALID_INDEX) {
       // Coincident or coplanar triangles: either is right if it is hit at the same t (an ulp
       // apart for coplanar ones: a box may then cull the other by that ulp).
       EXPECT_TRUE(relClose(h.t, want.t, 1e-6f)) << "ray " << i << ": " << h.t << " vs " << want.t;
@@ -408,7 +420,8 @@ TEST(StaticTraversal, DegenerateSoups) {
   Soup nested;
   for (int i = 0; i < 300; ++i) {
     const float k = 0.01f + 0.005f * float(i);
-    for (const glm::vec3 p : {glm::vec3(-k, -k, 0.2f * k), glm::vec3(2 * k, -k, -0.4f * k), glm::vec3(-k, 2 * k, 0.2f * k)}) {
+    for (const glm::vec3 p : {glm::vec3(-k, -k, 0.2f * k), glm::vec3(2 * k, -k, -0.4f * k),
+                              glm::vec3(-k, 2 * k, 0.2f * k)}) {
       nested.positions.push_back(p);
       nested.indices.push_back(uint32_t(nested.positions.size() - 1));
     }
@@ -449,7 +462,7 @@ TEST(StaticTraversal, EmptySceneHitsNothing) {
   StaticAccel a;
   a.build({}, {});
   const HostGeom hg(a, nullptr);
-    const SceneGeom g = hg.geom();
+  const SceneGeom g = hg.geom();
   Hit h;
   EXPECT_EQ(dev::intersect_scene(&g, makeRay({0, 0, 0}, {0, 0, 1}, 0.0f, PR_INF_F), &h), 0);
   EXPECT_EQ(h.prim, PR_INVALID_INDEX);
@@ -463,13 +476,14 @@ TEST(StaticTraversal, AxisAlignedRaysAndFaces) {
     for (int j = 0; j < 10; ++j) {
       const float x = float(i) * 0.2f - 1.0f, y = float(j) * 0.2f - 1.0f, z = float(i + j) * 0.05f;
       const uint32_t b = uint32_t(s.positions.size());
-      s.positions.insert(s.positions.end(), {{x, y, z}, {x + 0.2f, y, z}, {x + 0.2f, y + 0.2f, z}, {x, y + 0.2f, z}});
+      s.positions.insert(s.positions.end(),
+                         {{x, y, z}, {x + 0.2f, y, z}, {x + 0.2f, y + 0.2f, z}, {x, y + 0.2f, z}});
       s.indices.insert(s.indices.end(), {b, b + 1, b + 2, b, b + 2, b + 3});
     }
   StaticAccel a;
   a.build(s.positions, s.indices);
   const HostGeom hg(a, nullptr);
-    const SceneGeom g = hg.geom();
+  const SceneGeom g = hg.geom();
   const auto tris = packSoup(s);
   HitChecker c;
   std::mt19937 rng(3);
@@ -500,15 +514,16 @@ struct DynamicScene {
 
 glm::mat4 randomTransform(std::mt19937& rng) {
   std::uniform_real_distribution<float> u(-1.0f, 1.0f), s(0.3f, 1.5f);
-  const glm::quat q = glm::normalize(glm::quat(u(rng), u(rng), u(rng), u(rng)) + glm::quat(0.01f, 0, 0, 0));
+  const glm::quat q =
+      glm::normalize(glm::quat(u(rng), u(rng), u(rng), u(rng)) + glm::quat(0.01f, 0, 0, 0));
   glm::mat4 m = glm::translate(glm::mat4(1.0f), glm::vec3(u(rng), u(rng), u(rng)) * 1.5f);
   m = m * glm::mat4_cast(q);
   return glm::scale(m, glm::vec3(s(rng), s(rng), s(rng)));  // non-uniform
 }
 
 void makeDynamic(DynamicScene& d, uint32_t seed) {
-  d.meshes = {randomSoup(400, 0.25f, seed), randomSoup(1, 0.8f, seed + 1), randomSoup(0, 0.1f, seed + 2),
-              randomSoup(1500, 0.1f, seed + 3)};
+  d.meshes = {randomSoup(400, 0.25f, seed), randomSoup(1, 0.8f, seed + 1),
+              randomSoup(0, 0.1f, seed + 2), randomSoup(1500, 0.1f, seed + 3)};
   for (const Soup& m : d.meshes) d.accel.addMesh(m.positions, m.indices);
 }
 
@@ -516,17 +531,20 @@ void setFrame(DynamicScene& d, int frame) {
   std::mt19937 rng(1000 + uint32_t(frame));
   d.instances.clear();
   for (uint32_t i = 0; i < 9; ++i) d.instances.push_back({i % 4, randomTransform(rng)});
-  if (frame == 2) d.instances[5].objectToWorld = glm::scale(glm::mat4(1.0f), glm::vec3(1, 0, 1));  // singular
+  if (frame == 2)
+    d.instances[5].objectToWorld = glm::scale(glm::mat4(1.0f), glm::vec3(1, 0, 1));  // singular
   d.accel.setInstances(d.instances);
 }
 
 // Brute force over every instance in object space, using the records' world-to-object matrix.
-Hit bruteForceDynamic(const DynamicScene& d, const std::vector<std::vector<BvhTriangle>>& packed, Ray ray) {
+Hit bruteForceDynamic(const DynamicScene& d, const std::vector<std::vector<BvhTriangle>>& packed,
+                      Ray ray) {
   Hit best = dev::hit_none();
   const dev::BvhRay world = dev::bvh_ray_from(ray);
   for (const dev::BvhInstance& rec : d.accel.instances()) {
     const dev::BvhRay local = dev::instance_ray(&rec, &world);
-    Ray r = makeRay({local.o.x, local.o.y, local.o.z}, {local.d.x, local.d.y, local.d.z}, ray.tmin, ray.tmax);
+    Ray r = makeRay({local.o.x, local.o.y, local.o.z}, {local.d.x, local.d.y, local.d.z}, ray.tmin,
+                    ray.tmax);
     r.tmax = best.prim == PR_INVALID_INDEX ? ray.tmax : best.t;
     const Hit h = bruteForce(packed[rec.mesh], r, rec.instance_id);
     if (h.prim != PR_INVALID_INDEX) best = h;
@@ -555,7 +573,8 @@ std::vector<std::vector<BvhTriangle>> worldTriangles(const DynamicScene& d) {
     std::vector<BvhTriangle> tris;
     for (size_t t = 0; t < m.size(); ++t) {
       glm::vec3 v[3];
-      for (int k = 0; k < 3; ++k) v[k] = glm::vec3(in.objectToWorld * glm::vec4(m.vertex(t, k), 1.0f));
+      for (int k = 0; k < 3; ++k)
+        v[k] = glm::vec3(in.objectToWorld * glm::vec4(m.vertex(t, k), 1.0f));
       tris.push_back(packTriangle(v[0], v[1], v[2], bases[in.mesh] + uint32_t(t)));
     }
     out.push_back(tris);
@@ -566,7 +585,8 @@ std::vector<std::vector<BvhTriangle>> worldTriangles(const DynamicScene& d) {
 std::vector<glm::vec3> instanceCentres(const DynamicScene& d) {
   std::vector<glm::vec3> c;
   for (const InstanceInput& in : d.instances)
-    for (const glm::vec3& p : triangleCentres(d.meshes[in.mesh])) c.push_back(glm::vec3(in.objectToWorld * glm::vec4(p, 1.0f)));
+    for (const glm::vec3& p : triangleCentres(d.meshes[in.mesh]))
+      c.push_back(glm::vec3(in.objectToWorld * glm::vec4(p, 1.0f)));
   return c;
 }
 
@@ -648,7 +668,8 @@ TEST(SceneTraversal, NearerOfStaticAndDynamic) {
     for (size_t i = 0; i < rays.size(); ++i) {
       const Hit hs = bruteForce(stris, rays[i]);
       const Hit hd = bruteForceDynamic(d, packed, rays[i]);
-      const Hit want = hd.prim != PR_INVALID_INDEX && (hs.prim == PR_INVALID_INDEX || hd.t < hs.t) ? hd : hs;
+      const Hit want =
+          hd.prim != PR_INVALID_INDEX && (hs.prim == PR_INVALID_INDEX || hd.t < hs.t) ? hd : hs;
       fromDsg += want.inst != PR_INVALID_INDEX;
       Hit h;
       EXPECT_EQ(dev::intersect_scene(&g, rays[i], &h), want.prim != PR_INVALID_INDEX);
@@ -693,8 +714,10 @@ TEST(SelfIntersection, RaysLeavingASurfaceNeverHitIt) {
       } else {
         const auto& recs = d.accel.instances();
         const dev::BvhInstance& rec = recs[rng() % recs.size()];
-        const BvhTriangle& tri = d.accel.meshTriangles()[rec.first_triangle + rng() % (d.meshes[rec.mesh].size())];
-        const glm::vec3 v0(tri.v0x, tri.v0y, tri.v0z), e1(tri.e1x, tri.e1y, tri.e1z), e2(tri.e2x, tri.e2y, tri.e2z);
+        const BvhTriangle& tri =
+            d.accel.meshTriangles()[rec.first_triangle + rng() % (d.meshes[rec.mesh].size())];
+        const glm::vec3 v0(tri.v0x, tri.v0y, tri.v0z), e1(tri.e1x, tri.e1y, tri.e1z),
+            e2(tri.e2x, tri.e2y, tri.e2z);
         const glm::mat4 m = d.instances[rec.instance_id].objectToWorld;
         p = glm::vec3(m * glm::vec4(v0 + u * e1 + v * e2, 1.0f));
         ng = glm::transpose(glm::inverse(glm::mat3(m))) * glm::cross(e1, e2);
@@ -707,8 +730,9 @@ TEST(SelfIntersection, RaysLeavingASurfaceNeverHitIt) {
       glm::vec3 dir = randomDir(rng);
       if (i % 4 == 1) dir = glm::normalize(dir - glm::dot(dir, ng) * ng * 0.9999f);
       if (!(glm::length(dir) > 0.0f)) continue;
-      const Ray r = dev::spawn_ray(dev::make_float3(p.x, p.y, p.z), dev::make_float3(ng.x, ng.y, ng.z),
-                                   dev::make_float3(dir.x, dir.y, dir.z), PR_INF_F);
+      const Ray r =
+          dev::spawn_ray(dev::make_float3(p.x, p.y, p.z), dev::make_float3(ng.x, ng.y, ng.z),
+                         dev::make_float3(dir.x, dir.y, dir.z), PR_INF_F);
       Hit h;
       dev::intersect_scene(&g, r, &h);
       if (h.prim == prim && h.inst == inst && ++selfHits <= 5)
@@ -721,13 +745,13 @@ TEST(SelfIntersection, RaysLeavingASurfaceNeverHitIt) {
 TEST(SelfIntersection, ShadowSegmentsBetweenFacingSurfaces) {
   // Two facing quads and nothing between: no segment between them is ever occluded.
   Soup s;
-  s.positions = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0},
+  s.positions = {{-1, -1, 0},    {1, -1, 0},    {1, 1, 0},    {-1, 1, 0},
                  {-1, -1, 1.3f}, {1, -1, 1.7f}, {1, 1, 1.3f}, {-1, 1, 1.1f}};
   s.indices = {0, 1, 2, 0, 2, 3, 4, 6, 5, 4, 7, 6};
   StaticAccel a;
   a.build(s.positions, s.indices);
   const HostGeom hg(a, nullptr);
-    const SceneGeom g = hg.geom();
+  const SceneGeom g = hg.geom();
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> u01(0.0f, 1.0f);
   auto point = [&](size_t t, glm::vec3* n) {
@@ -741,8 +765,9 @@ TEST(SelfIntersection, ShadowSegmentsBetweenFacingSurfaces) {
   for (int i = 0; i < 20000; ++i) {
     glm::vec3 np, nq;
     const glm::vec3 p = point(rng() % 2, &np), q = point(2 + rng() % 2, &nq);
-    const Ray r = dev::spawn_ray_to(dev::make_float3(p.x, p.y, p.z), dev::make_float3(np.x, np.y, np.z),
-                                    dev::make_float3(q.x, q.y, q.z), dev::make_float3(nq.x, nq.y, nq.z));
+    const Ray r =
+        dev::spawn_ray_to(dev::make_float3(p.x, p.y, p.z), dev::make_float3(np.x, np.y, np.z),
+                          dev::make_float3(q.x, q.y, q.z), dev::make_float3(nq.x, nq.y, nq.z));
     blocked += dev::occluded_scene(&g, r);
   }
   EXPECT_EQ(blocked, 0);
@@ -756,8 +781,8 @@ bool nearEdge(const Hit& h) {
   return h.prim != PR_INVALID_INDEX && (h.u < 1e-4f || h.v < 1e-4f || 1.0f - h.u - h.v < 1e-4f);
 }
 
-void compareDevice(const SceneGeom& g, DeviceAccel& dacc, const std::vector<Ray>& rays, cl_uint mode,
-                   const std::string& what) {
+void compareDevice(const SceneGeom& g, DeviceAccel& dacc, const std::vector<Ray>& rays,
+                   cl_uint mode, const std::string& what) {
   const test::TracedRays dt = test::traceRays(dacc, rays, mode);
   HitChecker c;
   int edgeCases = 0;
@@ -822,7 +847,8 @@ TEST(DeviceTraversal, EveryWidthMatchesCpuReference) {
       const auto sc = triangleCentres(s);
       aim.insert(aim.end(), sc.begin(), sc.begin() + 2000);
       const auto rays = randomRays(3000, aim, 300 + uint32_t(frame));
-      for (cl_uint mode : {0u, 1u, 2u}) compareDevice(hg.geom(), dacc, rays, mode, "mode " + std::to_string(mode));
+      for (cl_uint mode : {0u, 1u, 2u})
+        compareDevice(hg.geom(), dacc, rays, mode, "mode " + std::to_string(mode));
     }
   }
   // A device compiled for one width refuses BVHs of another.

@@ -36,15 +36,20 @@ std::string base64(const std::string& bytes) {
 
 // A glTF document with one data: buffer that accessors are appended to.
 struct Builder {
-  json doc = {{"asset", {{"version", "2.0"}}}, {"bufferViews", json::array()}, {"accessors", json::array()}};
+  json doc = {{"asset", {{"version", "2.0"}}},
+              {"bufferViews", json::array()},
+              {"accessors", json::array()}};
   std::string bin;
 
   int floats(const std::vector<float>& v, const char* type) {
-    const size_t comps = std::string(type) == "SCALAR" ? 1 : std::string(type) == "VEC2" ? 2
-                         : std::string(type) == "VEC3" ? 3 : 4;
+    const size_t comps = std::string(type) == "SCALAR" ? 1
+                         : std::string(type) == "VEC2" ? 2
+                         : std::string(type) == "VEC3" ? 3
+                                                       : 4;
     const size_t offset = bin.size();
     bin.append(reinterpret_cast<const char*>(v.data()), v.size() * 4);
-    doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", v.size() * 4}});
+    doc["bufferViews"].push_back(
+        {{"buffer", 0}, {"byteOffset", offset}, {"byteLength", v.size() * 4}});
     doc["accessors"].push_back({{"bufferView", doc["bufferViews"].size() - 1},
                                 {"componentType", 5126},
                                 {"count", v.size() / comps},
@@ -81,19 +86,23 @@ LoadOptions quiet() {
 }
 
 // One node (child of an optional parent) animated by one sampler.
-Scene animatedScene(const std::string& path, const char* interpolation, const std::vector<float>& times,
-                    const std::vector<float>& values, const char* type) {
+Scene animatedScene(const std::string& path, const char* interpolation,
+                    const std::vector<float>& times, const std::vector<float>& values,
+                    const char* type) {
   Builder b;
   const int mesh = b.triangle();
   const int in = b.floats(times, "SCALAR");
   const int out = b.floats(values, type);
   b.doc["nodes"] = {{{"mesh", mesh}}};
   b.doc["scenes"] = {{{"nodes", {0}}}};
-  b.doc["animations"] = json::array({oneChannel({{"input", in}, {"output", out}, {"interpolation", interpolation}}, 0, path)});
+  b.doc["animations"] = json::array(
+      {oneChannel({{"input", in}, {"output", out}, {"interpolation", interpolation}}, 0, path)});
   return loadScene(b.write("anim.gltf"), quiet());
 }
 
-glm::vec3 translationAt(const Scene& s, double t) { return glm::vec3(s.nodeWorldTransform(0, t)[3]); }
+glm::vec3 translationAt(const Scene& s, double t) {
+  return glm::vec3(s.nodeWorldTransform(0, t)[3]);
+}
 
 void expectNear(const glm::vec3& a, const glm::vec3& b, float tol = 1e-5f) {
   EXPECT_NEAR(a.x, b.x, tol);
@@ -104,7 +113,7 @@ void expectNear(const glm::vec3& a, const glm::vec3& b, float tol = 1e-5f) {
 TEST(Animation, LinearTranslationAndClamping) {
   const Scene s = animatedScene("translation", "LINEAR", {1.0f, 3.0f}, {0, 0, 0, 4, 2, -2}, "VEC3");
   EXPECT_DOUBLE_EQ(s.animationDuration(), 3.0);
-  expectNear(translationAt(s, 0.0), {0, 0, 0});   // before the first key: first value
+  expectNear(translationAt(s, 0.0), {0, 0, 0});         // before the first key: first value
   expectNear(translationAt(s, 1.5), {1, 0.5f, -0.5f});  // a quarter of the way
   expectNear(translationAt(s, 2.0), {2, 1, -1});
   expectNear(translationAt(s, 10.0), {4, 2, -2});  // after the last key: last value
@@ -115,7 +124,8 @@ TEST(Animation, LinearTranslationAndClamping) {
 }
 
 TEST(Animation, StepHoldsTheKeyValue) {
-  const Scene s = animatedScene("translation", "STEP", {0.0f, 1.0f, 2.0f}, {0, 0, 0, 5, 0, 0, 7, 0, 0}, "VEC3");
+  const Scene s =
+      animatedScene("translation", "STEP", {0.0f, 1.0f, 2.0f}, {0, 0, 0, 5, 0, 0, 7, 0, 0}, "VEC3");
   expectNear(translationAt(s, 0.5), {0, 0, 0});
   expectNear(translationAt(s, 0.999), {0, 0, 0});
   expectNear(translationAt(s, 1.0), {5, 0, 0});
@@ -127,7 +137,8 @@ TEST(Animation, LinearRotationIsShortestSlerp) {
   // 0 to 90 degrees about Z; the second key is given as -q (the same rotation), so a plain
   // lerp would go the long way round.
   const float h = std::sqrt(0.5f);
-  const Scene s = animatedScene("rotation", "LINEAR", {0.0f, 1.0f}, {0, 0, 0, 1, 0, 0, -h, -h}, "VEC4");
+  const Scene s =
+      animatedScene("rotation", "LINEAR", {0.0f, 1.0f}, {0, 0, 0, 1, 0, 0, -h, -h}, "VEC4");
   const glm::mat4 m = s.nodeWorldTransform(0, 0.5);
   // Halfway is 45 degrees: +X goes to (cos 45, sin 45, 0).
   expectNear(glm::vec3(m * glm::vec4(1, 0, 0, 0)), {h, h, 0});
@@ -140,13 +151,13 @@ TEST(Animation, CubicSplineMatchesHandComputedHermite) {
   // Keys at t=0 and t=2 (dt = 2), x component only. Per key: in-tangent, value, out-tangent.
   const float v0 = 1, b0 = 3, a1 = -1, v1 = 4;
   const Scene s = animatedScene("translation", "CUBICSPLINE", {0.0f, 2.0f},
-                                {0, 0, 0, v0, 0, 0, b0, 0, 0,  // key 0: in, value, out
+                                {0, 0, 0, v0, 0, 0, b0, 0, 0,   // key 0: in, value, out
                                  a1, 0, 0, v1, 0, 0, 0, 0, 0},  // key 1
                                 "VEC3");
   for (double t : {0.5, 1.0, 1.5}) {
     const double dt = 2.0, u = t / dt, u2 = u * u, u3 = u2 * u;
-    const double expected = (2 * u3 - 3 * u2 + 1) * v0 + dt * (u3 - 2 * u2 + u) * b0 + (-2 * u3 + 3 * u2) * v1 +
-                            dt * (u3 - u2) * a1;
+    const double expected = (2 * u3 - 3 * u2 + 1) * v0 + dt * (u3 - 2 * u2 + u) * b0 +
+                            (-2 * u3 + 3 * u2) * v1 + dt * (u3 - u2) * a1;
     EXPECT_NEAR(translationAt(s, t).x, expected, 1e-5) << "t=" << t;
   }
   expectNear(translationAt(s, -1.0), {v0, 0, 0});  // the key value, not the tangent
@@ -155,7 +166,7 @@ TEST(Animation, CubicSplineMatchesHandComputedHermite) {
 
 TEST(Animation, CubicSplineRotationIsNormalised) {
   const Scene s = animatedScene("rotation", "CUBICSPLINE", {0.0f, 1.0f},
-                                {0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 1, 0,  // key 0: in, value, out
+                                {0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 1, 0,   // key 0: in, value, out
                                  0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 0, 0},  // key 1
                                 "VEC4");
   const glm::mat3 r(s.nodeWorldTransform(0, 0.5));
@@ -167,12 +178,13 @@ TEST(Animation, ParentMotionMovesStaticLocalChild) {
   const int mesh = b.triangle();
   const int in = b.floats({0.0f, 1.0f}, "SCALAR");
   const int out = b.floats({0, 0, 0, 0, 10, 0}, "VEC3");
-  b.doc["nodes"] = {{{"children", {1}}},                                  // 0: animated parent
-                    {{"translation", {1, 0, 0}}, {"children", {2}}},       // 1: static local
-                    {{"mesh", mesh}, {"scale", {2, 2, 2}}},                // 2: the mesh
-                    {{"mesh", mesh}, {"translation", {0, 0, 5}}}};         // 3: static root
+  b.doc["nodes"] = {{{"children", {1}}},                              // 0: animated parent
+                    {{"translation", {1, 0, 0}}, {"children", {2}}},  // 1: static local
+                    {{"mesh", mesh}, {"scale", {2, 2, 2}}},           // 2: the mesh
+                    {{"mesh", mesh}, {"translation", {0, 0, 5}}}};    // 3: static root
   b.doc["scenes"] = {{{"nodes", {0, 3}}}};
-  b.doc["animations"] = json::array({oneChannel({{"input", in}, {"output", out}}, 0, "translation")});
+  b.doc["animations"] =
+      json::array({oneChannel({{"input", in}, {"output", out}}, 0, "translation")});
   const Scene s = loadScene(b.write("nested.gltf"), quiet());
   ASSERT_EQ(s.instances.size(), 1u);
   EXPECT_EQ(s.instances[0].node, 2);
@@ -204,13 +216,18 @@ TEST(Animation, ExtrasDynamicIsInherited) {
 }
 
 TEST(Animation, TimesMustIncrease) {
-  EXPECT_THROW(animatedScene("translation", "LINEAR", {1.0f, 1.0f}, {0, 0, 0, 1, 1, 1}, "VEC3"), InputError);
-  EXPECT_THROW(animatedScene("translation", "LINEAR", {0.0f, NAN}, {0, 0, 0, 1, 1, 1}, "VEC3"), InputError);
-  // Output count must match: 2 keys, 3 values.
-  EXPECT_THROW(animatedScene("translation", "LINEAR", {0.0f, 1.0f}, {0, 0, 0, 1, 1, 1, 2, 2, 2}, "VEC3"),
+  EXPECT_THROW(animatedScene("translation", "LINEAR", {1.0f, 1.0f}, {0, 0, 0, 1, 1, 1}, "VEC3"),
                InputError);
+  EXPECT_THROW(animatedScene("translation", "LINEAR", {0.0f, NAN}, {0, 0, 0, 1, 1, 1}, "VEC3"),
+               InputError);
+  // Output count must match: 2 keys, 3 values.
+  EXPECT_THROW(
+      animatedScene("translation", "LINEAR", {0.0f, 1.0f}, {0, 0, 0, 1, 1, 1, 2, 2, 2}, "VEC3"),
+      InputError);
   // CUBICSPLINE needs three values per key.
-  EXPECT_THROW(animatedScene("translation", "CUBICSPLINE", {0.0f, 1.0f}, {0, 0, 0, 1, 1, 1}, "VEC3"), InputError);
+  EXPECT_THROW(
+      animatedScene("translation", "CUBICSPLINE", {0.0f, 1.0f}, {0, 0, 0, 1, 1, 1}, "VEC3"),
+      InputError);
 }
 
 }  // namespace

@@ -140,8 +140,8 @@ TEST(Bsdf, SamplingAgreesWithEvaluation) {
           const Estimate s = albedoBySampling(m, wo, 60000, 2);
           const Estimate e = albedoByEval(m, wo, 60000, 3);
           const double tol = 5 * std::sqrt(s.stderr_ * s.stderr_ + e.stderr_ * e.stderr_) + 2e-3;
-          EXPECT_NEAR(s.mean, e.mean, tol) << "metallic " << metallic << " roughness " << roughness
-                                           << " cos_o " << cos_o;
+          EXPECT_NEAR(s.mean, e.mean, tol)
+              << "metallic " << metallic << " roughness " << roughness << " cos_o " << cos_o;
           // Energy: no more than the light that arrives (a little slack for noise).
           EXPECT_LE(s.mean, 1.0 + tol);
         }
@@ -170,7 +170,8 @@ TEST(Bsdf, PdfIntegratesToAtMostOne) {
 // pbrt-v4's bsdfs_test does): the sphere cut into cells equal in solid angle (z bands x phi
 // sectors), each cell's expected count from integrating the pdf over it. Returns the tail
 // probability; `tilt` multiplies the reported pdf by (1 + tilt z), a mutation that must fail.
-double bsdfChiSquarePValue(const BsdfParams& m, float3 wo, int n, uint32_t seed, float tilt = 0.0f) {
+double bsdfChiSquarePValue(const BsdfParams& m, float3 wo, int n, uint32_t seed,
+                           float tilt = 0.0f) {
   constexpr int kZ = 16, kPhi = 32, kSub = 24;
   auto cellOf = [&](float3 w) {
     const int iz = std::min(kZ - 1, std::max(0, int((w.z + 1.0f) * 0.5f * kZ)));
@@ -245,7 +246,8 @@ TEST(Bsdf, GlassConservesEnergyAndRefractsBySnell) {
       float3 wi, w;
       float pdf;
       int delta;
-      ASSERT_TRUE(bsdf_sample(&m, wo, rng_next(&r), 0.5f, 0.5f, PR_IMPORTANCE, &wi, &w, &pdf, &delta));
+      ASSERT_TRUE(
+          bsdf_sample(&m, wo, rng_next(&r), 0.5f, 0.5f, PR_IMPORTANCE, &wi, &w, &pdf, &delta));
       EXPECT_TRUE(delta);
       EXPECT_NEAR(length(wi), 1.0f, 1e-5f);
       EXPECT_FLOAT_EQ(w.x, 1.0f);  // importance: no 1/eta^2

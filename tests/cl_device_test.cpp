@@ -223,7 +223,7 @@ TEST(Layout, DeviceAgreesWithHostOnEverySharedStruct) {
   names.push_back("sizeof " #T); \
   host.push_back(sizeof(T));
   PR_SHARED_STRUCTS(PR_HOST_SIZE)
-#define PR_HOST_OFFSET(T, m)             \
+#define PR_HOST_OFFSET(T, m)              \
   names.push_back("offsetof " #T "." #m); \
   host.push_back(offsetof(T, m));
   PR_SHARED_FIELDS(PR_HOST_OFFSET)

@@ -1,8 +1,8 @@
 // The light BVH (host/render/light_bvh.h, kernels/shared/light_bvh.h) on the CPU reference:
 // the choice it makes follows the pmf it reports (chi-square), the pmfs of all lights add to
-// at most one, no light that can reach a point (above its normal) is given probability 0, the cones and boxes of every
-// node hold their children's after build and after refit, and a point next to one of many
-// lights chooses that one far more often than power alone would.
+// at most one, no light that can reach a point (above its normal) is given probability 0, the cones
+// and boxes of every node hold their children's after build and after refit, and a point next to
+// one of many lights chooses that one far more often than power alone would.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -80,11 +80,10 @@ std::vector<Receiver> randomReceivers(uint32_t seed, int count) {
   std::uniform_real_distribution<float> pos(-6.0f, 6.0f);
   std::vector<Receiver> r;
   for (int i = 0; i < count; ++i)
-    r.push_back({make_float3(pos(g), pos(g), pos(g)),
-                 i % 4 == 3 ? make_float3(0, 0, 0) : randomUnit(g)});
+    r.push_back(
+        {make_float3(pos(g), pos(g), pos(g)), i % 4 == 3 ? make_float3(0, 0, 0) : randomUnit(g)});
   return r;
 }
-
 
 // Chi-square tail probability of n choices from (p, normal) against light_bvh_pmf.
 double choicePValue(const LightBvh& bvh, const std::vector<dev::Light>& lights, const Receiver& r,
@@ -141,8 +140,8 @@ TEST(LightBvh, PmfsAddToOneAndNoReachableLightIsImpossible) {
       if (l.type == PR_LIGHT_SPOT)
         reaches = reaches && -dev::dot(wi, make_float3(l.e1x, l.e1y, l.e1z)) > l.cos_outer + 1e-3f;
       if (l.type == PR_LIGHT_TRIANGLE) {
-        const float3 nl = dev::normalize(dev::cross(make_float3(l.e1x, l.e1y, l.e1z),
-                                                    make_float3(l.e2x, l.e2y, l.e2z)));
+        const float3 nl = dev::normalize(
+            dev::cross(make_float3(l.e1x, l.e1y, l.e1z), make_float3(l.e2x, l.e2y, l.e2z)));
         reaches = reaches && std::fabs(dev::dot(wi, nl)) > 1e-3f;
       }
       anyReaches = anyReaches || reaches;
@@ -248,8 +247,9 @@ TEST(LightBvh, ANearLightIsChosenMoreThanItsPowerShare) {
   LightBvh bvh;
   bvh.build(&lights, uint32_t(lights.size()));
   const dev::Light& near = lights[17];
-  const float3 c = make_float3(near.p0x, near.p0y, near.p0z) +
-                   make_float3(near.e1x + near.e2x, near.e1y + near.e2y, near.e1z + near.e2z) / 3.0f;
+  const float3 c =
+      make_float3(near.p0x, near.p0y, near.p0z) +
+      make_float3(near.e1x + near.e2x, near.e1y + near.e2y, near.e1z + near.e2z) / 3.0f;
   const float3 nl = dev::normalize(dev::cross(make_float3(near.e1x, near.e1y, near.e1z),
                                               make_float3(near.e2x, near.e2y, near.e2z)));
   const float3 p = c + nl * 0.05f;

@@ -37,11 +37,11 @@ TEST(LightSampler, LightBvhConvergesToThePowerChoiceWithLessNoise) {
   const std::string scene = lanternsScene();
   ASSERT_FALSE(scene.empty());
   auto render = [&](const char* sampler, int spp, int seed) {
-    const std::string dir = test::renderFrames(
-        scene, "0",
-        std::string(kDirect) + " --light-sampler " + sampler + " --spp " + std::to_string(spp) +
-            " --seed " + std::to_string(seed),
-        std::string("lanterns-") + sampler);
+    const std::string dir =
+        test::renderFrames(scene, "0",
+                           std::string(kDirect) + " --light-sampler " + sampler + " --spp " +
+                               std::to_string(spp) + " --seed " + std::to_string(seed),
+                           std::string("lanterns-") + sampler);
     return test::frameImage(dir, 0);
   };
   const Image refBvh = render("bvh", 256, 1), refPower = render("power", 256, 2);

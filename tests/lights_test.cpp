@@ -93,7 +93,6 @@ std::vector<double> cellProbabilities(const Tri& t, float3 p, bool solid) {
   return prob;
 }
 
-
 // Cell probabilities of the density light_pdf_triangle reports from p (shading normal n),
 // integrated over the triangle on a fine grid (solid angle = area x cos / d^2).
 std::vector<double> cellProbabilitiesOfPdf(const Tri& t, float3 p, float3 n) {
@@ -208,8 +207,8 @@ TEST(SphericalTriangle, CosineWarpedSamplesFollowTheReportedPdf) {
 // it with, in both regimes, with and without the cosine warp.
 TEST(SphericalTriangle, PdfOfAPointEqualsThePdfOfDrawingIt) {
   const dev::Light l = triangleLight(kBig);
-  for (const float3 n : {make_float3(0, 0, 0), make_float3(0, 1, 0),
-                         dev::normalize(make_float3(1.0f, 0.15f, 0.2f))})
+  for (const float3 n :
+       {make_float3(0, 0, 0), make_float3(0, 1, 0), dev::normalize(make_float3(1.0f, 0.15f, 0.2f))})
     for (const float3 p : {make_float3(0.1f, 0.2f, 0.3f), make_float3(1.2f, 1.15f, 0.3f),
                            make_float3(0.0f, 200.0f, 0.0f)}) {
       dev::Rng rng = dev::rng_make(5u, PR_RNG_TEST, 0u, 2u, 0u);
@@ -218,8 +217,7 @@ TEST(SphericalTriangle, PdfOfAPointEqualsThePdfOfDrawingIt) {
         dev::LightSample ls;
         float b1, b2;
         if (!dev::light_sample(&l, 0.25f, p, n, u1, u2, &ls, &b1, &b2)) continue;
-        const float pdf =
-            dev::light_pdf_triangle(0.25f, p, n, ls.pos, kBig.v0, kBig.e1, kBig.e2);
+        const float pdf = dev::light_pdf_triangle(0.25f, p, n, ls.pos, kBig.v0, kBig.e1, kBig.e2);
         ASSERT_NEAR(pdf, ls.pdf, 2e-3f * ls.pdf) << "sample " << s << " from y " << p.y;
       }
     }

@@ -20,8 +20,8 @@ TEST(RenderOptions, OutPatterns) {
   EXPECT_EQ(formatOutPath("f%d.exr", 12), "f12.exr");
   EXPECT_EQ(formatOutPath("100%%_%03i.exr", 5), "100%_005.exr");
   EXPECT_NO_THROW(validateOutPattern("a/b_%05d.exr"));
-  for (const char* bad : {"out.exr", "%s.exr", "%d_%d.exr", "%n.exr", "%0999d.exr", "%x.exr",
-                          "%.exr", "dir/%d/"})
+  for (const char* bad :
+       {"out.exr", "%s.exr", "%d_%d.exr", "%n.exr", "%0999d.exr", "%x.exr", "%.exr", "dir/%d/"})
     EXPECT_THROW(validateOutPattern(bad), InputError) << bad;
   EXPECT_EQ(withExtension("out/frame_0001.exr", ".png"), "out/frame_0001.png");
 }

@@ -21,8 +21,9 @@ using test::regionMean;
 
 Image render(const std::string& scene, const std::string& args, const std::string& tag) {
   const std::string dir = test::tempDir(tag);
-  const auto r = test::runPathreuse("render '" + scene + "' --quiet --exr-float --mode pathtrace --out '" +
-                                    dir + "/f_%04d.exr' " + args);
+  const auto r =
+      test::runPathreuse("render '" + scene + "' --quiet --exr-float --mode pathtrace --out '" +
+                         dir + "/f_%04d.exr' " + args);
   EXPECT_EQ(r.exitCode, 0) << r.err;
   return readExr(dir + "/f_0000.exr");
 }
@@ -35,12 +36,14 @@ TEST(PathTrace, WhiteFurnaceConvergesToLeOverOneMinusAlbedo) {
   b.addCamera(glm::vec3(0.1f, 0.2f, 0.3f), glm::vec3(1, 0.5f, -1), 1.2f, 1.0f);
   const std::string scene = b.write(test::tempDir("furnace"), "furnace");
   // Depth 40: the truncated series misses albedo^40 ~ 1e-12 of the answer.
-  const Image img = render(scene, "--frames 0 --width 48 --height 48 --spp 16 --max-depth 40 --force-diffuse",
-                           "furnace-out");
+  const Image img =
+      render(scene, "--frames 0 --width 48 --height 48 --spp 16 --max-depth 40 --force-diffuse",
+             "furnace-out");
   const double expected = le / (1.0 - albedo);
   for (int c = 0; c < 3; ++c) {
     const Moments m = regionMean(img, 0, 0, 48, 48, c);
-    EXPECT_NEAR(m.mean, expected, 5 * m.stderr_ + 1e-3) << "channel " << c << " stderr " << m.stderr_;
+    EXPECT_NEAR(m.mean, expected, 5 * m.stderr_ + 1e-3)
+        << "channel " << c << " stderr " << m.stderr_;
     EXPECT_LT(m.stderr_, 0.02);  // the test has power to see a 5% error
   }
   // Every region, not only the whole image.
@@ -63,8 +66,9 @@ TEST(PathTrace, DiffusePlaneUnderPointLightMatchesIrradianceLaw) {
   b.addCamera(eye, glm::vec3(0), yfov, 1.0f);
   const std::string scene = b.write(test::tempDir("plane"), "plane");
   const int n = 32;
-  const Image img = render(scene, "--frames 0 --width 32 --height 32 --spp 256 --max-depth 2 --force-diffuse",
-                           "plane-out");
+  const Image img =
+      render(scene, "--frames 0 --width 32 --height 32 --spp 256 --max-depth 2 --force-diffuse",
+             "plane-out");
   // The camera looks down -Y with up = -Z: pixel (x, y) maps to world (X, Z) on the plane.
   // Radiance changes by up to ~13% across a pixel at the edges; 256 jittered samples estimate
   // the pixel's mean to ~0.25%, so 1% is four standard errors.
@@ -96,8 +100,9 @@ TEST(PathTrace, SameSeedSameFrameDifferentSeedSameMean) {
   const std::string args = "--frames 10 --width 40 --height 30 --spp 8";
   auto renderFrame = [&](const std::string& seed, const std::string& tag) {
     const std::string dir = test::tempDir(tag);
-    const auto r = test::runPathreuse("render '" + scene + "' --quiet --exr-float --mode pathtrace --seed " + seed +
-                                      " --out '" + dir + "/f_%04d.exr' " + args);
+    const auto r =
+        test::runPathreuse("render '" + scene + "' --quiet --exr-float --mode pathtrace --seed " +
+                           seed + " --out '" + dir + "/f_%04d.exr' " + args);
     EXPECT_EQ(r.exitCode, 0) << r.err;
     return readExr(dir + "/f_0010.exr");
   };
@@ -129,9 +134,10 @@ uint64_t badSamplesIn(const std::string& statsFile, int* lines) {
 TEST(PathTrace, NoNonFiniteSamplesOnTheDemoScenes) {
   for (const char* name : {"scenes/cornell-dynamic.gltf", "scenes/cornell-orbit.gltf"}) {
     const std::string dir = test::tempDir("nan");
-    const auto r = test::runPathreuse("render '" + test::sourcePath(name) +
-                                      "' --quiet --mode pathtrace --frames 0-2 --width 48 --height 36 --spp 4 --out '" +
-                                      dir + "/f_%04d.exr' --stats '" + dir + "/stats.jsonl'");
+    const auto r = test::runPathreuse(
+        "render '" + test::sourcePath(name) +
+        "' --quiet --mode pathtrace --frames 0-2 --width 48 --height 36 --spp 4 --out '" + dir +
+        "/f_%04d.exr' --stats '" + dir + "/stats.jsonl'");
     ASSERT_EQ(r.exitCode, 0) << r.err;
     int lines = 0;
     EXPECT_EQ(badSamplesIn(dir + "/stats.jsonl", &lines), 0u) << name;
@@ -149,8 +155,10 @@ TEST(PathTrace, NoNonFiniteSamplesOnCornellNvpro) {
   const std::string scene = test::sharedScene("cornell-nvpro/cornellBox.gltf");
   if (scene.empty()) GTEST_SKIP() << "../shared/scenes/cornell-nvpro is absent";
   const std::string dir = test::tempDir("nan-nvpro");
-  const auto r = test::runPathreuse("render '" + scene + "' --quiet --mode pathtrace --frames 0 --width 64 --height 48 --spp 4 --out '" +
-                                    dir + "/f_%04d.exr' --stats '" + dir + "/stats.jsonl'");
+  const auto r = test::runPathreuse(
+      "render '" + scene +
+      "' --quiet --mode pathtrace --frames 0 --width 64 --height 48 --spp 4 --out '" + dir +
+      "/f_%04d.exr' --stats '" + dir + "/stats.jsonl'");
   ASSERT_EQ(r.exitCode, 0) << r.err;
   int lines = 0;
   EXPECT_EQ(badSamplesIn(dir + "/stats.jsonl", &lines), 0u);

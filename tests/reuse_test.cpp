@@ -264,8 +264,11 @@ TEST(Reuse, ResampledConnectionsConvergeOnGlossyAndDeltaMaterials) {
 TEST(Reuse, ResampledConnectionsTraceOneRayPerEyeVertex) {
   const std::string scene = test::sourcePath("scenes/cornell-dynamic.gltf");
   auto stats = [&](const std::string& mode) {
-    const std::string dir = test::renderFrames(scene, "0", "--mode reuse --width 64 --height 48 "
-                                               "--spp 4 --connections " + mode, "conn-" + mode);
+    const std::string dir = test::renderFrames(scene, "0",
+                                               "--mode reuse --width 64 --height 48 "
+                                               "--spp 4 --connections " +
+                                                   mode,
+                                               "conn-" + mode);
     const auto lines = test::statsLines(dir);
     EXPECT_EQ(lines.size(), 1u);
     return nlohmann::json::parse(lines.at(0));

@@ -54,7 +54,8 @@ TEST(SceneLoader, CornellNvpro) {
   if (path.empty()) GTEST_SKIP() << "../shared/scenes is absent";
   const auto start = std::chrono::steady_clock::now();
   const Scene s = loadScene(path, quiet());
-  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   std::cout << "cornell-nvpro loaded in " << ms << " ms\n";
   // The file's meshes hold 16,720 triangles; mesh 1 "cube_1" is placed twice (floor at y=-5,
   // ceiling at y=+5), so the world-space SSG holds 12 more.
@@ -81,7 +82,8 @@ TEST(SceneLoader, BoxAnimatedIsSplit) {
   if (path.empty()) GTEST_SKIP() << "../shared/scenes is absent";
   const Scene s = loadScene(path, quiet());
   EXPECT_GT(s.dynamicTriangleCount(), 0u);
-  EXPECT_EQ(s.dynamicTriangleCount(), 62u);  // node 2, under the translated node 0 and rotated itself
+  EXPECT_EQ(s.dynamicTriangleCount(),
+            62u);  // node 2, under the translated node 0 and rotated itself
   EXPECT_EQ(s.staticTriangleCount(), 192u);  // node 3, not animated
   EXPECT_NEAR(s.animationDuration(), 3.70833, 1e-4);
   ASSERT_EQ(s.cameras.size(), 1u);
@@ -127,7 +129,8 @@ TEST(SceneLoader, KhronosInvalidFilesAreRefused) {
 }
 
 TEST(SceneLoader, AssimpModelsLoadOrAreRefusedCleanly) {
-  if (!fs::exists(kAssimpDir)) GTEST_SKIP() << kAssimpDir << " is absent (apt-get install assimp-testmodels)";
+  if (!fs::exists(kAssimpDir))
+    GTEST_SKIP() << kAssimpDir << " is absent (apt-get install assimp-testmodels)";
   int loaded = 0, refused = 0;
   for (const auto& entry : fs::recursive_directory_iterator(kAssimpDir)) {
     const std::string ext = entry.path().extension().string();
@@ -157,19 +160,21 @@ TEST(SceneLoader, AssimpModelsLoadOrAreRefusedCleanly) {
 TEST(SceneLoader, AssimpBrokenModelsAreRefused) {
   if (!fs::exists(kAssimpDir)) GTEST_SKIP() << kAssimpDir << " is absent";
   const std::string d = kAssimpDir;
-  for (const char* rel : {"IndexOutOfRange/IndexOutOfRange.gltf", "IndexOutOfRange/AllIndicesOutOfRange.gltf",
-                          "wrongTypes/badArray.gltf", "wrongTypes/badExtension.gltf", "wrongTypes/badNumber.gltf",
-                          "wrongTypes/badObject.gltf", "wrongTypes/badString.gltf", "wrongTypes/badUint.gltf",
-                          "RecursiveNodes/RecursiveNodes.gltf", "MissingBin/BoxTextured.gltf",
-                          "SchemaFailures/sceneWrongType.gltf", "IncorrectVertexArrays/Cube.gltf",
-                          "BoxWithInfinites-glTF-Binary/BoxWithInfinites.glb",
-                          "draco/2CylinderEngine.gltf"}) {
+  for (const char* rel :
+       {"IndexOutOfRange/IndexOutOfRange.gltf", "IndexOutOfRange/AllIndicesOutOfRange.gltf",
+        "wrongTypes/badArray.gltf", "wrongTypes/badExtension.gltf", "wrongTypes/badNumber.gltf",
+        "wrongTypes/badObject.gltf", "wrongTypes/badString.gltf", "wrongTypes/badUint.gltf",
+        "RecursiveNodes/RecursiveNodes.gltf", "MissingBin/BoxTextured.gltf",
+        "SchemaFailures/sceneWrongType.gltf", "IncorrectVertexArrays/Cube.gltf",
+        "BoxWithInfinites-glTF-Binary/BoxWithInfinites.glb", "draco/2CylinderEngine.gltf"}) {
     SCOPED_TRACE(rel);
     expectRefused(d + "/" + rel);
   }
-  EXPECT_NE(tryLoad(d + "/IndexOutOfRange/IndexOutOfRange.gltf").find("out of range"), std::string::npos);
+  EXPECT_NE(tryLoad(d + "/IndexOutOfRange/IndexOutOfRange.gltf").find("out of range"),
+            std::string::npos);
   EXPECT_NE(tryLoad(d + "/RecursiveNodes/RecursiveNodes.gltf").find("cycle"), std::string::npos);
-  EXPECT_NE(tryLoad(d + "/draco/2CylinderEngine.gltf").find("KHR_draco_mesh_compression"), std::string::npos);
+  EXPECT_NE(tryLoad(d + "/draco/2CylinderEngine.gltf").find("KHR_draco_mesh_compression"),
+            std::string::npos);
 }
 
 TEST(SceneLoader, AssimpValidModelsLoad) {
@@ -189,13 +194,15 @@ TEST(SceneLoader, AssimpValidModelsLoad) {
   EXPECT_GE(s.fileCameraCount(), 1u);
   ASSERT_EQ(tryLoad(d + "/textureTransform/TextureTransformTest.gltf", &s), "");
   // Morph targets and skins: loaded in the bind pose with exactly one warning about it.
-  ASSERT_EQ(tryLoad(d + "/glTF-Sample-Models/AnimatedMorphCube-glTF/AnimatedMorphCube.gltf", &s), "");
+  ASSERT_EQ(tryLoad(d + "/glTF-Sample-Models/AnimatedMorphCube-glTF/AnimatedMorphCube.gltf", &s),
+            "");
   EXPECT_EQ(s.warnings.size(), 1u);
   EXPECT_GT(s.staticTriangleCount(), 0u);
   ASSERT_EQ(tryLoad(d + "/simple_skin/simple_skin.gltf", &s), "");
   EXPECT_EQ(s.warnings.size(), 1u);
   // Non-triangle modes are skipped with a warning.
-  ASSERT_EQ(tryLoad(d + "/glTF-Asset-Generator/Mesh_PrimitiveMode/Mesh_PrimitiveMode_01.gltf", &s), "");
+  ASSERT_EQ(tryLoad(d + "/glTF-Asset-Generator/Mesh_PrimitiveMode/Mesh_PrimitiveMode_01.gltf", &s),
+            "");
   EXPECT_EQ(s.staticTriangleCount(), 0u);
   EXPECT_EQ(s.warnings.size(), 1u);
 }
@@ -248,15 +255,19 @@ struct Quad {
            {"scene", 0},
            {"scenes", {{{"nodes", {0}}}}},
            {"nodes", {{{"mesh", 0}, {"name", "quad"}}}},
-           {"meshes", {{{"name", "Quad"}, {"primitives", {{{"attributes", {{"POSITION", 0}}}, {"indices", 1}}}}}}},
+           {"meshes",
+            {{{"name", "Quad"},
+              {"primitives", {{{"attributes", {{"POSITION", 0}}}, {"indices", 1}}}}}}},
            {"accessors",
             {{{"bufferView", 0}, {"componentType", 5126}, {"count", 4}, {"type", "VEC3"}},
              {{"bufferView", 1}, {"componentType", 5123}, {"count", 6}, {"type", "SCALAR"}}}},
-           {"bufferViews", {{{"buffer", 0}, {"byteOffset", 0}, {"byteLength", 48}},
-                            {{"buffer", 0}, {"byteOffset", 48}, {"byteLength", 12}}}}};
+           {"bufferViews",
+            {{{"buffer", 0}, {"byteOffset", 0}, {"byteLength", 48}},
+             {{"buffer", 0}, {"byteOffset", 48}, {"byteLength", 12}}}}};
   }
   std::string write(const std::string& name = "quad.gltf") {
-    doc["buffers"] = {{{"byteLength", bin.size()}, {"uri", "data:application/octet-stream;base64," + base64(bin)}}};
+    doc["buffers"] = {{{"byteLength", bin.size()},
+                       {"uri", "data:application/octet-stream;base64," + base64(bin)}}};
     const std::string path = test::tempDir("quad") + "/" + name;
     std::ofstream(path) << doc.dump();
     return path;
@@ -305,17 +316,19 @@ TEST(SceneLoader, InstancingAndMirroring) {
 
 TEST(SceneLoader, MaterialsAndExtensions) {
   Quad q;
-  q.doc["extensionsUsed"] = {"KHR_materials_emissive_strength", "KHR_materials_transmission", "KHR_materials_ior",
-                             "KHR_texture_transform"};
+  q.doc["extensionsUsed"] = {"KHR_materials_emissive_strength", "KHR_materials_transmission",
+                             "KHR_materials_ior", "KHR_texture_transform"};
   q.doc["materials"] = {
       {{"emissiveFactor", {1, 0.5, 0}},
        {"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", 4.0}}}}}},
-      {{"extensions", {{"KHR_materials_transmission", {{"transmissionFactor", 1.0}}},
-                       {"KHR_materials_ior", {{"ior", 1.33}}}}},
+      {{"extensions",
+        {{"KHR_materials_transmission", {{"transmissionFactor", 1.0}}},
+         {"KHR_materials_ior", {{"ior", 1.33}}}}},
        {"alphaMode", "MASK"},
        {"doubleSided", true}}};
   q.doc["meshes"][0]["primitives"][0]["material"] = 0;
-  q.doc["meshes"].push_back({{"primitives", {{{"attributes", {{"POSITION", 0}}}, {"material", 1}}}}});
+  q.doc["meshes"].push_back(
+      {{"primitives", {{{"attributes", {{"POSITION", 0}}}, {"material", 1}}}}});
   q.doc["nodes"].push_back({{"mesh", 1}});
   q.doc["scenes"][0]["nodes"] = {0, 1};
   Scene s;
@@ -329,7 +342,8 @@ TEST(SceneLoader, MaterialsAndExtensions) {
   EXPECT_FLOAT_EQ(s.materials[1].alphaCutoff, 0.5f);
   EXPECT_TRUE(s.materials[1].doubleSided);
   EXPECT_EQ(s.emissiveTriangleCount(), 2u);
-  EXPECT_EQ(s.staticTriangleCount(), 3u);  // 4 vertices non-indexed: 1 triangle, one vertex left over
+  EXPECT_EQ(s.staticTriangleCount(),
+            3u);  // 4 vertices non-indexed: 1 triangle, one vertex left over
 }
 
 TEST(SceneLoader, TextureTransformMath) {
@@ -345,17 +359,23 @@ TEST(SceneLoader, TextureTransformMath) {
 TEST(SceneLoader, PunctualLightsAndCameras) {
   Quad q;
   q.doc["extensionsUsed"] = {"KHR_lights_punctual"};
-  q.doc["extensions"] = {{"KHR_lights_punctual",
-                          {{"lights",
-                            {{{"type", "spot"}, {"intensity", 100}, {"spot", {{"innerConeAngle", 0.1}, {"outerConeAngle", 0.5}}}},
-                             {{"type", "directional"}, {"color", {1, 0.9, 0.8}}, {"intensity", 3}}}}}}};
+  q.doc["extensions"] = {
+      {"KHR_lights_punctual",
+       {{"lights",
+         {{{"type", "spot"},
+           {"intensity", 100},
+           {"spot", {{"innerConeAngle", 0.1}, {"outerConeAngle", 0.5}}}},
+          {{"type", "directional"}, {"color", {1, 0.9, 0.8}}, {"intensity", 3}}}}}}};
   q.doc["cameras"] = {{{"type", "perspective"}, {"perspective", {{"yfov", 0.8}, {"znear", 0.1}}}},
-                      {{"type", "orthographic"}, {"orthographic", {{"xmag", 1}, {"ymag", 1}, {"znear", 0}, {"zfar", 10}}}}};
-  q.doc["nodes"] = {{{"mesh", 0}},
-                    {{"translation", {0, 2, 0}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}},
-                    {{"rotation", {-0.7071068, 0, 0, 0.7071068}}, {"extensions", {{"KHR_lights_punctual", {{"light", 1}}}}}},
-                    {{"camera", 0}, {"translation", {0, 0, 10}}},
-                    {{"camera", 1}}};
+                      {{"type", "orthographic"},
+                       {"orthographic", {{"xmag", 1}, {"ymag", 1}, {"znear", 0}, {"zfar", 10}}}}};
+  q.doc["nodes"] = {
+      {{"mesh", 0}},
+      {{"translation", {0, 2, 0}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}},
+      {{"rotation", {-0.7071068, 0, 0, 0.7071068}},
+       {"extensions", {{"KHR_lights_punctual", {{"light", 1}}}}}},
+      {{"camera", 0}, {"translation", {0, 0, 10}}},
+      {{"camera", 1}}};
   q.doc["scenes"][0]["nodes"] = {0, 1, 2, 3, 4};
   Scene s;
   ASSERT_EQ(tryLoad(q.write(), &s), "");
@@ -388,18 +408,31 @@ TEST(SceneLoader, BrokenQuadsAreRefused) {
     const char* expected;  // part of the message
   };
   const std::vector<Case> cases = {
-      {"accessor past view", [](Quad& q) { q.doc["accessors"][0]["count"] = 5; }, "reads past the end of bufferView 0"},
-      {"view past buffer", [](Quad& q) { q.doc["bufferViews"][1]["byteLength"] = 100; }, "past the end of buffer"},
+      {"accessor past view", [](Quad& q) { q.doc["accessors"][0]["count"] = 5; },
+       "reads past the end of bufferView 0"},
+      {"view past buffer", [](Quad& q) { q.doc["bufferViews"][1]["byteLength"] = 100; },
+       "past the end of buffer"},
       {"bad stride", [](Quad& q) { q.doc["bufferViews"][0]["byteStride"] = 6; }, "byteStride"},
-      {"stride too small", [](Quad& q) { q.doc["bufferViews"][0]["byteStride"] = 8; }, "byteStride"},
+      {"stride too small", [](Quad& q) { q.doc["bufferViews"][0]["byteStride"] = 8; },
+       "byteStride"},
       {"index out of range", [](Quad& q) { q.bin[48] = 9; }, "out of range"},
-      {"position type", [](Quad& q) { q.doc["accessors"][0]["type"] = "VEC4"; q.doc["accessors"][0]["count"] = 3; },
+      {"position type",
+       [](Quad& q) {
+         q.doc["accessors"][0]["type"] = "VEC4";
+         q.doc["accessors"][0]["count"] = 3;
+       },
        "POSITION"},
-      {"float indices", [](Quad& q) { q.doc["accessors"][1]["componentType"] = 5126; q.doc["accessors"][1]["count"] = 3; },
+      {"float indices",
+       [](Quad& q) {
+         q.doc["accessors"][1]["componentType"] = 5126;
+         q.doc["accessors"][1]["count"] = 3;
+       },
        "indices"},
-      {"missing accessor", [](Quad& q) { q.doc["meshes"][0]["primitives"][0]["indices"] = 7; }, "indices"},
+      {"missing accessor", [](Quad& q) { q.doc["meshes"][0]["primitives"][0]["indices"] = 7; },
+       "indices"},
       {"missing mesh", [](Quad& q) { q.doc["nodes"][0]["mesh"] = 3; }, "mesh 3"},
-      {"missing material", [](Quad& q) { q.doc["meshes"][0]["primitives"][0]["material"] = 2; }, "material 2"},
+      {"missing material", [](Quad& q) { q.doc["meshes"][0]["primitives"][0]["material"] = 2; },
+       "material 2"},
       {"missing node", [](Quad& q) { q.doc["scenes"][0]["nodes"] = {4}; }, "node 4"},
       {"missing scene", [](Quad& q) { q.doc["scene"] = 3; }, "scene"},
       {"two parents",
@@ -409,42 +442,63 @@ TEST(SceneLoader, BrokenQuadsAreRefused) {
        },
        "two parents"},
       {"self child", [](Quad& q) { q.doc["nodes"][0]["children"] = {0}; }, "own child"},
-      {"nan translation", [](Quad& q) { q.doc["nodes"][0]["translation"] = {0, 1e39, 0}; }, "not finite"},
+      {"nan translation",
+       [](Quad& q) {
+         q.doc["nodes"][0]["translation"] = {0, 1e39, 0};
+       },
+       "not finite"},
       {"version 3", [](Quad& q) { q.doc["asset"]["version"] = "3.0"; }, "version"},
-      {"required ext", [](Quad& q) { q.doc["extensionsRequired"] = {"EXT_meshopt_compression"}; }, "EXT_meshopt"},
+      {"required ext", [](Quad& q) { q.doc["extensionsRequired"] = {"EXT_meshopt_compression"}; },
+       "EXT_meshopt"},
       {"negative strength",
        [](Quad& q) {
-         q.doc["materials"] = {{{"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", -1}}}}}}};
+         q.doc["materials"] = {
+             {{"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", -1}}}}}}};
        },
        "emissiveStrength"},
-      {"zero ior", [](Quad& q) { q.doc["materials"] = {{{"extensions", {{"KHR_materials_ior", {{"ior", 0}}}}}}}; },
+      {"zero ior",
+       [](Quad& q) {
+         q.doc["materials"] = {{{"extensions", {{"KHR_materials_ior", {{"ior", 0}}}}}}};
+       },
        "ior"},
-      {"bad texture", [](Quad& q) { q.doc["materials"] = {{{"emissiveTexture", {{"index", 0}}}}}; }, "texture 0"},
+      {"bad texture",
+       [](Quad& q) {
+         q.doc["materials"] = {{{"emissiveTexture", {{"index", 0}}}}};
+       },
+       "texture 0"},
       {"sparse out of range",
        [](Quad& q) {
-         q.doc["accessors"][0]["sparse"] = {{"count", 1},
-                                            {"indices", {{"bufferView", 1}, {"componentType", 5123}}},
-                                            {"values", {{"bufferView", 0}}}};
+         q.doc["accessors"][0]["sparse"] = {
+             {"count", 1},
+             {"indices", {{"bufferView", 1}, {"componentType", 5123}}},
+             {"values", {{"bufferView", 0}}}};
          q.bin[48] = 7;  // sparse index 7 >= count 4
        },
        "sparse"},
       {"animation target",
        [](Quad& q) {
-         json a = {{"samplers", json::array({json{{"input", 1}, {"output", 0}}})},
-                   {"channels", json::array({json{{"sampler", 0}, {"target", {{"node", 9}, {"path", "translation"}}}}})}};
+         json a = {
+             {"samplers", json::array({json{{"input", 1}, {"output", 0}}})},
+             {"channels", json::array({json{{"sampler", 0},
+                                            {"target", {{"node", 9}, {"path", "translation"}}}}})}};
          q.doc["animations"] = json::array({a});
        },
        "node 9"},
       {"animation sampler",
        [](Quad& q) {
-         json a = {{"samplers", json::array()},
-                   {"channels", json::array({json{{"sampler", 0}, {"target", {{"node", 0}, {"path", "translation"}}}}})}};
+         json a = {
+             {"samplers", json::array()},
+             {"channels", json::array({json{{"sampler", 0},
+                                            {"target", {{"node", 0}, {"path", "translation"}}}}})}};
          q.doc["animations"] = json::array({a});
        },
        "sampler 0"},
       {"camera ref", [](Quad& q) { q.doc["nodes"][0]["camera"] = 0; }, "camera 0"},
       {"light ref",
-       [](Quad& q) { q.doc["nodes"][0]["extensions"] = {{"KHR_lights_punctual", {{"light", 0}}}}; }, "light 0"},
+       [](Quad& q) {
+         q.doc["nodes"][0]["extensions"] = {{"KHR_lights_punctual", {{"light", 0}}}};
+       },
+       "light 0"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.name);

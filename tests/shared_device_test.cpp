@@ -1,7 +1,7 @@
 // The shared helpers (sampling, BSDFs, octahedral normals, ray offsets, light choice by power and
 // by the light BVH) give the same values on the device as the CPU reference, in every
-// work-item. A compiler that mishandles some lanes of a vectorised work-group (Intel's CPU runtime did, for helpers kept out of line
-// that pass float3 values) fails here with the lanes named.
+// work-item. A compiler that mishandles some lanes of a vectorised work-group (Intel's CPU runtime
+// did, for helpers kept out of line that pass float3 values) fails here with the lanes named.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -32,7 +32,9 @@ std::vector<float> powerTable() {
 LightBvh lightTree() {
   std::vector<dev::Light> lights;
   for (uint32_t k = 0; k < 61; ++k) {
-    auto u = [&](uint32_t j) { return float(dev::pr_hash_u32(k * 7u + j) >> 8) * (1.0f / 16777216.0f); };
+    auto u = [&](uint32_t j) {
+      return float(dev::pr_hash_u32(k * 7u + j) >> 8) * (1.0f / 16777216.0f);
+    };
     dev::Light l{};
     l.type = k % 5 == 4 ? PR_LIGHT_POINT : PR_LIGHT_TRIANGLE;
     l.p0x = 8.0f * u(0) - 4.0f, l.p0y = 8.0f * u(1) - 4.0f, l.p0z = 8.0f * u(2) - 4.0f;

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian packages that pathreuse's build, tests and PoCL need (python3-venv for
-# tools/intel-opencl.sh, the second platform of the tests; oclgrind for tools/oclgrind-check.sh).
+# tools/intel-opencl.sh, the second platform of the tests; oclgrind for tools/oclgrind-check.sh;
+# clang-format for tools/format-check.sh).
 # Idempotent: runs apt-get only when something is missing.
 set -euo pipefail
 
@@ -11,7 +12,7 @@ packages=(
   libopenexr-dev libcli11-dev libgtest-dev
   assimp-testmodels python3
   python3-matplotlib python3-numpy
-  python3-venv oclgrind
+  python3-venv oclgrind clang-format
 )
 
 missing=()

@@ -58,10 +58,16 @@ using dev::Hit;
 using dev::Ray;
 using json = nlohmann::json;
 
-double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
+double now() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
 
-glm::vec3 toGlm(dev::float3 v) { return glm::vec3(v.x, v.y, v.z); }
-dev::float3 toDev(glm::vec3 v) { return dev::make_float3(v.x, v.y, v.z); }
+glm::vec3 toGlm(dev::float3 v) {
+  return glm::vec3(v.x, v.y, v.z);
+}
+dev::float3 toDev(glm::vec3 v) {
+  return dev::make_float3(v.x, v.y, v.z);
+}
 
 // What the benchmark needs of a scene, in the renderer's numbering: DSG prims follow the SSG's.
 struct DynMesh {
@@ -94,7 +100,9 @@ BenchScene fromGltf(const std::string& path, double t) {
   for (size_t i = 0; i < s.instances.size(); ++i)
     b.instances.push_back({s.instances[i].mesh, s.instanceTransform(i, t)});
   b.camera = s.cameraAt(0, t);
-  auto emissive = [&](uint32_t mat) { return mat < s.materials.size() && s.materials[mat].isEmissive(); };
+  auto emissive = [&](uint32_t mat) {
+    return mat < s.materials.size() && s.materials[mat].isEmissive();
+  };
   const TriangleMesh& sm = s.staticMesh;
   for (size_t k = 0; k < sm.triangleCount(); ++k)
     if (emissive(sm.materials[k]))
@@ -102,10 +110,13 @@ BenchScene fromGltf(const std::string& path, double t) {
                             sm.positions[sm.indices[3 * k + 2]]});
   for (const accel::InstanceInput& in : b.instances) {
     const TriangleMesh& m = s.dynamicMeshes[in.mesh];
-    auto w = [&](uint32_t v) { return glm::vec3(in.objectToWorld * glm::vec4(m.positions[v], 1.0f)); };
+    auto w = [&](uint32_t v) {
+      return glm::vec3(in.objectToWorld * glm::vec4(m.positions[v], 1.0f));
+    };
     for (size_t k = 0; k < m.triangleCount(); ++k)
       if (emissive(m.materials[k]))
-        b.emitters.push_back({w(m.indices[3 * k]), w(m.indices[3 * k + 1]), w(m.indices[3 * k + 2])});
+        b.emitters.push_back(
+            {w(m.indices[3 * k]), w(m.indices[3 * k + 1]), w(m.indices[3 * k + 2])});
   }
   for (size_t i = 0; i < s.lights.size(); ++i) {
     const PunctualLight l = s.lightAt(i, t);
@@ -116,18 +127,21 @@ BenchScene fromGltf(const std::string& path, double t) {
 
 // --- the synthetic scene: a sphere flake over a ground quad, an emissive quad above ---
 
-void addSphere(std::vector<glm::vec3>& p, std::vector<uint32_t>& idx, glm::vec3 c, float r, int rings, int segments) {
+void addSphere(std::vector<glm::vec3>& p, std::vector<uint32_t>& idx, glm::vec3 c, float r,
+               int rings, int segments) {
   const uint32_t base = uint32_t(p.size());
   for (int i = 0; i <= rings; ++i) {
     const float th = PR_PI * float(i) / float(rings);
     for (int j = 0; j < segments; ++j) {
       const float ph = 2.0f * PR_PI * float(j) / float(segments);
-      p.push_back(c + r * glm::vec3(std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph)));
+      p.push_back(c + r * glm::vec3(std::sin(th) * std::cos(ph), std::cos(th),
+                                    std::sin(th) * std::sin(ph)));
     }
   }
   for (int i = 0; i < rings; ++i)
     for (int j = 0; j < segments; ++j) {
-      const uint32_t a = base + uint32_t(i * segments + j), b = base + uint32_t(i * segments + (j + 1) % segments);
+      const uint32_t a = base + uint32_t(i * segments + j),
+                     b = base + uint32_t(i * segments + (j + 1) % segments);
       const uint32_t c2 = a + uint32_t(segments), d = b + uint32_t(segments);
       if (i > 0) idx.insert(idx.end(), {a, c2, b});
       if (i < rings - 1) idx.insert(idx.end(), {b, c2, d});
@@ -135,7 +149,8 @@ void addSphere(std::vector<glm::vec3>& p, std::vector<uint32_t>& idx, glm::vec3 
 }
 
 // Nine children per sphere at a third of its radius, on the side away from the parent.
-void addFlake(std::vector<glm::vec3>& p, std::vector<uint32_t>& idx, glm::vec3 c, float r, glm::vec3 up, int levels) {
+void addFlake(std::vector<glm::vec3>& p, std::vector<uint32_t>& idx, glm::vec3 c, float r,
+              glm::vec3 up, int levels) {
   addSphere(p, idx, c, r, 10, 16);
   if (levels == 0) return;
   dev::float3 t3, b3;
@@ -144,7 +159,8 @@ void addFlake(std::vector<glm::vec3>& p, std::vector<uint32_t>& idx, glm::vec3 c
   for (int k = 0; k < 9; ++k) {
     const float elev = k < 6 ? 0.0f : 1.0f;  // six around the equator, three above
     const float az = 2.0f * PR_PI * (k < 6 ? float(k) / 6.0f : (float(k - 6) + 0.5f) / 3.0f);
-    const glm::vec3 dir = glm::normalize(std::cos(elev) * (std::cos(az) * t + std::sin(az) * b) + std::sin(elev) * up);
+    const glm::vec3 dir = glm::normalize(std::cos(elev) * (std::cos(az) * t + std::sin(az) * b) +
+                                         std::sin(elev) * up);
     addFlake(p, idx, c + dir * (r * 4.0f / 3.0f), r / 3.0f, dir, levels - 1);
   }
 }
@@ -169,12 +185,16 @@ BenchScene synthetic(int levels, int instances) {
   b.meshes.push_back(ball);
   for (int i = 0; i < instances; ++i) {
     const float a = 2.0f * PR_PI * float(i) / float(std::max(instances, 1));
-    b.instances.push_back({0, glm::scale(glm::translate(glm::mat4(1.0f), glm::vec3(2.2f * std::cos(a), 0.3f * float(i % 3), 2.2f * std::sin(a))),
-                                         glm::vec3(1.0f, 0.6f + 0.1f * float(i % 4), 1.0f))});
+    b.instances.push_back(
+        {0, glm::scale(
+                glm::translate(glm::mat4(1.0f), glm::vec3(2.2f * std::cos(a), 0.3f * float(i % 3),
+                                                          2.2f * std::sin(a))),
+                glm::vec3(1.0f, 0.6f + 0.1f * float(i % 4), 1.0f))});
   }
   b.camera.position = glm::vec3(0.5f, 1.5f, 5.0f);
   b.camera.forward = glm::normalize(glm::vec3(0.0f, 0.2f, 0.0f) - b.camera.position);
-  b.camera.up = glm::normalize(glm::cross(glm::cross(b.camera.forward, glm::vec3(0, 1, 0)), b.camera.forward));
+  b.camera.up = glm::normalize(
+      glm::cross(glm::cross(b.camera.forward, glm::vec3(0, 1, 0)), b.camera.forward));
   b.camera.yfov = 50.0f * PR_PI / 180.0f;
   return b;
 }
@@ -220,7 +240,9 @@ struct Rates {
   double med() const { return median(mrays); }
   double min() const { return mrays.empty() ? 0.0 : *std::min_element(mrays.begin(), mrays.end()); }
   double max() const { return mrays.empty() ? 0.0 : *std::max_element(mrays.begin(), mrays.end()); }
-  json toJson() const { return {{"median", med()}, {"min", min()}, {"max", max()}, {"runs", mrays}}; }
+  json toJson() const {
+    return {{"median", med()}, {"min", min()}, {"max", max()}, {"runs", mrays}};
+  }
 };
 
 // --- our tracer on the OpenCL device ---
@@ -228,7 +250,8 @@ struct Rates {
 class DeviceTracer {
  public:
   DeviceTracer(Context& ctx, accel::DeviceAccel& acc) : ctx_(ctx) {
-    ProgramBuild pb = ctx.buildProgram("test/trace.cl", "-DPR_BVH_WIDTH=" + std::to_string(acc.width()));
+    ProgramBuild pb =
+        ctx.buildProgram("test/trace.cl", "-DPR_BVH_WIDTH=" + std::to_string(acc.width()));
     cl_int err = CL_SUCCESS;
     closest_ = cl::Kernel(pb.program, "trace_closest", &err);
     CL_CHECK(err);
@@ -244,7 +267,8 @@ class DeviceTracer {
     rays_ = ctx_.allocate("bench rays", std::max<size_t>(n_, 1) * sizeof(Ray), CL_MEM_READ_ONLY);
     hits_ = ctx_.allocate("bench hits", std::max<size_t>(n_, 1) * sizeof(Hit));
     occ_ = ctx_.allocate("bench occluded", std::max<size_t>(n_, 1) * sizeof(cl_uint));
-    if (n_ > 0) CL_CHECK(ctx_.queue().enqueueWriteBuffer(rays_, CL_TRUE, 0, n_ * sizeof(Ray), rays.data()));
+    if (n_ > 0)
+      CL_CHECK(ctx_.queue().enqueueWriteBuffer(rays_, CL_TRUE, 0, n_ * sizeof(Ray), rays.data()));
     const cl_uint n = cl_uint(n_);
     CL_CHECK(closest_.setArg(0, rays_));
     CL_CHECK(closest_.setArg(1, hits_));
@@ -266,12 +290,14 @@ class DeviceTracer {
 
   std::vector<Hit> hits() {
     std::vector<Hit> h(n_);
-    if (n_ > 0) CL_CHECK(ctx_.queue().enqueueReadBuffer(hits_, CL_TRUE, 0, n_ * sizeof(Hit), h.data()));
+    if (n_ > 0)
+      CL_CHECK(ctx_.queue().enqueueReadBuffer(hits_, CL_TRUE, 0, n_ * sizeof(Hit), h.data()));
     return h;
   }
   std::vector<cl_uint> occluded() {
     std::vector<cl_uint> o(n_);
-    if (n_ > 0) CL_CHECK(ctx_.queue().enqueueReadBuffer(occ_, CL_TRUE, 0, n_ * sizeof(cl_uint), o.data()));
+    if (n_ > 0)
+      CL_CHECK(ctx_.queue().enqueueReadBuffer(occ_, CL_TRUE, 0, n_ * sizeof(cl_uint), o.data()));
     return o;
   }
 
@@ -317,7 +343,8 @@ class EmbreeTracer {
       if (m.indices.empty()) continue;
       RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_INSTANCE);
       rtcSetGeometryInstancedScene(g, meshScenes_[s.instances[i].mesh]);
-      rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, &s.instances[i].objectToWorld[0][0]);
+      rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR,
+                              &s.instances[i].objectToWorld[0][0]);
       rtcCommitGeometry(g);
       const unsigned id = rtcAttachGeometry(scene_, g);
       rtcReleaseGeometry(g);
@@ -328,7 +355,8 @@ class EmbreeTracer {
     }
     rtcCommitScene(scene_);
     buildSeconds_ = now() - t0;
-    if (rtcGetDeviceError(device_) != RTC_ERROR_NONE) throw RuntimeError("Embree: scene build failed");
+    if (rtcGetDeviceError(device_) != RTC_ERROR_NONE)
+      throw RuntimeError("Embree: scene build failed");
   }
   ~EmbreeTracer() {
     rtcReleaseScene(scene_);
@@ -356,9 +384,11 @@ class EmbreeTracer {
       for (size_t begin; (begin = next.fetch_add(chunk)) < n;) {
         const size_t end = std::min(n, begin + chunk);
         if (packet == 8)
-          for (size_t i = begin; i < end; i += 8) trace8(rays, i, std::min(end, i + 8), anyHit, &ctx, hits, occ);
+          for (size_t i = begin; i < end; i += 8)
+            trace8(rays, i, std::min(end, i + 8), anyHit, &ctx, hits, occ);
         else
-          for (size_t i = begin; i < end; ++i) trace1(rays[i], anyHit, &ctx, &(*hits)[i], &(*occ)[i]);
+          for (size_t i = begin; i < end; ++i)
+            trace1(rays[i], anyHit, &ctx, &(*hits)[i], &(*occ)[i]);
       }
     };
     const double t0 = now();
@@ -370,14 +400,17 @@ class EmbreeTracer {
   }
 
  private:
-  void addTriangles(RTCScene scene, const std::vector<glm::vec3>& p, const std::vector<uint32_t>& idx) {
+  void addTriangles(RTCScene scene, const std::vector<glm::vec3>& p,
+                    const std::vector<uint32_t>& idx) {
     RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
     rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_HIGH);
-    float* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                           3 * sizeof(float), std::max<size_t>(p.size(), 1)));
-    for (size_t i = 0; i < p.size(); ++i) v[3 * i] = p[i].x, v[3 * i + 1] = p[i].y, v[3 * i + 2] = p[i].z;
-    unsigned* t = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                                 3 * sizeof(unsigned), idx.size() / 3));
+    float* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0,
+                                                           RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                                           std::max<size_t>(p.size(), 1)));
+    for (size_t i = 0; i < p.size(); ++i)
+      v[3 * i] = p[i].x, v[3 * i + 1] = p[i].y, v[3 * i + 2] = p[i].z;
+    unsigned* t = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+        g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), idx.size() / 3));
     std::copy(idx.begin(), idx.end(), t);
     rtcCommitGeometry(g);
     rtcAttachGeometry(scene, g);
@@ -412,8 +445,8 @@ class EmbreeTracer {
     toHit(rh.hit.geomID, rh.hit.primID, rh.hit.instID[0], rh.ray.tfar, hit);
   }
 
-  void trace8(const std::vector<Ray>& rays, size_t begin, size_t end, bool anyHit, RTCIntersectContext* ctx,
-              std::vector<Hit>* hits, std::vector<cl_uint>* occ) const {
+  void trace8(const std::vector<Ray>& rays, size_t begin, size_t end, bool anyHit,
+              RTCIntersectContext* ctx, std::vector<Hit>* hits, std::vector<cl_uint>* occ) const {
     RTCRayHit8 p;
     int valid[8];
     for (size_t k = 0; k < 8; ++k) {
@@ -432,7 +465,8 @@ class EmbreeTracer {
     }
     rtcIntersect8(valid, scene_, ctx, &p);
     for (size_t k = 0; begin + k < end; ++k)
-      toHit(p.hit.geomID[k], p.hit.primID[k], p.hit.instID[0][k], p.ray.tfar[k], &(*hits)[begin + k]);
+      toHit(p.hit.geomID[k], p.hit.primID[k], p.hit.instID[0][k], p.ray.tfar[k],
+            &(*hits)[begin + k]);
   }
 
   int threads_;
@@ -460,7 +494,9 @@ std::array<glm::vec3, 3> hitTriangle(const BenchScene& s, const Hit& h) {
   const accel::InstanceInput& in = s.instances[h.inst];
   const DynMesh& m = s.meshes[in.mesh];
   const uint32_t* t = &m.indices[3 * size_t(h.prim - m.primBase)];
-  auto w = [&](uint32_t v) { return glm::vec3(in.objectToWorld * glm::vec4(m.positions[v], 1.0f)); };
+  auto w = [&](uint32_t v) {
+    return glm::vec3(in.objectToWorld * glm::vec4(m.positions[v], 1.0f));
+  };
   return {w(t[0]), w(t[1]), w(t[2])};
 }
 
@@ -497,16 +533,19 @@ RaySets makeRays(const BenchScene& s, DeviceTracer& tracer, int width, int heigh
     const float u1 = dev::rng_next(&rng), u2 = dev::rng_next(&rng), u3 = dev::rng_next(&rng);
     // Shadow ray: toward an emitter, a point light, or straight up.
     if (!s.emitters.empty()) {
-      const auto& e = s.emitters[std::min(s.emitters.size() - 1, size_t(u1 * float(s.emitters.size())))];
+      const auto& e =
+          s.emitters[std::min(s.emitters.size() - 1, size_t(u1 * float(s.emitters.size())))];
       const dev::float2 b = dev::sample_triangle(u2, u3);
       const glm::vec3 q = (1.0f - b.x - b.y) * e[0] + b.x * e[1] + b.y * e[2];
       const glm::vec3 nq = glm::cross(e[1] - e[0], e[2] - e[0]);
       sets.shadow.push_back(dev::spawn_ray_to(toDev(p), toDev(ng), toDev(q), toDev(nq)));
     } else if (!s.pointLights.empty()) {
-      const glm::vec3 q = s.pointLights[std::min(s.pointLights.size() - 1, size_t(u1 * float(s.pointLights.size())))];
+      const glm::vec3 q = s.pointLights[std::min(s.pointLights.size() - 1,
+                                                 size_t(u1 * float(s.pointLights.size())))];
       sets.shadow.push_back(dev::spawn_ray(toDev(p), toDev(ng), toDev(q - p), 1.0f));
     } else {
-      sets.shadow.push_back(dev::spawn_ray(toDev(p), toDev(ng), dev::make_float3(0.0f, 1.0f, 0.0f), PR_INF_F));
+      sets.shadow.push_back(
+          dev::spawn_ray(toDev(p), toDev(ng), dev::make_float3(0.0f, 1.0f, 0.0f), PR_INF_F));
     }
     // Bounce ray: cosine-weighted about ng.
     dev::float3 t3, b3;
@@ -541,16 +580,23 @@ int main(int argc, char** argv) {
   app.add_option("--frame-time", frameTime, "Animation time of the DSG instances and camera (s)");
   app.add_option("--width", width, "Camera ray image width")->check(CLI::PositiveNumber);
   app.add_option("--height", height, "Camera ray image height")->check(CLI::PositiveNumber);
-  app.add_option("--repeats", repeats, "Timed launches per set, after one warm-up")->check(CLI::PositiveNumber);
-  app.add_option("--device", deviceSpec, "OpenCL device (index, platform:device, cpu, gpu or name)");
+  app.add_option("--repeats", repeats, "Timed launches per set, after one warm-up")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--device", deviceSpec,
+                 "OpenCL device (index, platform:device, cpu, gpu or name)");
   app.add_option("--json", jsonPath, "Also write the results as JSON");
-  app.add_option("--levels", levels, "Synthetic scene: sphere-flake levels (3: about 236k triangles)");
-  app.add_option("--instances", instances, "Synthetic scene: dynamic instances of a 2k-triangle sphere");
-  app.add_option("--embree-threads", embreeThreads, "Threads of the Embree reference")->check(CLI::PositiveNumber);
+  app.add_option("--levels", levels,
+                 "Synthetic scene: sphere-flake levels (3: about 236k triangles)");
+  app.add_option("--instances", instances,
+                 "Synthetic scene: dynamic instances of a 2k-triangle sphere");
+  app.add_option("--embree-threads", embreeThreads, "Threads of the Embree reference")
+      ->check(CLI::PositiveNumber);
   app.add_option("--bvh-width", build.width, "Children per BVH node (2, 4 or 8)")
       ->check(CLI::IsMember({2, 4, 8}));
-  app.add_option("--leaf-size", build.maxLeafSize, "BVH builder: largest leaf (tuning experiments)");
-  app.add_option("--traversal-cost", build.traversalCost, "BVH builder: SAH node cost per triangle test");
+  app.add_option("--leaf-size", build.maxLeafSize,
+                 "BVH builder: largest leaf (tuning experiments)");
+  app.add_option("--traversal-cost", build.traversalCost,
+                 "BVH builder: SAH node cost per triangle test");
   app.add_flag("--no-embree", noEmbree, "Skip the Embree reference");
   CLI11_PARSE(app, argc, argv);
   try {
@@ -558,10 +604,12 @@ int main(int argc, char** argv) {
     Context ctx(selectDevice(devices, deviceSpec));
     const std::string deviceName = describeDevice(ctx.device());
     const char* cap = std::getenv("POCL_MAX_PTHREAD_COUNT");
-    std::printf("device: %s (POCL_MAX_PTHREAD_COUNT=%s)\n", deviceName.c_str(), cap ? cap : "unset");
+    std::printf("device: %s (POCL_MAX_PTHREAD_COUNT=%s)\n", deviceName.c_str(),
+                cap ? cap : "unset");
 
     double t0 = now();
-    const BenchScene s = scenePath.empty() ? synthetic(levels, instances) : fromGltf(scenePath, frameTime);
+    const BenchScene s =
+        scenePath.empty() ? synthetic(levels, instances) : fromGltf(scenePath, frameTime);
     const double loadSeconds = now() - t0;
     size_t dynTris = 0, instTris = 0;
     for (const DynMesh& m : s.meshes) dynTris += m.indices.size() / 3;
@@ -593,33 +641,40 @@ int main(int argc, char** argv) {
 
     const auto& st = ssg.stats();
     std::printf("scene: %s (loaded in %.2f s)\n", s.name.c_str(), loadSeconds);
-    std::printf("SSG:  %zu triangles, build %.1f ms, binary tree of %u nodes, %u leaves, depth %d, SAH cost %.1f; "
-                "%u nodes %d wide, stack need %d\n",
-                s.indices.size() / 3, ssgSeconds * 1e3, st.nodes, st.leaves, st.depth, sahCost(ssg.nodes(), 0),
-                ssg.wide().nodeCount(), ssg.wide().width, ssg.wide().stackNeed);
-    std::printf("DSG:  %zu meshes (%zu triangles), mesh BVHs %.2f ms, %u nodes; %zu instances (%zu triangles), "
-                "TLAS %.3f ms, %u nodes, depth %d\n",
-                s.meshes.size(), dynTris, meshSeconds * 1e3, meshNodes, s.instances.size(), instTris,
-                tlasSeconds * 1e3, dsg.tlasStats().nodes, dsg.tlasStats().depth);
+    std::printf(
+        "SSG:  %zu triangles, build %.1f ms, binary tree of %u nodes, %u leaves, depth %d, SAH "
+        "cost %.1f; "
+        "%u nodes %d wide, stack need %d\n",
+        s.indices.size() / 3, ssgSeconds * 1e3, st.nodes, st.leaves, st.depth,
+        sahCost(ssg.nodes(), 0), ssg.wide().nodeCount(), ssg.wide().width, ssg.wide().stackNeed);
+    std::printf(
+        "DSG:  %zu meshes (%zu triangles), mesh BVHs %.2f ms, %u nodes; %zu instances (%zu "
+        "triangles), "
+        "TLAS %.3f ms, %u nodes, depth %d\n",
+        s.meshes.size(), dynTris, meshSeconds * 1e3, meshNodes, s.instances.size(), instTris,
+        tlasSeconds * 1e3, dsg.tlasStats().nodes, dsg.tlasStats().depth);
     std::printf("device memory: SSG %.2f MiB, DSG meshes %.2f MiB, per frame %.1f KiB\n",
                 double(dacc.staticBytes()) / (1 << 20), double(dacc.meshBytes()) / (1 << 20),
                 double(dacc.frameBytes()) / 1024.0);
-    std::printf("emitters: %zu triangles, %zu point lights\n", s.emitters.size(), s.pointLights.size());
+    std::printf("emitters: %zu triangles, %zu point lights\n", s.emitters.size(),
+                s.pointLights.size());
 
     DeviceTracer ours(ctx, dacc);
     const RaySets sets = makeRays(s, ours, width, height);
-    std::printf("rays: %zu camera (%d x %d, %.1f%% hit), %zu shadow, %zu bounce\n", sets.camera.size(), width,
-                height, 100.0 * double(sets.camera.size()) / double(std::max<size_t>(sets.pixels, 1)),
+    std::printf("rays: %zu camera (%d x %d, %.1f%% hit), %zu shadow, %zu bounce\n",
+                sets.camera.size(), width, height,
+                100.0 * double(sets.camera.size()) / double(std::max<size_t>(sets.pixels, 1)),
                 sets.shadow.size(), sets.bounce.size());
 
 #ifdef PATHREUSE_HAVE_EMBREE
     std::unique_ptr<EmbreeTracer> embree;
     if (!noEmbree) embree = std::make_unique<EmbreeTracer>(s, embreeThreads);
     if (embree)
-      std::printf("Embree %d.%d.%d, %d threads: build (quality high) %.1f ms (meshes %.1f ms), %.2f MiB\n",
-                  RTC_VERSION_MAJOR, RTC_VERSION_MINOR, RTC_VERSION_PATCH, embreeThreads,
-                  embree->buildSeconds() * 1e3, embree->meshSeconds() * 1e3,
-                  double(g_embreeBytes.load()) / (1 << 20));
+      std::printf(
+          "Embree %d.%d.%d, %d threads: build (quality high) %.1f ms (meshes %.1f ms), %.2f MiB\n",
+          RTC_VERSION_MAJOR, RTC_VERSION_MINOR, RTC_VERSION_PATCH, embreeThreads,
+          embree->buildSeconds() * 1e3, embree->meshSeconds() * 1e3,
+          double(g_embreeBytes.load()) / (1 << 20));
 #else
     (void)noEmbree;
     (void)embreeThreads;
@@ -671,23 +726,30 @@ int main(int argc, char** argv) {
       }
     }
 
-    std::printf("\n%-7s %-7s %8s %6s | %-24s", "rays", "query", "count", "hit%", "ours Mrays/s med [min-max]");
+    std::printf("\n%-7s %-7s %8s %6s | %-24s", "rays", "query", "count", "hit%",
+                "ours Mrays/s med [min-max]");
     const bool ref = !results[0].embree1.mrays.empty();
-    if (ref) std::printf(" | %-9s %-9s %-6s %-9s %-9s", "Embree-1", "Embree-8", "ratio", "agree", "same-prim");
+    if (ref)
+      std::printf(" | %-9s %-9s %-6s %-9s %-9s", "Embree-1", "Embree-8", "ratio", "agree",
+                  "same-prim");
     std::printf("\n");
     for (const SetResult& r : results) {
       char ourCol[64];
-      std::snprintf(ourCol, sizeof ourCol, "%7.2f [%.2f-%.2f]", r.ours.med(), r.ours.min(), r.ours.max());
-      std::printf("%-7s %-7s %8zu %5.1f%% | %-24s", r.name, r.anyHit ? "any" : "closest", r.rays, 100.0 * r.hitFraction,
-                  ourCol);
+      std::snprintf(ourCol, sizeof ourCol, "%7.2f [%.2f-%.2f]", r.ours.med(), r.ours.min(),
+                    r.ours.max());
+      std::printf("%-7s %-7s %8zu %5.1f%% | %-24s", r.name, r.anyHit ? "any" : "closest", r.rays,
+                  100.0 * r.hitFraction, ourCol);
       if (ref) {
         const double best = std::max(r.embree1.med(), r.embree8.med());
         std::printf(" | %9.2f %9.2f %6.3f %8.4f%% %8.4f%%", r.embree1.med(), r.embree8.med(),
-                    best > 0.0 ? r.ours.med() / best : 0.0, 100.0 * r.agreeHit, 100.0 * r.agreePrim);
+                    best > 0.0 ? r.ours.med() / best : 0.0, 100.0 * r.agreeHit,
+                    100.0 * r.agreePrim);
       }
       std::printf("\n");
     }
-    if (ref) std::printf("ratio = ours / the better of Embree-1 (rtcIntersect1) and Embree-8 (8-wide packets)\n");
+    if (ref)
+      std::printf(
+          "ratio = ours / the better of Embree-1 (rtcIntersect1) and Embree-8 (8-wide packets)\n");
 
     if (!jsonPath.empty()) {
       json j;
@@ -696,21 +758,33 @@ int main(int argc, char** argv) {
       j["scene"] = s.name;
       j["frame_time"] = frameTime;
       j["image"] = {width, height};
-      j["ssg"] = {{"triangles", s.indices.size() / 3}, {"build_ms", ssgSeconds * 1e3}, {"nodes", st.nodes},
-                  {"leaves", st.leaves}, {"depth", st.depth}, {"sah_cost", sahCost(ssg.nodes(), 0)},
-                  {"wide_nodes", ssg.wide().nodeCount()}, {"width", ssg.wide().width},
+      j["ssg"] = {{"triangles", s.indices.size() / 3},
+                  {"build_ms", ssgSeconds * 1e3},
+                  {"nodes", st.nodes},
+                  {"leaves", st.leaves},
+                  {"depth", st.depth},
+                  {"sah_cost", sahCost(ssg.nodes(), 0)},
+                  {"wide_nodes", ssg.wide().nodeCount()},
+                  {"width", ssg.wide().width},
                   {"stack_need", ssg.wide().stackNeed}};
-      j["dsg"] = {{"meshes", s.meshes.size()}, {"mesh_triangles", dynTris}, {"mesh_build_ms", meshSeconds * 1e3},
-                  {"mesh_nodes", meshNodes}, {"instances", s.instances.size()}, {"instance_triangles", instTris},
+      j["dsg"] = {{"meshes", s.meshes.size()},          {"mesh_triangles", dynTris},
+                  {"mesh_build_ms", meshSeconds * 1e3}, {"mesh_nodes", meshNodes},
+                  {"instances", s.instances.size()},    {"instance_triangles", instTris},
                   {"tlas_build_ms", tlasSeconds * 1e3}, {"tlas_nodes", dsg.tlasStats().nodes}};
-      j["device_bytes"] = {{"ssg", dacc.staticBytes()}, {"dsg_meshes", dacc.meshBytes()}, {"per_frame", dacc.frameBytes()}};
+      j["device_bytes"] = {{"ssg", dacc.staticBytes()},
+                           {"dsg_meshes", dacc.meshBytes()},
+                           {"per_frame", dacc.frameBytes()}};
 #ifdef PATHREUSE_HAVE_EMBREE
       if (embree)
-        j["embree"] = {{"version", RTC_VERSION_STRING}, {"threads", embreeThreads},
-                       {"build_ms", embree->buildSeconds() * 1e3}, {"bytes", g_embreeBytes.load()}};
+        j["embree"] = {{"version", RTC_VERSION_STRING},
+                       {"threads", embreeThreads},
+                       {"build_ms", embree->buildSeconds() * 1e3},
+                       {"bytes", g_embreeBytes.load()}};
 #endif
       for (const SetResult& r : results) {
-        json e = {{"query", r.anyHit ? "any" : "closest"}, {"rays", r.rays}, {"hit_fraction", r.hitFraction},
+        json e = {{"query", r.anyHit ? "any" : "closest"},
+                  {"rays", r.rays},
+                  {"hit_fraction", r.hitFraction},
                   {"ours_mrays", r.ours.toJson()}};
         if (ref) {
           e["embree1_mrays"] = r.embree1.toJson();

@@ -12,6 +12,7 @@
 #include <glm/common.hpp>
 
 #include "shared/bvh.h"
+#include "util/check.h"
 #include "util/error.h"
 
 namespace pr::accel {
@@ -103,7 +104,8 @@ class Builder {
       const float area = bounds.halfArea();
       const float leafCost = blocks(n);
       const float splitCost = area > 0.0f ? o_.traversalCost + bestCost / area : leafCost;
-      if (n <= o_.maxLeafSize && leafCost <= splitCost) return makeLeaf(node, bounds, begin, n, depth);
+      if (n <= o_.maxLeafSize && leafCost <= splitCost)
+        return makeLeaf(node, bounds, begin, n, depth);
       if (bestAxis >= 0) {
         const float lo = cbounds.lo[bestAxis];
         const float scale = float(o_.bins) / extent[bestAxis];
@@ -123,10 +125,9 @@ class Builder {
       // Object median: on the widest centroid axis, or in input order when all coincide.
       mid = begin + n / 2;
       if (extent[axis] > 0.0f) {
-        std::nth_element(order_.begin() + begin, order_.begin() + mid,
-                         order_.begin() + end, [&](uint32_t a, uint32_t b) {
-                           return centroids_[a][axis] < centroids_[b][axis];
-                         });
+        std::nth_element(
+            order_.begin() + begin, order_.begin() + mid, order_.begin() + end,
+            [&](uint32_t a, uint32_t b) { return centroids_[a][axis] < centroids_[b][axis]; });
       }
     }
     const uint32_t left = uint32_t(nodes_.size());
@@ -252,8 +253,8 @@ Bvh buildBvh(const std::vector<Aabb>& boxes, const BuildOptions& options) {
   // The traversal stack must never overflow: check what was built, not what was intended.
   const int depth = bvhDepth(bvh.nodes);
   if (depth > PR_BVH_STACK_SIZE || depth != bvh.stats.depth)
-    throw RuntimeError("BVH build: depth " + std::to_string(depth) + " exceeds the traversal stack (" +
-                       std::to_string(PR_BVH_STACK_SIZE) + ")");
+    throw RuntimeError("BVH build: depth " + std::to_string(depth) +
+                       " exceeds the traversal stack (" + std::to_string(PR_BVH_STACK_SIZE) + ")");
   return bvh;
 }
 
@@ -308,7 +309,7 @@ class Collapser {
 
   uint32_t allocate() {
     const uint32_t node = out_.nodeCount();
-    out_.words.resize(out_.words.size() + 7 * size_t(w_));
+    out_.words.resize(out_.words.size() + wideNodeWords(w_));
     const float inf = std::numeric_limits<float>::infinity();
     for (int i = 0; i < w_; ++i) {
       for (int b = 0; b < 6; ++b) store(wideBound(w_, node, b, i), (b & 1) ? -inf : inf);
@@ -375,7 +376,13 @@ class Collapser {
 WideBvh collapseBvh(const std::vector<BinaryNode>& nodes, int width) {
   if (nodes.empty() || !(width == 2 || width == 4 || width == 8))
     throw RuntimeError("BVH collapse: no nodes or width " + std::to_string(width));
-  return Collapser(nodes, width).run();
+  WideBvh wide = Collapser(nodes, width).run();
+  PR_CHECK(wide.words.size() == size_t(wide.nodeCount()) * wideNodeWords(width));
+  // Every binary leaf but an empty root becomes one leaf reference.
+  PR_DCHECK(size_t(std::count_if(nodes.begin(), nodes.end(), [](const BinaryNode& n) {
+              return (n.meta & PR_BVH_LEAF_BIT) && (n.meta & ~PR_BVH_LEAF_BIT) > 0;
+            })) == wide.leaves.size());
+  return wide;
 }
 
 WideBvh buildWideBvh(const std::vector<Aabb>& boxes, const BuildOptions& options, Bvh* binary) {
@@ -389,13 +396,14 @@ WideBvh buildWideBvh(const std::vector<Aabb>& boxes, const BuildOptions& options
     const int lower = std::max(1, (over + o.width - 2) / (o.width - 1));
     if (o.maxDepth <= 1)
       throw RuntimeError("BVH build: the tree needs " + std::to_string(wide.stackNeed) +
-                         " traversal stack entries (at most " + std::to_string(PR_BVH_STACK_SIZE) + ")");
+                         " traversal stack entries (at most " + std::to_string(PR_BVH_STACK_SIZE) +
+                         ")");
     o.maxDepth = std::max(1, o.maxDepth - lower);
   }
 }
 
 void rebaseWide(std::vector<uint32_t>& words, int width, uint32_t nodeBase, uint32_t leafBase) {
-  const size_t stride = 7 * size_t(width);
+  const size_t stride = wideNodeWords(width);
   for (size_t n = 0; n < words.size() / stride; ++n) {
     for (int i = 0; i < width; ++i) {
       uint32_t& ref = words[n * stride + 6 * size_t(width) + size_t(i)];

@@ -60,7 +60,7 @@ struct BinaryNode {
 
 struct Bvh {
   std::vector<BinaryNode> nodes;  // root at 0; always at least one node
-  std::vector<uint32_t> order;      // leaf ranges index this; order[i] = input primitive
+  std::vector<uint32_t> order;    // leaf ranges index this; order[i] = input primitive
   BvhStats stats;
 };
 
@@ -74,6 +74,12 @@ int bvhDepth(const std::vector<BinaryNode>& nodes, uint32_t root = 0);
 // Node whose box is `b` (an empty box is stored as all zeros).
 BinaryNode makeNode(const Aabb& b, uint32_t index, uint32_t meta);
 
+// Words of one `width`-wide node (BvhNode in kernels/shared/types.h): 6 bounds and a child
+// reference per child.
+inline size_t wideNodeWords(int width) {
+  return 7 * size_t(width);
+}
+
 // A BVH of `width`-wide nodes in the device's layout, as 32-bit words (28 * width bytes per
 // node, see BvhNode in kernels/shared/types.h), root at node 0. Leaf references are
 // PR_BVH_LEAF_BIT | k for the k-th entry of `leaves`, the binary tree's leaves in the order
@@ -83,17 +89,17 @@ struct WideBvh {
   std::vector<uint32_t> words;
   std::vector<BinaryNode> leaves;
   int stackNeed = 0;  // the most traversal stack entries a ray can need
-  uint32_t nodeCount() const { return uint32_t(words.size() / (7 * size_t(width))); }
+  uint32_t nodeCount() const { return uint32_t(words.size() / wideNodeWords(width)); }
   uint64_t bytes() const { return uint64_t(words.size()) * 4u; }
 };
 
 // Word offsets inside wide node `node`: bound `b` (0..5 = lo_x, hi_x, lo_y, hi_y, lo_z, hi_z)
 // of child i, and the reference of child i.
 inline size_t wideBound(int width, uint32_t node, int b, int i) {
-  return size_t(node) * 7 * size_t(width) + size_t(b * width + i);
+  return size_t(node) * wideNodeWords(width) + size_t(b * width + i);
 }
 inline size_t wideChild(int width, uint32_t node, int i) {
-  return size_t(node) * 7 * size_t(width) + size_t(6 * width + i);
+  return size_t(node) * wideNodeWords(width) + size_t(6 * width + i);
 }
 
 // Collapses a binary tree into `width`-wide nodes: each wide node takes the children of a

@@ -11,6 +11,7 @@
 #include <glm/matrix.hpp>
 #include <glm/vec4.hpp>
 
+#include "util/check.h"
 #include "util/error.h"
 
 namespace pr::accel {
@@ -69,8 +70,9 @@ TriangleBvh buildTriangleBvh(const std::vector<glm::vec3>& positions,
                          std::to_string(i) + " of " + std::to_string(positions.size()));
       box.grow(positions[i]);
     }
-    const dev::BvhTriangle tri = packTriangle(positions[indices[3 * t]], positions[indices[3 * t + 1]],
-                                              positions[indices[3 * t + 2]], primBase + uint32_t(t));
+    const dev::BvhTriangle tri =
+        packTriangle(positions[indices[3 * t]], positions[indices[3 * t + 1]],
+                     positions[indices[3 * t + 2]], primBase + uint32_t(t));
     if (zeroArea(tri)) continue;
     packed.push_back(tri);
     boxes.push_back(box);
@@ -89,8 +91,11 @@ TriangleBvh buildTriangleBvh(const std::vector<glm::vec3>& positions,
     out.bounds.grow(boxes[k]);
   }
   out.packets.reserve(out.wide.leaves.size());
-  for (const BinaryNode& leaf : out.wide.leaves)
-    out.packets.push_back(packTriangles(out.triangles.data() + leaf.index, leaf.meta & ~PR_BVH_LEAF_BIT));
+  for (const BinaryNode& leaf : out.wide.leaves) {
+    const uint32_t count = leaf.meta & ~PR_BVH_LEAF_BIT;
+    PR_CHECK(count <= PR_BVH_PACKET && size_t(leaf.index) + count <= out.triangles.size());
+    out.packets.push_back(packTriangles(out.triangles.data() + leaf.index, count));
+  }
   return out;
 }
 
@@ -190,6 +195,7 @@ void DynamicAccel::setInstances(const std::vector<InstanceInput>& instances) {
   records_.clear();
   records_.reserve(tlas_.leaves.size());
   for (const BinaryNode& leaf : tlas_.leaves) {
+    PR_CHECK((leaf.meta & ~PR_BVH_LEAF_BIT) == 1u);  // leaf k is record k
     const uint32_t k = bvh.order[leaf.index];
     const uint32_t i = kept[k];
     const Mesh& mesh = meshes_[instances[i].mesh];

@@ -98,7 +98,7 @@ class DynamicAccel {
   const std::vector<dev::BvhTriPacket>& meshPackets() const { return meshPackets_; }
   // All meshes' triangles in their binary trees' leaf order (host only: tests, statistics).
   const std::vector<dev::BvhTriangle>& meshTriangles() const { return meshTris_; }
-  uint32_t meshNodeCount() const { return uint32_t(meshNodes_.size() / (7 * size_t(width_))); }
+  uint32_t meshNodeCount() const { return uint32_t(meshNodes_.size() / wideNodeWords(width_)); }
   // This frame's wide TLAS (root at 0); leaf k is instance record k.
   const WideBvh& tlas() const { return tlas_; }
   const std::vector<dev::BvhInstance>& instances() const { return records_; }

@@ -110,7 +110,8 @@ ProgramBuild Context::buildProgram(const std::string& mainFile, const std::strin
 cl::Kernel Context::kernel(const std::string& file, const char* name, const std::string& options) {
   cl_int err = CL_SUCCESS;
   cl::Kernel k(buildProgram(file, options).program, name, &err);
-  if (err != CL_SUCCESS) throw ClError(std::string("kernel ") + name + " of kernels/" + file, err, __FILE__, __LINE__);
+  if (err != CL_SUCCESS)
+    throw ClError(std::string("kernel ") + name + " of kernels/" + file, err, __FILE__, __LINE__);
   return k;
 }
 
@@ -180,16 +181,19 @@ cl::Buffer Context::allocate(const std::string& name, uint64_t bytes, cl_mem_fla
                        " but the largest allocation " + device_.name + " allows is " +
                        humanSize(device_.maxAllocBytes));
   // Some drivers allocate on first use; this names the buffer before a later launch fails.
-  if (device_.globalMemBytes > 0 && bytes > device_.globalMemBytes - std::min(bytesInUse_, device_.globalMemBytes))
-    throw RuntimeError("device out of memory: " + name + " (" + humanSize(bytes) + ") does not fit beside the " +
-                       humanSize(bytesInUse_) + " already in use of " + humanSize(device_.globalMemBytes) +
-                       " on " + device_.name);
+  if (device_.globalMemBytes > 0 &&
+      bytes > device_.globalMemBytes - std::min(bytesInUse_, device_.globalMemBytes))
+    throw RuntimeError("device out of memory: " + name + " (" + humanSize(bytes) +
+                       ") does not fit beside the " + humanSize(bytesInUse_) +
+                       " already in use of " + humanSize(device_.globalMemBytes) + " on " +
+                       device_.name);
   cl_int err = CL_SUCCESS;
   cl::Buffer buffer(context_, flags, bytes, nullptr, &err);
   if (err == CL_MEM_OBJECT_ALLOCATION_FAILURE || err == CL_OUT_OF_RESOURCES ||
       err == CL_OUT_OF_HOST_MEMORY)
-    throw RuntimeError("device out of memory: " + name + " (" + humanSize(bytes) + ") did not fit; " +
-                       humanSize(bytesInUse_) + " already in use on " + device_.name);
+    throw RuntimeError("device out of memory: " + name + " (" + humanSize(bytes) +
+                       ") did not fit; " + humanSize(bytesInUse_) + " already in use on " +
+                       device_.name);
   CL_CHECK(err);
   bytesInUse_ += bytes;
   return buffer;
@@ -206,7 +210,8 @@ void Context::zero(const cl::Buffer& buffer, uint64_t bytes) {
   }
 }
 
-void Context::launch1D(const cl::Kernel& kernel, size_t global, const char* stage, StageTimer* timer) {
+void Context::launch1D(const cl::Kernel& kernel, size_t global, const char* stage,
+                       StageTimer* timer) {
   if (global == 0) return;
   size_t local = 0;
   CL_CHECK(kernel.getWorkGroupInfo(device_.device, CL_KERNEL_WORK_GROUP_SIZE, &local));
@@ -224,13 +229,16 @@ void Context::launch1D(const cl::Kernel& kernel, size_t global, const char* stag
   const size_t chunk = std::max(local, kMaxLaunchItems / local * local);
   for (size_t offset = 0; offset < padded; offset += chunk) {
     const size_t n = std::min(chunk, padded - offset);
-    const cl_int err = queue_.enqueueNDRangeKernel(kernel, cl::NDRange(offset), cl::NDRange(n),
-                                                   cl::NDRange(local), nullptr,
-                                                   timer ? timer->next(stage) : nullptr);
-    if (err != CL_SUCCESS) throw ClError(std::string("launch of ") + stage, err, __FILE__, __LINE__);
+    const cl_int err =
+        queue_.enqueueNDRangeKernel(kernel, cl::NDRange(offset), cl::NDRange(n), cl::NDRange(local),
+                                    nullptr, timer ? timer->next(stage) : nullptr);
+    if (err != CL_SUCCESS)
+      throw ClError(std::string("launch of ") + stage, err, __FILE__, __LINE__);
   }
 }
 
-void Context::finish() { CL_CHECK(queue_.finish()); }
+void Context::finish() {
+  CL_CHECK(queue_.finish());
+}
 
 }  // namespace pr

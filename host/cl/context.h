@@ -44,7 +44,8 @@ class Context {
 
   // A device buffer of `bytes`, checked against the device's max allocation; `name` is used in
   // errors ("device out of memory: light vertex arena (1.2 GiB) ..."). Counted in bytesInUse().
-  cl::Buffer allocate(const std::string& name, uint64_t bytes, cl_mem_flags flags = CL_MEM_READ_WRITE);
+  cl::Buffer allocate(const std::string& name, uint64_t bytes,
+                      cl_mem_flags flags = CL_MEM_READ_WRITE);
   // Releases the count of a buffer made by allocate() (the buffer itself is reference counted).
   void release(uint64_t bytes) { bytesInUse_ -= bytes <= bytesInUse_ ? bytes : bytesInUse_; }
   uint64_t bytesInUse() const { return bytesInUse_; }

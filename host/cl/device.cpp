@@ -63,7 +63,8 @@ std::string deviceTypeName(cl_device_type type) {
 std::vector<DeviceEntry> enumerateDevices() {
   std::vector<cl::Platform> platforms;
   cl_int err = cl::Platform::get(&platforms);
-  // The ICD loader reports "no platform" as CL_PLATFORM_NOT_FOUND_KHR: an empty list, not a failure.
+  // The ICD loader reports "no platform" as CL_PLATFORM_NOT_FOUND_KHR: an empty list, not a
+  // failure.
   if (err == CL_PLATFORM_NOT_FOUND_KHR || err == CL_DEVICE_NOT_FOUND) return {};
   CL_CHECK(err);
 
@@ -150,8 +151,8 @@ const DeviceEntry& selectDevice(const std::vector<DeviceEntry>& devices, const s
 
 std::string describeDevice(const DeviceEntry& d) {
   std::ostringstream os;
-  os << "[" << d.index << "] " << d.platformIndex << ":" << d.deviceIndex << "  " << d.name
-     << "  (" << d.platformName << ")  " << deviceTypeName(d.type) << ", " << d.computeUnits
+  os << "[" << d.index << "] " << d.platformIndex << ":" << d.deviceIndex << "  " << d.name << "  ("
+     << d.platformName << ")  " << deviceTypeName(d.type) << ", " << d.computeUnits
      << " compute units, " << humanBytes(d.globalMemBytes) << " global, max alloc "
      << humanBytes(d.maxAllocBytes) << ", " << d.openclCVersion;
   return os.str();

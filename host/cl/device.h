@@ -10,9 +10,9 @@
 namespace pr {
 
 struct DeviceEntry {
-  int index = 0;           // position in the flat list of all devices
-  int platformIndex = 0;   // P in "P:D"
-  int deviceIndex = 0;     // D in "P:D"
+  int index = 0;          // position in the flat list of all devices
+  int platformIndex = 0;  // P in "P:D"
+  int deviceIndex = 0;    // D in "P:D"
   cl::Platform platform;
   cl::Device device;
   std::string platformName;

@@ -71,9 +71,11 @@ void writeExr(const std::string& path, const Image& image, ExrPixels pixels) {
                                        sizeof(half) * 4, sizeof(half) * 4 * image.width));
     } else {
       for (int c = 0; c < 4; ++c)
-        fb.insert(names[c],
-                  Imf::Slice(Imf::FLOAT, const_cast<char*>(reinterpret_cast<const char*>(image.rgba.data() + c)),
-                             sizeof(float) * 4, sizeof(float) * 4 * image.width));
+        fb.insert(
+            names[c],
+            Imf::Slice(Imf::FLOAT,
+                       const_cast<char*>(reinterpret_cast<const char*>(image.rgba.data() + c)),
+                       sizeof(float) * 4, sizeof(float) * 4 * image.width));
     }
     Imf::OutputFile file(encoded, header);
     file.setFrameBuffer(fb);

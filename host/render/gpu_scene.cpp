@@ -112,7 +112,8 @@ GpuScene::GpuScene(Context& ctx, const Scene& scene, const GpuSceneOptions& opti
     : ctx_(ctx),
       scene_(scene),
       options_(options),
-      bvhWidth_(options.bvhWidth ? options.bvhWidth : defaultBvhWidth((ctx.device().type & CL_DEVICE_TYPE_GPU) != 0)),
+      bvhWidth_(options.bvhWidth ? options.bvhWidth
+                                 : defaultBvhWidth((ctx.device().type & CL_DEVICE_TYPE_GPU) != 0)),
       dsg_(bvhWidth_),
       deviceAccel_(bvhWidth_) {
   const TriangleMesh& sm = scene.staticMesh;
@@ -151,7 +152,8 @@ GpuScene::GpuScene(Context& ctx, const Scene& scene, const GpuSceneOptions& opti
     const TriangleMesh& m = scene.dynamicMeshes[mi];
     uint32_t rank = 0;
     for (uint32_t k = 0; k < m.triangleCount(); ++k)
-      if (scene.materials[m.materials[k]].isEmissive()) primLight_[meshFirstTriangle_[mi] + k] = rank++;
+      if (scene.materials[m.materials[k]].isEmissive())
+        primLight_[meshFirstTriangle_[mi] + k] = rank++;
   }
   for (uint32_t i = 0; i < scene.instances.size(); ++i) {
     instanceFirstLight_.push_back(

@@ -11,7 +11,9 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-glm::vec3 load(float x, float y, float z) { return glm::vec3(x, y, z); }
+glm::vec3 load(float x, float y, float z) {
+  return glm::vec3(x, y, z);
+}
 
 // The solid angle measure of a cone of normals with emission beyond them (Estevez and Kulla
 // 2018, eq. 1): what the build's cost weighs besides power and size.

@@ -8,7 +8,9 @@
 
 namespace pr {
 
-int defaultBvhWidth(bool gpu) { return gpu ? 2 : 8; }
+int defaultBvhWidth(bool gpu) {
+  return gpu ? 2 : 8;
+}
 
 const char* renderModeName(RenderMode m) {
   switch (m) {

@@ -55,7 +55,7 @@ struct RenderOptions {
   int pathsPerPixel = 4;       // C: light paths each pixel sample connects to
   float clamp = 0.0f;          // clamp on the geometry term; 0 = off
   float connectionMis = 4.0f;  // MIS threshold on p_E / p_L (kernels/reuse/connect.cl); 0 = off
-  int connections = 0;  // RIS-chosen connections per eye vertex (1-4); 0: every candidate
+  int connections = 0;         // RIS-chosen connections per eye vertex (1-4); 0: every candidate
 };
 
 // "A-B" or "A" (non-negative, A <= B). Throws InputError naming --frames.

@@ -3,6 +3,7 @@
 #include <numeric>
 
 #include "cl/kernel_args.h"
+#include "util/check.h"
 #include "render/path_tracer.h"
 #include "shared/reuse.h"
 #include "util/error.h"
@@ -38,12 +39,12 @@ PathReuse::PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseS
   CL_CHECK(ctx_.queue().enqueueWriteBuffer(allSlots_, CL_TRUE, 0, all.size() * 4, all.data()));
   eye_ = alloc("eye vertices", uint64_t(film.pixels()) * sizeof(dev::EyeVertex));
   radiance_ = alloc("sample radiance", uint64_t(film.pixels()) * 16);
-  counters_ = alloc("reuse counters", PR_C_COUNT * 4);
+  counters_ = alloc("reuse counters", dev::PR_C_COUNT * 4);
 }
 
 void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameStats* stats) {
   StageTimer timer;
-  ctx_.zero(counters_, PR_C_COUNT * 4);
+  ctx_.zero(counters_, dev::PR_C_COUNT * 4);
   dev::ReuseParams rp{};
   rp.seed = settings_.seed;
   rp.slots = slots_;
@@ -65,9 +66,11 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
   const cl::Buffer* list = &allSlots_;
   if (!settings_.retraceAll && !first_) {
     setKernelArgs(invalidate_, scene_.setKernelArgs(invalidate_, 0), rp,
-                  cl_uint(scene_.anyInstanceMoved() ? 1 : 0), headers_, vertices_, list_, counters_);
+                  cl_uint(scene_.anyInstanceMoved() ? 1 : 0), headers_, vertices_, list_,
+                  counters_);
     ctx_.launch1D(invalidate_, slots_, "invalidate", &timer);
-    CL_CHECK(ctx_.queue().enqueueReadBuffer(counters_, CL_TRUE, PR_C_LIST * 4, 4, &toTrace));
+    CL_CHECK(ctx_.queue().enqueueReadBuffer(counters_, CL_TRUE, dev::PR_C_LIST * 4, 4, &toTrace));
+    PR_CHECK(toTrace <= slots_);  // invalidate lists each slot at most once
     list = &list_;
   }
   first_ = false;
@@ -96,28 +99,26 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
     ctx_.finish();
     if (interrupted()) return;
   }
-  cl_uint c[PR_C_COUNT] = {};
+  cl_uint c[dev::PR_C_COUNT] = {};
   CL_CHECK(ctx_.queue().enqueueReadBuffer(counters_, CL_TRUE, 0, sizeof c, c));
   auto times = timer.collect();
   if (!stats) return;
   for (const auto& [k, v] : times) stats->stageSeconds[k] += v;
-  stats->rays["invalidation"] += c[PR_C_INVALID_RAYS];
-  stats->rays["light"] += c[PR_C_LIGHT_RAYS];
-  stats->rays["camera"] += c[PR_C_CAMERA_RAYS];
-  stats->rays["shadow"] += c[PR_C_SHADOW_RAYS];
-  stats->rays["connection"] += c[PR_C_CONNECT_RAYS];
-  stats->rays["bounce"] += c[PR_C_BOUNCE_RAYS];
+    // Every counter where kernels/shared/reuse.h's list says.
+#define PR_REPORT_rays(key, value) stats->rays[key] += value;
+#define PR_REPORT_counters(key, value) stats->counters[key] = value;
+#define PR_REPORT_internal(key, value)
+#define PR_REPORT(name, group, key) PR_REPORT_##group(key, c[dev::PR_C_##name])
+  PR_REUSE_COUNTERS(PR_REPORT)
+#undef PR_REPORT
+#undef PR_REPORT_rays
+#undef PR_REPORT_counters
+#undef PR_REPORT_internal
   stats->counters["slots"] = slots_;
   stats->counters["slots_retraced"] = toTrace;
-  stats->counters["slots_invalidated"] = settings_.retraceAll ? slots_ : c[PR_C_LIST];
+  stats->counters["slots_invalidated"] = settings_.retraceAll ? slots_ : c[dev::PR_C_LIST];
   stats->counters["slots_reused"] = slots_ - toTrace;
-  stats->counters["light_vertices_ssg"] = c[PR_C_SSG_VERTICES];
-  stats->counters["light_vertices_dsg"] = c[PR_C_DSG_VERTICES];
   stats->counters["arena_bytes"] = arenaBytes();
-  if (settings_.clamp > 0.0f) stats->counters["connections_clamped"] = c[PR_C_CLAMPED];
-  if (settings_.misThreshold > 0.0f) stats->counters["connections_mis"] = c[PR_C_MIS_RAYS];
-  stats->counters["connection_candidates"] = c[PR_C_CANDIDATES];
-  stats->counters["connections_unoccluded"] = c[PR_C_CONNECTED];
 }
 
 void PathReuse::readArena(std::vector<dev::PathHeader>* headers,

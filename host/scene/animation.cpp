@@ -48,14 +48,16 @@ glm::vec4 keyValue(const AnimationSampler& s, size_t k) {
 glm::vec4 hermite(const AnimationSampler& s, const KeySpan& span) {
   const float u = span.u, u2 = u * u, u3 = u2 * u;
   const glm::vec4 v0 = s.values[3 * span.k + 1];
-  const glm::vec4 b0 = s.values[3 * span.k + 2];      // out-tangent of key k
-  const glm::vec4 a1 = s.values[3 * (span.k + 1)];    // in-tangent of key k+1
+  const glm::vec4 b0 = s.values[3 * span.k + 2];    // out-tangent of key k
+  const glm::vec4 a1 = s.values[3 * (span.k + 1)];  // in-tangent of key k+1
   const glm::vec4 v1 = s.values[3 * (span.k + 1) + 1];
   return (2.0f * u3 - 3.0f * u2 + 1.0f) * v0 + span.dt * (u3 - 2.0f * u2 + u) * b0 +
          (-2.0f * u3 + 3.0f * u2) * v1 + span.dt * (u3 - u2) * a1;
 }
 
-glm::quat toQuat(const glm::vec4& v) { return glm::quat(v.w, v.x, v.y, v.z); }
+glm::quat toQuat(const glm::vec4& v) {
+  return glm::quat(v.w, v.x, v.y, v.z);
+}
 
 glm::quat normalisedOrIdentity(const glm::quat& q) {
   const float len = glm::length(q);
@@ -87,7 +89,9 @@ glm::vec4 sampleRaw(const AnimationSampler& s, double t) {
   return glm::mix(s.values[span.k], s.values[span.k + 1], span.u);
 }
 
-glm::vec3 sampleVec3(const AnimationSampler& s, double t) { return glm::vec3(sampleRaw(s, t)); }
+glm::vec3 sampleVec3(const AnimationSampler& s, double t) {
+  return glm::vec3(sampleRaw(s, t));
+}
 
 glm::quat sampleQuat(const AnimationSampler& s, double t) {
   if (s.times.empty()) return glm::quat(1.0f, 0.0f, 0.0f, 0.0f);

@@ -59,9 +59,13 @@ std::string named(const char* kind, int index, const std::string& name) {
   return s;
 }
 
-bool finite(double v) { return std::isfinite(v); }
+bool finite(double v) {
+  return std::isfinite(v);
+}
 
-bool allFinite(const std::vector<double>& v) { return std::all_of(v.begin(), v.end(), finite); }
+bool allFinite(const std::vector<double>& v) {
+  return std::all_of(v.begin(), v.end(), finite);
+}
 
 const Value* member(const Value& obj, const char* key) {
   if (!obj.IsObject() || !obj.Has(key)) return nullptr;
@@ -76,50 +80,77 @@ const Value* extension(const tinygltf::ExtensionMap& ext, const char* name) {
 size_t componentSize(int componentType) {
   switch (componentType) {
     case TINYGLTF_COMPONENT_TYPE_BYTE:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+      return 1;
     case TINYGLTF_COMPONENT_TYPE_SHORT:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
+      return 2;
     case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
-    case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
-    default: return 0;
+    case TINYGLTF_COMPONENT_TYPE_FLOAT:
+      return 4;
+    default:
+      return 0;
   }
 }
 
 size_t componentCount(int type) {
   switch (type) {
-    case TINYGLTF_TYPE_SCALAR: return 1;
-    case TINYGLTF_TYPE_VEC2: return 2;
-    case TINYGLTF_TYPE_VEC3: return 3;
-    case TINYGLTF_TYPE_VEC4: return 4;
-    case TINYGLTF_TYPE_MAT2: return 4;
-    case TINYGLTF_TYPE_MAT3: return 9;
-    case TINYGLTF_TYPE_MAT4: return 16;
-    default: return 0;
+    case TINYGLTF_TYPE_SCALAR:
+      return 1;
+    case TINYGLTF_TYPE_VEC2:
+      return 2;
+    case TINYGLTF_TYPE_VEC3:
+      return 3;
+    case TINYGLTF_TYPE_VEC4:
+      return 4;
+    case TINYGLTF_TYPE_MAT2:
+      return 4;
+    case TINYGLTF_TYPE_MAT3:
+      return 9;
+    case TINYGLTF_TYPE_MAT4:
+      return 16;
+    default:
+      return 0;
   }
 }
 
 const char* typeName(int type) {
   switch (type) {
-    case TINYGLTF_TYPE_SCALAR: return "SCALAR";
-    case TINYGLTF_TYPE_VEC2: return "VEC2";
-    case TINYGLTF_TYPE_VEC3: return "VEC3";
-    case TINYGLTF_TYPE_VEC4: return "VEC4";
-    case TINYGLTF_TYPE_MAT2: return "MAT2";
-    case TINYGLTF_TYPE_MAT3: return "MAT3";
-    case TINYGLTF_TYPE_MAT4: return "MAT4";
-    default: return "unknown type";
+    case TINYGLTF_TYPE_SCALAR:
+      return "SCALAR";
+    case TINYGLTF_TYPE_VEC2:
+      return "VEC2";
+    case TINYGLTF_TYPE_VEC3:
+      return "VEC3";
+    case TINYGLTF_TYPE_VEC4:
+      return "VEC4";
+    case TINYGLTF_TYPE_MAT2:
+      return "MAT2";
+    case TINYGLTF_TYPE_MAT3:
+      return "MAT3";
+    case TINYGLTF_TYPE_MAT4:
+      return "MAT4";
+    default:
+      return "unknown type";
   }
 }
 
 const char* componentName(int componentType) {
   switch (componentType) {
-    case TINYGLTF_COMPONENT_TYPE_BYTE: return "BYTE";
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return "UNSIGNED_BYTE";
-    case TINYGLTF_COMPONENT_TYPE_SHORT: return "SHORT";
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return "UNSIGNED_SHORT";
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: return "UNSIGNED_INT";
-    case TINYGLTF_COMPONENT_TYPE_FLOAT: return "FLOAT";
-    default: return "unknown component type";
+    case TINYGLTF_COMPONENT_TYPE_BYTE:
+      return "BYTE";
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+      return "UNSIGNED_BYTE";
+    case TINYGLTF_COMPONENT_TYPE_SHORT:
+      return "SHORT";
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
+      return "UNSIGNED_SHORT";
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+      return "UNSIGNED_INT";
+    case TINYGLTF_COMPONENT_TYPE_FLOAT:
+      return "FLOAT";
+    default:
+      return "unknown component type";
   }
 }
 
@@ -146,12 +177,14 @@ double readComponent(const uint8_t* p, int componentType, bool normalized) {
       std::memcpy(&v, p, 2);
       return normalized ? std::max(v / 32767.0, -1.0) : v;
     }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? *p / 255.0 : *p;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+      return normalized ? *p / 255.0 : *p;
     case TINYGLTF_COMPONENT_TYPE_BYTE: {
       const int8_t v = static_cast<int8_t>(*p);
       return normalized ? std::max(v / 127.0, -1.0) : v;
     }
-    default: return 0.0;
+    default:
+      return 0.0;
   }
 }
 
@@ -171,11 +204,15 @@ struct AccessorRule {
 
 class Loader {
  public:
-  Loader(std::string path, const LoadOptions& options) : path_(std::move(path)), options_(options) {}
+  Loader(std::string path, const LoadOptions& options)
+      : path_(std::move(path)), options_(options) {}
   // In memory: `bytes` stand for the file at `path_` (named in errors; external URIs resolve
   // beside it).
   Loader(std::string path, const std::string& bytes, const LoadOptions& options)
-      : path_(std::move(path)), options_(options), bytes_(bytes.begin(), bytes.end()), inMemory_(true) {}
+      : path_(std::move(path)),
+        options_(options),
+        bytes_(bytes.begin(), bytes.end()),
+        inMemory_(true) {}
 
   Scene load() {
     parse();
@@ -201,7 +238,8 @@ class Loader {
 
   void warn(const std::string& line) {
     const std::string w = oneLine(path_ + ": warning: " + line);
-    if (std::find(scene_.warnings.begin(), scene_.warnings.end(), w) != scene_.warnings.end()) return;
+    if (std::find(scene_.warnings.begin(), scene_.warnings.end(), w) != scene_.warnings.end())
+      return;
     scene_.warnings.push_back(w);
     std::ostream* out = options_.warningStream;
     if (!out && options_.printWarnings) out = &std::cerr;
@@ -227,7 +265,8 @@ class Loader {
     if (bytes.empty()) fail("file is empty");
 
     std::string ext = fs::path(path_).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return std::tolower(c); });
     binary_ = ext == ".glb" || (bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0);
 
     std::string baseDir = fs::path(path_).parent_path().string();
@@ -244,7 +283,8 @@ class Loader {
         ok = gltf.LoadBinaryFromMemory(&model_, &err, &warnText, bytes.data(),
                                        static_cast<unsigned int>(bytes.size()), baseDir);
       } else {
-        ok = gltf.LoadASCIIFromString(&model_, &err, &warnText, reinterpret_cast<const char*>(bytes.data()),
+        ok = gltf.LoadASCIIFromString(&model_, &err, &warnText,
+                                      reinterpret_cast<const char*>(bytes.data()),
                                       static_cast<unsigned int>(bytes.size()), baseDir);
       }
     } catch (const InputError&) {
@@ -291,7 +331,8 @@ class Loader {
     if (j.contains("extensionsRequired"))
       for (const auto& e : j["extensionsRequired"])
         if (!isSupportedExtension(e.get<std::string>()))
-          fail("requires extension " + e.get<std::string>() + ", which is not supported", "extensionsRequired");
+          fail("requires extension " + e.get<std::string>() + ", which is not supported",
+               "extensionsRequired");
   }
 
   void checkAssetAndExtensions() {
@@ -303,7 +344,8 @@ class Loader {
     if (!minV.empty() && minV != "2.0")
       fail("requires glTF version " + minV + " (asset.minVersion; only 2.0 is supported)");
     for (const std::string& e : model_.extensionsRequired)
-      if (!isSupportedExtension(e)) fail("requires extension " + e + ", which is not supported", "extensionsRequired");
+      if (!isSupportedExtension(e))
+        fail("requires extension " + e + ", which is not supported", "extensionsRequired");
   }
 
   // --- buffers, views, accessors ---------------------------------------------------------------
@@ -321,12 +363,13 @@ class Loader {
       if (v.byteLength == 0) fail("byteLength is 0", where);
       const size_t size = model_.buffers[size_t(v.buffer)].data.size();
       if (!fits(v.byteOffset, v.byteLength, 1, size))
-        fail("bytes " + std::to_string(v.byteOffset) + ".." + std::to_string(v.byteOffset + v.byteLength) +
-                 " lie past the end of buffer " + std::to_string(v.buffer) + " (" + std::to_string(size) +
-                 " bytes)",
+        fail("bytes " + std::to_string(v.byteOffset) + ".." +
+                 std::to_string(v.byteOffset + v.byteLength) + " lie past the end of buffer " +
+                 std::to_string(v.buffer) + " (" + std::to_string(size) + " bytes)",
              where);
       if (v.byteStride != 0 && (v.byteStride < 4 || v.byteStride > 252 || v.byteStride % 4 != 0))
-        fail("byteStride " + std::to_string(v.byteStride) + " is not a multiple of 4 in 4..252", where);
+        fail("byteStride " + std::to_string(v.byteStride) + " is not a multiple of 4 in 4..252",
+             where);
     }
   }
 
@@ -349,18 +392,23 @@ class Loader {
     const size_t elem = cs * nc;
     if (a.bufferView >= 0) {
       if (size_t(a.bufferView) >= model_.bufferViews.size())
-        fail(who + "refers to bufferView " + std::to_string(a.bufferView) + ", which does not exist", at);
+        fail(
+            who + "refers to bufferView " + std::to_string(a.bufferView) + ", which does not exist",
+            at);
       const auto& v = model_.bufferViews[size_t(a.bufferView)];
       size_t stride = elem;
       if (v.byteStride != 0) {
         stride = v.byteStride;
         if (stride < elem || stride % cs != 0)
           fail(who + "has byteStride " + std::to_string(stride) + ", which does not suit its " +
-                   std::to_string(elem) + "-byte elements (bufferView " + std::to_string(a.bufferView) + ")",
+                   std::to_string(elem) + "-byte elements (bufferView " +
+                   std::to_string(a.bufferView) + ")",
                at);
       }
-      if (!fits(a.byteOffset + elem, stride, a.count - 1, v.byteLength) || a.byteOffset > v.byteLength)
-        fail((where.empty() ? self : self) + " reads past the end of bufferView " + std::to_string(a.bufferView),
+      if (!fits(a.byteOffset + elem, stride, a.count - 1, v.byteLength) ||
+          a.byteOffset > v.byteLength)
+        fail((where.empty() ? self : self) + " reads past the end of bufferView " +
+                 std::to_string(a.bufferView),
              where);
     } else if (!a.sparse.isSparse) {
       // No buffer view and no sparse data: all zeros, as the spec says.
@@ -374,7 +422,9 @@ class Loader {
     const auto& sp = a.sparse;
     const std::string self = "sparse accessor " + std::to_string(index);
     if (sp.count <= 0 || size_t(sp.count) > a.count)
-      fail(self + " has sparse count " + std::to_string(sp.count) + " outside 1.." + std::to_string(a.count), at);
+      fail(self + " has sparse count " + std::to_string(sp.count) + " outside 1.." +
+               std::to_string(a.count),
+           at);
     const size_t is = componentSize(sp.indices.componentType);
     if (is == 0 || sp.indices.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT ||
         sp.indices.componentType == TINYGLTF_COMPONENT_TYPE_BYTE ||
@@ -382,10 +432,13 @@ class Loader {
       fail(self + " has invalid sparse index componentType", at);
     auto view = [&](int bv, int offset, size_t bytes, const char* what) {
       if (bv < 0 || size_t(bv) >= model_.bufferViews.size())
-        fail(self + " refers to " + what + " bufferView " + std::to_string(bv) + ", which does not exist", at);
+        fail(self + " refers to " + what + " bufferView " + std::to_string(bv) +
+                 ", which does not exist",
+             at);
       if (offset < 0) fail(self + " has a negative " + what + " byteOffset", at);
       const auto& v = model_.bufferViews[size_t(bv)];
-      if (v.byteStride != 0) fail(self + " " + what + " bufferView " + std::to_string(bv) + " has a byteStride", at);
+      if (v.byteStride != 0)
+        fail(self + " " + what + " bufferView " + std::to_string(bv) + " has a byteStride", at);
       if (!fits(size_t(offset), bytes, 1, v.byteLength))
         fail(self + " " + what + " read past the end of bufferView " + std::to_string(bv), at);
     };
@@ -394,12 +447,15 @@ class Loader {
          componentSize(a.componentType) * componentCount(a.type) * size_t(sp.count), "values");
     // Indices strictly increasing and in range.
     const auto& v = model_.bufferViews[size_t(sp.indices.bufferView)];
-    const uint8_t* p = model_.buffers[size_t(v.buffer)].data.data() + v.byteOffset + size_t(sp.indices.byteOffset);
+    const uint8_t* p =
+        model_.buffers[size_t(v.buffer)].data.data() + v.byteOffset + size_t(sp.indices.byteOffset);
     double prev = -1.0;
     for (int i = 0; i < sp.count; ++i) {
       const double k = readComponent(p + size_t(i) * is, sp.indices.componentType, false);
       if (k <= prev || k >= double(a.count))
-        fail(self + " has sparse index " + std::to_string(uint64_t(k)) + " out of order or out of range", at);
+        fail(self + " has sparse index " + std::to_string(uint64_t(k)) +
+                 " out of order or out of range",
+             at);
       prev = k;
     }
   }
@@ -412,12 +468,14 @@ class Loader {
     checkAccessor(index, where);
     const auto& a = model_.accessors[size_t(index)];
     const bool typeOk = std::find(rule.types.begin(), rule.types.end(), a.type) != rule.types.end();
-    const bool compOk = std::find(rule.componentTypes.begin(), rule.componentTypes.end(), a.componentType) !=
-                        rule.componentTypes.end();
-    const bool normOk = !rule.normalizedIntegers || a.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT || a.normalized;
+    const bool compOk = std::find(rule.componentTypes.begin(), rule.componentTypes.end(),
+                                  a.componentType) != rule.componentTypes.end();
+    const bool normOk = !rule.normalizedIntegers ||
+                        a.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT || a.normalized;
     if (!typeOk || !compOk || !normOk)
-      fail("accessor " + std::to_string(index) + " is " + (a.normalized ? "normalized " : "") + typeName(a.type) +
-               " " + componentName(a.componentType) + ", which is not allowed here",
+      fail("accessor " + std::to_string(index) + " is " + (a.normalized ? "normalized " : "") +
+               typeName(a.type) + " " + componentName(a.componentType) +
+               ", which is not allowed here",
            where);
   }
 
@@ -429,22 +487,28 @@ class Loader {
     if (a.bufferView >= 0) {
       const auto& v = model_.bufferViews[size_t(a.bufferView)];
       const size_t stride = v.byteStride ? v.byteStride : elem;
-      const uint8_t* base = model_.buffers[size_t(v.buffer)].data.data() + v.byteOffset + a.byteOffset;
+      const uint8_t* base =
+          model_.buffers[size_t(v.buffer)].data.data() + v.byteOffset + a.byteOffset;
       for (size_t i = 0; i < a.count; ++i)
         for (size_t c = 0; c < nc; ++c)
-          out[i * nc + c] = readComponent(base + i * stride + c * cs, a.componentType, a.normalized);
+          out[i * nc + c] =
+              readComponent(base + i * stride + c * cs, a.componentType, a.normalized);
     }
     if (a.sparse.isSparse) {
       const auto& sp = a.sparse;
       const auto& iv = model_.bufferViews[size_t(sp.indices.bufferView)];
       const auto& vv = model_.bufferViews[size_t(sp.values.bufferView)];
-      const uint8_t* ip = model_.buffers[size_t(iv.buffer)].data.data() + iv.byteOffset + size_t(sp.indices.byteOffset);
-      const uint8_t* vp = model_.buffers[size_t(vv.buffer)].data.data() + vv.byteOffset + size_t(sp.values.byteOffset);
+      const uint8_t* ip = model_.buffers[size_t(iv.buffer)].data.data() + iv.byteOffset +
+                          size_t(sp.indices.byteOffset);
+      const uint8_t* vp = model_.buffers[size_t(vv.buffer)].data.data() + vv.byteOffset +
+                          size_t(sp.values.byteOffset);
       const size_t is = componentSize(sp.indices.componentType);
       for (int i = 0; i < sp.count; ++i) {
-        const size_t k = size_t(readComponent(ip + size_t(i) * is, sp.indices.componentType, false));
+        const size_t k =
+            size_t(readComponent(ip + size_t(i) * is, sp.indices.componentType, false));
         for (size_t c = 0; c < nc; ++c)
-          out[k * nc + c] = readComponent(vp + size_t(i) * elem + c * cs, a.componentType, a.normalized);
+          out[k * nc + c] =
+              readComponent(vp + size_t(i) * elem + c * cs, a.componentType, a.normalized);
       }
     }
     return out;
@@ -458,7 +522,8 @@ class Loader {
       const std::string where = named("image", int(i), im.name);
       if (im.bufferView >= 0) {
         if (size_t(im.bufferView) >= model_.bufferViews.size())
-          fail("refers to bufferView " + std::to_string(im.bufferView) + ", which does not exist", where);
+          fail("refers to bufferView " + std::to_string(im.bufferView) + ", which does not exist",
+               where);
       } else if (im.uri.empty() && !images_.encoded.count(int(i))) {
         fail("has neither uri nor bufferView", where);
       }
@@ -472,8 +537,9 @@ class Loader {
     }
     std::set<int> used;  // textures that materials use
     for (const auto& m : model_.materials)
-      for (int t : {m.pbrMetallicRoughness.baseColorTexture.index, m.pbrMetallicRoughness.metallicRoughnessTexture.index,
-                    m.emissiveTexture.index, m.normalTexture.index, m.occlusionTexture.index})
+      for (int t : {m.pbrMetallicRoughness.baseColorTexture.index,
+                    m.pbrMetallicRoughness.metallicRoughnessTexture.index, m.emissiveTexture.index,
+                    m.normalTexture.index, m.occlusionTexture.index})
         used.insert(t);
     for (size_t i = 0; i < model_.textures.size(); ++i) {
       auto& t = model_.textures[i];
@@ -492,9 +558,12 @@ class Loader {
     }
   }
 
-  void checkFactor(double v, double lo, double hi, const std::string& what, const std::string& where) {
+  void checkFactor(double v, double lo, double hi, const std::string& what,
+                   const std::string& where) {
     if (!finite(v) || v < lo || v > hi)
-      fail(what + " " + std::to_string(v) + " is outside " + std::to_string(lo) + ".." + std::to_string(hi), where);
+      fail(what + " " + std::to_string(v) + " is outside " + std::to_string(lo) + ".." +
+               std::to_string(hi),
+           where);
   }
 
   void checkTextureInfo(int index, const std::string& what, const std::string& where) {
@@ -509,12 +578,14 @@ class Loader {
       const std::string where = named("material", int(i), m.name);
       const auto& pbr = m.pbrMetallicRoughness;
       if (pbr.baseColorFactor.size() != 4) fail("baseColorFactor must have 4 numbers", where);
-      for (double c : pbr.baseColorFactor) checkFactor(c, 0.0, 1.0, "baseColorFactor component", where);
+      for (double c : pbr.baseColorFactor)
+        checkFactor(c, 0.0, 1.0, "baseColorFactor component", where);
       checkFactor(pbr.metallicFactor, 0.0, 1.0, "metallicFactor", where);
       checkFactor(pbr.roughnessFactor, 0.0, 1.0, "roughnessFactor", where);
       if (m.emissiveFactor.size() != 3) fail("emissiveFactor must have 3 numbers", where);
       // Above 1 is against the spec but common (exporters predating emissive_strength): allowed.
-      for (double c : m.emissiveFactor) checkFactor(c, 0.0, 3.0e38, "emissiveFactor component", where);
+      for (double c : m.emissiveFactor)
+        checkFactor(c, 0.0, 3.0e38, "emissiveFactor component", where);
       if (m.alphaMode != "OPAQUE" && m.alphaMode != "MASK" && m.alphaMode != "BLEND")
         fail("unknown alphaMode \"" + m.alphaMode + "\"", where);
       if (!finite(m.alphaCutoff) || m.alphaCutoff < 0.0) fail("alphaCutoff must be >= 0", where);
@@ -541,7 +612,9 @@ class Loader {
             bool ok = v->IsArray() && v->ArrayLen() == 2;
             for (int k = 0; ok && k < 2; ++k)
               ok = v->Get(k).IsNumber() && finite(v->Get(k).GetNumberAsDouble());
-            if (!ok) fail(std::string("KHR_texture_transform ") + key + " must be 2 finite numbers", where);
+            if (!ok)
+              fail(std::string("KHR_texture_transform ") + key + " must be 2 finite numbers",
+                   where);
           }
         };
         arr2("offset");
@@ -561,10 +634,12 @@ class Loader {
       const std::string where = named("camera", int(i), c.name);
       if (c.type == "perspective") {
         const auto& p = c.perspective;
-        if (!finite(p.yfov) || p.yfov <= 0.0 || p.yfov >= kPi) fail("yfov must be in (0, pi)", where);
+        if (!finite(p.yfov) || p.yfov <= 0.0 || p.yfov >= kPi)
+          fail("yfov must be in (0, pi)", where);
         if (!finite(p.znear) || p.znear <= 0.0) fail("znear must be > 0", where);
         if (!finite(p.aspectRatio) || p.aspectRatio < 0.0) fail("aspectRatio must be > 0", where);
-        if (!finite(p.zfar) || (p.zfar != 0.0 && p.zfar <= p.znear)) fail("zfar must be > znear", where);
+        if (!finite(p.zfar) || (p.zfar != 0.0 && p.zfar <= p.znear))
+          fail("zfar must be > znear", where);
       } else if (c.type == "orthographic") {
         const auto& o = c.orthographic;
         if (!finite(o.xmag) || !finite(o.ymag) || o.xmag == 0.0 || o.ymag == 0.0)
@@ -583,7 +658,8 @@ class Loader {
       if (!l.color.empty() && l.color.size() != 3) fail("color must have 3 numbers", where);
       for (double c : l.color)
         if (!finite(c) || c < 0.0) fail("color must be finite and >= 0", where);
-      if (!finite(l.intensity) || l.intensity < 0.0) fail("intensity must be finite and >= 0", where);
+      if (!finite(l.intensity) || l.intensity < 0.0)
+        fail("intensity must be finite and >= 0", where);
       if (!finite(l.range) || l.range < 0.0) fail("range must be > 0", where);
       if (l.type == "spot") {
         const double in = l.spot.innerConeAngle, out = l.spot.outerConeAngle;
@@ -599,18 +675,21 @@ class Loader {
     const AccessorRule position{{TINYGLTF_TYPE_VEC3}, {TINYGLTF_COMPONENT_TYPE_FLOAT}};
     const AccessorRule normal = position;
     const AccessorRule tangent{{TINYGLTF_TYPE_VEC4}, {TINYGLTF_COMPONENT_TYPE_FLOAT}};
-    const AccessorRule texcoord{{TINYGLTF_TYPE_VEC2},
-                                {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
-                                 TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
-                                true};
-    const AccessorRule indices{{TINYGLTF_TYPE_SCALAR},
-                               {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
-                                TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT}};
+    const AccessorRule texcoord{
+        {TINYGLTF_TYPE_VEC2},
+        {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
+         TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
+        true};
+    const AccessorRule indices{
+        {TINYGLTF_TYPE_SCALAR},
+        {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
+         TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT}};
     for (size_t mi = 0; mi < model_.meshes.size(); ++mi) {
       const auto& mesh = model_.meshes[mi];
       for (size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
         const auto& p = mesh.primitives[pi];
-        const std::string where = named("mesh", int(mi), mesh.name) + ", primitive " + std::to_string(pi);
+        const std::string where =
+            named("mesh", int(mi), mesh.name) + ", primitive " + std::to_string(pi);
         if (p.material >= 0 ? size_t(p.material) >= model_.materials.size() : p.material != -1)
           fail("material " + std::to_string(p.material) + " does not exist", where);
         if (p.mode < -1 || p.mode > 6) fail("invalid mode " + std::to_string(p.mode), where);
@@ -618,14 +697,21 @@ class Loader {
         bool first = true;
         for (const auto& [name, acc] : p.attributes) {
           const std::string at = where + ", " + name;
-          if (name == "POSITION") checkRule(acc, position, at);
-          else if (name == "NORMAL") checkRule(acc, normal, at);
-          else if (name == "TANGENT") checkRule(acc, tangent, at);
-          else if (name == "TEXCOORD_0") checkRule(acc, texcoord, at);
-          else checkAccessor(acc, at);
+          if (name == "POSITION")
+            checkRule(acc, position, at);
+          else if (name == "NORMAL")
+            checkRule(acc, normal, at);
+          else if (name == "TANGENT")
+            checkRule(acc, tangent, at);
+          else if (name == "TEXCOORD_0")
+            checkRule(acc, texcoord, at);
+          else
+            checkAccessor(acc, at);
           const size_t c = model_.accessors[size_t(acc)].count;
           if (!first && c != count)
-            fail("attributes have different counts (" + std::to_string(count) + " and " + std::to_string(c) + ")", at);
+            fail("attributes have different counts (" + std::to_string(count) + " and " +
+                     std::to_string(c) + ")",
+                 at);
           count = c;
           first = false;
         }
@@ -656,8 +742,8 @@ class Loader {
         if (c < 0 || size_t(c) >= n) fail("child " + std::to_string(c) + " does not exist", where);
         if (c == int(i)) fail("is its own child", where);
         if (parents_[size_t(c)] >= 0)
-          fail("node " + std::to_string(c) + " has two parents (nodes " + std::to_string(parents_[size_t(c)]) +
-                   " and " + std::to_string(i) + ")",
+          fail("node " + std::to_string(c) + " has two parents (nodes " +
+                   std::to_string(parents_[size_t(c)]) + " and " + std::to_string(i) + ")",
                where);
         parents_[size_t(c)] = int(i);
       }
@@ -671,7 +757,8 @@ class Loader {
       if (light != -1 && (light < 0 || size_t(light) >= model_.lights.size()))
         fail("KHR_lights_punctual light " + std::to_string(light) + " does not exist", where);
       auto checkArray = [&](const std::vector<double>& v, size_t size, const char* what) {
-        if (!v.empty() && v.size() != size) fail(std::string(what) + " must have " + std::to_string(size) + " numbers", where);
+        if (!v.empty() && v.size() != size)
+          fail(std::string(what) + " must have " + std::to_string(size) + " numbers", where);
         if (!allFinite(v)) fail(std::string(what) + " is not finite", where);
       };
       checkArray(node.translation, 3, "translation");
@@ -679,8 +766,9 @@ class Loader {
       checkArray(node.scale, 3, "scale");
       checkArray(node.matrix, 16, "matrix");
       if (node.rotation.size() == 4) {
-        const double len2 = node.rotation[0] * node.rotation[0] + node.rotation[1] * node.rotation[1] +
-                            node.rotation[2] * node.rotation[2] + node.rotation[3] * node.rotation[3];
+        const double len2 =
+            node.rotation[0] * node.rotation[0] + node.rotation[1] * node.rotation[1] +
+            node.rotation[2] * node.rotation[2] + node.rotation[3] * node.rotation[3];
         if (!(len2 > 1e-12)) fail("rotation is not a unit quaternion", where);
       }
     }
@@ -689,7 +777,8 @@ class Loader {
     for (size_t i = 0; i < n; ++i) {
       std::vector<size_t> walk;
       for (size_t k = i; state[k] != 2;) {
-        if (state[k] == 1) fail("node hierarchy has a cycle", named("node", int(k), model_.nodes[k].name));
+        if (state[k] == 1)
+          fail("node hierarchy has a cycle", named("node", int(k), model_.nodes[k].name));
         state[k] = 1;
         walk.push_back(k);
         if (parents_[k] < 0) break;
@@ -704,12 +793,14 @@ class Loader {
         const std::string where = named("scene", int(s), sc.name);
         if (r < 0 || size_t(r) >= n) fail("node " + std::to_string(r) + " does not exist", where);
         if (parents_[size_t(r)] >= 0)
-          fail("root node " + std::to_string(r) + " is also a child of node " + std::to_string(parents_[size_t(r)]),
+          fail("root node " + std::to_string(r) + " is also a child of node " +
+                   std::to_string(parents_[size_t(r)]),
                where);
         if (!seen.insert(r).second) fail("node " + std::to_string(r) + " is listed twice", where);
       }
     }
-    if (model_.defaultScene >= 0 ? size_t(model_.defaultScene) >= model_.scenes.size() : model_.defaultScene != -1)
+    if (model_.defaultScene >= 0 ? size_t(model_.defaultScene) >= model_.scenes.size()
+                                 : model_.defaultScene != -1)
       fail("default scene " + std::to_string(model_.defaultScene) + " does not exist", "scene");
   }
 
@@ -741,7 +832,8 @@ class Loader {
           fail("unknown target path \"" + path + "\"", where);
         const auto& s = anim.samplers[size_t(ch.sampler)];
         const std::string swhere = aname + ", sampler " + std::to_string(ch.sampler);
-        if (s.interpolation != "LINEAR" && s.interpolation != "STEP" && s.interpolation != "CUBICSPLINE")
+        if (s.interpolation != "LINEAR" && s.interpolation != "STEP" &&
+            s.interpolation != "CUBICSPLINE")
           fail("unknown interpolation \"" + s.interpolation + "\"", swhere);
         checkRule(s.input, times, swhere + ", input");
         checkAccessor(s.output, swhere + ", output");
@@ -776,7 +868,8 @@ class Loader {
     }
   }
 
-  AnimationSampler readSampler(const tinygltf::Animation& anim, int index, const std::string& where) {
+  AnimationSampler readSampler(const tinygltf::Animation& anim, int index,
+                               const std::string& where) {
     const auto& s = anim.samplers[size_t(index)];
     AnimationSampler out;
     out.interpolation = s.interpolation == "STEP"          ? Interpolation::Step
@@ -792,8 +885,8 @@ class Loader {
     const auto& oa = model_.accessors[size_t(s.output)];
     const size_t perKey = out.interpolation == Interpolation::CubicSpline ? 3 : 1;
     if (oa.count != in.size() * perKey)
-      fail("output has " + std::to_string(oa.count) + " values for " + std::to_string(in.size()) + " keys" +
-               (perKey == 3 ? " (CUBICSPLINE needs 3 per key)" : ""),
+      fail("output has " + std::to_string(oa.count) + " values for " + std::to_string(in.size()) +
+               " keys" + (perKey == 3 ? " (CUBICSPLINE needs 3 per key)" : ""),
            where);
     const size_t nc = componentCount(oa.type);
     const std::vector<double> values = readAccessor(s.output);
@@ -801,7 +894,8 @@ class Loader {
       glm::vec4 v(0.0f);
       for (size_t c = 0; c < nc && c < 4; ++c) {
         const double x = values[i * nc + c];
-        if (!finite(x) || std::abs(x) > 3.0e38) fail("output value " + std::to_string(i) + " is not finite", where);
+        if (!finite(x) || std::abs(x) > 3.0e38)
+          fail("output value " + std::to_string(i) + " is not finite", where);
         v[int(c)] = float(x);
       }
       out.values.push_back(v);
@@ -839,7 +933,8 @@ class Loader {
         dst.rotation = glm::normalize(glm::quat(float(src.rotation[3]), float(src.rotation[0]),
                                                 float(src.rotation[1]), float(src.rotation[2])));
       if (src.scale.size() == 3) dst.scale = glm::vec3(src.scale[0], src.scale[1], src.scale[2]);
-      if (const Value* d = member(src.extras, "dynamic")) dst.dynamic = d->IsBool() && d->Get<bool>();
+      if (const Value* d = member(src.extras, "dynamic"))
+        dst.dynamic = d->IsBool() && d->Get<bool>();
     }
     for (uint32_t a = 0; a < scene_.animations.size(); ++a)
       for (uint32_t c = 0; c < scene_.animations[a].channels.size(); ++c) {
@@ -874,8 +969,11 @@ class Loader {
     for (const Node& node : scene_.nodes) {
       bool finiteWorld = true;
       for (int c = 0; c < 4; ++c)
-        for (int r = 0; r < 4; ++r) finiteWorld = finiteWorld && std::isfinite(node.restWorld[c][r]);
-      if (!finiteWorld) fail("world transform is not finite", named("node", int(&node - scene_.nodes.data()), node.name));
+        for (int r = 0; r < 4; ++r)
+          finiteWorld = finiteWorld && std::isfinite(node.restWorld[c][r]);
+      if (!finiteWorld)
+        fail("world transform is not finite",
+             named("node", int(&node - scene_.nodes.data()), node.name));
     }
   }
 
@@ -896,17 +994,20 @@ class Loader {
     TriangleMesh out;
     out.name = mesh.name;
     bool anyTangents = false;
-    for (const auto& p : mesh.primitives) anyTangents = anyTangents || p.attributes.count("TANGENT");
+    for (const auto& p : mesh.primitives)
+      anyTangents = anyTangents || p.attributes.count("TANGENT");
     for (size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
       const auto& p = mesh.primitives[pi];
-      const std::string where = named("mesh", meshIndex, mesh.name) + ", primitive " + std::to_string(pi);
+      const std::string where =
+          named("mesh", meshIndex, mesh.name) + ", primitive " + std::to_string(pi);
       const int mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
       if (mode != TINYGLTF_MODE_TRIANGLES) {
-        static const char* names[] = {"POINTS", "LINES", "LINE_LOOP", "LINE_STRIP", "TRIANGLES", "TRIANGLE_STRIP", "TRIANGLE_FAN"};
+        static const char* names[] = {"POINTS",    "LINES",          "LINE_LOOP",   "LINE_STRIP",
+                                      "TRIANGLES", "TRIANGLE_STRIP", "TRIANGLE_FAN"};
         // One line per mode, however many primitives use it.
         if (skippedModes_.insert(mode).second)
-          warn(std::string("skipping primitives with mode ") + names[mode] + ": only TRIANGLES are rendered (first: " +
-               where + ")");
+          warn(std::string("skipping primitives with mode ") + names[mode] +
+               ": only TRIANGLES are rendered (first: " + where + ")");
         continue;
       }
       if (!p.targets.empty()) unsupportedMorph_ = true;
@@ -918,7 +1019,8 @@ class Loader {
       const std::vector<double> positions = readAccessor(pos->second);
       const size_t vcount = positions.size() / 3;
       for (double x : positions)
-        if (!finite(x) || std::abs(x) > 3.0e38) fail("POSITION has a value that is not finite", where + ", POSITION");
+        if (!finite(x) || std::abs(x) > 3.0e38)
+          fail("POSITION has a value that is not finite", where + ", POSITION");
       std::vector<uint32_t> idx;
       if (p.indices >= 0) {
         const std::vector<double> raw = readAccessor(p.indices);
@@ -935,8 +1037,8 @@ class Loader {
         for (size_t i = 0; i < vcount; ++i) idx[i] = uint32_t(i);
       }
       if (idx.size() % 3 != 0) {
-        warn("primitive has " + std::to_string(idx.size()) + " indices, not a multiple of 3: the rest is ignored (" +
-             where + ")");
+        warn("primitive has " + std::to_string(idx.size()) +
+             " indices, not a multiple of 3: the rest is ignored (" + where + ")");
         idx.resize(idx.size() - idx.size() % 3);
       }
       const uint32_t base = uint32_t(out.positions.size());
@@ -954,7 +1056,8 @@ class Loader {
         for (int k = 0; k < 3; ++k) faceNormals[idx[t + size_t(k)]] += n;
       }
       std::vector<double> normals;
-      if (const auto it = p.attributes.find("NORMAL"); it != p.attributes.end()) normals = readAccessor(it->second);
+      if (const auto it = p.attributes.find("NORMAL"); it != p.attributes.end())
+        normals = readAccessor(it->second);
       for (size_t v = 0; v < vcount; ++v) {
         glm::vec3 n(0.0f);
         if (!normals.empty()) n = glm::vec3(normals[3 * v], normals[3 * v + 1], normals[3 * v + 2]);
@@ -963,12 +1066,14 @@ class Loader {
           n = faceNormals[v];
           len = glm::length(n);
         }
-        out.normals.push_back(len > 0.0f && std::isfinite(len) ? n / len : glm::vec3(0.0f, 0.0f, 1.0f));
+        out.normals.push_back(len > 0.0f && std::isfinite(len) ? n / len
+                                                               : glm::vec3(0.0f, 0.0f, 1.0f));
       }
       if (const auto it = p.attributes.find("TEXCOORD_0"); it != p.attributes.end()) {
         const std::vector<double> uv = readAccessor(it->second);
         for (size_t v = 0; v < vcount; ++v) {
-          if (!finite(uv[2 * v]) || !finite(uv[2 * v + 1])) fail("TEXCOORD_0 is not finite", where + ", TEXCOORD_0");
+          if (!finite(uv[2 * v]) || !finite(uv[2 * v + 1]))
+            fail("TEXCOORD_0 is not finite", where + ", TEXCOORD_0");
           out.uvs.emplace_back(uv[2 * v], uv[2 * v + 1]);
         }
       } else {
@@ -976,13 +1081,15 @@ class Loader {
       }
       if (anyTangents) {
         std::vector<double> tan;
-        if (const auto it = p.attributes.find("TANGENT"); it != p.attributes.end()) tan = readAccessor(it->second);
+        if (const auto it = p.attributes.find("TANGENT"); it != p.attributes.end())
+          tan = readAccessor(it->second);
         for (size_t v = 0; v < vcount; ++v) {
           glm::vec4 t(1.0f, 0.0f, 0.0f, 1.0f);
           if (!tan.empty()) {
             glm::vec3 xyz(tan[4 * v], tan[4 * v + 1], tan[4 * v + 2]);
             const float len = glm::length(xyz);
-            if (len > 0.0f && std::isfinite(len)) t = glm::vec4(xyz / len, tan[4 * v + 3] < 0.0 ? -1.0f : 1.0f);
+            if (len > 0.0f && std::isfinite(len))
+              t = glm::vec4(xyz / len, tan[4 * v + 3] < 0.0 ? -1.0f : 1.0f);
           }
           out.tangents.push_back(t);
         }
@@ -1029,7 +1136,8 @@ class Loader {
       }
     }
     for (size_t t = 0; t < mesh.triangleCount(); ++t) {
-      const uint32_t a = mesh.indices[3 * t], b = mesh.indices[3 * t + 1], c = mesh.indices[3 * t + 2];
+      const uint32_t a = mesh.indices[3 * t], b = mesh.indices[3 * t + 1],
+                     c = mesh.indices[3 * t + 2];
       ssg.indices.push_back(base + a);
       // A mirroring transform turns the winding around; swap to keep front faces in front.
       ssg.indices.push_back(base + (det < 0.0f ? c : b));
@@ -1044,32 +1152,43 @@ class Loader {
       Material m;
       m.name = src.name;
       const auto& pbr = src.pbrMetallicRoughness;
-      m.baseColorFactor = glm::vec4(pbr.baseColorFactor[0], pbr.baseColorFactor[1], pbr.baseColorFactor[2],
-                                    pbr.baseColorFactor[3]);
+      m.baseColorFactor = glm::vec4(pbr.baseColorFactor[0], pbr.baseColorFactor[1],
+                                    pbr.baseColorFactor[2], pbr.baseColorFactor[3]);
       m.metallicFactor = float(pbr.metallicFactor);
       m.roughnessFactor = float(pbr.roughnessFactor);
-      m.emissiveFactor = glm::vec3(src.emissiveFactor[0], src.emissiveFactor[1], src.emissiveFactor[2]);
-      m.alphaMode = src.alphaMode == "MASK" ? AlphaMode::Mask : src.alphaMode == "BLEND" ? AlphaMode::Blend : AlphaMode::Opaque;
+      m.emissiveFactor =
+          glm::vec3(src.emissiveFactor[0], src.emissiveFactor[1], src.emissiveFactor[2]);
+      m.alphaMode = src.alphaMode == "MASK"    ? AlphaMode::Mask
+                    : src.alphaMode == "BLEND" ? AlphaMode::Blend
+                                               : AlphaMode::Opaque;
       m.alphaCutoff = float(src.alphaCutoff);
       m.doubleSided = src.doubleSided;
       m.normalScale = float(src.normalTexture.scale);
       const std::string where = named("material", int(i), src.name);
-      m.baseColorTexture = textureRef(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, true, where);
+      m.baseColorTexture =
+          textureRef(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, true, where);
       if (const Value* t = extension(pbr.baseColorTexture.extensions, "KHR_texture_transform")) {
         if (const Value* v = member(*t, "offset"))
-          m.baseColorTexture.offset = glm::vec2(v->Get(0).GetNumberAsDouble(), v->Get(1).GetNumberAsDouble());
+          m.baseColorTexture.offset =
+              glm::vec2(v->Get(0).GetNumberAsDouble(), v->Get(1).GetNumberAsDouble());
         if (const Value* v = member(*t, "scale"))
-          m.baseColorTexture.scale = glm::vec2(v->Get(0).GetNumberAsDouble(), v->Get(1).GetNumberAsDouble());
-        if (const Value* v = member(*t, "rotation")) m.baseColorTexture.rotation = float(v->GetNumberAsDouble());
+          m.baseColorTexture.scale =
+              glm::vec2(v->Get(0).GetNumberAsDouble(), v->Get(1).GetNumberAsDouble());
+        if (const Value* v = member(*t, "rotation"))
+          m.baseColorTexture.rotation = float(v->GetNumberAsDouble());
       }
-      m.metallicRoughnessTexture =
-          textureRef(pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord, false, where);
-      m.emissiveTexture = textureRef(src.emissiveTexture.index, src.emissiveTexture.texCoord, true, where);
-      m.normalTexture = textureRef(src.normalTexture.index, src.normalTexture.texCoord, false, where);
+      m.metallicRoughnessTexture = textureRef(pbr.metallicRoughnessTexture.index,
+                                              pbr.metallicRoughnessTexture.texCoord, false, where);
+      m.emissiveTexture =
+          textureRef(src.emissiveTexture.index, src.emissiveTexture.texCoord, true, where);
+      m.normalTexture =
+          textureRef(src.normalTexture.index, src.normalTexture.texCoord, false, where);
       if (const Value* e = extension(src.extensions, "KHR_materials_emissive_strength"))
-        if (const Value* s = member(*e, "emissiveStrength")) m.emissiveStrength = float(s->GetNumberAsDouble());
+        if (const Value* s = member(*e, "emissiveStrength"))
+          m.emissiveStrength = float(s->GetNumberAsDouble());
       if (const Value* e = extension(src.extensions, "KHR_materials_transmission"))
-        if (const Value* s = member(*e, "transmissionFactor")) m.transmission = float(s->GetNumberAsDouble());
+        if (const Value* s = member(*e, "transmissionFactor"))
+          m.transmission = float(s->GetNumberAsDouble());
       if (const Value* e = extension(src.extensions, "KHR_materials_ior"))
         if (const Value* s = member(*e, "ior")) m.ior = float(s->GetNumberAsDouble());
       scene_.materials.push_back(m);
@@ -1080,7 +1199,9 @@ class Loader {
   TextureRef textureRef(int gltfTexture, int texCoord, bool srgb, const std::string& where) {
     TextureRef ref;
     if (gltfTexture < 0) return ref;
-    if (texCoord != 0) warn("only TEXCOORD_0 is supported; texCoord " + std::to_string(texCoord) + " reads it (" + where + ")");
+    if (texCoord != 0)
+      warn("only TEXCOORD_0 is supported; texCoord " + std::to_string(texCoord) + " reads it (" +
+           where + ")");
     const auto key = std::make_pair(gltfTexture, srgb);
     if (const auto it = textureIndex_.find(key); it != textureIndex_.end()) {
       ref.texture = it->second;
@@ -1174,7 +1295,8 @@ class Loader {
           scene_.instances.push_back({it->second, int(i), node.name});
         } else {
           flatten(mesh, node.restWorld);
-          if (staticMeshes.insert(node.mesh).second) scene_.staticMeshTriangles += mesh.triangleCount();
+          if (staticMeshes.insert(node.mesh).second)
+            scene_.staticMeshTriangles += mesh.triangleCount();
         }
       }
       const int light = nodeLight(src);
@@ -1182,7 +1304,9 @@ class Loader {
         const auto& l = model_.lights[size_t(light)];
         PunctualLightDef d;
         d.name = l.name;
-        d.type = l.type == "spot" ? LightType::Spot : l.type == "directional" ? LightType::Directional : LightType::Point;
+        d.type = l.type == "spot"          ? LightType::Spot
+                 : l.type == "directional" ? LightType::Directional
+                                           : LightType::Point;
         if (l.color.size() == 3) d.color = glm::vec3(l.color[0], l.color[1], l.color[2]);
         d.intensity = float(l.intensity);
         d.range = float(l.range);
@@ -1245,9 +1369,9 @@ class Loader {
 }  // namespace
 
 bool isSupportedExtension(const std::string& name) {
-  static const std::set<std::string> supported = {"KHR_materials_emissive_strength", "KHR_materials_transmission",
-                                                  "KHR_materials_ior", "KHR_texture_transform",
-                                                  "KHR_lights_punctual"};
+  static const std::set<std::string> supported = {"KHR_materials_emissive_strength",
+                                                  "KHR_materials_transmission", "KHR_materials_ior",
+                                                  "KHR_texture_transform", "KHR_lights_punctual"};
   return supported.count(name) > 0;
 }
 
@@ -1255,7 +1379,8 @@ Scene loadScene(const std::string& path, const LoadOptions& options) {
   return Loader(path, options).load();
 }
 
-Scene loadSceneFromMemory(const std::string& bytes, const std::string& path, const LoadOptions& options) {
+Scene loadSceneFromMemory(const std::string& bytes, const std::string& path,
+                          const LoadOptions& options) {
   return Loader(path, bytes, options).load();
 }
 

@@ -23,7 +23,8 @@ Scene loadScene(const std::string& path, const LoadOptions& options = {});
 // The same checks on a file's bytes already in memory (the fuzz target uses it). `path` names
 // the file in errors, its extension or the GLB magic says whether the bytes are GLB, and
 // external buffer and image URIs resolve beside it.
-Scene loadSceneFromMemory(const std::string& bytes, const std::string& path, const LoadOptions& options = {});
+Scene loadSceneFromMemory(const std::string& bytes, const std::string& path,
+                          const LoadOptions& options = {});
 
 // The extensions a file may list in extensionsRequired.
 bool isSupportedExtension(const std::string& name);

@@ -9,7 +9,20 @@ namespace {
 
 using nlohmann::json;
 
-enum class Kind { Any, String, Number, Uint, Bool, Object, Array, NumberArray, UintArray, StringArray, ObjectArray, UintMap };
+enum class Kind {
+  Any,
+  String,
+  Number,
+  Uint,
+  Bool,
+  Object,
+  Array,
+  NumberArray,
+  UintArray,
+  StringArray,
+  ObjectArray,
+  UintMap
+};
 
 struct Schema;
 
@@ -42,17 +55,26 @@ struct Schemas {
     auto obj = [](const Schema& s) { return Prop{Kind::Object, &s}; };
     auto objs = [](const Schema& s) { return Prop{Kind::ObjectArray, &s}; };
 
-    root.props = {{"asset", req(obj(asset))},  {"scene", uint},
-                  {"scenes", objs(scene)},     {"nodes", objs(node)},
-                  {"meshes", objs(mesh)},      {"accessors", objs(accessor)},
-                  {"bufferViews", objs(bufferView)}, {"buffers", objs(buffer)},
-                  {"materials", objs(material)}, {"textures", objs(texture)},
-                  {"images", objs(image)},     {"samplers", objs(sampler)},
-                  {"cameras", objs(camera)},   {"animations", objs(animation)},
-                  {"skins", objs(skin)},       {"extensionsUsed", Prop{Kind::StringArray}},
+    root.props = {{"asset", req(obj(asset))},
+                  {"scene", uint},
+                  {"scenes", objs(scene)},
+                  {"nodes", objs(node)},
+                  {"meshes", objs(mesh)},
+                  {"accessors", objs(accessor)},
+                  {"bufferViews", objs(bufferView)},
+                  {"buffers", objs(buffer)},
+                  {"materials", objs(material)},
+                  {"textures", objs(texture)},
+                  {"images", objs(image)},
+                  {"samplers", objs(sampler)},
+                  {"cameras", objs(camera)},
+                  {"animations", objs(animation)},
+                  {"skins", objs(skin)},
+                  {"extensionsUsed", Prop{Kind::StringArray}},
                   {"extensionsRequired", Prop{Kind::StringArray}}};
     root.extensions = {{"KHR_lights_punctual", &lightsRoot}};
-    asset.props = {{"version", req(str)}, {"minVersion", str}, {"generator", str}, {"copyright", str}};
+    asset.props = {
+        {"version", req(str)}, {"minVersion", str}, {"generator", str}, {"copyright", str}};
     scene.props = {{"nodes", uints}};
     node.props = {{"children", uints}, {"mesh", uint},        {"camera", uint},
                   {"skin", uint},      {"matrix", nums},      {"rotation", nums},
@@ -64,21 +86,29 @@ struct Schemas {
                        {"material", uint},
                        {"mode", uint},
                        {"targets", Prop{Kind::ObjectArray, &anyObject}}};
-    accessor.props = {{"bufferView", uint},     {"byteOffset", uint}, {"componentType", req(uint)},
-                      {"normalized", boolean},  {"count", req(uint)}, {"type", req(str)},
-                      {"max", nums},            {"min", nums},        {"sparse", obj(sparse)}};
+    accessor.props = {{"bufferView", uint},    {"byteOffset", uint}, {"componentType", req(uint)},
+                      {"normalized", boolean}, {"count", req(uint)}, {"type", req(str)},
+                      {"max", nums},           {"min", nums},        {"sparse", obj(sparse)}};
     sparse.props = {{"count", req(uint)},
                     {"indices", req(obj(sparseIndices))},
                     {"values", req(obj(sparseValues))}};
-    sparseIndices.props = {{"bufferView", req(uint)}, {"byteOffset", uint}, {"componentType", req(uint)}};
+    sparseIndices.props = {
+        {"bufferView", req(uint)}, {"byteOffset", uint}, {"componentType", req(uint)}};
     sparseValues.props = {{"bufferView", req(uint)}, {"byteOffset", uint}};
-    bufferView.props = {{"buffer", req(uint)}, {"byteOffset", uint}, {"byteLength", req(uint)},
-                        {"byteStride", uint},  {"target", uint}};
+    bufferView.props = {{"buffer", req(uint)},
+                        {"byteOffset", uint},
+                        {"byteLength", req(uint)},
+                        {"byteStride", uint},
+                        {"target", uint}};
     buffer.props = {{"uri", str}, {"byteLength", req(uint)}};
-    material.props = {{"pbrMetallicRoughness", obj(pbr)}, {"normalTexture", obj(textureInfo)},
-                      {"occlusionTexture", obj(textureInfo)}, {"emissiveTexture", obj(textureInfo)},
-                      {"emissiveFactor", nums},  {"alphaMode", str},
-                      {"alphaCutoff", num},      {"doubleSided", boolean}};
+    material.props = {{"pbrMetallicRoughness", obj(pbr)},
+                      {"normalTexture", obj(textureInfo)},
+                      {"occlusionTexture", obj(textureInfo)},
+                      {"emissiveTexture", obj(textureInfo)},
+                      {"emissiveFactor", nums},
+                      {"alphaMode", str},
+                      {"alphaCutoff", num},
+                      {"doubleSided", boolean}};
     material.extensions = {{"KHR_materials_emissive_strength", &emissiveStrength},
                            {"KHR_materials_transmission", &transmission},
                            {"KHR_materials_ior", &ior}};
@@ -87,26 +117,35 @@ struct Schemas {
                  {"metallicFactor", num},
                  {"roughnessFactor", num},
                  {"metallicRoughnessTexture", obj(textureInfo)}};
-    textureInfo.props = {{"index", req(uint)}, {"texCoord", uint}, {"scale", num}, {"strength", num}};
+    textureInfo.props = {
+        {"index", req(uint)}, {"texCoord", uint}, {"scale", num}, {"strength", num}};
     textureInfo.extensions = {{"KHR_texture_transform", &textureTransform}};
     texture.props = {{"sampler", uint}, {"source", uint}};
     image.props = {{"uri", str}, {"mimeType", str}, {"bufferView", uint}};
     sampler.props = {{"magFilter", uint}, {"minFilter", uint}, {"wrapS", uint}, {"wrapT", uint}};
-    camera.props = {{"type", req(str)}, {"perspective", obj(perspective)}, {"orthographic", obj(orthographic)}};
-    perspective.props = {{"aspectRatio", num}, {"yfov", req(num)}, {"zfar", num}, {"znear", req(num)}};
-    orthographic.props = {{"xmag", req(num)}, {"ymag", req(num)}, {"zfar", req(num)}, {"znear", req(num)}};
+    camera.props = {
+        {"type", req(str)}, {"perspective", obj(perspective)}, {"orthographic", obj(orthographic)}};
+    perspective.props = {
+        {"aspectRatio", num}, {"yfov", req(num)}, {"zfar", num}, {"znear", req(num)}};
+    orthographic.props = {
+        {"xmag", req(num)}, {"ymag", req(num)}, {"zfar", req(num)}, {"znear", req(num)}};
     animation.props = {{"channels", req(objs(channel))}, {"samplers", req(objs(animSampler))}};
     channel.props = {{"sampler", req(uint)}, {"target", req(obj(target))}};
     target.props = {{"node", uint}, {"path", req(str)}};
     animSampler.props = {{"input", req(uint)}, {"interpolation", str}, {"output", req(uint)}};
     skin.props = {{"inverseBindMatrices", uint}, {"skeleton", uint}, {"joints", req(uints)}};
 
-    textureTransform.props = {{"offset", nums}, {"rotation", num}, {"scale", nums}, {"texCoord", uint}};
+    textureTransform.props = {
+        {"offset", nums}, {"rotation", num}, {"scale", nums}, {"texCoord", uint}};
     emissiveStrength.props = {{"emissiveStrength", num}};
     transmission.props = {{"transmissionFactor", num}, {"transmissionTexture", obj(textureInfo)}};
     ior.props = {{"ior", num}};
     lightsRoot.props = {{"lights", objs(light)}};
-    light.props = {{"type", req(str)}, {"color", nums}, {"intensity", num}, {"range", num}, {"spot", obj(spot)}};
+    light.props = {{"type", req(str)},
+                   {"color", nums},
+                   {"intensity", num},
+                   {"range", num},
+                   {"spot", obj(spot)}};
     spot.props = {{"innerConeAngle", num}, {"outerConeAngle", num}};
     nodeLight.props = {{"light", req(uint)}};
   }
@@ -114,18 +153,30 @@ struct Schemas {
 
 const char* kindName(Kind k) {
   switch (k) {
-    case Kind::String: return "a string";
-    case Kind::Number: return "a number";
-    case Kind::Uint: return "a non-negative integer";
-    case Kind::Bool: return "a boolean";
-    case Kind::Object: return "an object";
-    case Kind::Array: return "an array";
-    case Kind::NumberArray: return "an array of numbers";
-    case Kind::UintArray: return "an array of non-negative integers";
-    case Kind::StringArray: return "an array of strings";
-    case Kind::ObjectArray: return "an array of objects";
-    case Kind::UintMap: return "an object of non-negative integers";
-    case Kind::Any: break;
+    case Kind::String:
+      return "a string";
+    case Kind::Number:
+      return "a number";
+    case Kind::Uint:
+      return "a non-negative integer";
+    case Kind::Bool:
+      return "a boolean";
+    case Kind::Object:
+      return "an object";
+    case Kind::Array:
+      return "an array";
+    case Kind::NumberArray:
+      return "an array of numbers";
+    case Kind::UintArray:
+      return "an array of non-negative integers";
+    case Kind::StringArray:
+      return "an array of strings";
+    case Kind::ObjectArray:
+      return "an array of objects";
+    case Kind::UintMap:
+      return "an object of non-negative integers";
+    case Kind::Any:
+      break;
   }
   return "a value";
 }
@@ -150,17 +201,28 @@ bool hasKind(const json& v, Kind k) {
     return true;
   };
   switch (k) {
-    case Kind::Any: return true;
-    case Kind::String: return v.is_string();
-    case Kind::Number: return v.is_number();
-    case Kind::Uint: return isUint(v);
-    case Kind::Bool: return v.is_boolean();
-    case Kind::Object: return v.is_object();
-    case Kind::Array: return v.is_array();
-    case Kind::NumberArray: return all([](const json& e) { return e.is_number(); });
-    case Kind::UintArray: return all(isUint);
-    case Kind::StringArray: return all([](const json& e) { return e.is_string(); });
-    case Kind::ObjectArray: return all([](const json& e) { return e.is_object(); });
+    case Kind::Any:
+      return true;
+    case Kind::String:
+      return v.is_string();
+    case Kind::Number:
+      return v.is_number();
+    case Kind::Uint:
+      return isUint(v);
+    case Kind::Bool:
+      return v.is_boolean();
+    case Kind::Object:
+      return v.is_object();
+    case Kind::Array:
+      return v.is_array();
+    case Kind::NumberArray:
+      return all([](const json& e) { return e.is_number(); });
+    case Kind::UintArray:
+      return all(isUint);
+    case Kind::StringArray:
+      return all([](const json& e) { return e.is_string(); });
+    case Kind::ObjectArray:
+      return all([](const json& e) { return e.is_object(); });
     case Kind::UintMap:
       if (!v.is_object()) return false;
       for (const auto& e : v.items())
@@ -197,7 +259,8 @@ std::string check(const json& o, const Schema& s, const std::string& where) {
     if (!it->is_object()) return "\"extensions\" must be an object (" + loc + ")";
     for (const auto& e : it->items()) {
       const std::string inner = (where.empty() ? "" : where + ".") + "extensions." + e.key();
-      if (!e.value().is_object()) return "extension \"" + e.key() + "\" must be an object (" + inner + ")";
+      if (!e.value().is_object())
+        return "extension \"" + e.key() + "\" must be an object (" + inner + ")";
       const auto ext = s.extensions.find(e.key());
       if (ext != s.extensions.end()) {
         std::string err = check(e.value(), *ext->second, inner);

@@ -62,7 +62,8 @@ bool decodeImageRgba8(const std::vector<uint8_t>& encoded, DecodedImage* out, st
   }
   if (!plausibleImage(encoded, why)) return false;
   int w = 0, h = 0, channels = 0;
-  stbi_uc* pixels = stbi_load_from_memory(encoded.data(), int(encoded.size()), &w, &h, &channels, 4);
+  stbi_uc* pixels =
+      stbi_load_from_memory(encoded.data(), int(encoded.size()), &w, &h, &channels, 4);
   if (!pixels) {
     const char* reason = stbi_failure_reason();
     *why = reason ? reason : "unknown format";

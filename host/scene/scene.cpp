@@ -47,9 +47,15 @@ glm::mat4 Scene::nodeLocalTransform(int node, double t) const {
     const AnimationChannel& c = a.channels[ref.channel];
     const AnimationSampler& s = a.samplers[static_cast<size_t>(c.sampler)];
     switch (c.path) {
-      case AnimationPath::Translation: translation = sampleVec3(s, t); break;
-      case AnimationPath::Rotation: rotation = sampleQuat(s, t); break;
-      case AnimationPath::Scale: scale = sampleVec3(s, t); break;
+      case AnimationPath::Translation:
+        translation = sampleVec3(s, t);
+        break;
+      case AnimationPath::Rotation:
+        rotation = sampleQuat(s, t);
+        break;
+      case AnimationPath::Scale:
+        scale = sampleVec3(s, t);
+        break;
     }
   }
   return glm::translate(glm::mat4(1.0f), translation) * glm::mat4_cast(rotation) *
@@ -85,9 +91,10 @@ CameraPose Scene::cameraAt(int camera, double t) const {
   // Scale or shear in the node may tilt +Y off the view axis: keep it orthogonal.
   glm::vec3 up = glm::vec3(m * glm::vec4(0.0f, 1.0f, 0.0f, 0.0f));
   up -= glm::dot(up, pose.forward) * pose.forward;
-  const glm::vec3 fallbackUp = std::abs(pose.forward.y) < 0.99f ? glm::vec3(0.0f, 1.0f, 0.0f)
-                                                                 : glm::vec3(0.0f, 0.0f, 1.0f);
-  pose.up = unitOr(up, glm::normalize(fallbackUp - glm::dot(fallbackUp, pose.forward) * pose.forward));
+  const glm::vec3 fallbackUp =
+      std::abs(pose.forward.y) < 0.99f ? glm::vec3(0.0f, 1.0f, 0.0f) : glm::vec3(0.0f, 0.0f, 1.0f);
+  pose.up =
+      unitOr(up, glm::normalize(fallbackUp - glm::dot(fallbackUp, pose.forward) * pose.forward));
   pose.yfov = c.yfov;
   pose.aspect = c.aspectRatio;
   pose.znear = c.znear;
@@ -160,7 +167,9 @@ size_t emissiveCount(const TriangleMesh& m, const std::vector<Material>& materia
 }
 }  // namespace
 
-size_t Scene::staticEmissiveTriangleCount() const { return emissiveCount(staticMesh, materials); }
+size_t Scene::staticEmissiveTriangleCount() const {
+  return emissiveCount(staticMesh, materials);
+}
 
 size_t Scene::dynamicEmissiveTriangleCount() const {
   size_t n = 0;
@@ -169,13 +178,13 @@ size_t Scene::dynamicEmissiveTriangleCount() const {
 }
 
 size_t Scene::dynamicLightCount() const {
-  return static_cast<size_t>(
-      std::count_if(lights.begin(), lights.end(), [](const PunctualLightDef& l) { return l.dynamic; }));
+  return static_cast<size_t>(std::count_if(lights.begin(), lights.end(),
+                                           [](const PunctualLightDef& l) { return l.dynamic; }));
 }
 
 size_t Scene::fileCameraCount() const {
-  return static_cast<size_t>(
-      std::count_if(cameras.begin(), cameras.end(), [](const CameraDef& c) { return !c.isDefault; }));
+  return static_cast<size_t>(std::count_if(cameras.begin(), cameras.end(),
+                                           [](const CameraDef& c) { return !c.isDefault; }));
 }
 
 }  // namespace pr

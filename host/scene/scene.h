@@ -79,7 +79,7 @@ struct Material {
   TextureRef normalTexture;             // linear, loaded for completeness
   float normalScale = 1.0f;
   glm::vec3 emissiveFactor{0.0f};
-  TextureRef emissiveTexture;    // sRGB texture
+  TextureRef emissiveTexture;     // sRGB texture
   float emissiveStrength = 1.0f;  // KHR_materials_emissive_strength
   float transmission = 0.0f;      // KHR_materials_transmission factor
   float ior = 1.5f;               // KHR_materials_ior
@@ -117,8 +117,8 @@ struct PunctualLightDef {
   float range = 0.0f;      // 0 = infinite
   float innerConeAngle = 0.0f;
   float outerConeAngle = 0.7853981634f;  // pi/4
-  int node = -1;         // the node that places it
-  bool dynamic = false;  // the node or an ancestor is animated (or marked dynamic)
+  int node = -1;                         // the node that places it
+  bool dynamic = false;                  // the node or an ancestor is animated (or marked dynamic)
 };
 
 // A punctual light evaluated at a time: world-space position and direction.
@@ -136,15 +136,15 @@ struct PunctualLight {
 // A camera as placed by one node (or the default camera framing the scene).
 struct CameraDef {
   std::string name;
-  bool perspective = true;    // orthographic cameras load but render refuses them
-  float yfov = 0.6981317f;    // radians (40 degrees)
-  float aspectRatio = 0.0f;   // 0 = unspecified, use the image's
+  bool perspective = true;   // orthographic cameras load but render refuses them
+  float yfov = 0.6981317f;   // radians (40 degrees)
+  float aspectRatio = 0.0f;  // 0 = unspecified, use the image's
   float znear = 0.01f;
-  float zfar = 0.0f;          // 0 = infinite
+  float zfar = 0.0f;               // 0 = infinite
   float xmag = 0.0f, ymag = 0.0f;  // orthographic only
-  int node = -1;               // -1 for the default camera
+  int node = -1;                   // -1 for the default camera
   bool dynamic = false;
-  bool isDefault = false;      // made by the loader because the file has no camera
+  bool isDefault = false;        // made by the loader because the file has no camera
   glm::mat4 defaultWorld{1.0f};  // world transform of the default camera
 };
 
@@ -171,11 +171,11 @@ struct Node {
   glm::quat rotation{1.0f, 0.0f, 0.0f, 0.0f};  // w, x, y, z
   glm::vec3 scale{1.0f};
   int mesh = -1;
-  int camera = -1;  // glTF camera index
-  bool inScene = false;     // reachable from the scene that was loaded
-  bool animated = false;    // target of a translation/rotation/scale channel
-  bool dynamic = false;     // it or an ancestor is animated or marked "dynamic": true
-  bool moves = false;       // it or an ancestor is animated: world transform depends on t
+  int camera = -1;                   // glTF camera index
+  bool inScene = false;              // reachable from the scene that was loaded
+  bool animated = false;             // target of a translation/rotation/scale channel
+  bool dynamic = false;              // it or an ancestor is animated or marked "dynamic": true
+  bool moves = false;                // it or an ancestor is animated: world transform depends on t
   std::vector<ChannelRef> channels;  // the channels that target it
   glm::mat4 restWorld{1.0f};         // world transform with no animation applied
 

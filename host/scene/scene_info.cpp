@@ -5,15 +5,19 @@
 namespace pr {
 
 namespace {
-nlohmann::ordered_json vec3Json(const glm::vec3& v) { return {v.x, v.y, v.z}; }
+nlohmann::ordered_json vec3Json(const glm::vec3& v) {
+  return {v.x, v.y, v.z};
+}
 }  // namespace
 
 nlohmann::ordered_json sceneInfoJson(const Scene& scene, double fps) {
   nlohmann::ordered_json j;
   j["file"] = scene.path;
-  j["triangles"] = {{"static", scene.staticTriangleCount()}, {"dynamic", scene.dynamicTriangleCount()},
+  j["triangles"] = {{"static", scene.staticTriangleCount()},
+                    {"dynamic", scene.dynamicTriangleCount()},
                     {"static_per_mesh", scene.staticMeshTriangles}};
-  j["instances"] = {{"dynamic", scene.instances.size()}, {"dynamic_meshes", scene.dynamicMeshes.size()}};
+  j["instances"] = {{"dynamic", scene.instances.size()},
+                    {"dynamic_meshes", scene.dynamicMeshes.size()}};
   j["materials"] = scene.materials.size();
   j["textures"] = scene.textures.size();
   j["lights"] = {{"emissive_triangles", scene.emissiveTriangleCount()},
@@ -22,7 +26,8 @@ nlohmann::ordered_json sceneInfoJson(const Scene& scene, double fps) {
                  {"punctual_dynamic", scene.dynamicLightCount()}};
   j["cameras"] = scene.fileCameraCount();
   j["default_camera"] = scene.fileCameraCount() == 0;
-  j["animation"] = {{"duration_s", scene.animationDuration()}, {"frames", scene.frameCount(fps)}, {"fps", fps}};
+  j["animation"] = {
+      {"duration_s", scene.animationDuration()}, {"frames", scene.frameCount(fps)}, {"fps", fps}};
   const Bounds& b = scene.bounds;
   if (b.empty()) {
     j["bounds"] = {{"min", nullptr}, {"max", nullptr}};
@@ -36,12 +41,13 @@ nlohmann::ordered_json sceneInfoJson(const Scene& scene, double fps) {
 std::string sceneInfoText(const Scene& scene, double fps) {
   std::ostringstream s;
   s << "file:       " << scene.path << "\n";
-  s << "triangles:  " << scene.staticTriangleCount() << " static (SSG), " << scene.dynamicTriangleCount()
-    << " dynamic (DSG)";
+  s << "triangles:  " << scene.staticTriangleCount() << " static (SSG), "
+    << scene.dynamicTriangleCount() << " dynamic (DSG)";
   if (scene.staticMeshTriangles != scene.staticTriangleCount())
     s << "; " << scene.staticMeshTriangles << " static counting each mesh once";
   s << "\n";
-  s << "instances:  " << scene.instances.size() << " dynamic, of " << scene.dynamicMeshes.size() << " meshes\n";
+  s << "instances:  " << scene.instances.size() << " dynamic, of " << scene.dynamicMeshes.size()
+    << " meshes\n";
   s << "materials:  " << scene.materials.size() << ", textures: " << scene.textures.size() << "\n";
   s << "lights:     " << scene.emissiveTriangleCount() << " emissive triangles ("
     << scene.dynamicEmissiveTriangleCount() << " dynamic), " << scene.lights.size() << " punctual ("
@@ -60,8 +66,8 @@ std::string sceneInfoText(const Scene& scene, double fps) {
   if (b.empty())
     s << "empty (nothing to render)\n";
   else
-    s << "[" << b.min.x << ", " << b.min.y << ", " << b.min.z << "] .. [" << b.max.x << ", " << b.max.y << ", "
-      << b.max.z << "]\n";
+    s << "[" << b.min.x << ", " << b.min.y << ", " << b.min.z << "] .. [" << b.max.x << ", "
+      << b.max.y << ", " << b.max.z << "]\n";
   for (const std::string& w : scene.warnings) s << w << "\n";
   return s.str();
 }

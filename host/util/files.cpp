@@ -41,7 +41,8 @@ void createParent(const std::string& path) {
   std::error_code ec;
   if (!parent.empty()) {
     fs::create_directories(parent, ec);
-    if (ec) throw RuntimeError(path + ": cannot create folder " + parent.string() + ": " + ec.message());
+    if (ec)
+      throw RuntimeError(path + ": cannot create folder " + parent.string() + ": " + ec.message());
   }
 }
 

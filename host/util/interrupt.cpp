@@ -10,7 +10,9 @@ namespace {
 
 volatile std::sig_atomic_t g_signal = 0;
 
-extern "C" void onInterrupt(int signal) { g_signal = signal; }
+extern "C" void onInterrupt(int signal) {
+  g_signal = signal;
+}
 
 }  // namespace
 
@@ -26,8 +28,12 @@ void installInterruptHandlers() {
   std::signal(SIGXFSZ, SIG_IGN);
 }
 
-int interruptSignal() { return g_signal; }
+int interruptSignal() {
+  return g_signal;
+}
 
-void setInterruptSignal(int signal) { g_signal = signal; }
+void setInterruptSignal(int signal) {
+  g_signal = signal;
+}
 
 }  // namespace pr

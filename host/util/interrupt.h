@@ -11,7 +11,9 @@ void installInterruptHandlers();
 
 // The signal that asked to stop (SIGINT, SIGTERM), or 0.
 int interruptSignal();
-inline bool interrupted() { return interruptSignal() != 0; }
+inline bool interrupted() {
+  return interruptSignal() != 0;
+}
 
 // Records `signal` as if it had arrived (tests), or clears the request with 0.
 void setInterruptSignal(int signal);

@@ -6,7 +6,8 @@
 #include "shared/path_state.h"
 
 __kernel void pt_shade(PR_SCENE_PARAMS, __global PathState* states, __global const Hit* hits,
-                       __global float4* radiance, __global ShadowRay* shadows, uint count, uint seed, uint frame, uint sample, uint max_depth) {
+                       __global float4* radiance, __global ShadowRay* shadows, uint count,
+                       uint seed, uint frame, uint sample, uint max_depth) {
   const uint i = (uint)get_global_id(0);
   if (i >= count) return;
   const SceneData s = PR_SCENE();

@@ -55,6 +55,7 @@ PR_INLINE float3 connection(const SceneData* s, const ReuseParams* rp, Reservoir
                             float3 c, Ray ray, u32 mis, ConnectCounts* n) {
   ++n->candidates;
   if (rp->resample > 0u) {
+    PR_KCHECK(rp->resample <= PR_MAX_CONNECTIONS);
     const float w = luminance(c);
     if (w > 0.0f) {
       res->w_sum += w;
@@ -115,8 +116,8 @@ PR_INLINE float light_emit_pdf(const SceneData* s, u32 light, PR_GLOBAL const Li
 PR_INLINE float3 connect_light_paths(const SceneData* s, const ReuseParams* rp, const SurfaceHit* x,
                                      const ShadingFrame* fx, float3 wo, float3 tp, uint depth,
                                      uint j, __global const PathHeader* headers,
-                                     __global const LightVertex* vertices, Reservoir* res,
-                                     Rng* rr, ConnectCounts* n) {
+                                     __global const LightVertex* vertices, Reservoir* res, Rng* rr,
+                                     ConnectCounts* n) {
   float3 sum = make_float3(0.0f, 0.0f, 0.0f);
   const float3 wol = to_local(wo, fx->t, fx->b, fx->n);
   const float inv_c = 1.0f / (float)rp->paths_per_pixel;
@@ -294,7 +295,8 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
     float pdf;
     int delta;
     const float3 wol = to_local(wo, f.t, f.b, f.n);
-    if (!bsdf_sample(&f.bsdf, wol, u0, u12.x, u12.y, PR_RADIANCE, &wil, &weight, &pdf, &delta)) break;
+    if (!bsdf_sample(&f.bsdf, wol, u0, u12.x, u12.y, PR_RADIANCE, &wil, &weight, &pdf, &delta))
+      break;
     float3 d = normalize(to_world(wil, f.t, f.b, f.n));
     if (dot(d, f.ng) * dot(wo, f.ng) <= 0.0f) break;
     float3 t2 = tp * weight;
@@ -333,7 +335,8 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
       const float w0 = rng_next(&rng);
       const float2 w12 = rng_next2(&rng);
       const float3 hl = to_local(-d, fh.t, fh.b, fh.n);
-      if (!bsdf_sample(&fh.bsdf, hl, w0, w12.x, w12.y, PR_RADIANCE, &wil, &weight, &pdf, &delta)) break;
+      if (!bsdf_sample(&fh.bsdf, hl, w0, w12.x, w12.y, PR_RADIANCE, &wil, &weight, &pdf, &delta))
+        break;
       d = normalize(to_world(wil, fh.t, fh.b, fh.n));
       t2 = t2 * weight;
       ray = spawn_ray(h.p, fh.ng, d, PR_INF_F);

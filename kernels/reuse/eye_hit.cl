@@ -54,7 +54,8 @@ __kernel void eye_hit(PR_SCENE_PARAMS, ReuseParams rp, CameraParams cam, uint sa
     float pdf;
     int delta;
     const float3 wol = to_local(wo, f.t, f.b, f.n);
-    if (!bsdf_sample(&f.bsdf, wol, u0, u12.x, u12.y, PR_RADIANCE, &wil, &weight, &pdf, &delta)) break;
+    if (!bsdf_sample(&f.bsdf, wol, u0, u12.x, u12.y, PR_RADIANCE, &wil, &weight, &pdf, &delta))
+      break;
     d = normalize(to_world(wil, f.t, f.b, f.n));
     tp = tp * weight;
     ray = spawn_ray(h.p, f.ng, d, PR_INF_F);

@@ -18,7 +18,7 @@ __kernel void invalidate(PR_SCENE_PARAMS, ReuseParams rp, uint test_segments,
   int ok = h.valid != 0u;
   uint rays = 0u;
   if (ok && h.light != PR_INVALID_INDEX && s.lights.lights[h.light].moved) ok = 0;  // (c)
-  for (uint k = 1u; ok && k < h.vertex_count; ++k) {                               // (b)
+  for (uint k = 1u; ok && k < h.vertex_count; ++k) {                                // (b)
     const uint inst = v[k].inst;
     if (inst != PR_INVALID_INDEX && s.sd.instances[inst].moved) ok = 0;
   }

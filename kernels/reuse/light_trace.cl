@@ -67,10 +67,10 @@ __kernel void light_trace(PR_SCENE_PARAMS, ReuseParams rp, __global const float*
   } else {
     p0 = make_float3(L.p0x, L.p0y, L.p0z);
     const float pdf_dir = light_sample_emit_dir(&L, n0, u4, u5, &dir);
-    const float att = L.type == PR_LIGHT_SPOT
-                          ? spot_attenuation(dot(dir, make_float3(L.e1x, L.e1y, L.e1z)),
-                                             L.cos_inner, L.cos_outer)
-                          : 1.0f;
+    const float att =
+        L.type == PR_LIGHT_SPOT
+            ? spot_attenuation(dot(dir, make_float3(L.e1x, L.e1y, L.e1z)), L.cos_inner, L.cos_outer)
+            : 1.0f;
     tp = make_float3(L.le_r, L.le_g, L.le_b) * (att / (pmf * pdf_dir));
   }
   if (!(pmf > 0.0f) || !(max3(tp) > 0.0f) || !(max3(tp) < PR_INF_F)) {

@@ -26,14 +26,14 @@ typedef struct {
 // 64 bytes.
 typedef struct {
   float px, py, pz;
-  float t;              // distance along the arriving ray (unit direction) from the previous vertex
-  float wx, wy, wz;     // unit direction of the arriving ray (from the previous vertex)
-  u32 ng_oct;           // geometric normal, octahedron-encoded (for the light: emission side)
+  float t;           // distance along the arriving ray (unit direction) from the previous vertex
+  float wx, wy, wz;  // unit direction of the arriving ray (from the previous vertex)
+  u32 ng_oct;        // geometric normal, octahedron-encoded (for the light: emission side)
   float tp_r, tp_g, tp_b;  // throughput of the light sub-path arriving at this vertex
-  u32 ns_oct;           // shading normal, same side as ng
-  u32 prim;             // shading triangle (PR_INVALID_INDEX for punctual lights)
-  u32 inst;             // DSG instance, PR_INVALID_INDEX on the SSG
-  float b1, b2;         // barycentrics on prim (uv and material come from them)
+  u32 ns_oct;              // shading normal, same side as ng
+  u32 prim;                // shading triangle (PR_INVALID_INDEX for punctual lights)
+  u32 inst;                // DSG instance, PR_INVALID_INDEX on the SSG
+  float b1, b2;            // barycentrics on prim (uv and material come from them)
 } LightVertex;
 
 // The first non-delta eye vertex of a pixel sample, written by eye_hit for connect. 64 bytes.
@@ -50,7 +50,9 @@ typedef struct {
 } EyeVertex;
 
 // Octahedral normal encoding, two 16-bit fixed-point coordinates (Cigolle et al., JCGT 2014).
-PR_INLINE float pr_sign_nz(float v) { return v >= 0.0f ? 1.0f : -1.0f; }
+PR_INLINE float pr_sign_nz(float v) {
+  return v >= 0.0f ? 1.0f : -1.0f;
+}
 
 PR_INLINE u32 oct_encode(float3 n) {
   const float l1 = fabs(n.x) + fabs(n.y) + fabs(n.z);

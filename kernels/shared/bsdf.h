@@ -88,8 +88,8 @@ PR_INLINE float3 bsdf_eval(const BsdfParams* m, float3 wo, float3 wi, float* pdf
   const float w5 = schlick_weight(voh);
   const float fd = 0.04f + 0.96f * w5;
   const float3 fm = m->base + (make_float3(1.0f, 1.0f, 1.0f) - m->base) * w5;
-  const float3 dielectric = make_float3(fd * spec, fd * spec, fd * spec) +
-                            m->base * ((1.0f - fd) * PR_INV_PI);
+  const float3 dielectric =
+      make_float3(fd * spec, fd * spec, fd * spec) + m->base * ((1.0f - fd) * PR_INV_PI);
   const float3 f = dielectric * (1.0f - m->metallic) + fm * (spec * m->metallic);
   // VNDF pdf: G1(wo) D(h) / (4 cos_o).
   const float ps = bsdf_spec_probability(m, wo.z);
@@ -103,8 +103,8 @@ PR_INLINE float3 bsdf_eval(const BsdfParams* m, float3 wo, float3 wi, float* pdf
 PR_INLINE float3 ggx_sample_vndf(float3 wo, float alpha, float u1, float u2) {
   const float3 vh = normalize(make_float3(alpha * wo.x, alpha * wo.y, wo.z));
   const float lensq = vh.x * vh.x + vh.y * vh.y;
-  const float3 t1 = lensq > 0.0f ? make_float3(-vh.y, vh.x, 0.0f) / sqrt(lensq)
-                                 : make_float3(1.0f, 0.0f, 0.0f);
+  const float3 t1 =
+      lensq > 0.0f ? make_float3(-vh.y, vh.x, 0.0f) / sqrt(lensq) : make_float3(1.0f, 0.0f, 0.0f);
   const float3 t2 = cross(vh, t1);
   const float r = sqrt(u1), phi = 2.0f * PR_PI * u2;
   const float p1 = r * cos(phi);

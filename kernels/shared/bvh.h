@@ -39,11 +39,11 @@ PR_NAMESPACE_BEGIN
 // (OpenCL C 1.2 allows pointers to __global in private structs, not in kernel arguments):
 // see PR_SCENE_GEOM_PARAMS / pr_scene_geom below.
 typedef struct {
-  PR_GLOBAL const BvhNode* static_nodes;     // root at 0; an empty SSG is a node with no child
+  PR_GLOBAL const BvhNode* static_nodes;  // root at 0; an empty SSG is a node with no child
   PR_GLOBAL const BvhTriPacket* static_tris;
-  PR_GLOBAL const BvhNode* tlas_nodes;       // root at 0; read only when instance_count > 0
-  PR_GLOBAL const BvhInstance* instances;    // indexed by the TLAS's leaves
-  PR_GLOBAL const BvhNode* mesh_nodes;       // all meshes' BVHs, absolute indices
+  PR_GLOBAL const BvhNode* tlas_nodes;     // root at 0; read only when instance_count > 0
+  PR_GLOBAL const BvhInstance* instances;  // indexed by the TLAS's leaves
+  PR_GLOBAL const BvhNode* mesh_nodes;     // all meshes' BVHs, absolute indices
   PR_GLOBAL const BvhTriPacket* mesh_tris;
   u32 instance_count;
 } SceneGeom;
@@ -203,8 +203,8 @@ PR_INLINE int intersect_triangle(PR_GLOBAL const BvhTriangle* tri, float3 o, flo
 // The ray against a leaf's triangles: the lane of the nearest hit in (tmin, tmax) (the lowest
 // lane among equal distances) with its t, u, v, or -1. The device runs intersect_triangle's
 // operations on all lanes at once with float4s; the host runs intersect_triangle lane by lane.
-PR_INLINE int intersect_packet(PR_GLOBAL const BvhTriPacket* p, const BvhRay* r, float* t,
-                               float* u, float* v) {
+PR_INLINE int intersect_packet(PR_GLOBAL const BvhTriPacket* p, const BvhRay* r, float* t, float* u,
+                               float* v) {
 #ifdef PR_DEVICE_CODE
   const float3 d = r->d;
   const float4 e1x = vload4(0, p->e1x), e1y = vload4(0, p->e1y), e1z = vload4(0, p->e1z);
@@ -218,8 +218,8 @@ PR_INLINE int intersect_packet(PR_GLOBAL const BvhTriPacket* p, const BvhRay* r,
   const float4 qx = sy * e1z - sz * e1y, qy = sz * e1x - sx * e1z, qz = sx * e1y - sy * e1x;
   const float4 vv = (d.x * qx + d.y * qy + d.z * qz) * inv_det;
   const float4 tt = (e2x * qx + e2y * qy + e2z * qz) * inv_det;
-  const int4 ok = (det != 0.0f) & (uu >= 0.0f) & (uu <= 1.0f) & (vv >= 0.0f) &
-                  (uu + vv <= 1.0f) & (tt > r->tmin) & (tt < r->tmax);
+  const int4 ok = (det != 0.0f) & (uu >= 0.0f) & (uu <= 1.0f) & (vv >= 0.0f) & (uu + vv <= 1.0f) &
+                  (tt > r->tmin) & (tt < r->tmax);
   if (!any(ok)) return -1;
   float ta[4], ua[4], va[4];
   vstore4(select((float4)(PR_INF_F), tt, ok), 0, ta);
@@ -266,6 +266,7 @@ PR_INLINE int bvh_push_children(PR_GLOBAL const BvhNode* n, const BvhRay* r, u32
   for (; mask != 0u; mask &= mask - 1u) {
     const int i = 31 - (int)clz(mask & (0u - mask));  // lowest set bit
     const float t = entry[i];
+    PR_KCHECK(top < PR_BVH_STACK_SIZE);  // the builder bounds every path's need
     int j = top++;
     if (!any_hit) {
       for (; j > base && stack_t[j - 1] <= t; --j) {
@@ -390,8 +391,8 @@ PR_INLINE Hit hit_none(void) {
 }
 
 PR_INLINE BvhRay bvh_ray_from(Ray ray) {
-  return bvh_ray(make_float3(ray.ox, ray.oy, ray.oz), make_float3(ray.dx, ray.dy, ray.dz),
-                 ray.tmin, ray.tmax);
+  return bvh_ray(make_float3(ray.ox, ray.oy, ray.oz), make_float3(ray.dx, ray.dy, ray.dz), ray.tmin,
+                 ray.tmax);
 }
 
 // Closest hit on the SSG. *hit is always written (prim == PR_INVALID_INDEX: no hit).
@@ -488,10 +489,10 @@ PR_NAMESPACE_END
 #ifdef PR_DEVICE_CODE
 // Kernel parameters that carry a SceneGeom, and the struct built from them in the kernel body.
 // The host's DeviceAccel::setKernelArgs sets them in this order.
-#define PR_SCENE_GEOM_PARAMS                                                                    \
-  __global const BvhNode *pr_static_nodes, __global const BvhTriPacket *pr_static_tris,         \
-      __global const BvhNode *pr_tlas_nodes, __global const BvhInstance *pr_instances,          \
-      __global const BvhNode *pr_mesh_nodes, __global const BvhTriPacket *pr_mesh_tris,         \
+#define PR_SCENE_GEOM_PARAMS                                                            \
+  __global const BvhNode *pr_static_nodes, __global const BvhTriPacket *pr_static_tris, \
+      __global const BvhNode *pr_tlas_nodes, __global const BvhInstance *pr_instances,  \
+      __global const BvhNode *pr_mesh_nodes, __global const BvhTriPacket *pr_mesh_tris, \
       uint pr_instance_count
 PR_INLINE SceneGeom pr_scene_geom(__global const BvhNode* sn, __global const BvhTriPacket* st,
                                   __global const BvhNode* tn, __global const BvhInstance* in,
@@ -507,7 +508,7 @@ PR_INLINE SceneGeom pr_scene_geom(__global const BvhNode* sn, __global const Bvh
   g.instance_count = count;
   return g;
 }
-#define PR_SCENE_GEOM()                                                                     \
+#define PR_SCENE_GEOM()                                                                      \
   pr_scene_geom(pr_static_nodes, pr_static_tris, pr_tlas_nodes, pr_instances, pr_mesh_nodes, \
                 pr_mesh_tris, pr_instance_count)
 #endif

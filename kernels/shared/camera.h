@@ -23,7 +23,9 @@ PR_INLINE float3 camera_direction(const CameraParams* c, float sx, float sy) {
   return normalize(d);
 }
 
-PR_INLINE float3 camera_position(const CameraParams* c) { return make_float3(c->px, c->py, c->pz); }
+PR_INLINE float3 camera_position(const CameraParams* c) {
+  return make_float3(c->px, c->py, c->pz);
+}
 
 PR_NAMESPACE_END
 

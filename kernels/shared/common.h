@@ -40,3 +40,19 @@ typedef int32_t i32;
 typedef uint64_t u64;
 PR_NAMESPACE_END
 #endif
+
+// Internal invariants of the shared code (host/util/check.h's PR_CHECK for the host): the
+// host's CPU reference, which runs this code in the tests, checks them and aborts on a failed
+// one. Kernels compile them out: OpenCL C 1.2 has no way to stop a kernel, and a printf in the
+// traversal loop crashed PoCL 3.1's work-group compiler.
+#ifdef PR_DEVICE_CODE
+#define PR_KCHECK(cond) ((void)0)
+#else
+#include <cstdio>
+#include <cstdlib>
+#define PR_KCHECK(cond)                                                                     \
+  ((cond) ? (void)0                                                                         \
+          : (std::fprintf(stderr, "pathreuse: check failed: %s (%s:%d)\n", #cond, __FILE__, \
+                          __LINE__),                                                        \
+             std::abort()))
+#endif

@@ -27,8 +27,8 @@ typedef struct {
   float world_to_object[12];
   u32 first_triangle;  // the instance's mesh's first triangle in the shading triangle array
   u32 mesh;
-  u32 moved;           // transform changed since the previous frame (for invalidation)
-  u32 first_light;     // the light of the instance's first emissive triangle
+  u32 moved;        // transform changed since the previous frame (for invalidation)
+  u32 first_light;  // the light of the instance's first emissive triangle
 } ShadingInstance;
 
 PR_NAMESPACE_END
@@ -36,4 +36,5 @@ PR_NAMESPACE_END
 PR_STATIC_ASSERT(sizeof(pr::dev::ShadingVertex) == 32, "ShadingVertex layout");
 PR_STATIC_ASSERT(sizeof(pr::dev::ShadingTriangle) == 16, "ShadingTriangle layout");
 PR_STATIC_ASSERT(sizeof(pr::dev::ShadingInstance) == 112, "ShadingInstance layout");
-PR_STATIC_ASSERT(offsetof(pr::dev::ShadingInstance, first_triangle) == 96, "ShadingInstance layout");
+PR_STATIC_ASSERT(offsetof(pr::dev::ShadingInstance, first_triangle) == 96,
+                 "ShadingInstance layout");

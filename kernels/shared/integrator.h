@@ -22,7 +22,8 @@ PR_INLINE int surface_passes(const SceneData* s, const SurfaceHit* h) {
   if (!(m->flags & (PR_MAT_ALPHA_MASK | PR_MAT_ALPHA_BLEND))) return 0;
   const float alpha = material_base(&s->sd, h).w;
   if (m->flags & PR_MAT_ALPHA_MASK) return alpha < m->alpha_cutoff;
-  const u32 key = pr_hash_u32(h->prim ^ pr_hash_u32(pr_as_uint(h->uv.x) ^ pr_hash_u32(pr_as_uint(h->uv.y))));
+  const u32 key =
+      pr_hash_u32(h->prim ^ pr_hash_u32(pr_as_uint(h->uv.x) ^ pr_hash_u32(pr_as_uint(h->uv.y))));
   return (float)(key >> 8) * (1.0f / 16777216.0f) >= alpha;
 }
 
@@ -137,7 +138,8 @@ PR_INLINE int next_event(const SceneData* s, const SurfaceHit* h, const ShadingF
   if (l.type == PR_LIGHT_TRIANGLE) {
     *shadow = spawn_ray_to(h->p, f->ng, ls.pos, ls.normal);
   } else {
-    *shadow = spawn_ray(h->p, f->ng, ls.wi, ls.dist < PR_INF_F ? ls.dist * (1.0f - 1e-4f) : PR_INF_F);
+    *shadow =
+        spawn_ray(h->p, f->ng, ls.wi, ls.dist < PR_INF_F ? ls.dist * (1.0f - 1e-4f) : PR_INF_F);
   }
   return 1;
 }

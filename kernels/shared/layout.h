@@ -17,20 +17,20 @@
   S(BvhNode)                 \
   S(BvhTriangle)             \
   S(BvhTriPacket)            \
-  S(BvhInstance)              \
-  S(Material)                 \
-  S(TextureInfo)              \
-  S(CameraParams)             \
-  S(Light)                    \
-  S(LightNode)                \
-  S(ShadingVertex)            \
-  S(ShadingTriangle)          \
-  S(ShadingInstance)          \
-  S(PathState)                \
-  S(ShadowRay)                \
-  S(PathHeader)               \
-  S(LightVertex)              \
-  S(EyeVertex)                \
+  S(BvhInstance)             \
+  S(Material)                \
+  S(TextureInfo)             \
+  S(CameraParams)            \
+  S(Light)                   \
+  S(LightNode)               \
+  S(ShadingVertex)           \
+  S(ShadingTriangle)         \
+  S(ShadingInstance)         \
+  S(PathState)               \
+  S(ShadowRay)               \
+  S(PathHeader)              \
+  S(LightVertex)             \
+  S(EyeVertex)               \
   S(ReuseParams)
 
 #define PR_SHARED_FIELDS(F)           \

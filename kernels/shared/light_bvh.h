@@ -16,16 +16,16 @@ PR_NAMESPACE_BEGIN
 // 64 bytes. Depth-first order: an interior node's first child is the next node. The lights'
 // box is kept as its bounding sphere, which is all the importance needs.
 typedef struct {
-  float cx, cy, cz;  // centre of the lights' bounding box
-  float power;       // sum of the lights' selection weights
+  float cx, cy, cz;              // centre of the lights' bounding box
+  float power;                   // sum of the lights' selection weights
   float axis_x, axis_y, axis_z;  // the cone holding every emitter's normal (or spot axis)
   u32 index;                     // interior: second child; leaf: the light
-  float cos_o, sin_o;  // cosine and sine of that cone's half angle
-  float cos_e;         // cosine of the angle from a normal beyond which nothing is emitted
-  float r2;            // squared half diagonal of the box
-  u32 flags;           // PR_LIGHT_NODE_*
-  u32 parent;          // PR_INVALID_INDEX at the root
-  float radius;        // half diagonal of the box
+  float cos_o, sin_o;            // cosine and sine of that cone's half angle
+  float cos_e;   // cosine of the angle from a normal beyond which nothing is emitted
+  float r2;      // squared half diagonal of the box
+  u32 flags;     // PR_LIGHT_NODE_*
+  u32 parent;    // PR_INVALID_INDEX at the root
+  float radius;  // half diagonal of the box
   u32 pad;
 } LightNode;
 

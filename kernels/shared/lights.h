@@ -23,8 +23,8 @@ typedef struct {
   u32 inst;             // DSG instance of an emissive triangle, PR_INVALID_INDEX on SSG
   float e2x, e2y, e2z;  // triangle edge v2 - v0
   u32 prim;             // scene triangle of an emissive triangle (SSG index or DSG mesh triangle)
-  float le_r, le_g, le_b;  // radiance factor (triangle), intensity in cd (point, spot), or lux
-  float area;              // world area (triangle)
+  float le_r, le_g, le_b;      // radiance factor (triangle), intensity in cd (point, spot), or lux
+  float area;                  // world area (triangle)
   float cos_inner, cos_outer;  // spot cone
   float power;                 // selection weight by power: light_power()
   u32 material;
@@ -147,8 +147,7 @@ PR_INLINE float2 invert_spherical_triangle(const SphericalTriangle* t, float ome
   cp = cp / lp;
   if (dot(cp, t->a + t->c) < 0.0f) cp = -cp;
   const float triple = fabs(dot(t->a, cross(t->b, cp)));
-  const float part =
-      2.0f * atan2(triple, 1.0f + dot(t->a, t->b) + dot(t->b, cp) + dot(cp, t->a));
+  const float part = 2.0f * atan2(triple, 1.0f + dot(t->a, t->b) + dot(t->b, cp) + dot(cp, t->a));
   const float3 cc = cp - t->b;
   const float den = dot(cc, cc);
   return make_float2(clamp(part / omega, 0.0f, 1.0f),
@@ -326,7 +325,7 @@ PR_INLINE float light_pdf_triangle(float pmf, float3 ref, float3 n_ref, float3 p
 // The light table as kernels see it (built from PR_LIGHT_PARAMS).
 typedef struct {
   PR_GLOBAL const Light* lights;
-  PR_GLOBAL const float* cdf;  // running sum of power; cdf[count - 1] == total_power
+  PR_GLOBAL const float* cdf;        // running sum of power; cdf[count - 1] == total_power
   PR_GLOBAL const LightNode* nodes;  // the light BVH over lights [0, tree_count)
   // Per shading triangle: its light (SSG), or its rank among its mesh's emissive triangles (DSG,
   // added to the instance's first_light); PR_INVALID_INDEX where it is no light.
@@ -380,9 +379,9 @@ PR_INLINE float light_choice_pmf(const LightData* d, u32 light, float3 p, float3
 PR_NAMESPACE_END
 
 #ifdef PR_DEVICE_CODE
-#define PR_LIGHT_PARAMS                                                                        \
-  __global const Light *pr_lights, __global const float *pr_light_cdf,                         \
-      __global const LightNode *pr_light_nodes, __global const uint *pr_prim_light,            \
+#define PR_LIGHT_PARAMS                                                             \
+  __global const Light *pr_lights, __global const float *pr_light_cdf,              \
+      __global const LightNode *pr_light_nodes, __global const uint *pr_prim_light, \
       uint pr_light_count, uint pr_light_tree_count, float pr_total_power
 PR_INLINE LightData pr_light_data(__global const Light* l, __global const float* cdf,
                                   __global const LightNode* nodes, __global const uint* prim_light,
@@ -397,7 +396,7 @@ PR_INLINE LightData pr_light_data(__global const Light* l, __global const float*
   d.total_power = total;
   return d;
 }
-#define PR_LIGHTS()                                                                      \
+#define PR_LIGHTS()                                                                     \
   pr_light_data(pr_lights, pr_light_cdf, pr_light_nodes, pr_prim_light, pr_light_count, \
                 pr_light_tree_count, pr_total_power)
 #endif

@@ -12,7 +12,7 @@ PR_NAMESPACE_BEGIN
 #define PR_MAT_MIRROR 8u       // delta reflection (metallic 1, roughness ~0)
 #define PR_MAT_GLASS 16u       // delta dielectric (KHR_materials_transmission)
 #define PR_MAT_EMISSIVE 32u
-#define PR_MAT_LAMBERT 64u     // shaded as pure Lambert with the base colour (--force-diffuse)
+#define PR_MAT_LAMBERT 64u  // shaded as pure Lambert with the base colour (--force-diffuse)
 
 #define PR_NO_TEXTURE (-1)
 
@@ -23,8 +23,8 @@ typedef struct {
   u32 flags;
   float metallic, roughness, ior, transmission;
   float alpha_cutoff;
-  i32 base_texture;      // index into the texture table, or PR_NO_TEXTURE
-  i32 mr_texture;        // metallicRoughness (G = roughness, B = metallic)
+  i32 base_texture;  // index into the texture table, or PR_NO_TEXTURE
+  i32 mr_texture;    // metallicRoughness (G = roughness, B = metallic)
   i32 emission_texture;
   // KHR_texture_transform of the baseColor texture as a 2x3 matrix: uv' = M * (u, v, 1).
   float uv_m00, uv_m01, uv_m02;
@@ -36,7 +36,7 @@ typedef struct {
 typedef struct {
   u32 offset;  // first texel
   u32 width, height;
-  u32 flags;   // PR_TEX_SRGB
+  u32 flags;  // PR_TEX_SRGB
 } TextureInfo;
 
 #define PR_TEX_SRGB 1u

@@ -11,11 +11,11 @@ typedef struct {
   Ray ray;
   float tp_r, tp_g, tp_b;
   float last_pdf;  // solid-angle pdf of the BSDF sample that made `ray`; 0 after delta/camera
-  u32 depth;    // surface interactions so far
+  u32 depth;       // surface interactions so far
   u32 pixel;
   u32 alive;
-  u32 rng_dim;  // next random dimension of this sample
-  u32 flags;    // PR_PATH_*
+  u32 rng_dim;                      // next random dimension of this sample
+  u32 flags;                        // PR_PATH_*
   float prev_x, prev_y, prev_z;     // the vertex `ray` leaves and its shading normal (for the
   float prev_nx, prev_ny, prev_nz;  // emitter pdf of its hit)
   u32 pad;

@@ -22,25 +22,31 @@ typedef struct {
   float trace_total;
   float scene_radius;
   float mis_threshold;  // connection MIS: strategy E runs where p_E / p_L >= this; 0 = off
-  float cx, cy, cz;  // scene centre
-  u32 resample;      // connections per eye vertex chosen by RIS (1-4); 0 = every candidate
+  float cx, cy, cz;     // scene centre
+  u32 resample;         // connections per eye vertex chosen by RIS (1-4); 0 = every candidate
 } ReuseParams;
 
-// Counters the kernels add to (one atomic add per work-item and counter).
-#define PR_C_LIST 0          // invalid slots listed by invalidate
-#define PR_C_INVALID_RAYS 1  // DSG rays of invalidation
-#define PR_C_LIGHT_RAYS 2
-#define PR_C_CAMERA_RAYS 3
-#define PR_C_SHADOW_RAYS 4   // next-event estimation
-#define PR_C_CONNECT_RAYS 5
-#define PR_C_BOUNCE_RAYS 6   // eye rays after the first hit (delta chains, extensions)
-#define PR_C_SSG_VERTICES 7  // light vertices k >= 1 on static geometry
-#define PR_C_DSG_VERTICES 8
-#define PR_C_CLAMPED 9       // connections whose geometry term was clamped
-#define PR_C_MIS_RAYS 10     // connection rays of strategy E (a subset of PR_C_CONNECT_RAYS)
-#define PR_C_CANDIDATES 11   // connections evaluated (each would cost a ray without resampling)
-#define PR_C_CONNECTED 12    // connection rays found unoccluded
-#define PR_C_COUNT 13
+// Counters the kernels add to (one atomic add per work-item and counter), and where `--stats`
+// reports each: X(NAME, group, "key") adds counter PR_C_NAME, reported as rays.key or
+// counters.key (group rays / counters), or not at all (internal).
+#define PR_REUSE_COUNTERS(X)                                                           \
+  X(LIST, internal, "")                 /* invalid slots listed by invalidate */       \
+  X(INVALID_RAYS, rays, "invalidation") /* DSG rays of invalidation */                 \
+  X(LIGHT_RAYS, rays, "light")                                                         \
+  X(CAMERA_RAYS, rays, "camera")                                                       \
+  X(SHADOW_RAYS, rays, "shadow") /* next-event estimation */                           \
+  X(CONNECT_RAYS, rays, "connection")                                                  \
+  X(BOUNCE_RAYS, rays, "bounce")                  /* eye rays after the first hit */   \
+  X(SSG_VERTICES, counters, "light_vertices_ssg") /* light vertices k >= 1 */          \
+  X(DSG_VERTICES, counters, "light_vertices_dsg")                                      \
+  X(CLAMPED, counters, "connections_clamped")      /* geometry term clamped */         \
+  X(MIS_RAYS, counters, "connections_mis")         /* connection rays of strategy E */ \
+  X(CANDIDATES, counters, "connection_candidates") /* each a ray without resampling */ \
+  X(CONNECTED, counters, "connections_unoccluded")
+
+#define PR_C_ENUM(name, group, key) PR_C_##name,
+enum { PR_REUSE_COUNTERS(PR_C_ENUM) PR_C_COUNT };
+#undef PR_C_ENUM
 
 // The ray of the segment leaving a stored vertex in direction dir: from the exact point for
 // punctual lights (prim == PR_INVALID_INDEX), else offset off the surface along the decoded
@@ -50,8 +56,12 @@ PR_INLINE Ray light_segment_ray(float3 p, u32 ng_oct, u32 prim, float3 dir) {
   return spawn_ray(p, oct_decode(ng_oct), dir, PR_INF_F);
 }
 
-PR_INLINE float3 vertex_pos(PR_GLOBAL const LightVertex* v) { return make_float3(v->px, v->py, v->pz); }
-PR_INLINE float3 vertex_dir(PR_GLOBAL const LightVertex* v) { return make_float3(v->wx, v->wy, v->wz); }
+PR_INLINE float3 vertex_pos(PR_GLOBAL const LightVertex* v) {
+  return make_float3(v->px, v->py, v->pz);
+}
+PR_INLINE float3 vertex_dir(PR_GLOBAL const LightVertex* v) {
+  return make_float3(v->wx, v->wy, v->wz);
+}
 
 // Veach's correction for shading normals on light paths (importance transport), for light that
 // came from direction wo and leaves along wi: |wo.ns| |wi.ng| / (|wo.ng| |wi.ns|).

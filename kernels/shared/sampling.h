@@ -33,7 +33,8 @@ PR_INLINE float3 sample_uniform_sphere(float u1, float u2) {
   return make_float3(r * cos(phi), r * sin(phi), z);
 }
 
-// Uniform direction in a cone around +Z with cos of the half-angle cos_max; pdf = 1/(2pi(1-cos_max)).
+// Uniform direction in a cone around +Z with cos of the half-angle cos_max; pdf =
+// 1/(2pi(1-cos_max)).
 PR_INLINE float3 sample_uniform_cone(float u1, float u2, float cos_max) {
   const float cos_t = 1.0f - u1 * (1.0f - cos_max);
   const float sin_t = sqrt(fmax(0.0f, 1.0f - cos_t * cos_t));
@@ -72,7 +73,9 @@ PR_INLINE float2 sample_triangle(float u1, float u2) {
 }
 
 // Local (tangent-space) vector to world, and back, for an orthonormal frame (t, b, n).
-PR_INLINE float3 to_world(float3 v, float3 t, float3 b, float3 n) { return v.x * t + v.y * b + v.z * n; }
+PR_INLINE float3 to_world(float3 v, float3 t, float3 b, float3 n) {
+  return v.x * t + v.y * b + v.z * n;
+}
 PR_INLINE float3 to_local(float3 v, float3 t, float3 b, float3 n) {
   return make_float3(dot(v, t), dot(v, b), dot(v, n));
 }

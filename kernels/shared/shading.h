@@ -26,8 +26,8 @@ typedef struct {
   float3 ns;  // unit shading normal, on the same side as ng
   float2 uv;
   u32 material;
-  u32 prim;   // shading triangle index
-  u32 inst;   // PR_INVALID_INDEX on the SSG
+  u32 prim;  // shading triangle index
+  u32 inst;  // PR_INVALID_INDEX on the SSG
 } SurfaceHit;
 
 PR_INLINE float3 xform_point12(PR_GLOBAL const float* m, float3 p) {
@@ -133,8 +133,9 @@ PR_CALLABLE float4 texture_sample(const ShadingData* sd, i32 index, float2 uv) {
   const float big = 1048576.0f;
   const int x0 = (int)clamp(x0f, -big, big), y0 = (int)clamp(y0f, -big, big);
   if (t.flags & PR_TEX_NEAREST) {
-    return texel_at(sd, t, wrap_texel((int)clamp(floor(uv.x * (float)t.width), -big, big), (int)t.width, ws),
-                    wrap_texel((int)clamp(floor(uv.y * (float)t.height), -big, big), (int)t.height, wt));
+    return texel_at(
+        sd, t, wrap_texel((int)clamp(floor(uv.x * (float)t.width), -big, big), (int)t.width, ws),
+        wrap_texel((int)clamp(floor(uv.y * (float)t.height), -big, big), (int)t.height, wt));
   }
   const float ax = fx - x0f, ay = fy - y0f;
   const int xa = wrap_texel(x0, (int)t.width, ws), xb = wrap_texel(x0 + 1, (int)t.width, ws);
@@ -204,8 +205,8 @@ PR_INLINE float3 material_emission_factor(const ShadingData* sd, u32 material) {
 PR_NAMESPACE_END
 
 #ifdef PR_DEVICE_CODE
-#define PR_SHADING_PARAMS                                                                       \
-  __global const ShadingVertex *pr_vertices, __global const ShadingTriangle *pr_triangles,     \
+#define PR_SHADING_PARAMS                                                                          \
+  __global const ShadingVertex *pr_vertices, __global const ShadingTriangle *pr_triangles,         \
       __global const ShadingInstance *pr_shading_instances, __global const Material *pr_materials, \
       __global const TextureInfo *pr_textures, __global const uint *pr_texels
 PR_INLINE ShadingData pr_shading_data(__global const ShadingVertex* v,
@@ -221,6 +222,7 @@ PR_INLINE ShadingData pr_shading_data(__global const ShadingVertex* v,
   sd.texels = tl;
   return sd;
 }
-#define PR_SHADING() \
-  pr_shading_data(pr_vertices, pr_triangles, pr_shading_instances, pr_materials, pr_textures, pr_texels)
+#define PR_SHADING()                                                                          \
+  pr_shading_data(pr_vertices, pr_triangles, pr_shading_instances, pr_materials, pr_textures, \
+                  pr_texels)
 #endif

@@ -91,7 +91,8 @@ PR_STATIC_ASSERT(offsetof(pr::dev::Hit, inst) == 16, "Hit layout");
 PR_STATIC_ASSERT(sizeof(pr::dev::BvhNode) == 28 * PR_BVH_WIDTH, "BvhNode layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::BvhNode, child) == 24 * PR_BVH_WIDTH, "BvhNode layout");
 PR_STATIC_ASSERT(sizeof(pr::dev::BvhTriPacket) == 40 * PR_BVH_PACKET, "BvhTriPacket layout");
-PR_STATIC_ASSERT(offsetof(pr::dev::BvhTriPacket, prim) == 36 * PR_BVH_PACKET, "BvhTriPacket layout");
+PR_STATIC_ASSERT(offsetof(pr::dev::BvhTriPacket, prim) == 36 * PR_BVH_PACKET,
+                 "BvhTriPacket layout");
 PR_STATIC_ASSERT(sizeof(pr::dev::BvhTriangle) == 48, "BvhTriangle layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::BvhTriangle, prim) == 12, "BvhTriangle layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::BvhTriangle, e1x) == 16, "BvhTriangle layout");

@@ -8,9 +8,9 @@ __kernel void struct_layout(__global uint* out) {
   uint i = 0;
 #define PR_WRITE_SIZE(T) out[i++] = (uint)sizeof(T);
   PR_SHARED_STRUCTS(PR_WRITE_SIZE)
-#define PR_WRITE_OFFSET(T, m)                                            \
-  {                                                                      \
-    T probe;                                                             \
+#define PR_WRITE_OFFSET(T, m)                                               \
+  {                                                                         \
+    T probe;                                                                \
     out[i++] = (uint)((__private char*)&probe.m - (__private char*)&probe); \
   }
   PR_SHARED_FIELDS(PR_WRITE_OFFSET)

@@ -2,7 +2,8 @@
 // random case per work-item, so that the host can compare every lane with the same helpers
 // compiled as C++ (test/shared_check.h is compiled for both). Each helper is
 // called from two sites, as in the rendering kernels, which is what once made a compiler keep
-// them out of line. Reads the light power table and a light BVH; writes PR_CHECK_STRIDE floats per work-item.
+// them out of line. Reads the light power table and a light BVH; writes PR_CHECK_STRIDE floats per
+// work-item.
 #include "test/shared_check.h"
 
 __kernel void shared_check(__global float* out, uint n, __global const float* cdf, uint cdf_count,

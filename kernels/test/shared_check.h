@@ -28,7 +28,7 @@ PR_INLINE float3 check_unit(Rng* rng) {
 }
 
 PR_INLINE void shared_check_case(u32 i, PR_GLOBAL const float* cdf, u32 cdf_count,
-                                  PR_GLOBAL const LightNode* nodes, u32 node_count, float* r) {
+                                 PR_GLOBAL const LightNode* nodes, u32 node_count, float* r) {
   for (u32 k = 0u; k < PR_CHECK_STRIDE; ++k) r[k] = 0.0f;
   Rng rng = rng_make(7u, PR_RNG_TEST, 0u, i, 0u);
 

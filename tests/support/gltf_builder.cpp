@@ -38,7 +38,8 @@ int GltfBuilder::addMaterial(const MaterialSpec& m) {
   if (m.emissive != glm::vec3(0.0f)) {
     mat["emissiveFactor"] = {m.emissive.r, m.emissive.g, m.emissive.b};
     if (m.emissiveStrength != 1.0f)
-      mat["extensions"]["KHR_materials_emissive_strength"] = {{"emissiveStrength", m.emissiveStrength}};
+      mat["extensions"]["KHR_materials_emissive_strength"] = {
+          {"emissiveStrength", m.emissiveStrength}};
   }
   if (m.transmission > 0.0f) {
     mat["extensions"]["KHR_materials_transmission"] = {{"transmissionFactor", m.transmission}};
@@ -48,13 +49,15 @@ int GltfBuilder::addMaterial(const MaterialSpec& m) {
   return static_cast<int>(materials_.size() - 1);
 }
 
-int GltfBuilder::addMesh(const std::vector<glm::vec3>& positions, const std::vector<uint32_t>& indices,
-                         int material, const std::vector<glm::vec3>& normals) {
+int GltfBuilder::addMesh(const std::vector<glm::vec3>& positions,
+                         const std::vector<uint32_t>& indices, int material,
+                         const std::vector<glm::vec3>& normals) {
   glm::vec3 lo(1e30f), hi(-1e30f);
   for (const auto& p : positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
-  const int pos = addAccessor(positions.data(), positions.size() * 12, 5126, positions.size(), "VEC3",
-                              true, json::array({{lo.x, lo.y, lo.z}, {hi.x, hi.y, hi.z}}));
-  const int idx = addAccessor(indices.data(), indices.size() * 4, 5125, indices.size(), "SCALAR", false);
+  const int pos = addAccessor(positions.data(), positions.size() * 12, 5126, positions.size(),
+                              "VEC3", true, json::array({{lo.x, lo.y, lo.z}, {hi.x, hi.y, hi.z}}));
+  const int idx =
+      addAccessor(indices.data(), indices.size() * 4, 5125, indices.size(), "SCALAR", false);
   json prim = {{"attributes", {{"POSITION", pos}}}, {"indices", idx}, {"material", material}};
   if (!normals.empty())
     prim["attributes"]["NORMAL"] =
@@ -71,9 +74,11 @@ int GltfBuilder::addBox(glm::vec3 lo, glm::vec3 hi, int material, bool inward) {
   std::vector<glm::vec3> p;
   std::vector<uint32_t> idx;
   // Each face: four corners counter-clockwise seen from outside.
-  const glm::vec3 c[8] = {{lo.x, lo.y, lo.z}, {hi.x, lo.y, lo.z}, {hi.x, hi.y, lo.z}, {lo.x, hi.y, lo.z},
-                          {lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z}, {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z}};
-  const int faces[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 4, 7, 3}, {1, 2, 6, 5}, {0, 1, 5, 4}, {3, 7, 6, 2}};
+  const glm::vec3 c[8] = {{lo.x, lo.y, lo.z}, {hi.x, lo.y, lo.z}, {hi.x, hi.y, lo.z},
+                          {lo.x, hi.y, lo.z}, {lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z},
+                          {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z}};
+  const int faces[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 4, 7, 3},
+                           {1, 2, 6, 5}, {0, 1, 5, 4}, {3, 7, 6, 2}};
   for (const auto& f : faces) {
     const uint32_t base = static_cast<uint32_t>(p.size());
     for (int k = 0; k < 4; ++k) p.push_back(c[f[k]]);
@@ -86,7 +91,9 @@ int GltfBuilder::addBox(glm::vec3 lo, glm::vec3 hi, int material, bool inward) {
 }
 
 int GltfBuilder::addNode(int mesh, glm::vec3 t, glm::quat r, glm::vec3 s) {
-  json n = {{"translation", {t.x, t.y, t.z}}, {"rotation", {r.x, r.y, r.z, r.w}}, {"scale", {s.x, s.y, s.z}}};
+  json n = {{"translation", {t.x, t.y, t.z}},
+            {"rotation", {r.x, r.y, r.z, r.w}},
+            {"scale", {s.x, s.y, s.z}}};
   if (mesh >= 0) n["mesh"] = mesh;
   nodes_.push_back(n);
   return static_cast<int>(nodes_.size() - 1);
@@ -108,7 +115,8 @@ int GltfBuilder::addCamera(glm::vec3 eye, glm::vec3 target, float yfov, float as
 }
 
 int GltfBuilder::addPointLight(glm::vec3 position, glm::vec3 color, float intensity) {
-  lights_.push_back({{"type", "point"}, {"color", {color.r, color.g, color.b}}, {"intensity", intensity}});
+  lights_.push_back(
+      {{"type", "point"}, {"color", {color.r, color.g, color.b}}, {"intensity", intensity}});
   nodes_.push_back({{"translation", {position.x, position.y, position.z}},
                     {"extensions", {{"KHR_lights_punctual", {{"light", lights_.size() - 1}}}}}});
   return static_cast<int>(nodes_.size() - 1);
@@ -121,7 +129,8 @@ void GltfBuilder::animateTranslation(int node, const std::vector<float>& times,
   const int out = addAccessor(keys.data(), keys.size() * 12, 5126, keys.size(), "VEC3", false);
   animations_.push_back(
       {{"samplers", json::array({{{"input", in}, {"output", out}, {"interpolation", "LINEAR"}}})},
-       {"channels", json::array({{{"sampler", 0}, {"target", {{"node", node}, {"path", "translation"}}}}})}});
+       {"channels",
+        json::array({{{"sampler", 0}, {"target", {{"node", node}, {"path", "translation"}}}}})}});
 }
 
 std::string GltfBuilder::write(const std::string& dir, const std::string& name) const {

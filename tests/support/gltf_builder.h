@@ -45,8 +45,8 @@ class GltfBuilder {
   std::string write(const std::string& dir, const std::string& name) const;
 
  private:
-  int addAccessor(const void* data, size_t bytes, int componentType, size_t count,
-                  const char* type, bool vertexData, const nlohmann::json& minmax = nullptr);
+  int addAccessor(const void* data, size_t bytes, int componentType, size_t count, const char* type,
+                  bool vertexData, const nlohmann::json& minmax = nullptr);
   std::vector<unsigned char> bin_;
   nlohmann::json accessors_ = nlohmann::json::array(), views_ = nlohmann::json::array(),
                  meshes_ = nlohmann::json::array(), materials_ = nlohmann::json::array(),

@@ -26,11 +26,12 @@ Moments regionMean(const Image& img, int x0, int y0, int x1, int y1, int c) {
   return m;
 }
 
-std::string renderFrames(const std::string& scene, const std::string& frames, const std::string& args,
-                         const std::string& tag) {
+std::string renderFrames(const std::string& scene, const std::string& frames,
+                         const std::string& args, const std::string& tag) {
   const std::string dir = tempDir(tag);
-  const auto r = runPathreuse("render '" + scene + "' --quiet --exr-float --frames " + frames +
-                              " --out '" + dir + "/f_%04d.exr' --stats '" + dir + "/stats.jsonl' " + args);
+  const auto r =
+      runPathreuse("render '" + scene + "' --quiet --exr-float --frames " + frames + " --out '" +
+                   dir + "/f_%04d.exr' --stats '" + dir + "/stats.jsonl' " + args);
   EXPECT_EQ(r.exitCode, 0) << r.err;
   return dir;
 }

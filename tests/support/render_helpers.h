@@ -18,8 +18,8 @@ Moments regionMean(const Image& img, int x0, int y0, int x1, int y1, int c);
 
 // Renders `frames` ("A" or "A-B") of `scene` with extra `args` into a fresh folder; returns
 // the folder. Fails the current test on a non-zero exit.
-std::string renderFrames(const std::string& scene, const std::string& frames, const std::string& args,
-                         const std::string& tag);
+std::string renderFrames(const std::string& scene, const std::string& frames,
+                         const std::string& args, const std::string& tag);
 
 // The float EXR of frame f in a folder made by renderFrames.
 Image frameImage(const std::string& dir, int frame);

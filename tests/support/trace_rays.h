@@ -11,8 +11,8 @@
 namespace pr::test {
 
 struct TracedRays {
-  std::vector<dev::Hit> hits;         // closest hits
-  std::vector<cl_uint> occluded;      // any-hit answers
+  std::vector<dev::Hit> hits;     // closest hits
+  std::vector<cl_uint> occluded;  // any-hit answers
 };
 
 // mode 0: whole scene, 1: SSG only, 2: DSG only.
