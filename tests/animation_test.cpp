@@ -228,6 +228,17 @@ TEST(Animation, TimesMustIncrease) {
   EXPECT_THROW(
       animatedScene("translation", "CUBICSPLINE", {0.0f, 1.0f}, {0, 0, 0, 1, 1, 1}, "VEC3"),
       InputError);
+  // And at least two keys (one key: in-tangent, value, out-tangent, but nothing to span).
+  try {
+    animatedScene("translation", "CUBICSPLINE", {0.0f}, {0, 0, 0, 1, 1, 1, 0, 0, 0}, "VEC3");
+    ADD_FAILURE() << "a one-key CUBICSPLINE sampler loaded";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("CUBICSPLINE needs at least 2 keys, the input has 1"),
+              std::string::npos)
+        << e.what();
+  }
+  // A single LINEAR or STEP key is a constant, which the spec allows.
+  EXPECT_NO_THROW(animatedScene("translation", "LINEAR", {0.0f}, {1, 2, 3}, "VEC3"));
 }
 
 }  // namespace

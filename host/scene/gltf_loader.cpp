@@ -876,6 +876,9 @@ class Loader {
                         : s.interpolation == "CUBICSPLINE" ? Interpolation::CubicSpline
                                                            : Interpolation::Linear;
     const std::vector<double> in = readAccessor(s.input);
+    // The glTF spec (and its validator: ANIMATION_SAMPLER_INPUT_ACCESSOR_TOO_FEW_ELEMENTS).
+    if (out.interpolation == Interpolation::CubicSpline && in.size() < 2)
+      fail("CUBICSPLINE needs at least 2 keys, the input has " + std::to_string(in.size()), where);
     for (size_t i = 0; i < in.size(); ++i) {
       if (!finite(in[i])) fail("input time " + std::to_string(i) + " is not finite", where);
       if (i > 0 && !(float(in[i]) > float(in[i - 1])))
