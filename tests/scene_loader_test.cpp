@@ -289,6 +289,21 @@ TEST(SceneLoader, QuadDefaultsAndComputedNormals) {
   EXPECT_EQ(s.cameras.size(), 1u);  // default
 }
 
+// An optional extension we do not support is named once in a warning; the file still loads.
+TEST(SceneLoader, UnsupportedOptionalExtensionsAreNamedOnce) {
+  Quad q;
+  q.doc["extensionsUsed"] = {"KHR_materials_clearcoat", "KHR_materials_ior", "EXT_foo"};
+  Scene s;
+  ASSERT_EQ(tryLoad(q.write(), &s), "");
+  EXPECT_EQ(s.staticTriangleCount(), 2u);
+  ASSERT_EQ(s.warnings.size(), 2u);
+  EXPECT_NE(s.warnings[0].find("extension KHR_materials_clearcoat is not supported"),
+            std::string::npos)
+      << s.warnings[0];
+  EXPECT_NE(s.warnings[1].find("extension EXT_foo is not supported"), std::string::npos)
+      << s.warnings[1];
+}
+
 TEST(SceneLoader, InstancingAndMirroring) {
   Quad q;
   q.doc["nodes"] = {{{"mesh", 0}, {"translation", {0, 0, 1}}},

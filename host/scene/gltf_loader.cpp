@@ -346,6 +346,10 @@ class Loader {
     for (const std::string& e : model_.extensionsRequired)
       if (!isSupportedExtension(e))
         fail("requires extension " + e + ", which is not supported", "extensionsRequired");
+    // Optional ones: named once each, and rendered without what they add.
+    for (const std::string& e : model_.extensionsUsed)
+      if (!isSupportedExtension(e))
+        warn("extension " + e + " is not supported; what it adds is ignored (extensionsUsed)");
   }
 
   // --- buffers, views, accessors ---------------------------------------------------------------
