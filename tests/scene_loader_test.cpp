@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "render/gpu_scene.h"
 #include "scene/gltf_loader.h"
 #include "support/test_env.h"
 #include "util/error.h"
@@ -359,6 +360,45 @@ TEST(SceneLoader, MaterialsAndExtensions) {
   EXPECT_EQ(s.emissiveTriangleCount(), 2u);
   EXPECT_EQ(s.staticTriangleCount(),
             3u);  // 4 vertices non-indexed: 1 triangle, one vertex left over
+}
+
+// KHR_texture_transform is read on every texture, not only the base colour's, and reaches the
+// device material as one matrix per texture.
+TEST(SceneLoader, TextureTransformOnEveryTexture) {
+  Quad q;
+  q.doc["extensionsUsed"] = {"KHR_texture_transform"};
+  q.doc["images"] = {{{"uri",
+                       "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAIAAAACCAIAAAD91JpzAAAAEkl"
+                       "EQVR4nGP4z8DAAMIM/4EAAB/uBfsL2WiLAAAAAElFTkSuQmCC"}}};
+  q.doc["textures"] = {{{"source", 0}}};
+  const json mrTransform = {{"offset", {0.25, 0.5}}, {"scale", {2.0, 3.0}}};
+  q.doc["materials"] = {
+      {{"pbrMetallicRoughness",
+        {{"metallicRoughnessTexture",
+          {{"index", 0}, {"extensions", {{"KHR_texture_transform", mrTransform}}}}}}},
+       {"emissiveFactor", {1, 1, 1}},
+       {"emissiveTexture",
+        {{"index", 0}, {"extensions", {{"KHR_texture_transform", {{"rotation", 1.5707963}}}}}}}}};
+  q.doc["meshes"][0]["primitives"][0]["material"] = 0;
+  Scene s;
+  ASSERT_EQ(tryLoad(q.write(), &s), "");
+  ASSERT_EQ(s.materials.size(), 1u);
+  const Material& m = s.materials[0];
+  EXPECT_EQ(m.metallicRoughnessTexture.offset, glm::vec2(0.25f, 0.5f));
+  EXPECT_EQ(m.metallicRoughnessTexture.scale, glm::vec2(2.0f, 3.0f));
+  EXPECT_NEAR(m.emissiveTexture.rotation, 1.5707963f, 1e-7f);
+  const dev::Material d = toDeviceMaterial(m);
+  const float mr[6] = {2, 0, 0.25f, 0, 3, 0.5f};
+  for (int k = 0; k < 6; ++k) EXPECT_NEAR(d.mr_uv[k], mr[k], 1e-6f) << k;
+  const float em[6] = {0, 1, 0, -1, 0, 0};
+  for (int k = 0; k < 6; ++k) EXPECT_NEAR(d.emission_uv[k], em[k], 1e-6f) << k;
+  const float id[6] = {1, 0, 0, 0, 1, 0};
+  for (int k = 0; k < 6; ++k) EXPECT_EQ(d.base_uv[k], id[k]) << k;
+  // A broken transform on any texture is refused, naming that texture.
+  q.doc["materials"][0]["emissiveTexture"]["extensions"]["KHR_texture_transform"]["scale"] = {1};
+  const std::string err = tryLoad(q.write("broken.gltf"), &s);
+  EXPECT_NE(err.find("emissiveTexture"), std::string::npos) << err;
+  EXPECT_NE(err.find("scale must be 2 finite numbers"), std::string::npos) << err;
 }
 
 TEST(SceneLoader, TextureTransformMath) {

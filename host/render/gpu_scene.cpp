@@ -85,10 +85,14 @@ dev::Material toDeviceMaterial(const Material& m, bool forceDiffuse) {
   if (forceDiffuse && !(flags & (PR_MAT_GLASS | PR_MAT_MIRROR))) flags |= PR_MAT_LAMBERT;
   d.flags = flags;
   // KHR_texture_transform: uv' = T * R * S * uv with R = [[c, s], [-s, c]].
-  const TextureRef& t = m.baseColorTexture;
-  const float c = std::cos(t.rotation), s = std::sin(t.rotation);
-  d.uv_m00 = c * t.scale.x, d.uv_m01 = s * t.scale.y, d.uv_m02 = t.offset.x;
-  d.uv_m10 = -s * t.scale.x, d.uv_m11 = c * t.scale.y, d.uv_m12 = t.offset.y;
+  auto transform = [](const TextureRef& t, float* out) {
+    const float c = std::cos(t.rotation), s = std::sin(t.rotation);
+    out[0] = c * t.scale.x, out[1] = s * t.scale.y, out[2] = t.offset.x;
+    out[3] = -s * t.scale.x, out[4] = c * t.scale.y, out[5] = t.offset.y;
+  };
+  transform(m.baseColorTexture, d.base_uv);
+  transform(m.metallicRoughnessTexture, d.mr_uv);
+  transform(m.emissiveTexture, d.emission_uv);
   return d;
 }
 

@@ -610,7 +610,17 @@ class Loader {
         if (const Value* s = member(*e, "transmissionFactor"))
           checkFactor(s->IsNumber() ? s->GetNumberAsDouble() : -1.0, 0.0, 1.0,
                       "KHR_materials_transmission transmissionFactor", where);
-      if (const Value* t = extension(pbr.baseColorTexture.extensions, "KHR_texture_transform")) {
+      // KHR_texture_transform on every texture the material uses.
+      const std::pair<const char*, const tinygltf::ExtensionMap*> textures[] = {
+          {"baseColorTexture", &pbr.baseColorTexture.extensions},
+          {"metallicRoughnessTexture", &pbr.metallicRoughnessTexture.extensions},
+          {"emissiveTexture", &m.emissiveTexture.extensions},
+          {"normalTexture", &m.normalTexture.extensions},
+          {"occlusionTexture", &m.occlusionTexture.extensions}};
+      for (const auto& [name, extensions] : textures) {
+        const Value* t = extension(*extensions, "KHR_texture_transform");
+        if (!t) continue;
+        const std::string twhere = where + ", " + name;
         auto arr2 = [&](const char* key) {
           if (const Value* v = member(*t, key)) {
             bool ok = v->IsArray() && v->ArrayLen() == 2;
@@ -618,14 +628,14 @@ class Loader {
               ok = v->Get(k).IsNumber() && finite(v->Get(k).GetNumberAsDouble());
             if (!ok)
               fail(std::string("KHR_texture_transform ") + key + " must be 2 finite numbers",
-                   where);
+                   twhere);
           }
         };
         arr2("offset");
         arr2("scale");
         if (const Value* r = member(*t, "rotation"))
           if (!r->IsNumber() || !finite(r->GetNumberAsDouble()))
-            fail("KHR_texture_transform rotation must be a finite number", where);
+            fail("KHR_texture_transform rotation must be a finite number", twhere);
       }
     }
   }
@@ -1174,22 +1184,16 @@ class Loader {
       const std::string where = named("material", int(i), src.name);
       m.baseColorTexture =
           textureRef(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, true, where);
-      if (const Value* t = extension(pbr.baseColorTexture.extensions, "KHR_texture_transform")) {
-        if (const Value* v = member(*t, "offset"))
-          m.baseColorTexture.offset =
-              glm::vec2(v->Get(0).GetNumberAsDouble(), v->Get(1).GetNumberAsDouble());
-        if (const Value* v = member(*t, "scale"))
-          m.baseColorTexture.scale =
-              glm::vec2(v->Get(0).GetNumberAsDouble(), v->Get(1).GetNumberAsDouble());
-        if (const Value* v = member(*t, "rotation"))
-          m.baseColorTexture.rotation = float(v->GetNumberAsDouble());
-      }
+      readTransform(pbr.baseColorTexture.extensions, &m.baseColorTexture);
       m.metallicRoughnessTexture = textureRef(pbr.metallicRoughnessTexture.index,
                                               pbr.metallicRoughnessTexture.texCoord, false, where);
+      readTransform(pbr.metallicRoughnessTexture.extensions, &m.metallicRoughnessTexture);
       m.emissiveTexture =
           textureRef(src.emissiveTexture.index, src.emissiveTexture.texCoord, true, where);
+      readTransform(src.emissiveTexture.extensions, &m.emissiveTexture);
       m.normalTexture =
           textureRef(src.normalTexture.index, src.normalTexture.texCoord, false, where);
+      readTransform(src.normalTexture.extensions, &m.normalTexture);
       if (const Value* e = extension(src.extensions, "KHR_materials_emissive_strength"))
         if (const Value* s = member(*e, "emissiveStrength"))
           m.emissiveStrength = float(s->GetNumberAsDouble());
@@ -1200,6 +1204,17 @@ class Loader {
         if (const Value* s = member(*e, "ior")) m.ior = float(s->GetNumberAsDouble());
       scene_.materials.push_back(m);
     }
+  }
+
+  // A texture's KHR_texture_transform (validated in checkMaterials), if it has one.
+  void readTransform(const tinygltf::ExtensionMap& extensions, TextureRef* ref) {
+    const Value* t = extension(extensions, "KHR_texture_transform");
+    if (!t) return;
+    if (const Value* v = member(*t, "offset"))
+      ref->offset = glm::vec2(v->Get(0).GetNumberAsDouble(), v->Get(1).GetNumberAsDouble());
+    if (const Value* v = member(*t, "scale"))
+      ref->scale = glm::vec2(v->Get(0).GetNumberAsDouble(), v->Get(1).GetNumberAsDouble());
+    if (const Value* v = member(*t, "rotation")) ref->rotation = float(v->GetNumberAsDouble());
   }
 
   // A scene texture for (glTF texture, colour space), decoded once.

@@ -62,8 +62,9 @@
   F(Material, flags)                  \
   F(Material, alpha_cutoff)           \
   F(Material, emission_texture)       \
-  F(Material, uv_m00)                 \
-  F(Material, uv_m12)                 \
+  F(Material, base_uv)                \
+  F(Material, mr_uv)                  \
+  F(Material, emission_uv)            \
   F(TextureInfo, flags)               \
   F(CameraParams, fx)                 \
   F(CameraParams, aspect)             \

@@ -26,9 +26,10 @@ typedef struct {
   i32 base_texture;  // index into the texture table, or PR_NO_TEXTURE
   i32 mr_texture;    // metallicRoughness (G = roughness, B = metallic)
   i32 emission_texture;
-  // KHR_texture_transform of the baseColor texture as a 2x3 matrix: uv' = M * (u, v, 1).
-  float uv_m00, uv_m01, uv_m02;
-  float uv_m10, uv_m11, uv_m12;
+  // KHR_texture_transform of each texture as a 2x3 matrix, rows first: uv' = M * (u, v, 1).
+  float base_uv[6];
+  float mr_uv[6];
+  float emission_uv[6];
   float pad0, pad1;
 } Material;
 
@@ -47,8 +48,9 @@ typedef struct {
 
 PR_NAMESPACE_END
 
-PR_STATIC_ASSERT(sizeof(pr::dev::Material) == 96, "Material layout");
+PR_STATIC_ASSERT(sizeof(pr::dev::Material) == 144, "Material layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::Material, flags) == 28, "Material layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::Material, alpha_cutoff) == 48, "Material layout");
-PR_STATIC_ASSERT(offsetof(pr::dev::Material, uv_m00) == 64, "Material layout");
+PR_STATIC_ASSERT(offsetof(pr::dev::Material, base_uv) == 64, "Material layout");
+PR_STATIC_ASSERT(offsetof(pr::dev::Material, emission_uv) == 112, "Material layout");
 PR_STATIC_ASSERT(sizeof(pr::dev::TextureInfo) == 16, "TextureInfo layout");

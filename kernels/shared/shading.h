@@ -145,9 +145,9 @@ PR_CALLABLE float4 texture_sample(const ShadingData* sd, i32 index, float2 uv) {
   return (c00 * (1.0f - ax) + c10 * ax) * (1.0f - ay) + (c01 * (1.0f - ax) + c11 * ax) * ay;
 }
 
-PR_INLINE float2 material_base_uv(PR_GLOBAL const Material* m, float2 uv) {
-  return make_float2(m->uv_m00 * uv.x + m->uv_m01 * uv.y + m->uv_m02,
-                     m->uv_m10 * uv.x + m->uv_m11 * uv.y + m->uv_m12);
+// A texture's coordinates under its KHR_texture_transform matrix m (2x3, rows first).
+PR_INLINE float2 texture_uv(PR_GLOBAL const float* m, float2 uv) {
+  return make_float2(m[0] * uv.x + m[1] * uv.y + m[2], m[3] * uv.x + m[4] * uv.y + m[5]);
 }
 
 // Base colour (rgb) and alpha at the surface.
@@ -155,7 +155,7 @@ PR_INLINE float4 material_base(const ShadingData* sd, const SurfaceHit* s) {
   PR_GLOBAL const Material* m = sd->materials + s->material;
   float4 c = make_float4(m->base_r, m->base_g, m->base_b, m->base_a);
   if (m->base_texture != PR_NO_TEXTURE) {
-    const float4 t = texture_sample(sd, m->base_texture, material_base_uv(m, s->uv));
+    const float4 t = texture_sample(sd, m->base_texture, texture_uv(m->base_uv, s->uv));
     c = make_float4(c.x * t.x, c.y * t.y, c.z * t.z, c.w * t.w);
   }
   return c;
@@ -168,7 +168,7 @@ PR_INLINE BsdfParams material_bsdf(const ShadingData* sd, const SurfaceHit* s) {
   p.base = make_float3(base.x, base.y, base.z);
   float metallic = m->metallic, roughness = m->roughness;
   if (m->mr_texture != PR_NO_TEXTURE) {
-    const float4 t = texture_sample(sd, m->mr_texture, s->uv);
+    const float4 t = texture_sample(sd, m->mr_texture, texture_uv(m->mr_uv, s->uv));
     roughness *= t.y;
     metallic *= t.z;
   }
@@ -191,7 +191,7 @@ PR_INLINE float3 material_emission(const ShadingData* sd, const SurfaceHit* s) {
   PR_GLOBAL const Material* m = sd->materials + s->material;
   float3 e = make_float3(m->emit_r, m->emit_g, m->emit_b);
   if (m->emission_texture != PR_NO_TEXTURE) {
-    const float4 t = texture_sample(sd, m->emission_texture, s->uv);
+    const float4 t = texture_sample(sd, m->emission_texture, texture_uv(m->emission_uv, s->uv));
     e = e * make_float3(t.x, t.y, t.z);
   }
   return e;
