@@ -10,11 +10,8 @@ __kernel void pt_generate(CameraParams cam, uint seed, uint frame, uint sample,
   const uint i = (uint)get_global_id(0);
   if (i >= count) return;
   Rng rng = rng_make(seed, PR_RNG_CAMERA, frame, i, sample);
-  const float2 j = rng_next2(&rng);
-  const uint x = i % cam.width, y = i / cam.width;
-  const float3 d = camera_direction(&cam, (float)x + j.x, (float)y + j.y);
   PathState s;
-  s.ray = make_ray(camera_position(&cam), d, 0.0f, PR_INF_F);
+  s.ray = camera_ray(&cam, i, rng_next2(&rng));
   s.tp_r = s.tp_g = s.tp_b = 1.0f;
   s.last_pdf = 0.0f;
   s.depth = 0u;

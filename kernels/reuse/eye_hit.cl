@@ -11,10 +11,8 @@ __kernel void eye_hit(PR_SCENE_PARAMS, ReuseParams rp, CameraParams cam, uint sa
   if (i >= rp.pixel_count) return;
   const SceneData s = PR_SCENE();
   Rng rng = rng_make(rp.seed, PR_RNG_CAMERA, rp.frame, i, sample);
-  const float2 j = rng_next2(&rng);
-  const uint x = i % cam.width, y = i / cam.width;
-  float3 d = camera_direction(&cam, (float)x + j.x, (float)y + j.y);
-  Ray ray = make_ray(camera_position(&cam), d, 0.0f, PR_INF_F);
+  Ray ray = camera_ray(&cam, i, rng_next2(&rng));
+  float3 d = make_float3(ray.dx, ray.dy, ray.dz);
   float3 tp = make_float3(1.0f, 1.0f, 1.0f), L = make_float3(0.0f, 0.0f, 0.0f);
   EyeVertex e;
   e.prim = PR_INVALID_INDEX;

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "shared/math.h"
+#include "shared/types.h"
 
 PR_NAMESPACE_BEGIN
 
@@ -25,6 +26,17 @@ PR_INLINE float3 camera_direction(const CameraParams* c, float sx, float sy) {
 
 PR_INLINE float3 camera_position(const CameraParams* c) {
   return make_float3(c->px, c->py, c->pz);
+}
+
+// The camera ray of pixel `pixel` (row-major) through its point offset by `jitter` in [0, 1)^2:
+// the one generator of camera rays, for every mode.
+PR_INLINE Ray camera_ray(const CameraParams* c, u32 pixel, float2 jitter) {
+  const u32 x = pixel % c->width, y = pixel / c->width;
+  const float3 d = camera_direction(c, (float)x + jitter.x, (float)y + jitter.y);
+  Ray r;
+  r.ox = c->px, r.oy = c->py, r.oz = c->pz, r.tmin = 0.0f;
+  r.dx = d.x, r.dy = d.y, r.dz = d.z, r.tmax = PR_INF_F;
+  return r;
 }
 
 PR_NAMESPACE_END
