@@ -291,10 +291,7 @@ class Collapser {
     if (!isLeaf(root)) {
       fill(node, 0);
     } else if ((root.meta & ~PR_BVH_LEAF_BIT) > 0) {
-      const float bounds[6] = {root.lo_x, root.hi_x, root.lo_y, root.hi_y, root.lo_z, root.hi_z};
-      for (int i = 0; i < 6; ++i) store(wideBound(w_, node, i, 0), bounds[i]);
-      out_.words[wideChild(w_, node, 0)] = PR_BVH_LEAF_BIT;
-      out_.leaves.push_back(root);
+      setChild(node, 0, root, addLeaf(root));
     }
     out_.stackNeed = need(0);
     return std::move(out_);
@@ -320,6 +317,19 @@ class Collapser {
 
   void store(size_t word, float f) { std::memcpy(&out_.words[word], &f, 4); }
 
+  // The reference of a new leaf: the next entry of out_.leaves.
+  uint32_t addLeaf(const BinaryNode& n) {
+    out_.leaves.push_back(n);
+    return PR_BVH_LEAF_BIT | uint32_t(out_.leaves.size() - 1);
+  }
+
+  // Slot i of wide node `node`: binary node n's box and reference ref.
+  void setChild(uint32_t node, int i, const BinaryNode& n, uint32_t ref) {
+    const float bounds[6] = {n.lo_x, n.hi_x, n.lo_y, n.hi_y, n.lo_z, n.hi_z};
+    for (int b = 0; b < 6; ++b) store(wideBound(w_, node, b, i), bounds[b]);
+    out_.words[wideChild(w_, node, i)] = ref;
+  }
+
   // Fills wide node `node` with the children gathered under interior binary node b. The wide
   // children are allocated side by side before any of them is filled (siblings share cache
   // lines and pages, which measured faster than depth-first order), and so are the leaves.
@@ -339,15 +349,8 @@ class Collapser {
     std::vector<uint32_t> refs(kids.size());
     for (size_t k = 0; k < kids.size(); ++k) {
       const BinaryNode& n = nodes_[kids[k]];
-      if (isLeaf(n)) {
-        refs[k] = PR_BVH_LEAF_BIT | uint32_t(out_.leaves.size());
-        out_.leaves.push_back(n);
-      } else {
-        refs[k] = allocate();
-      }
-      const float bounds[6] = {n.lo_x, n.hi_x, n.lo_y, n.hi_y, n.lo_z, n.hi_z};
-      for (int i = 0; i < 6; ++i) store(wideBound(w_, node, i, int(k)), bounds[i]);
-      out_.words[wideChild(w_, node, int(k))] = refs[k];
+      refs[k] = isLeaf(n) ? addLeaf(n) : allocate();
+      setChild(node, int(k), n, refs[k]);
     }
     for (size_t k = 0; k < kids.size(); ++k)
       if (!(refs[k] & PR_BVH_LEAF_BIT)) fill(refs[k], kids[k]);

@@ -56,6 +56,7 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
   rp.frame = settings_.fixedNoise ? 0u : static_cast<uint32_t>(frame);  // RNG key only
   rp.clamp = settings_.clamp;
   rp.mis_threshold = settings_.misThreshold;
+  PR_CHECK(settings_.resample <= PR_MAX_CONNECTIONS);  // the CLI allows 1-4
   rp.resample = settings_.resample;
   rp.trace_total = scene_.traceTotalPower();
   rp.scene_radius = scene_.sceneRadius();

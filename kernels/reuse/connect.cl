@@ -18,18 +18,18 @@
 // stays unbiased. E needs y_{k-1} to be connectable: not a delta surface, nor a spot or
 // directional light's vertex 0 (left to L alone).
 //
-// Resampled connections (rp.resample = 1). Every connection above (both strategies, all the
-// light vertices of the C paths) is a candidate with an unshadowed contribution c_i, found
-// without a ray. One candidate per eye vertex is kept by weighted reservoir sampling with
-// weights luminance(c_i) (resampled importance sampling, Talbot 2005), and only it is traced:
-// it counts c_k * (sum of weights) / weight_k when unoccluded, an unbiased estimate of the sum
-// of all candidates' shadowed contributions, for one shadow ray instead of one per candidate.
-// The reservoir's draws come from a stream of their own, so the path's draws stay in place.
+// Resampled connections (rp.resample = K, 1 to PR_MAX_CONNECTIONS). Every connection above
+// (both strategies, all the light vertices of the C paths) is a candidate with an unshadowed
+// contribution c_i, found without a ray. K candidates per eye vertex are kept by weighted
+// reservoir sampling with weights luminance(c_i) (resampled importance sampling, Talbot 2005),
+// and only they are traced: each counts c_k * (sum of weights) / (weight_k K) when unoccluded,
+// an unbiased estimate of the sum of all candidates' shadowed contributions, for K shadow rays
+// instead of one per candidate. The reservoir's draws come from a stream of their own, so the
+// path's draws stay in place.
 #include "shared/reuse.h"
 
 // The connections kept so far among an eye vertex's candidates: rp.resample of them, each
 // chosen independently among all (with replacement), sharing the sum of the weights.
-#define PR_MAX_CONNECTIONS 4
 typedef struct {
   Ray ray[PR_MAX_CONNECTIONS];
   float c[3 * PR_MAX_CONNECTIONS];  // unshadowed contributions
@@ -55,7 +55,6 @@ PR_INLINE float3 connection(const SceneData* s, const ReuseParams* rp, Reservoir
                             float3 c, Ray ray, u32 mis, ConnectCounts* n) {
   ++n->candidates;
   if (rp->resample > 0u) {
-    PR_KCHECK(rp->resample <= PR_MAX_CONNECTIONS);
     const float w = luminance(c);
     if (w > 0.0f) {
       res->w_sum += w;

@@ -93,7 +93,6 @@ PR_INLINE float bvh_max(float a, float b) {
 // bvh_bits(m): bit i set where lane i of the comparison mask m is true.
 #if PR_BVH_WIDTH == 2
 typedef float2 bvh_fw;
-typedef int2 bvh_iw;
 #define bvh_loadw(p) vload2(0, p)
 #define bvh_storew(v, p) vstore2(v, 0, p)
 PR_INLINE u32 bvh_bits(int2 m) {
@@ -102,7 +101,6 @@ PR_INLINE u32 bvh_bits(int2 m) {
 }
 #elif PR_BVH_WIDTH == 4
 typedef float4 bvh_fw;
-typedef int4 bvh_iw;
 #define bvh_loadw(p) vload4(0, p)
 #define bvh_storew(v, p) vstore4(v, 0, p)
 PR_INLINE u32 bvh_bits(int4 m) {
@@ -112,7 +110,6 @@ PR_INLINE u32 bvh_bits(int4 m) {
 }
 #elif PR_BVH_WIDTH == 8
 typedef float8 bvh_fw;
-typedef int8 bvh_iw;
 #define bvh_loadw(p) vload8(0, p)
 #define bvh_storew(v, p) vstore8(v, 0, p)
 PR_INLINE u32 bvh_bits(int8 m) {
@@ -221,13 +218,13 @@ PR_INLINE int intersect_packet(PR_GLOBAL const BvhTriPacket* p, const BvhRay* r,
   const int4 ok = (det != 0.0f) & (uu >= 0.0f) & (uu <= 1.0f) & (vv >= 0.0f) & (uu + vv <= 1.0f) &
                   (tt > r->tmin) & (tt < r->tmax);
   if (!any(ok)) return -1;
-  float ta[4], ua[4], va[4];
+  float ta[PR_BVH_PACKET], ua[PR_BVH_PACKET], va[PR_BVH_PACKET];
   vstore4(select((float4)(PR_INF_F), tt, ok), 0, ta);
   vstore4(uu, 0, ua);
   vstore4(vv, 0, va);
   int lane = -1;
   float best = r->tmax;
-  for (int i = 0; i < 4; ++i) {
+  for (int i = 0; i < PR_BVH_PACKET; ++i) {
     if (ta[i] < best) {
       best = ta[i];
       lane = i;

@@ -23,8 +23,12 @@ typedef struct {
   float scene_radius;
   float mis_threshold;  // connection MIS: strategy E runs where p_E / p_L >= this; 0 = off
   float cx, cy, cz;     // scene centre
-  u32 resample;         // connections per eye vertex chosen by RIS (1-4); 0 = every candidate
+  u32 resample;         // RIS-chosen connections per eye vertex, at most PR_MAX_CONNECTIONS;
+                        // 0 = every candidate
 } ReuseParams;
+
+// Most resampled connections per eye vertex (ReuseParams.resample; reservoir slots in connect).
+#define PR_MAX_CONNECTIONS 4
 
 // Counters the kernels add to (one atomic add per work-item and counter), and where `--stats`
 // reports each: X(NAME, group, "key") adds counter PR_C_NAME, reported as rays.key or
