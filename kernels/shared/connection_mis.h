@@ -1,0 +1,31 @@
+// The MIS weights of the reuse connections (docs/design.md section 5), shared by the connect
+// kernel and the host's unit tests, which check that the strategies' weights add to 1.
+#pragma once
+
+#include "shared/common.h"
+
+PR_NAMESPACE_BEGIN
+
+// The two strategies that find a connected path x - Y - y_{k-1} - ...: the light tracer stepped
+// to Y and x connects to it (L), or x's BSDF sample found Y and Y connects to y_{k-1} (E).
+#define PR_STRATEGY_L 0u
+#define PR_STRATEGY_E 1u
+
+// The pdf per unit area at a point at squared distance dist2 whose normal makes |cosine| cos_t
+// with the direction sampled with solid-angle pdf pdf_w.
+PR_INLINE float solid_angle_to_area_pdf(float pdf_w, float cos_t, float dist2) {
+  return pdf_w * cos_t / dist2;
+}
+
+// The weight of `strategy` for a path whose area pdfs of Y are p_l under L and p_e under E:
+// the power heuristic on r = p_e / p_l where r >= threshold, and L alone below it, so that E
+// costs shadow rays only near the 1/d^2 singularity where L's variance is unbounded. E cannot
+// make the path: pass p_e = 0 (r = 0, or NaN where p_l = 0 too: L alone either way). L cannot
+// (p_l = 0 < p_e): r = inf, E alone. threshold 0 turns E off. The weights add to 1 always.
+PR_INLINE float connection_mis_weight(u32 strategy, float p_l, float p_e, float threshold) {
+  const float r = p_e / p_l;
+  const float w_l = (threshold > 0.0f && r >= threshold) ? 1.0f / (1.0f + r * r) : 1.0f;
+  return strategy == PR_STRATEGY_L ? w_l : 1.0f - w_l;
+}
+
+PR_NAMESPACE_END
