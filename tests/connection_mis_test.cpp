@@ -26,8 +26,8 @@ float weightE(float pl, float pe, float t) {
 TEST(ConnectionMis, WeightsAddToOneForEveryPath) {
   const float inf = std::numeric_limits<float>::infinity();
   const float nan = std::numeric_limits<float>::quiet_NaN();
-  std::vector<float> pdfs = {0.0f, 1e-30f, 1e-6f, 0.5f, 1.0f, 3.999f, 4.0f, 7.0f, 1e6f, 1e30f,
-                             inf,  nan};
+  std::vector<float> pdfs = {0.0f, 1e-30f, 1e-6f, 0.5f,  1.0f, 3.999f,
+                             4.0f, 7.0f,   1e6f,  1e30f, inf,  nan};
   std::mt19937 gen(7);
   std::uniform_real_distribution<float> logu(-20.0f, 20.0f);
   for (int i = 0; i < 200; ++i) pdfs.push_back(std::exp(logu(gen)));
@@ -82,7 +82,7 @@ TEST(ConnectionMis, ThresholdedWeightsKeepAnEstimatorUnbiased) {
   const int n = 400000;
   double sum = 0.0, sum2 = 0.0;
   for (int i = 0; i < n; ++i) {
-    const double xl = 1.0 - u(gen);            // p_l = 1
+    const double xl = 1.0 - u(gen);             // p_l = 1
     const double xe = std::sqrt(1.0 - u(gen));  // p_e = 2x
     const auto f = [](double x) { return x * x + 0.1; };
     const double est = weightL(1.0f, float(2.0 * xl), t) * f(xl) +

@@ -7,6 +7,7 @@ lanterns), and three moving objects.
   python3 tools/gen_atrium.py --size 1 --out /tmp/atrium/atrium.gltf   # ~300k triangles
   python3 tools/gen_atrium.py --size 0.1 --out /tmp/atrium-small.gltf  # quick test scene
   python3 tools/gen_atrium.py --light lanterns --out /tmp/atrium-lanterns/atrium.gltf
+  python3 tools/gen_atrium.py --normal-maps --out /tmp/atrium-tiles/atrium.gltf  # bevelled tiles
 
 --size scales the tessellation (triangles grow about linearly with it); the layout, the
 cameras and the lanterns do not change. --light picks the lighting:
@@ -164,9 +165,27 @@ def bays():
     return out
 
 
-def build_static(c):
-    """Returns {material name: Mesh} of everything that does not move."""
+def tile_normal_map(size=64, bevel=0.06, depth=0.03):
+    """PNG of a tangent-space normal map: one square tile per uv unit, its edges bevelled
+    (slope depth / bevel) down to a groove."""
+    def height(x, y):
+        d = min(x, 1.0 - x, y, 1.0 - y)
+        return depth * min(1.0, d / bevel)
+
+    def pixel(i, j):
+        x, y, e = (i + 0.5) / size, (j + 0.5) / size, 0.5 / size
+        dx = (height(x + e, y) - height(x - e, y)) / (2 * e)
+        dy = (height(x, y + e) - height(x, y - e)) / (2 * e)
+        n = gw.normalize((-dx, -dy, 1.0))
+        return tuple(int(round((c * 0.5 + 0.5) * 255)) for c in n)
+    return gw.png_rgb(size, size, pixel)
+
+
+def build_static(c, normal_maps=False):
+    """Returns {material name: Mesh} of everything that does not move. With normal_maps the
+    courtyard tiles are meshes of their own, with uvs of one unit per tile."""
     stone, dark, plaster = gw.Mesh(), gw.Mesh(), gw.Mesh()
+    tiles = (gw.Mesh(), gw.Mesh()) if normal_maps else (stone, dark)
     cloths = [gw.Mesh(), gw.Mesh(), gw.Mesh()]
     for level, (floor_y, col_top, arcade_top) in enumerate(STOREYS):
         shaft = column(col_top - floor_y - PLINTH_H, c)
@@ -193,7 +212,11 @@ def build_static(c):
     for i in range(tx):
         for j in range(tz):
             tile = gw.quad((-IN_X + wx * i, 0.0, -IN_Z + wz * (j + 1)), (wx, 0, 0), (0, 0, -wz))
-            (stone if (i + j) % 2 else dark).add(tile)
+            if normal_maps:
+                p = tile.pos
+                tile.uv = [f for k in range(0, len(p), 3)
+                           for f in ((p[k] + IN_X) / wx - i, (p[k + 2] + IN_Z) / wz - j)]
+            tiles[0 if (i + j) % 2 else 1].add(tile)
 
     # outer walls, closing the building up to the roof
     y0, y1, t = -0.2, ROOF_TOP, WALL_T
@@ -214,8 +237,11 @@ def build_static(c):
         # local +z faces the courtyard
         cloths[k % 3].add(cl, rotation=gw.quat_axis_angle((0, 1, 0), yaw), translation=(x, 0, zz))
         k += 1
-    return {"stone": stone, "dark_stone": dark, "plaster": plaster, "cloth_red": cloths[0],
-            "cloth_green": cloths[1], "cloth_blue": cloths[2]}
+    out = {"stone": stone, "dark_stone": dark, "plaster": plaster, "cloth_red": cloths[0],
+           "cloth_green": cloths[1], "cloth_blue": cloths[2]}
+    if normal_maps:
+        out["stone_tiles"], out["dark_tiles"] = tiles
+    return out
 
 
 # ---------------------------------------------------------------- moving parts
@@ -499,10 +525,11 @@ def punctual_light(g, name, kind, color, intensity, cone=None):
     return len(ext["lights"]) - 1
 
 
-def build(size, light):
+def build(size, light, normal_maps=False):
     c = counts(size)
     g = gw.Gltf("pathreuse tools/gen_atrium.py --size %g" % size
-                + (" --light lanterns" if light == "lanterns" else ""))
+                + (" --light lanterns" if light == "lanterns" else "")
+                + (" --normal-maps" if normal_maps else ""))
     mats = {
         "stone": g.material("stone", (0.62, 0.58, 0.5), roughness=0.9),
         "dark_stone": g.material("dark_stone", (0.32, 0.3, 0.27), roughness=0.8),
@@ -511,8 +538,14 @@ def build(size, light):
         "cloth_green": g.material("cloth_green", (0.1, 0.35, 0.12), double_sided=True),
         "cloth_blue": g.material("cloth_blue", (0.1, 0.15, 0.45), double_sided=True),
     }
+    if normal_maps:
+        bumps = g.png_texture("tile_normals", tile_normal_map())
+        mats["stone_tiles"] = g.material("stone_tiles", (0.62, 0.58, 0.5), roughness=0.9,
+                                         normal_texture=bumps)
+        mats["dark_tiles"] = g.material("dark_tiles", (0.32, 0.3, 0.27), roughness=0.8,
+                                        normal_texture=bumps)
     emitters = 0
-    static = build_static(c)
+    static = build_static(c, normal_maps)
     roots = [g.node("atrium", mesh=g.mesh("atrium", [(static[k], mats[k]) for k in mats]))]
 
     if light == "sky":
@@ -577,12 +610,14 @@ def main():
     ap.add_argument("--light", choices=("sky", "sun", "lanterns"), default="sky",
                     help="emissive sky quad over the opening (default), a KHR_lights_punctual "
                     "sun, or night lit by several hundred small emissive lanterns")
+    ap.add_argument("--normal-maps", action="store_true",
+                    help="bevelled courtyard tiles: a normal map (and uvs) on the floor tiles")
     args = ap.parse_args()
     if not args.size > 0:
         ap.error("--size must be positive")
     start = time.time()
     try:
-        g, roots, emitters = build(args.size, args.light)
+        g, roots, emitters = build(args.size, args.light, args.normal_maps)
         os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
         g.write(args.out, roots, embedded=False)
         s = gw.validate(args.out)

@@ -12,6 +12,7 @@ import math
 import os
 import re
 import struct
+import zlib
 
 FLOAT, USHORT, UINT = 5126, 5123, 5125
 ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER = 34962, 34963
@@ -95,12 +96,13 @@ def mat_vec(m, v):
 # ---------------------------------------------------------------- meshes
 
 class Mesh:
-    """Indexed triangles with per-vertex normals, as flat lists."""
+    """Indexed triangles with per-vertex normals (and uvs, where set), as flat lists."""
 
     def __init__(self):
         self.pos = []
         self.nrm = []
         self.idx = []
+        self.uv = []  # empty, or 2 per vertex
 
     @property
     def vertex_count(self):
@@ -113,6 +115,10 @@ class Mesh:
     def add(self, other, rotation=None, translation=(0.0, 0.0, 0.0)):
         """Appends `other`, optionally moved rigidly (rotation is a quaternion)."""
         base = self.vertex_count
+        if other.uv or self.uv:
+            if not self.uv:
+                self.uv = [0.0] * (2 * base)
+            self.uv += other.uv if other.uv else [0.0] * (2 * other.vertex_count)
         m = quat_to_matrix(rotation) if rotation else None
         tx, ty, tz = translation
         p, n = other.pos, other.nrm
@@ -279,8 +285,21 @@ class Gltf:
             acc["max"] = [conv(max(c)) for c in cols]
         return self._append("accessors", acc)
 
+    def png_texture(self, name, png):
+        """A texture (repeating, linear filtering) of PNG bytes stored in the buffer."""
+        while len(self.bin) % 4:
+            self.bin.append(0)
+        view = self._append("bufferViews", {"buffer": 0, "byteOffset": len(self.bin),
+                                            "byteLength": len(png)})
+        self.bin += png
+        image = self._append("images", {"name": name, "bufferView": view,
+                                        "mimeType": "image/png"})
+        if "samplers" not in self.doc:
+            self._append("samplers", {"magFilter": 9729, "minFilter": 9729})
+        return self._append("textures", {"name": name, "sampler": 0, "source": image})
+
     def material(self, name, base, metallic=0.0, roughness=1.0, emissive=None,
-                 strength=None, double_sided=False):
+                 strength=None, double_sided=False, normal_texture=None):
         mat = {"name": name, "pbrMetallicRoughness": {
             "baseColorFactor": list(base) + [1.0] if len(base) == 3 else list(base),
             "metallicFactor": metallic, "roughnessFactor": roughness}}
@@ -292,6 +311,8 @@ class Gltf:
             self.extensions.add("KHR_materials_emissive_strength")
         if double_sided:
             mat["doubleSided"] = True
+        if normal_texture is not None:
+            mat["normalTexture"] = {"index": normal_texture}
         return self._append("materials", mat)
 
     def mesh(self, name, primitives):
@@ -302,8 +323,10 @@ class Gltf:
             nrm = self.accessor(m.nrm, FLOAT, "VEC3", ARRAY_BUFFER)
             ctype = USHORT if m.vertex_count <= 65535 else UINT
             idx = self.accessor(m.idx, ctype, "SCALAR", ELEMENT_ARRAY_BUFFER)
-            prims.append({"attributes": {"POSITION": pos, "NORMAL": nrm},
-                          "indices": idx, "material": mat, "mode": 4})
+            attrs = {"POSITION": pos, "NORMAL": nrm}
+            if m.uv:
+                attrs["TEXCOORD_0"] = self.accessor(m.uv, FLOAT, "VEC2", ARRAY_BUFFER)
+            prims.append({"attributes": attrs, "indices": idx, "material": mat, "mode": 4})
         return self._append("meshes", {"name": name, "primitives": prims})
 
     def node(self, name, mesh=None, camera=None, translation=None, rotation=None,
@@ -367,7 +390,8 @@ class Gltf:
         if self.extensions:
             self.doc["extensionsUsed"] = sorted(self.extensions)
         order = ["asset", "extensionsUsed", "extensions", "scene", "scenes", "nodes",
-                 "cameras", "meshes", "materials", "animations", "accessors",
+                 "cameras", "meshes", "materials", "textures", "images", "samplers",
+                 "animations", "accessors",
                  "bufferViews", "buffers"]
         return {k: self.doc[k] for k in order if k in self.doc}
 
@@ -387,6 +411,19 @@ class Gltf:
         if not embedded:
             with open(os.path.join(os.path.dirname(path) or ".", uri), "wb") as fh:
                 fh.write(self.bin)
+
+
+def png_rgb(width, height, pixel):
+    """PNG bytes of an 8-bit RGB image; pixel(x, y) gives (r, g, b), each 0-255."""
+    raw = b"".join(b"\x00" + bytes(c for x in range(width) for c in pixel(x, y))
+                   for y in range(height))
+
+    def chunk(kind, data):
+        return (struct.pack(">I", len(data)) + kind + data
+                + struct.pack(">I", zlib.crc32(kind + data) & 0xffffffff))
+    return (b"\x89PNG\r\n\x1a\n"
+            + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0))
+            + chunk(b"IDAT", zlib.compress(raw, 9)) + chunk(b"IEND", b""))
 
 
 # a JSON list holding only numbers/literals, to be printed on one line

@@ -54,4 +54,7 @@ python3 tools/gen_atrium.py --size 0.02 --light lanterns --out "$work/lanterns/a
 for mode in pathtrace reuse; do
   run "lanterns-$mode" "$work/lanterns/atrium.gltf" --frames 0-1 --mode "$mode" --light-sampler bvh
 done
+# Normal maps (generated tangents) in every kernel that shades.
+python3 tools/gen_atrium.py --size 0.02 --normal-maps --out "$work/bumps/atrium.gltf" >/dev/null
+run "atrium-normal-maps-reuse" "$work/bumps/atrium.gltf" --frames 0-1 --mode reuse --camera 1
 exit $fail

@@ -71,6 +71,12 @@ dev::Material toDeviceMaterial(const Material& m, bool forceDiffuse) {
   d.mr_texture =
       m.metallicRoughnessTexture.valid() ? m.metallicRoughnessTexture.texture : PR_NO_TEXTURE;
   d.emission_texture = m.emissiveTexture.valid() ? m.emissiveTexture.texture : PR_NO_TEXTURE;
+  d.normal_texture = m.normalTexture.valid() ? m.normalTexture.texture : PR_NO_TEXTURE;
+  d.normal_scale = m.normalScale;
+  d.uv_sets = (m.baseColorTexture.texCoord == 1 ? PR_UV_BASE : 0u) |
+              (m.metallicRoughnessTexture.texCoord == 1 ? PR_UV_MR : 0u) |
+              (m.emissiveTexture.texCoord == 1 ? PR_UV_EMISSION : 0u) |
+              (m.normalTexture.texCoord == 1 ? PR_UV_NORMAL : 0u);
   uint32_t flags = 0;
   if (m.doubleSided) flags |= PR_MAT_DOUBLE_SIDED;
   if (m.alphaMode == AlphaMode::Mask) flags |= PR_MAT_ALPHA_MASK;
@@ -93,6 +99,7 @@ dev::Material toDeviceMaterial(const Material& m, bool forceDiffuse) {
   transform(m.baseColorTexture, d.base_uv);
   transform(m.metallicRoughnessTexture, d.mr_uv);
   transform(m.emissiveTexture, d.emission_uv);
+  transform(m.normalTexture, d.normal_uv);
   return d;
 }
 
@@ -220,6 +227,10 @@ void GpuScene::uploadShading() {
       if (v < m.normals.size())
         sv.nx = m.normals[v].x, sv.ny = m.normals[v].y, sv.nz = m.normals[v].z;
       if (v < m.uvs.size()) sv.u = m.uvs[v].x, sv.v = m.uvs[v].y;
+      const glm::vec2 uv1 = v < m.uvs1.size() ? m.uvs1[v] : glm::vec2(sv.u, sv.v);
+      sv.u1 = uv1.x, sv.v1 = uv1.y;
+      const glm::vec4 t = v < m.tangents.size() ? m.tangents[v] : glm::vec4(1, 0, 0, 1);
+      sv.tx = t.x, sv.ty = t.y, sv.tz = t.z, sv.tw = t.w;
       verts.push_back(sv);
     }
     for (size_t t = 0; t < m.triangleCount(); ++t)

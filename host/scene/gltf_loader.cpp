@@ -15,6 +15,7 @@
 
 #include "scene/gltf_schema.h"
 #include "scene/image_decode.h"
+#include "scene/tangents.h"
 #include "util/error.h"
 
 namespace pr {
@@ -636,6 +637,9 @@ class Loader {
         if (const Value* r = member(*t, "rotation"))
           if (!r->IsNumber() || !finite(r->GetNumberAsDouble()))
             fail("KHR_texture_transform rotation must be a finite number", twhere);
+        if (const Value* c = member(*t, "texCoord"))
+          if (!c->IsInt() || c->GetNumberAsInt() < 0)
+            fail("KHR_texture_transform texCoord must be a non-negative integer", twhere);
       }
     }
   }
@@ -717,7 +721,7 @@ class Loader {
             checkRule(acc, normal, at);
           else if (name == "TANGENT")
             checkRule(acc, tangent, at);
-          else if (name == "TEXCOORD_0")
+          else if (name == "TEXCOORD_0" || name == "TEXCOORD_1")
             checkRule(acc, texcoord, at);
           else
             checkAccessor(acc, at);
@@ -1010,9 +1014,14 @@ class Loader {
     const auto& mesh = model_.meshes[size_t(meshIndex)];
     TriangleMesh out;
     out.name = mesh.name;
-    bool anyTangents = false;
-    for (const auto& p : mesh.primitives)
+    bool anyTangents = false, anyUv1 = false, anyNormalMap = false;
+    for (const auto& p : mesh.primitives) {
       anyTangents = anyTangents || p.attributes.count("TANGENT");
+      anyUv1 = anyUv1 || p.attributes.count("TEXCOORD_1");
+      anyNormalMap =
+          anyNormalMap || scene_.materials[size_t(materialIndex(p.material))].normalTexture.valid();
+    }
+    std::vector<uint8_t> normalUvSet;  // per triangle: the uv set its normal map reads
     for (size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
       const auto& p = mesh.primitives[pi];
       const std::string where =
@@ -1096,6 +1105,20 @@ class Loader {
       } else {
         out.uvs.resize(out.positions.size(), glm::vec2(0.0f));
       }
+      if (anyUv1) {
+        std::vector<double> uv;
+        if (const auto it = p.attributes.find("TEXCOORD_1"); it != p.attributes.end())
+          uv = readAccessor(it->second);
+        for (size_t v = 0; v < vcount; ++v) {
+          if (uv.empty()) {
+            out.uvs1.push_back(out.uvs[base + v]);  // TEXCOORD_0 stands in
+            continue;
+          }
+          if (!finite(uv[2 * v]) || !finite(uv[2 * v + 1]))
+            fail("TEXCOORD_1 is not finite", where + ", TEXCOORD_1");
+          out.uvs1.emplace_back(uv[2 * v], uv[2 * v + 1]);
+        }
+      }
       if (anyTangents) {
         std::vector<double> tan;
         if (const auto it = p.attributes.find("TANGENT"); it != p.attributes.end())
@@ -1114,7 +1137,11 @@ class Loader {
       const uint32_t mat = uint32_t(materialIndex(p.material));
       for (uint32_t i : idx) out.indices.push_back(base + i);
       out.materials.insert(out.materials.end(), idx.size() / 3, mat);
+      normalUvSet.insert(normalUvSet.end(), idx.size() / 3,
+                         uint8_t(scene_.materials[mat].normalTexture.texCoord == 1));
     }
+    // glTF asks for MikkTSpace tangents where a normal-mapped mesh has none.
+    if (!anyTangents && anyNormalMap) generateTangents(out, normalUvSet);
     return out;
   }
 
@@ -1134,6 +1161,8 @@ class Loader {
     const float sign = det < 0.0f ? -1.0f : 1.0f;
     const uint32_t base = uint32_t(ssg.positions.size());
     if (uint64_t(base) + mesh.positions.size() > 0xffffffffull) fail("scene has too many vertices");
+    if (!mesh.uvs1.empty() && ssg.uvs1.size() < ssg.positions.size())
+      ssg.uvs1 = ssg.uvs;  // earlier meshes had none: their TEXCOORD_0 stands in
     const bool tangents = !mesh.tangents.empty();
     if (tangents && ssg.tangents.size() < ssg.positions.size())
       ssg.tangents.resize(ssg.positions.size(), glm::vec4(1.0f, 0.0f, 0.0f, 1.0f));
@@ -1143,6 +1172,10 @@ class Loader {
       const float len = glm::length(n);
       ssg.normals.push_back(len > 0.0f && std::isfinite(len) ? n / len : mesh.normals[v]);
       ssg.uvs.push_back(mesh.uvs[v]);
+      if (!mesh.uvs1.empty())
+        ssg.uvs1.push_back(mesh.uvs1[v]);
+      else if (!ssg.uvs1.empty())
+        ssg.uvs1.push_back(mesh.uvs[v]);
       if (tangents) {
         glm::vec3 t = linear * glm::vec3(mesh.tangents[v]);
         const float tl = glm::length(t);
@@ -1184,16 +1217,16 @@ class Loader {
       const std::string where = named("material", int(i), src.name);
       m.baseColorTexture =
           textureRef(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, true, where);
-      readTransform(pbr.baseColorTexture.extensions, &m.baseColorTexture);
+      readTransform(pbr.baseColorTexture.extensions, &m.baseColorTexture, where);
       m.metallicRoughnessTexture = textureRef(pbr.metallicRoughnessTexture.index,
                                               pbr.metallicRoughnessTexture.texCoord, false, where);
-      readTransform(pbr.metallicRoughnessTexture.extensions, &m.metallicRoughnessTexture);
+      readTransform(pbr.metallicRoughnessTexture.extensions, &m.metallicRoughnessTexture, where);
       m.emissiveTexture =
           textureRef(src.emissiveTexture.index, src.emissiveTexture.texCoord, true, where);
-      readTransform(src.emissiveTexture.extensions, &m.emissiveTexture);
+      readTransform(src.emissiveTexture.extensions, &m.emissiveTexture, where);
       m.normalTexture =
           textureRef(src.normalTexture.index, src.normalTexture.texCoord, false, where);
-      readTransform(src.normalTexture.extensions, &m.normalTexture);
+      readTransform(src.normalTexture.extensions, &m.normalTexture, where);
       if (const Value* e = extension(src.extensions, "KHR_materials_emissive_strength"))
         if (const Value* s = member(*e, "emissiveStrength"))
           m.emissiveStrength = float(s->GetNumberAsDouble());
@@ -1206,10 +1239,21 @@ class Loader {
     }
   }
 
-  // A texture's KHR_texture_transform (validated in checkMaterials), if it has one.
-  void readTransform(const tinygltf::ExtensionMap& extensions, TextureRef* ref) {
+  // The uv set a texture reads: TEXCOORD_0 or TEXCOORD_1 (others warned of, TEXCOORD_0 read).
+  int uvSet(int texCoord, const std::string& where) {
+    if (texCoord == 0 || texCoord == 1) return texCoord;
+    warn("only TEXCOORD_0 and TEXCOORD_1 are supported; texCoord " + std::to_string(texCoord) +
+         " reads TEXCOORD_0 (" + where + ")");
+    return 0;
+  }
+
+  // A texture's KHR_texture_transform (validated in checkMaterials), if it has one; its
+  // texCoord overrides the texture's.
+  void readTransform(const tinygltf::ExtensionMap& extensions, TextureRef* ref,
+                     const std::string& where) {
     const Value* t = extension(extensions, "KHR_texture_transform");
     if (!t) return;
+    if (const Value* v = member(*t, "texCoord")) ref->texCoord = uvSet(v->GetNumberAsInt(), where);
     if (const Value* v = member(*t, "offset"))
       ref->offset = glm::vec2(v->Get(0).GetNumberAsDouble(), v->Get(1).GetNumberAsDouble());
     if (const Value* v = member(*t, "scale"))
@@ -1221,9 +1265,7 @@ class Loader {
   TextureRef textureRef(int gltfTexture, int texCoord, bool srgb, const std::string& where) {
     TextureRef ref;
     if (gltfTexture < 0) return ref;
-    if (texCoord != 0)
-      warn("only TEXCOORD_0 is supported; texCoord " + std::to_string(texCoord) + " reads it (" +
-           where + ")");
+    ref.texCoord = uvSet(texCoord, where);
     const auto key = std::make_pair(gltfTexture, srgb);
     if (const auto it = textureIndex_.find(key); it != textureIndex_.end()) {
       ref.texture = it->second;

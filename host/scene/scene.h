@@ -44,6 +44,7 @@ struct TriangleMesh {
   std::vector<glm::vec3> positions;
   std::vector<glm::vec3> normals;   // one per vertex, unit length
   std::vector<glm::vec2> uvs;       // one per vertex (TEXCOORD_0, zero when absent)
+  std::vector<glm::vec2> uvs1;      // empty, or one per vertex (TEXCOORD_1)
   std::vector<glm::vec4> tangents;  // empty, or one per vertex (xyz, w = handedness)
   std::vector<uint32_t> indices;    // 3 per triangle
   std::vector<uint32_t> materials;  // one per triangle, index into Scene::materials
@@ -58,7 +59,7 @@ enum class AlphaMode : uint32_t { Opaque = 0, Mask = 1, Blend = 2 };
 // A material's use of a texture, with KHR_texture_transform (identity when absent).
 struct TextureRef {
   int texture = -1;  // index into Scene::textures, -1 = none
-  int texCoord = 0;  // only set 0 is loaded; others fall back to it
+  int texCoord = 0;  // uv set: TEXCOORD_0 or TEXCOORD_1
   glm::vec2 offset{0.0f};
   float rotation = 0.0f;  // radians, counter-clockwise in uv as the extension defines it
   glm::vec2 scale{1.0f};
@@ -76,7 +77,7 @@ struct Material {
   float metallicFactor = 1.0f;
   float roughnessFactor = 1.0f;
   TextureRef metallicRoughnessTexture;  // linear: G = roughness, B = metallic
-  TextureRef normalTexture;             // linear, loaded for completeness
+  TextureRef normalTexture;             // linear tangent-space normal map
   float normalScale = 1.0f;
   glm::vec3 emissiveFactor{0.0f};
   TextureRef emissiveTexture;     // sRGB texture

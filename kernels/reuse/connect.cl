@@ -87,7 +87,7 @@ PR_INLINE EyePoint eye_point(const SceneData* s, const SurfaceHit* h, float3 wo,
 
 PR_INLINE LightPoint light_point(const SceneData* s, __global const LightVertex* v) {
   LightPoint y;
-  y.h = surface_at(&s->sd, v->prim, v->inst, v->b1, v->b2);
+  y.h = surface_interp(&s->sd, v->prim, v->inst, v->b1, v->b2, 0);  // ns as stored
   y.h.p = vertex_pos(v);
   y.h.ng = oct_decode(v->ng_oct);
   y.h.ns = oct_decode(v->ns_oct);

@@ -7,11 +7,14 @@
 
 PR_NAMESPACE_BEGIN
 
-// 32 bytes.
+// 56 bytes.
 typedef struct {
   float px, py, pz;
   float nx, ny, nz;
-  float u, v;
+  float u, v;        // TEXCOORD_0
+  float u1, v1;      // TEXCOORD_1 (TEXCOORD_0 where absent)
+  float tx, ty, tz;  // tangent (normal maps): loaded, or generated from the normal map's uvs
+  float tw;          // bitangent sign: b = tw cross(n, t)
 } ShadingVertex;
 
 // Absolute vertex indices into the one vertex array. 16 bytes.
@@ -33,7 +36,7 @@ typedef struct {
 
 PR_NAMESPACE_END
 
-PR_STATIC_ASSERT(sizeof(pr::dev::ShadingVertex) == 32, "ShadingVertex layout");
+PR_STATIC_ASSERT(sizeof(pr::dev::ShadingVertex) == 56, "ShadingVertex layout");
 PR_STATIC_ASSERT(sizeof(pr::dev::ShadingTriangle) == 16, "ShadingTriangle layout");
 PR_STATIC_ASSERT(sizeof(pr::dev::ShadingInstance) == 112, "ShadingInstance layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::ShadingInstance, first_triangle) == 96,

@@ -34,7 +34,8 @@ PR_CALLABLE int trace_closest(const SceneData* s, Ray ray, Hit* hit) {
 #ifdef PR_HAS_ALPHA
   for (int layer = 0; layer < PR_MAX_ALPHA_LAYERS; ++layer) {
     if (!intersect_scene(&s->geom, ray, hit)) return 0;
-    const SurfaceHit h = surface_at(&s->sd, hit->prim, hit->inst, hit->u, hit->v);
+    // Coverage needs only the material and uvs: no normal map.
+    const SurfaceHit h = surface_interp(&s->sd, hit->prim, hit->inst, hit->u, hit->v, 0);
     if (!surface_passes(s, &h)) return 1;
     ray.tmin = hit->t;  // continue past this point, same ray
   }
@@ -50,7 +51,7 @@ PR_CALLABLE int trace_occluded(const SceneData* s, Ray ray) {
   for (int layer = 0; layer < PR_MAX_ALPHA_LAYERS; ++layer) {
     Hit hit;
     if (!intersect_scene(&s->geom, ray, &hit)) return 0;
-    const SurfaceHit h = surface_at(&s->sd, hit.prim, hit.inst, hit.u, hit.v);
+    const SurfaceHit h = surface_interp(&s->sd, hit.prim, hit.inst, hit.u, hit.v, 0);
     if (!surface_passes(s, &h)) return 1;
     ray.tmin = hit.t;
   }
@@ -125,7 +126,7 @@ PR_INLINE int next_event(const SceneData* s, const SurfaceHit* h, const ShadingF
   if (dot(ls.wi, f->ng) <= 0.0f) return 0;  // below the geometric surface
   float3 le = ls.le;
   if (l.type == PR_LIGHT_TRIANGLE) {
-    const SurfaceHit e = surface_at(&s->sd, l.prim, l.inst, b1, b2);
+    const SurfaceHit e = surface_interp(&s->sd, l.prim, l.inst, b1, b2, 0);
     le = material_emission(&s->sd, &e);
   }
   float bsdf_pdf = 0.0f;

@@ -65,6 +65,9 @@
   F(Material, base_uv)                \
   F(Material, mr_uv)                  \
   F(Material, emission_uv)            \
+  F(Material, normal_texture)         \
+  F(Material, normal_uv)              \
+  F(Material, uv_sets)                \
   F(TextureInfo, flags)               \
   F(CameraParams, fx)                 \
   F(CameraParams, aspect)             \
@@ -80,6 +83,9 @@
   F(Light, material)                  \
   F(ShadingVertex, nx)                \
   F(ShadingVertex, v)                 \
+  F(ShadingVertex, u1)                \
+  F(ShadingVertex, tx)                \
+  F(ShadingVertex, tw)                \
   F(ShadingTriangle, material)        \
   F(ShadingInstance, world_to_object) \
   F(ShadingInstance, first_triangle)  \

@@ -1,5 +1,6 @@
 // Materials as the kernels see them: glTF metallic-roughness with emission, transmission
-// (delta dielectric), alpha cut-out/coverage and a baseColor texture transform.
+// (delta dielectric), alpha cut-out/coverage, textures with their transforms and uv sets, normal
+// maps.
 #pragma once
 
 #include "shared/common.h"
@@ -16,7 +17,7 @@ PR_NAMESPACE_BEGIN
 
 #define PR_NO_TEXTURE (-1)
 
-// 96 bytes.
+// 176 bytes.
 typedef struct {
   float base_r, base_g, base_b, base_a;  // linear baseColorFactor
   float emit_r, emit_g, emit_b;          // emissiveFactor * emissive_strength (radiance)
@@ -30,8 +31,17 @@ typedef struct {
   float base_uv[6];
   float mr_uv[6];
   float emission_uv[6];
-  float pad0, pad1;
+  i32 normal_texture;  // tangent-space normal map (linear), or PR_NO_TEXTURE
+  float normal_scale;  // scales the map's x and y
+  float normal_uv[6];
+  u32 uv_sets;  // bit PR_UV_*: that texture reads TEXCOORD_1, else TEXCOORD_0
+  float pad0;
 } Material;
+
+#define PR_UV_BASE 1u
+#define PR_UV_MR 2u
+#define PR_UV_EMISSION 4u
+#define PR_UV_NORMAL 8u
 
 // One texture in the shared texel buffer (RGBA8 packed in u32, row-major). 16 bytes.
 typedef struct {
@@ -48,9 +58,10 @@ typedef struct {
 
 PR_NAMESPACE_END
 
-PR_STATIC_ASSERT(sizeof(pr::dev::Material) == 144, "Material layout");
+PR_STATIC_ASSERT(sizeof(pr::dev::Material) == 176, "Material layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::Material, flags) == 28, "Material layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::Material, alpha_cutoff) == 48, "Material layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::Material, base_uv) == 64, "Material layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::Material, emission_uv) == 112, "Material layout");
+PR_STATIC_ASSERT(offsetof(pr::dev::Material, normal_uv) == 144, "Material layout");
 PR_STATIC_ASSERT(sizeof(pr::dev::TextureInfo) == 16, "TextureInfo layout");

@@ -21,10 +21,11 @@ typedef struct {
 } ShadingData;
 
 typedef struct {
-  float3 p;   // world position
-  float3 ng;  // unit geometric normal (winding order), world space
-  float3 ns;  // unit shading normal, on the same side as ng
-  float2 uv;
+  float3 p;    // world position
+  float3 ng;   // unit geometric normal (winding order), world space
+  float3 ns;   // unit shading normal, on the same side as ng
+  float2 uv;   // TEXCOORD_0
+  float2 uv1;  // TEXCOORD_1
   u32 material;
   u32 prim;  // shading triangle index
   u32 inst;  // PR_INVALID_INDEX on the SSG
@@ -41,38 +42,6 @@ PR_INLINE float3 xform_normal12(PR_GLOBAL const float* w2o, float3 n) {
   return make_float3(w2o[0] * n.x + w2o[4] * n.y + w2o[8] * n.z,
                      w2o[1] * n.x + w2o[5] * n.y + w2o[9] * n.z,
                      w2o[2] * n.x + w2o[6] * n.y + w2o[10] * n.z);
-}
-
-// The surface at barycentrics (b1, b2) of a triangle (b1 weights v1, b2 weights v2).
-PR_INLINE SurfaceHit surface_at(const ShadingData* sd, u32 prim, u32 inst, float b1, float b2) {
-  SurfaceHit s;
-  // Hits report shading triangle indices: DSG meshes are numbered after the SSG's triangles.
-  s.prim = prim;
-  s.inst = inst;
-  const ShadingTriangle tri = sd->triangles[s.prim];
-  s.material = tri.material;
-  const ShadingVertex a = sd->vertices[tri.v0], b = sd->vertices[tri.v1], c = sd->vertices[tri.v2];
-  const float b0 = 1.0f - b1 - b2;
-  float3 pa = make_float3(a.px, a.py, a.pz), pb = make_float3(b.px, b.py, b.pz),
-         pc = make_float3(c.px, c.py, c.pz);
-  float3 n = make_float3(a.nx, a.ny, a.nz) * b0 + make_float3(b.nx, b.ny, b.nz) * b1 +
-             make_float3(c.nx, c.ny, c.nz) * b2;
-  if (inst != PR_INVALID_INDEX) {
-    PR_GLOBAL const ShadingInstance* in = sd->instances + inst;
-    pa = xform_point12(in->object_to_world, pa);
-    pb = xform_point12(in->object_to_world, pb);
-    pc = xform_point12(in->object_to_world, pc);
-    n = xform_normal12(in->world_to_object, n);
-  }
-  s.p = pa * b0 + pb * b1 + pc * b2;
-  const float3 cr = cross(pb - pa, pc - pa);
-  const float cl = length(cr);
-  s.ng = cl > 0.0f ? cr / cl : make_float3(0.0f, 0.0f, 1.0f);
-  const float nl = length(n);
-  s.ns = nl > 0.0f && isfinite_f(nl) ? n / nl : s.ng;
-  if (dot(s.ns, s.ng) < 0.0f) s.ns = -s.ns;
-  s.uv = make_float2(a.u * b0 + b.u * b1 + c.u * b2, a.v * b0 + b.v * b1 + c.v * b2);
-  return s;
 }
 
 // The world-space corners of a surface's triangle: v0 and the edges to v1 and v2.
@@ -150,12 +119,104 @@ PR_INLINE float2 texture_uv(PR_GLOBAL const float* m, float2 uv) {
   return make_float2(m[0] * uv.x + m[1] * uv.y + m[2], m[3] * uv.x + m[4] * uv.y + m[5]);
 }
 
+PR_INLINE float3 xform_vector12(PR_GLOBAL const float* m, float3 v) {
+  return make_float3(m[0] * v.x + m[1] * v.y + m[2] * v.z, m[4] * v.x + m[5] * v.y + m[6] * v.z,
+                     m[8] * v.x + m[9] * v.y + m[10] * v.z);
+}
+
+PR_INLINE float det12(PR_GLOBAL const float* m) {
+  return m[0] * (m[5] * m[10] - m[6] * m[9]) - m[1] * (m[4] * m[10] - m[6] * m[8]) +
+         m[2] * (m[4] * m[9] - m[5] * m[8]);
+}
+
+// A texture's coordinates at the surface: its uv set (bit `set` of the material's uv_sets
+// chooses TEXCOORD_1) under its transform xf.
+PR_INLINE float2 material_uv(PR_GLOBAL const Material* m, u32 set, PR_GLOBAL const float* xf,
+                             float2 uv0, float2 uv1) {
+  return texture_uv(xf, (m->uv_sets & set) ? uv1 : uv0);
+}
+
+// The glTF normal map's normal: the texel's tangent-space normal, x and y scaled, in the frame
+// of the unit interpolated normal n, the tangent t made orthogonal to it and b = tw cross(n, t).
+// n itself where the tangent is degenerate or the mapped normal would cross the geometric
+// surface (ng) to the other side than n.
+PR_INLINE float3 normal_mapped(const ShadingData* sd, PR_GLOBAL const Material* m, float2 uv,
+                               float3 n, float3 t, float tw, float3 ng) {
+  const float4 c = texture_sample(sd, m->normal_texture, uv);
+  const float3 tn = make_float3((2.0f * c.x - 1.0f) * m->normal_scale,
+                                (2.0f * c.y - 1.0f) * m->normal_scale, 2.0f * c.z - 1.0f);
+  const float3 to = t - n * dot(n, t);
+  const float tl = length(to);
+  if (!(tl > 1e-6f) || !isfinite_f(tl)) return n;
+  const float3 tu = to / tl;
+  const float3 b = cross(n, tu) * (tw < 0.0f ? -1.0f : 1.0f);
+  const float3 p = tu * tn.x + b * tn.y + n * tn.z;
+  const float pl = length(p);
+  if (!(pl > 0.0f) || !isfinite_f(pl)) return n;
+  const float3 r = p / pl;
+  return dot(r, ng) * dot(n, ng) > 0.0f ? r : n;
+}
+
+// The surface at barycentrics (b1, b2) of a triangle (b1 weights v1, b2 weights v2); with its
+// normal map applied where map_normals (not where the caller has the shading normal already).
+PR_INLINE SurfaceHit surface_interp(const ShadingData* sd, u32 prim, u32 inst, float b1, float b2,
+                                    int map_normals) {
+  SurfaceHit s;
+  // Hits report shading triangle indices: DSG meshes are numbered after the SSG's triangles.
+  s.prim = prim;
+  s.inst = inst;
+  const ShadingTriangle tri = sd->triangles[s.prim];
+  s.material = tri.material;
+  const ShadingVertex a = sd->vertices[tri.v0], b = sd->vertices[tri.v1], c = sd->vertices[tri.v2];
+  const float b0 = 1.0f - b1 - b2;
+  float3 pa = make_float3(a.px, a.py, a.pz), pb = make_float3(b.px, b.py, b.pz),
+         pc = make_float3(c.px, c.py, c.pz);
+  float3 n = make_float3(a.nx, a.ny, a.nz) * b0 + make_float3(b.nx, b.ny, b.nz) * b1 +
+             make_float3(c.nx, c.ny, c.nz) * b2;
+  if (inst != PR_INVALID_INDEX) {
+    PR_GLOBAL const ShadingInstance* in = sd->instances + inst;
+    pa = xform_point12(in->object_to_world, pa);
+    pb = xform_point12(in->object_to_world, pb);
+    pc = xform_point12(in->object_to_world, pc);
+    n = xform_normal12(in->world_to_object, n);
+  }
+  s.p = pa * b0 + pb * b1 + pc * b2;
+  const float3 cr = cross(pb - pa, pc - pa);
+  const float cl = length(cr);
+  s.ng = cl > 0.0f ? cr / cl : make_float3(0.0f, 0.0f, 1.0f);
+  const float nl = length(n);
+  s.ns = nl > 0.0f && isfinite_f(nl) ? n / nl : s.ng;
+  s.uv = make_float2(a.u * b0 + b.u * b1 + c.u * b2, a.v * b0 + b.v * b1 + c.v * b2);
+  s.uv1 = make_float2(a.u1 * b0 + b.u1 * b1 + c.u1 * b2, a.v1 * b0 + b.v1 * b1 + c.v1 * b2);
+  PR_GLOBAL const Material* m = sd->materials + s.material;
+  if (map_normals && m->normal_texture != PR_NO_TEXTURE) {
+    float3 t = make_float3(a.tx, a.ty, a.tz) * b0 + make_float3(b.tx, b.ty, b.tz) * b1 +
+               make_float3(c.tx, c.ty, c.tz) * b2;
+    float tw = a.tw;
+    if (inst != PR_INVALID_INDEX) {
+      PR_GLOBAL const ShadingInstance* in = sd->instances + inst;
+      t = xform_vector12(in->object_to_world, t);
+      // A mirroring transform turns the bitangent's handedness around.
+      if (det12(in->object_to_world) < 0.0f) tw = -tw;
+    }
+    s.ns = normal_mapped(sd, m, material_uv(m, PR_UV_NORMAL, m->normal_uv, s.uv, s.uv1), s.ns, t,
+                         tw, s.ng);
+  }
+  if (dot(s.ns, s.ng) < 0.0f) s.ns = -s.ns;
+  return s;
+}
+
+PR_INLINE SurfaceHit surface_at(const ShadingData* sd, u32 prim, u32 inst, float b1, float b2) {
+  return surface_interp(sd, prim, inst, b1, b2, 1);
+}
+
 // Base colour (rgb) and alpha at the surface.
 PR_INLINE float4 material_base(const ShadingData* sd, const SurfaceHit* s) {
   PR_GLOBAL const Material* m = sd->materials + s->material;
   float4 c = make_float4(m->base_r, m->base_g, m->base_b, m->base_a);
   if (m->base_texture != PR_NO_TEXTURE) {
-    const float4 t = texture_sample(sd, m->base_texture, texture_uv(m->base_uv, s->uv));
+    const float4 t =
+        texture_sample(sd, m->base_texture, material_uv(m, PR_UV_BASE, m->base_uv, s->uv, s->uv1));
     c = make_float4(c.x * t.x, c.y * t.y, c.z * t.z, c.w * t.w);
   }
   return c;
@@ -168,7 +229,8 @@ PR_INLINE BsdfParams material_bsdf(const ShadingData* sd, const SurfaceHit* s) {
   p.base = make_float3(base.x, base.y, base.z);
   float metallic = m->metallic, roughness = m->roughness;
   if (m->mr_texture != PR_NO_TEXTURE) {
-    const float4 t = texture_sample(sd, m->mr_texture, texture_uv(m->mr_uv, s->uv));
+    const float4 t =
+        texture_sample(sd, m->mr_texture, material_uv(m, PR_UV_MR, m->mr_uv, s->uv, s->uv1));
     roughness *= t.y;
     metallic *= t.z;
   }
@@ -191,7 +253,8 @@ PR_INLINE float3 material_emission(const ShadingData* sd, const SurfaceHit* s) {
   PR_GLOBAL const Material* m = sd->materials + s->material;
   float3 e = make_float3(m->emit_r, m->emit_g, m->emit_b);
   if (m->emission_texture != PR_NO_TEXTURE) {
-    const float4 t = texture_sample(sd, m->emission_texture, texture_uv(m->emission_uv, s->uv));
+    const float4 t = texture_sample(sd, m->emission_texture,
+                                    material_uv(m, PR_UV_EMISSION, m->emission_uv, s->uv, s->uv1));
     e = e * make_float3(t.x, t.y, t.z);
   }
   return e;
