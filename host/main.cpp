@@ -131,6 +131,20 @@ int main(int argc, char** argv) {
                    "unshadowed contribution, or all (one shadow ray per candidate)")
       ->check(CLI::IsMember({"1", "2", "3", "4", "all"}))
       ->capture_default_str();
+  render->add_option(
+      "--env", ro.env,
+      "Environment light: an equirectangular map (.exr or .hdr; +Y up, its centre looking along "
+      "-Z), or none (default: a uniform one of --env-color where that is given, else white "
+      "where the scene has no lights, else none)");
+  render->add_option("--env-color", ro.envColor,
+                     "R,G,B: a uniform environment of this radiance, or the map's tint");
+  render->add_option("--env-strength", ro.envStrength, "Scales the environment's radiance")
+      ->capture_default_str();
+  render
+      ->add_option("--env-rotate", ro.envRotate,
+                   "Turns the environment about +Y by this many degrees (counter-clockwise seen "
+                   "from above)")
+      ->capture_default_str();
   render->add_option("--camera", ro.camera, "Camera index (default: the scene's first)");
   render->add_option("--out", ro.outPattern, "Output EXR path with a frame number conversion")
       ->capture_default_str();

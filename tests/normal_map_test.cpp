@@ -88,7 +88,7 @@ struct PlaneScene {
   std::string bin;
   std::vector<uint8_t> normalTexel = {191, 128, 238, 255};  // about (0.5, 0, 0.87): 30 deg to +x
   float normalScale = 1.0f;
-  float lightAngle = 0.0f;    // light from (sin a, 0, cos a), or (0, -sin a, cos a):
+  float lightAngle = 0.0f;   // light from (sin a, 0, cos a), or (0, -sin a, cos a):
   bool lightAboutX = false;  // the light turned about x instead of y
   json planeNode = {{"mesh", 0}};
   bool withTangents = false;
@@ -99,8 +99,8 @@ struct PlaneScene {
     const std::string dir = test::tempDir(tag);
     const float pos[] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
     const float nrm[] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
-    const float uv0[] = {0, 0, 1, 0, 1, 1, 0, 1};      // u along +x
-    const float uv1[] = {0, 0, 0, -1, 1, -1, 1, 0};    // u along +y, v along -x
+    const float uv0[] = {0, 0, 1, 0, 1, 1, 0, 1};    // u along +x
+    const float uv1[] = {0, 0, 0, -1, 1, -1, 1, 0};  // u along +y, v along -x
     const float tan[] = {tangent.x, tangent.y, tangent.z, tangent.w, tangent.x, tangent.y,
                          tangent.z, tangent.w, tangent.x, tangent.y, tangent.z, tangent.w,
                          tangent.x, tangent.y, tangent.z, tangent.w};
@@ -125,38 +125,36 @@ struct PlaneScene {
     const int indices = add(idx, sizeof idx, 5123, 6, "SCALAR");
     accessors[0]["min"] = {-1, -1, 0};
     accessors[0]["max"] = {1, 1, 0};
-    {
-      std::ofstream(dir + "/plane.bin", std::ios::binary) << bin;
-    }
+    { std::ofstream(dir + "/plane.bin", std::ios::binary) << bin; }
     stbi_write_png((dir + "/n.png").c_str(), 1, 1, 4, normalTexel.data(), 4);
     const float s = std::sin(lightAngle / 2), c = std::cos(lightAngle / 2);
-    doc = {{"asset", {{"version", "2.0"}}},
-           {"extensionsUsed", {"KHR_lights_punctual"}},
-           {"extensions",
-            {{"KHR_lights_punctual",
-              {{"lights", {{{"type", "directional"}, {"intensity", 2.0}}}}}}}},
-           {"scene", 0},
-           {"scenes", {{{"nodes", {0, 1, 2}}}}},
-           {"nodes",
-            {planeNode,
-             {{"camera", 0}, {"translation", {0, 0, 3}}},
-             {{"rotation", lightAboutX ? json{s, 0, 0, c} : json{0, s, 0, c}},  // shines along -z
-              {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}}}},
-           {"cameras",
-            {{{"type", "perspective"},
-              {"perspective", {{"yfov", 0.5}, {"aspectRatio", 1.0}, {"znear", 0.01}}}}}},
-           {"meshes",
-            {{{"primitives", {{{"attributes", attrs}, {"indices", indices}, {"material", 0}}}}}}},
-           {"materials",
-            {{{"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 0.5, 0.5, 1}}}},
-              {"normalTexture",
-               {{"index", 0}, {"scale", normalScale}, {"texCoord", normalTexCoord}}}}}},
-           {"textures", {{{"source", 0}, {"sampler", 0}}}},
-           {"samplers", {{{"magFilter", 9728}, {"minFilter", 9728}}}},
-           {"images", {{{"uri", "n.png"}}}},
-           {"accessors", accessors},
-           {"bufferViews", views},
-           {"buffers", {{{"byteLength", bin.size()}, {"uri", "plane.bin"}}}}};
+    doc = {
+        {"asset", {{"version", "2.0"}}},
+        {"extensionsUsed", {"KHR_lights_punctual"}},
+        {"extensions",
+         {{"KHR_lights_punctual", {{"lights", {{{"type", "directional"}, {"intensity", 2.0}}}}}}}},
+        {"scene", 0},
+        {"scenes", {{{"nodes", {0, 1, 2}}}}},
+        {"nodes",
+         {planeNode,
+          {{"camera", 0}, {"translation", {0, 0, 3}}},
+          {{"rotation", lightAboutX ? json{s, 0, 0, c} : json{0, s, 0, c}},  // shines along -z
+           {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}}}},
+        {"cameras",
+         {{{"type", "perspective"},
+           {"perspective", {{"yfov", 0.5}, {"aspectRatio", 1.0}, {"znear", 0.01}}}}}},
+        {"meshes",
+         {{{"primitives", {{{"attributes", attrs}, {"indices", indices}, {"material", 0}}}}}}},
+        {"materials",
+         {{{"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 0.5, 0.5, 1}}}},
+           {"normalTexture",
+            {{"index", 0}, {"scale", normalScale}, {"texCoord", normalTexCoord}}}}}},
+        {"textures", {{{"source", 0}, {"sampler", 0}}}},
+        {"samplers", {{{"magFilter", 9728}, {"minFilter", 9728}}}},
+        {"images", {{{"uri", "n.png"}}}},
+        {"accessors", accessors},
+        {"bufferViews", views},
+        {"buffers", {{{"byteLength", bin.size()}, {"uri", "plane.bin"}}}}};
     const std::string path = dir + "/plane.gltf";
     std::ofstream(path) << doc.dump();
     return path;
@@ -213,17 +211,14 @@ TEST(NormalMap, TexCoordOfTheTransformOverridesAndUnknownSetsWarn) {
   quiet.printWarnings = false;
   auto load = [&](int texCoord) {
     ext["texCoord"] = texCoord;
-    {
-      std::ofstream(path) << doc.dump();
-    }
+    { std::ofstream(path) << doc.dump(); }
     return loadScene(path, quiet);
   };
   EXPECT_EQ(load(1).materials[0].normalTexture.texCoord, 1);
   const Scene s = load(2);
   EXPECT_EQ(s.materials[0].normalTexture.texCoord, 0);
   ASSERT_EQ(s.warnings.size(), 1u);
-  EXPECT_NE(s.warnings[0].find("texCoord 2 reads TEXCOORD_0"), std::string::npos)
-      << s.warnings[0];
+  EXPECT_NE(s.warnings[0].find("texCoord 2 reads TEXCOORD_0"), std::string::npos) << s.warnings[0];
   try {
     load(-1);
     ADD_FAILURE() << "a negative texCoord loaded";

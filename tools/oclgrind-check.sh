@@ -54,7 +54,19 @@ python3 tools/gen_atrium.py --size 0.02 --light lanterns --out "$work/lanterns/a
 for mode in pathtrace reuse; do
   run "lanterns-$mode" "$work/lanterns/atrium.gltf" --frames 0-1 --mode "$mode" --light-sampler bvh
 done
-# Normal maps (generated tangents) in every kernel that shades.
+# Normal maps (generated tangents) in every kernel that shades, under an environment map too.
 python3 tools/gen_atrium.py --size 0.02 --normal-maps --out "$work/bumps/atrium.gltf" >/dev/null
-run "atrium-normal-maps-reuse" "$work/bumps/atrium.gltf" --frames 0-1 --mode reuse --camera 1
+python3 - "$work/bumps/sky.hdr" <<'PY'
+import sys
+w, h = 8, 4  # flat RGBE scanlines: a bright texel in a dim sky
+with open(sys.argv[1], "wb") as f:
+    f.write(b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y %d +X %d\n" % (h, w))
+    for y in range(h):
+        for x in range(w):
+            f.write(bytes([200, 160, 120, 134] if (x, y) == (5, 1) else [100, 120, 160, 128]))
+PY
+for mode in pathtrace reuse; do
+  run "atrium-normal-maps-env-$mode" "$work/bumps/atrium.gltf" --frames 0-1 --mode "$mode" \
+    --camera 1 --env "$work/bumps/sky.hdr" --env-rotate 40
+done
 exit $fail

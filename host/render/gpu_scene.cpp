@@ -193,6 +193,12 @@ GpuScene::GpuScene(Context& ctx, const Scene& scene, const GpuSceneOptions& opti
     sceneCentre_ = b.centre();
   }
   uploadShading();
+  // The environment's map and sampling tables (a placeholder float without one).
+  std::vector<float> envData = {0.0f};
+  if (options_.environment.present())
+    envData = environmentTables(options_.environment, &envMeanLuminance_);
+  envBuffer_ =
+      upload("environment map", envData.data(), envData.size() * sizeof(float), &shadingBytes_);
   // The light-tracing selection table, at time 0 once and for all.
   const std::vector<dev::Light> atZero = lightsAt(0.0);
   traceTotal_ = runningSums(atZero, &traceCdf_);
@@ -343,7 +349,7 @@ std::vector<dev::Light> GpuScene::lightsAt(double t) const {
     if (!(l.area > 0.0f) || !std::isfinite(l.power)) l.power = 0.0f, l.area = 0.0f;
     lights.push_back(l);
   }
-  // Directional lights last: the light BVH holds the lights before them.
+  // Directional lights and the environment last: the light BVH holds the lights before them.
   std::vector<size_t> punctual;
   for (int directional = 0; directional < 2; ++directional)
     for (size_t i = 0; i < scene_.lights.size(); ++i)
@@ -376,7 +382,27 @@ std::vector<dev::Light> GpuScene::lightsAt(double t) const {
     if (!std::isfinite(l.power) || !(l.power > 0.0f)) l.power = 0.0f;
     lights.push_back(l);
   }
+  const Environment& env = options_.environment;
+  if (env.present()) {
+    dev::Light l{};
+    l.type = PR_LIGHT_ENV;
+    l.inst = static_cast<uint32_t>(env.width);
+    l.prim = static_cast<uint32_t>(env.height);
+    l.p0x = std::cos(env.rotation);
+    l.p0y = std::sin(env.rotation);
+    l.le_r = env.scale.r, l.le_g = env.scale.g, l.le_b = env.scale.b;
+    l.area = envMeanLuminance_;
+    l.leaf = PR_INVALID_INDEX;
+    l.power = dev::light_power(&l, sceneRadius_);
+    if (!std::isfinite(l.power) || !(l.power > 0.0f)) l.power = 0.0f;
+    lights.push_back(l);
+  }
   return lights;
+}
+
+uint32_t GpuScene::environmentLight() const {
+  return options_.environment.present() ? static_cast<uint32_t>(lights_.size() - 1)
+                                        : PR_INVALID_INDEX;
 }
 
 void GpuScene::buildLights(double t) {
@@ -392,7 +418,8 @@ void GpuScene::buildLights(double t) {
   // refitted and uploaded again only when a light moved. Its size never changes.
   if (!lightBvhBuilt_) {
     treeLights_ = 0;
-    while (treeLights_ < lights_.size() && lights_[treeLights_].type != PR_LIGHT_DIRECTIONAL)
+    while (treeLights_ < lights_.size() && lights_[treeLights_].type != PR_LIGHT_DIRECTIONAL &&
+           lights_[treeLights_].type != PR_LIGHT_ENV)
       ++treeLights_;
     lightBvh_.build(&lights_, useLightBvh_ ? treeLights_ : 0u);
     lightBvhBuilt_ = true;
@@ -434,8 +461,9 @@ cl_uint GpuScene::setKernelArgs(cl::Kernel& kernel, cl_uint first) {
   const cl_uint lights = pr::setKernelArgs(kernel, shading, vertices_, triangles_,
                                            shadingInstances_, materials_, textures_, texels_);
   return pr::setKernelArgs(kernel, lights, lightBuffer_, cdfBuffer_, lightNodeBuffer_,
-                           primLightBuffer_, static_cast<cl_uint>(lights_.size()),
-                           static_cast<cl_uint>(treeLights_), totalPower_);
+                           primLightBuffer_, envBuffer_, static_cast<cl_uint>(lights_.size()),
+                           static_cast<cl_uint>(treeLights_), totalPower_,
+                           static_cast<cl_uint>(environmentLight()));
 }
 
 std::string GpuScene::buildOptions() const {

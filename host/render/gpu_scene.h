@@ -11,6 +11,7 @@
 #include "cl/context.h"
 #include "render/light_bvh.h"
 #include "render/options.h"
+#include "scene/environment.h"
 #include "scene/scene.h"
 #include "shared/camera.h"
 #include "shared/geometry.h"
@@ -24,7 +25,8 @@ struct GpuSceneOptions {
   // a diagnostic with exactly known albedo, used by the furnace tests.
   bool forceDiffuse = false;
   LightSampler lightSampler = LightSampler::Auto;
-  int bvhWidth = 0;  // children per BVH node; 0: defaultBvhWidth of the device
+  int bvhWidth = 0;         // children per BVH node; 0: defaultBvhWidth of the device
+  Environment environment;  // the environment light; none where !present()
 };
 
 // Host-side conversions, exposed for tests.
@@ -54,6 +56,8 @@ class GpuScene {
   float traceTotalPower() const { return traceTotal_; }
   // Radius and centre of the scene's bounding sphere (directional lights emit from its disk).
   float sceneRadius() const { return sceneRadius_; }
+  // The environment light's index in the light table, or PR_INVALID_INDEX.
+  uint32_t environmentLight() const;
   glm::vec3 sceneCentre() const { return sceneCentre_; }
 
   const Scene& scene() const { return scene_; }
@@ -101,7 +105,8 @@ class GpuScene {
   LightBvh lightBvh_;
   bool lightBvhBuilt_ = false;
   bool useLightBvh_ = true;
-  uint32_t treeLights_ = 0;  // lights in the tree: all but the directional ones, which are last
+  // Lights in the tree: all but the directional ones and the environment, which are last.
+  uint32_t treeLights_ = 0;
   std::vector<dev::Light> lights_;
   std::vector<float> cdf_;
   float totalPower_ = 0.0f;
@@ -113,7 +118,8 @@ class GpuScene {
   bool lightsAnimated_ = false;
 
   cl::Buffer vertices_, triangles_, shadingInstances_, materials_, textures_, texels_;
-  cl::Buffer lightBuffer_, cdfBuffer_, lightNodeBuffer_, primLightBuffer_;
+  cl::Buffer lightBuffer_, cdfBuffer_, lightNodeBuffer_, primLightBuffer_, envBuffer_;
+  float envMeanLuminance_ = 0.0f;
   uint64_t lightNodeBytes_ = 0;
   uint64_t shadingBytes_ = 0, instanceBytes_ = 0, lightBytes_ = 0;
   size_t lightCapacity_ = 0, instanceCapacity_ = 0;

@@ -1,6 +1,8 @@
 #include "render/options.h"
 
 #include <cctype>
+#include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <filesystem>
 
@@ -118,6 +120,22 @@ std::string withExtension(const std::string& path, const std::string& ext) {
   std::filesystem::path p(path);
   p.replace_extension(ext);
   return p.string();
+}
+
+void parseColor(const std::string& text, float rgb[3]) {
+  const std::string bad = "--env-color " + text + ": must be R,G,B (three numbers, 0 or more)";
+  size_t pos = 0;
+  for (int c = 0; c < 3; ++c) {
+    const size_t end = c < 2 ? text.find(',', pos) : text.size();
+    if (end == std::string::npos) throw InputError(bad);
+    const std::string part = text.substr(pos, end - pos);
+    char* stop = nullptr;
+    const float v = std::strtof(part.c_str(), &stop);
+    if (part.empty() || stop != part.c_str() + part.size() || !std::isfinite(v) || v < 0.0f)
+      throw InputError(bad);
+    rgb[c] = v;
+    pos = end + 1;
+  }
 }
 
 }  // namespace pr

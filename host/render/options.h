@@ -56,7 +56,16 @@ struct RenderOptions {
   float clamp = 0.0f;          // clamp on the geometry term; 0 = off
   float connectionMis = 4.0f;  // MIS threshold on p_E / p_L (kernels/reuse/connect.cl); 0 = off
   int connections = 0;         // RIS-chosen connections per eye vertex (1-4); 0: every candidate
+  // The environment light (scene/environment.h): a map file, "none", or "" (a uniform one of
+  // envColor where --env-color is given, else white where the scene has no lights, else none).
+  std::string env;
+  std::string envColor;  // "R,G,B"; "" = white
+  float envStrength = 1.0f;
+  float envRotate = 0.0f;  // degrees about +Y
 };
+
+// "R,G,B": three finite non-negative numbers. Throws InputError naming --env-color.
+void parseColor(const std::string& text, float rgb[3]);
 
 // "A-B" or "A" (non-negative, A <= B). Throws InputError naming --frames.
 FrameRange parseFrameRange(const std::string& text);

@@ -95,8 +95,13 @@ int runRender(const RenderOptions& o) {
   installInterruptHandlers();
   validateRenderOptions(o);
   const Scene scene = loadScene(o.scene);
-  if (scene.emissiveTriangleCount() == 0 && scene.lights.empty() && !o.quiet)
-    std::cerr << "warning: " << o.scene << ": no lights; frames will be black\n";
+  if (sceneHasNoLights(scene) && !o.quiet) {
+    if (o.env.empty() && o.envColor.empty())
+      std::cerr << "note: " << o.scene
+                << ": no lights; lit by a uniform white environment (--env none keeps it dark)\n";
+    else if (o.env == "none")
+      std::cerr << "warning: " << o.scene << ": no lights and --env none; frames will be black\n";
+  }
   // Unwritable output is found before the kernels are built, not after the first frame.
   checkWritable(formatOutPath(o.outPattern, o.framesGiven ? o.frames.first : 0));
   std::unique_ptr<StatsFile> stats;

@@ -38,6 +38,26 @@ int checkedCamera(const Scene& scene, const RenderOptions& o) {
 
 }  // namespace
 
+Environment resolveEnvironment(const RenderOptions& o, const Scene& scene) {
+  if (o.env == "none") return Environment{};
+  float color[3] = {1.0f, 1.0f, 1.0f};
+  if (!o.envColor.empty()) parseColor(o.envColor, color);
+  Environment env;
+  if (!o.env.empty())
+    env = loadEnvironment(o.env);
+  else if (!o.envColor.empty() || sceneHasNoLights(scene))
+    env = constantEnvironment(glm::vec3(1.0f));
+  else
+    return env;
+  env.scale = glm::vec3(color[0], color[1], color[2]) * o.envStrength;
+  env.rotation = o.envRotate * float(M_PI / 180.0);
+  return env;
+}
+
+bool sceneHasNoLights(const Scene& scene) {
+  return scene.emissiveTriangleCount() == 0 && scene.lights.empty();
+}
+
 void validateRenderOptions(const RenderOptions& o) {
   validateOutPattern(o.outPattern);
   if (o.spp < 1 || o.spp > 1 << 20)
@@ -59,6 +79,14 @@ void validateRenderOptions(const RenderOptions& o) {
   if (!(o.connectionMis >= 0.0f) || !std::isfinite(o.connectionMis))
     throw InputError("--connection-mis: must be 0 (off) or positive");
   if (!std::isfinite(o.exposure)) throw InputError("--exposure: must be finite");
+  if (!(o.envStrength >= 0.0f) || !std::isfinite(o.envStrength))
+    throw InputError("--env-strength: must be 0 or positive");
+  if (!std::isfinite(o.envRotate)) throw InputError("--env-rotate: must be finite");
+  if (!o.envColor.empty()) {
+    float rgb[3];
+    parseColor(o.envColor, rgb);
+    if (o.env == "none") throw InputError("--env-color: contradicts --env none");
+  }
 }
 
 RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
@@ -73,6 +101,7 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
   sceneOptions.forceDiffuse = options.forceDiffuse;
   sceneOptions.lightSampler = options.lightSampler;
   sceneOptions.bvhWidth = options.bvhWidth;
+  sceneOptions.environment = resolveEnvironment(options, scene);
   gpu_ = std::make_unique<GpuScene>(ctx_, scene, sceneOptions);
   film_ = std::make_unique<Film>(ctx_, width_, height_);
   const RenderOptions& o = options_;

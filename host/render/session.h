@@ -19,6 +19,14 @@ namespace pr {
 // Checks the options that do not need the scene; throws InputError naming the option.
 void validateRenderOptions(const RenderOptions& o);
 
+// Neither an emissive triangle nor a punctual light.
+bool sceneHasNoLights(const Scene& scene);
+
+// The environment the options ask for: a map, a colour, none, or (no option given, a scene
+// with no lights) a uniform white one, as model viewers light such scenes. Throws InputError
+// naming the map file where it cannot be read.
+Environment resolveEnvironment(const RenderOptions& o, const Scene& scene);
+
 class RenderSession {
  public:
   // `scene` must outlive the session. Picks the camera and image size, builds the device scene

@@ -76,4 +76,25 @@ bool decodeImageRgba8(const std::vector<uint8_t>& encoded, DecodedImage* out, st
   return true;
 }
 
+bool decodeImageRgbFloat(const std::vector<uint8_t>& encoded, int* width, int* height,
+                         std::vector<float>* rgb, std::string* why) {
+  if (encoded.empty() || encoded.size() > size_t(INT_MAX)) {
+    *why = encoded.empty() ? "no image data" : "image data too large";
+    return false;
+  }
+  if (!plausibleImage(encoded, why)) return false;
+  int w = 0, h = 0, channels = 0;
+  float* pixels = stbi_loadf_from_memory(encoded.data(), int(encoded.size()), &w, &h, &channels, 3);
+  if (!pixels) {
+    const char* reason = stbi_failure_reason();
+    *why = reason ? reason : "unknown format";
+    return false;
+  }
+  *width = w;
+  *height = h;
+  rgb->assign(pixels, pixels + size_t(w) * size_t(h) * 3);
+  stbi_image_free(pixels);
+  return true;
+}
+
 }  // namespace pr

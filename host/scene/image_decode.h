@@ -20,4 +20,8 @@ constexpr uint64_t kMaxImagePixels = uint64_t(8192) * 8192;
 // kMaxImagePixels, or (PNG) hold a chunk longer than the data.
 bool decodeImageRgba8(const std::vector<uint8_t>& encoded, DecodedImage* out, std::string* why);
 
+// The same checks; linear RGB floats (3 per pixel), as Radiance .hdr files hold them.
+bool decodeImageRgbFloat(const std::vector<uint8_t>& encoded, int* width, int* height,
+                         std::vector<float>* rgb, std::string* why);
+
 }  // namespace pr

@@ -28,9 +28,8 @@ void generateTangents(TriangleMesh& mesh, const std::vector<uint8_t>& uvSet) {
   const size_t nv = mesh.vertexCount();
   std::vector<glm::vec3> sumT(nv, glm::vec3(0.0f)), sumB(nv, glm::vec3(0.0f));
   for (size_t t = 0; t < mesh.triangleCount(); ++t) {
-    const std::vector<glm::vec2>& uvs = (t < uvSet.size() && uvSet[t] && !mesh.uvs1.empty())
-                                            ? mesh.uvs1
-                                            : mesh.uvs;
+    const std::vector<glm::vec2>& uvs =
+        (t < uvSet.size() && uvSet[t] && !mesh.uvs1.empty()) ? mesh.uvs1 : mesh.uvs;
     if (uvs.size() < nv) continue;
     const uint32_t i[3] = {mesh.indices[3 * t], mesh.indices[3 * t + 1], mesh.indices[3 * t + 2]};
     const glm::vec3 e1 = mesh.positions[i[1]] - mesh.positions[i[0]];
@@ -43,7 +42,8 @@ void generateTangents(TriangleMesh& mesh, const std::vector<uint8_t>& uvSet) {
     if (!usable(dpdu) || !usable(dpdv)) continue;
     for (int k = 0; k < 3; ++k) {
       const glm::vec3& p = mesh.positions[i[k]];
-      const glm::vec3 a = mesh.positions[i[(k + 1) % 3]] - p, b = mesh.positions[i[(k + 2) % 3]] - p;
+      const glm::vec3 a = mesh.positions[i[(k + 1) % 3]] - p,
+                      b = mesh.positions[i[(k + 2) % 3]] - p;
       if (!usable(a) || !usable(b)) continue;
       const float angle =
           std::acos(glm::clamp(glm::dot(glm::normalize(a), glm::normalize(b)), -1.0f, 1.0f));

@@ -17,7 +17,19 @@ __kernel void pt_shade(PR_SCENE_PARAMS, __global PathState* states, __global con
 
   const Hit hit = hits[i];
   if (hit.prim == PR_INVALID_INDEX) {
-    p.alive = 0u;  // no environment light: escaped paths carry nothing
+    // Escaped: the environment's light, MIS-weighted against next-event estimation.
+    const float3 d = make_float3(p.ray.dx, p.ray.dy, p.ray.dz);
+    const float3 le = environment_radiance(&s, d);
+    if (max3(le) > 0.0f) {
+      float w = 1.0f;
+      if (!(p.flags & PR_PATH_SPECULAR))
+        w = power_heuristic(p.last_pdf,
+                            environment_pdf(&s, make_float3(p.prev_x, p.prev_y, p.prev_z),
+                                            make_float3(p.prev_nx, p.prev_ny, p.prev_nz), d));
+      const float3 add = make_float3(p.tp_r, p.tp_g, p.tp_b) * le * w;
+      radiance[i] += (float4)(add.x, add.y, add.z, 0.0f);
+    }
+    p.alive = 0u;
     states[i] = p;
     return;
   }

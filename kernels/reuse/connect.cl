@@ -362,7 +362,14 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
     for (uint chain = 0u; depth < rp.max_depth; ++chain) {
       Hit hit;
       ++bounce_rays;
-      if (!trace_closest(&s, ray, &hit)) break;
+      if (!trace_closest(&s, ray, &hit)) {
+        // The environment: the sample from x shares it with next-event estimation at x.
+        const float3 le = environment_radiance(&s, d);
+        if (max3(le) > 0.0f)
+          L += t2 * le *
+               (chain == 0u ? power_heuristic(pdf, environment_pdf(&s, x.h.p, x.f.n, d)) : 1.0f);
+        break;
+      }
       const SurfaceHit h = surface_at(&s.sd, hit.prim, hit.inst, hit.u, hit.v);
       const EyePoint y = eye_point(&s, &h, -d, t2, depth + 1u);
       const int is_delta = bsdf_is_delta(&y.f.bsdf);

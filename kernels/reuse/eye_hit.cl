@@ -21,7 +21,10 @@ __kernel void eye_hit(PR_SCENE_PARAMS, ReuseParams rp, CameraParams cam, uint sa
   uint bounces = 0u;
   for (uint depth = 1u; depth <= rp.max_depth; ++depth) {
     Hit hit;
-    if (!trace_closest(&s, ray, &hit)) break;
+    if (!trace_closest(&s, ray, &hit)) {
+      L += tp * environment_radiance(&s, d);  // seen directly or through delta bounces
+      break;
+    }
     const SurfaceHit h = surface_at(&s.sd, hit.prim, hit.inst, hit.u, hit.v);
     const float3 wo = -d;
     if (s.sd.materials[h.material].flags & PR_MAT_EMISSIVE) L += tp * surface_emission(&s, &h);

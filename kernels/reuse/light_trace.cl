@@ -55,15 +55,25 @@ __kernel void light_trace(PR_SCENE_PARAMS, ReuseParams rp, __global const float*
                         : make_float3(0.0f, 0.0f, 0.0f);
     prim0 = L.prim;
     inst0 = L.inst;
-  } else if (L.type == PR_LIGHT_DIRECTIONAL) {
-    // Parallel rays from a disk that covers the scene's bounding sphere.
-    light_sample_emit_dir(&L, n0, u4, u5, &dir);
+  } else if (L.type == PR_LIGHT_DIRECTIONAL || L.type == PR_LIGHT_ENV) {
+    // Parallel rays from a disk that covers the scene's bounding sphere; the environment's
+    // direction from its importance map (Le / pdf of the direction).
+    float3 le = make_float3(L.le_r, L.le_g, L.le_b);
+    if (L.type == PR_LIGHT_ENV) {
+      float3 wi = make_float3(0.0f, 1.0f, 0.0f);
+      float pdf_w;
+      if (!env_sample(&L, s.lights.env, u4, u5, &wi, &pdf_w, &le)) pdf_w = 0.0f;
+      dir = -wi;
+      le = pdf_w > 0.0f ? le / pdf_w : make_float3(0.0f, 0.0f, 0.0f);
+    } else {
+      light_sample_emit_dir(&L, n0, u4, u5, &dir);
+    }
     float3 t, bt;
     orthonormal_basis(dir, &t, &bt);
     const float3 d = sample_cosine_hemisphere(u1, u2);  // its xy is uniform on the unit disk
     const float r = rp.scene_radius;
     p0 = make_float3(rp.cx, rp.cy, rp.cz) - dir * (1.01f * r) + (t * d.x + bt * d.y) * r;
-    tp = make_float3(L.le_r, L.le_g, L.le_b) * (PR_PI * r * r / pmf);
+    tp = le * (PR_PI * r * r / pmf);
   } else {
     p0 = make_float3(L.p0x, L.p0y, L.p0z);
     const float pdf_dir = light_sample_emit_dir(&L, n0, u4, u5, &dir);

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "shared/bvh.h"
+#include "shared/environment.h"
 #include "shared/lights.h"
 #include "shared/rng.h"
 #include "shared/shading.h"
@@ -104,6 +105,23 @@ PR_INLINE float emitter_pdf(const SceneData* s, const SurfaceHit* h, float3 ref,
   return light_pdf_triangle(pmf, ref, n_ref, h->p, v0, e1, e2);
 }
 
+// Radiance from the environment along dir, for a ray that leaves the scene (0 without one).
+PR_INLINE float3 environment_radiance(const SceneData* s, float3 dir) {
+  if (s->lights.env_light == PR_INVALID_INDEX) return make_float3(0.0f, 0.0f, 0.0f);
+  const Light l = s->lights.lights[s->lights.env_light];
+  return env_radiance(&l, s->lights.env, dir);
+}
+
+// The pdf that next-event estimation at `ref`, with shading normal n_ref, would have had for
+// reaching the environment along dir.
+PR_INLINE float environment_pdf(const SceneData* s, float3 ref, float3 n_ref, float3 dir) {
+  if (s->lights.env_light == PR_INVALID_INDEX) return 0.0f;
+  const float pmf = light_choice_pmf(&s->lights, s->lights.env_light, ref, n_ref);
+  if (!(pmf > 0.0f)) return 0.0f;
+  const Light l = s->lights.lights[s->lights.env_light];
+  return pmf * env_pdf(&l, s->lights.env, dir);
+}
+
 // Next-event estimation at a non-delta surface: chooses a light for this point and a point on
 // it. Returns 1 with the shadow ray and the unoccluded contribution (to be multiplied by the
 // path throughput), or 0 when the sample carries nothing. With use_mis, area lights are
@@ -122,7 +140,15 @@ PR_INLINE int next_event(const SceneData* s, const SurfaceHit* h, const ShadingF
   const Light l = s->lights.lights[idx];
   LightSample ls;
   float b1, b2;
-  if (!light_sample(&l, pmf, h->p, f->n, u1, u2, &ls, &b1, &b2)) return 0;
+  if (l.type == PR_LIGHT_ENV) {
+    float pdf_w;
+    if (!env_sample(&l, s->lights.env, u1, u2, &ls.wi, &pdf_w, &ls.le)) return 0;
+    ls.pdf = pmf * pdf_w;
+    ls.delta = 0;
+    ls.dist = PR_INF_F;
+  } else if (!light_sample(&l, pmf, h->p, f->n, u1, u2, &ls, &b1, &b2)) {
+    return 0;
+  }
   if (dot(ls.wi, f->ng) <= 0.0f) return 0;  // below the geometric surface
   float3 le = ls.le;
   if (l.type == PR_LIGHT_TRIANGLE) {

@@ -14,6 +14,7 @@ PR_NAMESPACE_BEGIN
 #define PR_LIGHT_POINT 1u
 #define PR_LIGHT_SPOT 2u
 #define PR_LIGHT_DIRECTIONAL 3u
+#define PR_LIGHT_ENV 4u  // the environment (shared/environment.h): last in the table
 
 // 96 bytes.
 typedef struct {
@@ -30,6 +31,7 @@ typedef struct {
   u32 material;
   u32 moved;  // changed since the previous frame (for invalidation)
   u32 leaf;   // the light's node in the light BVH; PR_INVALID_INDEX for directional lights
+              // and the environment
   float pad2, pad3;
 } Light;
 
@@ -262,6 +264,8 @@ PR_INLINE float light_power(const Light* l, float scene_radius) {
   if (l->type == PR_LIGHT_POINT) return 4.0f * PR_PI * lum;
   if (l->type == PR_LIGHT_SPOT)
     return 2.0f * PR_PI * (1.0f - 0.5f * (l->cos_inner + l->cos_outer)) * lum;
+  if (l->type == PR_LIGHT_ENV)  // radiance over all directions through the scene's disk
+    return 4.0f * PR_PI * PR_PI * scene_radius * scene_radius * lum * l->area;
   return PR_PI * scene_radius * scene_radius * lum;
 }
 
@@ -330,9 +334,11 @@ typedef struct {
   // Per shading triangle: its light (SSG), or its rank among its mesh's emissive triangles (DSG,
   // added to the instance's first_light); PR_INVALID_INDEX where it is no light.
   PR_GLOBAL const u32* prim_light;
+  PR_GLOBAL const float* env;  // the environment's map and tables (shared/environment.h)
   u32 count;
-  u32 tree_count;  // directional lights come after the tree's
+  u32 tree_count;  // directional lights and the environment come after the tree's
   float total_power;
+  u32 env_light;  // the environment's index, or PR_INVALID_INDEX
 } LightData;
 
 // Chooses a light for the receiver at p with shading normal n (zero: none) with u; *pmf is the
@@ -382,23 +388,27 @@ PR_NAMESPACE_END
 #define PR_LIGHT_PARAMS                                                             \
   __global const Light *pr_lights, __global const float *pr_light_cdf,              \
       __global const LightNode *pr_light_nodes, __global const uint *pr_prim_light, \
-      uint pr_light_count, uint pr_light_tree_count, float pr_total_power
+      __global const float *pr_env, uint pr_light_count, uint pr_light_tree_count,  \
+      float pr_total_power, uint pr_env_light
 PR_INLINE LightData pr_light_data(__global const Light* l, __global const float* cdf,
                                   __global const LightNode* nodes, __global const uint* prim_light,
-                                  uint count, uint tree_count, float total) {
+                                  __global const float* env, uint count, uint tree_count,
+                                  float total, uint env_light) {
   LightData d;
   d.lights = l;
   d.cdf = cdf;
   d.nodes = nodes;
   d.prim_light = prim_light;
+  d.env = env;
   d.count = count;
   d.tree_count = tree_count;
   d.total_power = total;
+  d.env_light = env_light;
   return d;
 }
-#define PR_LIGHTS()                                                                     \
-  pr_light_data(pr_lights, pr_light_cdf, pr_light_nodes, pr_prim_light, pr_light_count, \
-                pr_light_tree_count, pr_total_power)
+#define PR_LIGHTS()                                                                             \
+  pr_light_data(pr_lights, pr_light_cdf, pr_light_nodes, pr_prim_light, pr_env, pr_light_count, \
+                pr_light_tree_count, pr_total_power, pr_env_light)
 #endif
 
 PR_STATIC_ASSERT(sizeof(pr::dev::Light) == 96, "Light layout");
