@@ -185,9 +185,7 @@ TEST(Environment, ReadsExrAndRadianceHdr) {
   };
   refused(dir + "/missing.exr", "missing.exr");
   refused(dir + "/map.png", "must be .exr or .hdr");
-  {
-    std::ofstream(dir + "/bad.hdr") << "not a radiance file";
-  }
+  { std::ofstream(dir + "/bad.hdr") << "not a radiance file"; }
   refused(dir + "/bad.hdr", "cannot read the environment map");
   img.rgba[4] = -1.0f;
   writeExr(dir + "/negative.exr", img, ExrPixels::Float);

@@ -194,13 +194,15 @@ TEST(SceneLoader, AssimpValidModelsLoad) {
   ASSERT_EQ(tryLoad(d + "/cameras/Cameras.gltf", &s), "");
   EXPECT_GE(s.fileCameraCount(), 1u);
   ASSERT_EQ(tryLoad(d + "/textureTransform/TextureTransformTest.gltf", &s), "");
-  // Morph targets and skins: loaded in the bind pose with exactly one warning about it.
+  // Morph targets and skins: deforming dynamic meshes, without a warning.
   ASSERT_EQ(tryLoad(d + "/glTF-Sample-Models/AnimatedMorphCube-glTF/AnimatedMorphCube.gltf", &s),
             "");
-  EXPECT_EQ(s.warnings.size(), 1u);
-  EXPECT_GT(s.staticTriangleCount(), 0u);
+  EXPECT_TRUE(s.warnings.empty());
+  EXPECT_EQ(s.deformingTriangleCount(), 12u);
   ASSERT_EQ(tryLoad(d + "/simple_skin/simple_skin.gltf", &s), "");
-  EXPECT_EQ(s.warnings.size(), 1u);
+  EXPECT_TRUE(s.warnings.empty());
+  EXPECT_EQ(s.deformingTriangleCount(), 8u);
+  ASSERT_EQ(s.skins.size(), 1u);
   // Non-triangle modes are skipped with a warning.
   ASSERT_EQ(tryLoad(d + "/glTF-Asset-Generator/Mesh_PrimitiveMode/Mesh_PrimitiveMode_01.gltf", &s),
             "");

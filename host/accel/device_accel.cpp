@@ -38,14 +38,14 @@ void DeviceAccel::uploadStatic(Context& ctx, const StaticAccel& ssg) {
          false);
 }
 
-void DeviceAccel::uploadMeshes(Context& ctx, const DynamicAccel& dsg) {
+void DeviceAccel::uploadMeshes(Context& ctx, const DynamicAccel& dsg, bool grow) {
   if (dsg.width() != width_)
     throw RuntimeError("DeviceAccel: dynamic BVHs are " + std::to_string(dsg.width()) +
                        " wide, the kernels take " + std::to_string(width_));
   upload(ctx, meshNodes_, "dynamic mesh BVH nodes", dsg.meshNodes().data(),
-         byteSize(dsg.meshNodes()), false);
+         byteSize(dsg.meshNodes()), grow);
   upload(ctx, meshTris_, "dynamic mesh triangles", dsg.meshPackets().data(),
-         byteSize(dsg.meshPackets()), false);
+         byteSize(dsg.meshPackets()), grow);
 }
 
 void DeviceAccel::uploadFrame(Context& ctx, const DynamicAccel& dsg) {

@@ -16,8 +16,9 @@ class DeviceAccel {
   int width() const { return width_; }
 
   void uploadStatic(Context& ctx, const StaticAccel& ssg);
-  // The meshes' BVHs (once, after the last addMesh).
-  void uploadMeshes(Context& ctx, const DynamicAccel& dsg);
+  // The meshes' BVHs (after the last addMesh, and again after replaceMesh: grow leaves room
+  // for a deforming mesh's BVH to grow).
+  void uploadMeshes(Context& ctx, const DynamicAccel& dsg, bool grow = false);
   // This frame's TLAS and instance records; buffers grow as needed and are reused.
   void uploadFrame(Context& ctx, const DynamicAccel& dsg);
 

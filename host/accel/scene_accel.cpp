@@ -1,5 +1,7 @@
 #include "accel/scene_accel.h"
 
+#include "util/check.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -127,6 +129,7 @@ uint32_t DynamicAccel::addMesh(const std::vector<glm::vec3>& positions,
   m.primBase = primBase;
   m.bounds = bvh.bounds;
   m.stats = bvh.stats;
+  parts_.push_back({bvh.wide.words, bvh.packets, bvh.triangles});
   // Rebase to absolute indices in the concatenated buffers.
   rebaseWide(bvh.wide.words, width_, m.rootNode, uint32_t(meshPackets_.size()));
   meshNodes_.insert(meshNodes_.end(), bvh.wide.words.begin(), bvh.wide.words.end());
@@ -135,6 +138,38 @@ uint32_t DynamicAccel::addMesh(const std::vector<glm::vec3>& positions,
   nextPrimBase_ = std::max(nextPrimBase_, primBase + m.triangleCount);
   meshes_.push_back(m);
   return uint32_t(meshes_.size() - 1);
+}
+
+void DynamicAccel::replaceMesh(uint32_t index, const std::vector<glm::vec3>& positions,
+                               const std::vector<uint32_t>& indices, const BuildOptions& options) {
+  PR_CHECK(index < meshes_.size());
+  const std::string what = "dynamic mesh " + std::to_string(index);
+  BuildOptions o = options;
+  o.width = width_;
+  Mesh& m = meshes_[index];
+  TriangleBvh bvh = buildTriangleBvh(positions, indices, m.primBase, o, what.c_str());
+  m.triangleCount = uint32_t(bvh.triangles.size());
+  m.bounds = bvh.bounds;
+  m.stats = bvh.stats;
+  parts_[index] = {std::move(bvh.wide.words), std::move(bvh.packets), std::move(bvh.triangles)};
+  concatenate();
+}
+
+void DynamicAccel::concatenate() {
+  meshNodes_.clear();
+  meshPackets_.clear();
+  meshTris_.clear();
+  for (size_t i = 0; i < meshes_.size(); ++i) {
+    Mesh& m = meshes_[i];
+    const Part& p = parts_[i];
+    m.rootNode = meshNodeCount();
+    m.firstTriangle = uint32_t(meshTris_.size());
+    std::vector<uint32_t> words = p.words;
+    rebaseWide(words, width_, m.rootNode, uint32_t(meshPackets_.size()));
+    meshNodes_.insert(meshNodes_.end(), words.begin(), words.end());
+    meshPackets_.insert(meshPackets_.end(), p.packets.begin(), p.packets.end());
+    meshTris_.insert(meshTris_.end(), p.triangles.begin(), p.triangles.end());
+  }
 }
 
 namespace {

@@ -85,6 +85,11 @@ class DynamicAccel {
   uint32_t addMesh(const std::vector<glm::vec3>& positions, const std::vector<uint32_t>& indices,
                    uint32_t primBase, const BuildOptions& options = {});
 
+  // Builds mesh m's BVH again over new vertex positions (a deforming mesh: same triangles, same
+  // prim numbers). The concatenated arrays are rebuilt; setInstances must follow.
+  void replaceMesh(uint32_t m, const std::vector<glm::vec3>& positions,
+                   const std::vector<uint32_t>& indices, const BuildOptions& options = {});
+
   // This frame: world bounds of every instance and the top-level BVH over them. Instances of
   // empty meshes or with a singular or non-finite transform cannot be hit and are left out.
   // Throws InputError on a mesh index out of range.
@@ -112,8 +117,16 @@ class DynamicAccel {
     Aabb bounds;
     BvhStats stats;
   };
+  // One mesh's BVH with mesh-relative references, kept to concatenate again.
+  struct Part {
+    std::vector<uint32_t> words;
+    std::vector<dev::BvhTriPacket> packets;
+    std::vector<dev::BvhTriangle> triangles;
+  };
+  void concatenate();
   int width_;
   std::vector<Mesh> meshes_;
+  std::vector<Part> parts_;
   uint32_t nextPrimBase_ = 0;
   std::vector<uint32_t> meshNodes_;
   std::vector<dev::BvhTriPacket> meshPackets_;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstring>
+#include <map>
 
 #include <glm/gtc/matrix_inverse.hpp>
 
@@ -193,6 +194,11 @@ GpuScene::GpuScene(Context& ctx, const Scene& scene, const GpuSceneOptions& opti
     sceneCentre_ = b.centre();
   }
   uploadShading();
+  deformed_.resize(scene.dynamicMeshes.size());
+  lastPositions_.resize(scene.dynamicMeshes.size());
+  lastNormals_.resize(scene.dynamicMeshes.size());
+  for (size_t m = 0; m < scene.dynamicMeshes.size(); ++m)
+    if (scene.meshDeforms(m)) deformed_[m] = scene.dynamicMeshes[m];
   // The environment's map and sampling tables (a placeholder float without one).
   std::vector<float> envData = {0.0f};
   if (options_.environment.present())
@@ -222,29 +228,37 @@ cl::Buffer GpuScene::upload(const char* name, const void* data, uint64_t bytes, 
   return b;
 }
 
+namespace {
+
+dev::ShadingVertex shadingVertex(const TriangleMesh& m, size_t v) {
+  dev::ShadingVertex sv{};
+  sv.px = m.positions[v].x, sv.py = m.positions[v].y, sv.pz = m.positions[v].z;
+  if (v < m.normals.size()) sv.nx = m.normals[v].x, sv.ny = m.normals[v].y, sv.nz = m.normals[v].z;
+  if (v < m.uvs.size()) sv.u = m.uvs[v].x, sv.v = m.uvs[v].y;
+  const glm::vec2 uv1 = v < m.uvs1.size() ? m.uvs1[v] : glm::vec2(sv.u, sv.v);
+  sv.u1 = uv1.x, sv.v1 = uv1.y;
+  const glm::vec4 t = v < m.tangents.size() ? m.tangents[v] : glm::vec4(1, 0, 0, 1);
+  sv.tx = t.x, sv.ty = t.y, sv.tz = t.z, sv.tw = t.w;
+  return sv;
+}
+
+}  // namespace
+
 void GpuScene::uploadShading() {
   std::vector<dev::ShadingVertex> verts;
   std::vector<dev::ShadingTriangle> tris;
   auto addMesh = [&](const TriangleMesh& m) {
     const uint32_t base = static_cast<uint32_t>(verts.size());
-    for (size_t v = 0; v < m.vertexCount(); ++v) {
-      dev::ShadingVertex sv{};
-      sv.px = m.positions[v].x, sv.py = m.positions[v].y, sv.pz = m.positions[v].z;
-      if (v < m.normals.size())
-        sv.nx = m.normals[v].x, sv.ny = m.normals[v].y, sv.nz = m.normals[v].z;
-      if (v < m.uvs.size()) sv.u = m.uvs[v].x, sv.v = m.uvs[v].y;
-      const glm::vec2 uv1 = v < m.uvs1.size() ? m.uvs1[v] : glm::vec2(sv.u, sv.v);
-      sv.u1 = uv1.x, sv.v1 = uv1.y;
-      const glm::vec4 t = v < m.tangents.size() ? m.tangents[v] : glm::vec4(1, 0, 0, 1);
-      sv.tx = t.x, sv.ty = t.y, sv.tz = t.z, sv.tw = t.w;
-      verts.push_back(sv);
-    }
+    for (size_t v = 0; v < m.vertexCount(); ++v) verts.push_back(shadingVertex(m, v));
     for (size_t t = 0; t < m.triangleCount(); ++t)
       tris.push_back({base + m.indices[3 * t], base + m.indices[3 * t + 1],
                       base + m.indices[3 * t + 2], m.materials[t]});
   };
   addMesh(scene_.staticMesh);
-  for (const TriangleMesh& m : scene_.dynamicMeshes) addMesh(m);
+  for (const TriangleMesh& m : scene_.dynamicMeshes) {
+    meshFirstVertex_.push_back(static_cast<uint32_t>(verts.size()));
+    addMesh(m);
+  }
 
   std::vector<dev::Material> mats;
   for (const Material& m : scene_.materials)
@@ -283,7 +297,35 @@ void GpuScene::uploadShading() {
   texels_ = upload("texels", texels.data(), texels.size() * 4, &shadingBytes_);
 }
 
+bool GpuScene::deformMeshes(double t, std::vector<bool>* changed) {
+  bool any = false;
+  changed->assign(scene_.dynamicMeshes.size(), false);
+  for (size_t m = 0; m < scene_.dynamicMeshes.size(); ++m) {
+    if (!scene_.meshDeforms(m)) continue;
+    TriangleMesh& shape = deformed_[m];
+    scene_.deformMesh(m, t, &shape);
+    const bool same =
+        !firstFrame_ && shape.positions == lastPositions_[m] && shape.normals == lastNormals_[m];
+    if (same) continue;
+    lastPositions_[m] = shape.positions;
+    lastNormals_[m] = shape.normals;
+    (*changed)[m] = any = true;
+    accel::BuildOptions build;
+    build.width = bvhWidth_;
+    dsg_.replaceMesh(static_cast<uint32_t>(m), shape.positions, shape.indices, build);
+    std::vector<dev::ShadingVertex> verts(shape.vertexCount());
+    for (size_t v = 0; v < verts.size(); ++v) verts[v] = shadingVertex(shape, v);
+    CL_CHECK(ctx_.queue().enqueueWriteBuffer(
+        vertices_, CL_TRUE, meshFirstVertex_[m] * sizeof(dev::ShadingVertex),
+        verts.size() * sizeof(dev::ShadingVertex), verts.data()));
+  }
+  if (any) deviceAccel_.uploadMeshes(ctx_, dsg_, true);
+  return any;
+}
+
 void GpuScene::setTime(double t) {
+  std::vector<bool> reshaped;
+  deformMeshes(t, &reshaped);
   const size_t n = scene_.instances.size();
   std::vector<accel::InstanceInput> inputs(n);
   instances_.resize(n);
@@ -299,7 +341,9 @@ void GpuScene::setTime(double t) {
     s.first_triangle = meshFirstTriangle_[scene_.instances[i].mesh];
     s.mesh = scene_.instances[i].mesh;
     s.first_light = instanceFirstLight_[i];
-    const bool moved = firstFrame_ || std::memcmp(&m, &lastTransforms_[i], sizeof m) != 0;
+    // A deformed mesh moves its instance: light paths on it or through where it is change.
+    const bool moved = firstFrame_ || std::memcmp(&m, &lastTransforms_[i], sizeof m) != 0 ||
+                       reshaped[scene_.instances[i].mesh];
     s.moved = moved ? 1u : 0u;
     anyMoved_ = anyMoved_ || moved;
     lastTransforms_[i] = m;
@@ -335,11 +379,22 @@ std::vector<dev::Light> GpuScene::lightsAt(double t) const {
   std::vector<dev::Light> lights = staticEmitters_;
   std::vector<glm::mat4> xforms(scene_.instances.size());
   std::vector<bool> have(scene_.instances.size(), false);
+  std::map<uint32_t, TriangleMesh> shapes;  // deforming meshes with emitters, at t
   for (const DynamicEmitter& e : dynamicEmitters_) {
     if (!have[e.instance])
       xforms[e.instance] = scene_.instanceTransform(e.instance, t), have[e.instance] = true;
     const glm::mat4& x = xforms[e.instance];
-    const TriangleMesh& m = scene_.dynamicMeshes[scene_.instances[e.instance].mesh];
+    const uint32_t mesh = scene_.instances[e.instance].mesh;
+    const TriangleMesh* shape = &scene_.dynamicMeshes[mesh];
+    if (scene_.meshDeforms(mesh)) {
+      auto it = shapes.find(mesh);
+      if (it == shapes.end()) {
+        it = shapes.emplace(mesh, scene_.dynamicMeshes[mesh]).first;
+        scene_.deformMesh(mesh, t, &it->second);
+      }
+      shape = &it->second;
+    }
+    const TriangleMesh& m = *shape;
     auto w = [&](uint32_t v) { return glm::vec3(x * glm::vec4(m.positions[v], 1.0f)); };
     dev::Light l = triangleLight(
         w(m.indices[3 * e.triangle]), w(m.indices[3 * e.triangle + 1]),

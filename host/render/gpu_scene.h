@@ -73,6 +73,9 @@ class GpuScene {
 
  private:
   void uploadShading();
+  // Deforming meshes at t: their BVHs built again and shading vertices uploaded where their
+  // shape changed (*changed, per dynamic mesh). Returns whether any did.
+  bool deformMeshes(double t, std::vector<bool>* changed);
   void buildLights(double t);
   std::vector<dev::Light> lightsAt(double t) const;
   cl::Buffer upload(const char* name, const void* data, uint64_t bytes, uint64_t* counter);
@@ -87,6 +90,9 @@ class GpuScene {
 
   uint32_t staticTriangles_ = 0;
   std::vector<uint32_t> meshFirstTriangle_;  // per dynamic mesh, in the shading triangle array
+  std::vector<uint32_t> meshFirstVertex_;    // per dynamic mesh, in the shading vertex array
+  std::vector<TriangleMesh> deformed_;       // per dynamic mesh: its shape this frame
+  std::vector<std::vector<glm::vec3>> lastPositions_, lastNormals_;
   std::vector<dev::ShadingInstance> instances_;
   std::vector<glm::mat4> lastTransforms_;
   bool firstFrame_ = true;

@@ -13,11 +13,12 @@
 namespace pr {
 
 enum class Interpolation : uint32_t { Linear = 0, Step = 1, CubicSpline = 2 };
-enum class AnimationPath : uint32_t { Translation = 0, Rotation = 1, Scale = 2 };
+enum class AnimationPath : uint32_t { Translation = 0, Rotation = 1, Scale = 2, Weights = 3 };
 
 // Key times (strictly increasing, finite) and values. Values hold 3 (translation, scale:
-// w unused) or 4 (rotation quaternion x, y, z, w) components. For CUBICSPLINE each key has
-// three values in a row: in-tangent, value, out-tangent.
+// w unused) or 4 (rotation quaternion x, y, z, w) components, or 4 morph weights (a weights
+// channel is split into one sampler per 4 targets). For CUBICSPLINE each key has three values
+// in a row: in-tangent, value, out-tangent.
 struct AnimationSampler {
   std::vector<float> times;
   std::vector<glm::vec4> values;
@@ -31,12 +32,13 @@ struct AnimationChannel {
   int sampler = 0;  // index into the animation's samplers
   int node = -1;
   AnimationPath path = AnimationPath::Translation;
+  int firstWeight = 0;  // Weights: the sampler's 4 values are morph weights firstWeight...+3
 };
 
 struct Animation {
   std::string name;
   std::vector<AnimationSampler> samplers;
-  std::vector<AnimationChannel> channels;  // translation/rotation/scale only
+  std::vector<AnimationChannel> channels;
 };
 
 // Which channel of which animation drives a node.

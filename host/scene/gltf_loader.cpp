@@ -225,6 +225,7 @@ class Loader {
     checkCamerasAndLights();
     checkMeshes();
     checkNodesAndScenes();
+    checkSkins();
     checkAnimations();
     build();
     return std::move(scene_);
@@ -702,6 +703,14 @@ class Loader {
         {TINYGLTF_TYPE_SCALAR},
         {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
          TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT}};
+    const AccessorRule joints{
+        {TINYGLTF_TYPE_VEC4},
+        {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT}};
+    const AccessorRule weights{
+        {TINYGLTF_TYPE_VEC4},
+        {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
+         TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
+        true};
     for (size_t mi = 0; mi < model_.meshes.size(); ++mi) {
       const auto& mesh = model_.meshes[mi];
       for (size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
@@ -723,6 +732,10 @@ class Loader {
             checkRule(acc, tangent, at);
           else if (name == "TEXCOORD_0" || name == "TEXCOORD_1")
             checkRule(acc, texcoord, at);
+          else if (name.rfind("JOINTS_", 0) == 0)
+            checkRule(acc, joints, at);
+          else if (name.rfind("WEIGHTS_", 0) == 0)
+            checkRule(acc, weights, at);
           else
             checkAccessor(acc, at);
           const size_t c = model_.accessors[size_t(acc)].count;
@@ -734,9 +747,45 @@ class Loader {
           first = false;
         }
         if (p.indices >= 0 || p.indices < -1) checkRule(p.indices, indices, where + ", indices");
+        if (p.targets.size() != mesh.primitives[0].targets.size())
+          fail("primitives have different numbers of morph targets", where);
         for (size_t ti = 0; ti < p.targets.size(); ++ti)
-          for (const auto& [name, acc] : p.targets[ti])
-            checkAccessor(acc, where + ", morph target " + std::to_string(ti) + " " + name);
+          for (const auto& [name, acc] : p.targets[ti]) {
+            const std::string at = where + ", morph target " + std::to_string(ti) + " " + name;
+            if (name == "POSITION" || name == "NORMAL")
+              checkRule(acc, position, at);
+            else
+              checkAccessor(acc, at);
+            if (model_.accessors[size_t(acc)].count != count)
+              fail("has " + std::to_string(model_.accessors[size_t(acc)].count) + " values for " +
+                       std::to_string(count) + " vertices",
+                   at);
+          }
+        if (!mesh.weights.empty() && mesh.weights.size() != p.targets.size())
+          fail("weights has " + std::to_string(mesh.weights.size()) + " numbers for " +
+                   std::to_string(p.targets.size()) + " morph targets",
+               named("mesh", int(mi), mesh.name));
+      }
+    }
+  }
+
+  // --- skins -----------------------------------------------------------------------------------
+
+  void checkSkins() {
+    const AccessorRule mat4{{TINYGLTF_TYPE_MAT4}, {TINYGLTF_COMPONENT_TYPE_FLOAT}};
+    for (size_t si = 0; si < model_.skins.size(); ++si) {
+      const auto& s = model_.skins[si];
+      const std::string where = named("skin", int(si), s.name);
+      if (s.joints.empty()) fail("has no joints", where);
+      for (int j : s.joints)
+        if (j < 0 || size_t(j) >= model_.nodes.size())
+          fail("joint node " + std::to_string(j) + " does not exist", where);
+      if (s.inverseBindMatrices >= 0 || s.inverseBindMatrices < -1) {
+        checkRule(s.inverseBindMatrices, mat4, where + ", inverseBindMatrices");
+        if (model_.accessors[size_t(s.inverseBindMatrices)].count < s.joints.size())
+          fail("inverseBindMatrices has fewer matrices than the " +
+                   std::to_string(s.joints.size()) + " joints",
+               where);
       }
     }
   }
@@ -783,6 +832,7 @@ class Loader {
       checkArray(node.rotation, 4, "rotation");
       checkArray(node.scale, 3, "scale");
       checkArray(node.matrix, 16, "matrix");
+      if (!allFinite(node.weights)) fail("weights is not finite", where);
       if (node.rotation.size() == 4) {
         const double len2 =
             node.rotation[0] * node.rotation[0] + node.rotation[1] * node.rotation[1] +
@@ -827,6 +877,12 @@ class Loader {
   void checkAnimations() {
     const AccessorRule times{{TINYGLTF_TYPE_SCALAR}, {TINYGLTF_COMPONENT_TYPE_FLOAT}};
     const AccessorRule vec3{{TINYGLTF_TYPE_VEC3}, {TINYGLTF_COMPONENT_TYPE_FLOAT}};
+    const AccessorRule weightValues{
+        {TINYGLTF_TYPE_SCALAR},
+        {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE,
+         TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_SHORT,
+         TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
+        true};
     const AccessorRule quat{{TINYGLTF_TYPE_VEC4},
                             {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE,
                              TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_SHORT,
@@ -855,11 +911,22 @@ class Loader {
           fail("unknown interpolation \"" + s.interpolation + "\"", swhere);
         checkRule(s.input, times, swhere + ", input");
         checkAccessor(s.output, swhere + ", output");
+        if (ch.target_node < 0) continue;  // target given by an extension we do not know
         if (path == "weights") {
-          unsupportedMorph_ = true;
+          checkRule(s.output, weightValues, swhere + ", output");
+          // One sampler per 4 targets, each a vec4 channel of its own.
+          const std::vector<AnimationSampler> parts = readWeightSamplers(anim, ch.sampler, swhere);
+          for (size_t k = 0; k < parts.size(); ++k) {
+            AnimationChannel c;
+            c.sampler = int(out.samplers.size());
+            c.node = ch.target_node;
+            c.path = AnimationPath::Weights;
+            c.firstWeight = int(4 * k);
+            out.samplers.push_back(parts[k]);
+            out.channels.push_back(c);
+          }
           continue;
         }
-        if (ch.target_node < 0) continue;  // target given by an extension we do not know
         const auto& node = model_.nodes[size_t(ch.target_node)];
         if (!node.matrix.empty())
           fail("node " + std::to_string(ch.target_node) + " is animated but has a matrix", where);
@@ -924,6 +991,45 @@ class Loader {
     return out;
   }
 
+  // A morph weights sampler (n scalars per key, 3n for CUBICSPLINE) as ceil(n / 4) samplers of
+  // vec4s, targets 4k .. 4k + 3 in part k.
+  std::vector<AnimationSampler> readWeightSamplers(const tinygltf::Animation& anim, int index,
+                                                   const std::string& where) {
+    const auto& s = anim.samplers[size_t(index)];
+    AnimationSampler proto;
+    proto.interpolation = s.interpolation == "STEP"          ? Interpolation::Step
+                          : s.interpolation == "CUBICSPLINE" ? Interpolation::CubicSpline
+                                                             : Interpolation::Linear;
+    const std::vector<double> in = readAccessor(s.input);
+    if (proto.interpolation == Interpolation::CubicSpline && in.size() < 2)
+      fail("CUBICSPLINE needs at least 2 keys, the input has " + std::to_string(in.size()), where);
+    for (size_t i = 0; i < in.size(); ++i) {
+      if (!finite(in[i])) fail("input time " + std::to_string(i) + " is not finite", where);
+      if (i > 0 && !(float(in[i]) > float(in[i - 1])))
+        fail("input times are not strictly increasing at key " + std::to_string(i), where);
+      proto.times.push_back(float(in[i]));
+    }
+    const size_t perKey = proto.interpolation == Interpolation::CubicSpline ? 3 : 1;
+    const std::vector<double> values = readAccessor(s.output);
+    const size_t slots = in.size() * perKey;
+    if (slots == 0 || values.size() % slots != 0 || values.empty())
+      fail("output has " + std::to_string(values.size()) + " weights, not a multiple of the " +
+               std::to_string(slots) + " key values",
+           where);
+    const size_t n = values.size() / slots;
+    for (double v : values)
+      if (!finite(v)) fail("output has a weight that is not finite", where);
+    std::vector<AnimationSampler> parts((n + 3) / 4, proto);
+    for (size_t k = 0; k < parts.size(); ++k)
+      for (size_t slot = 0; slot < slots; ++slot) {
+        glm::vec4 v(0.0f);
+        for (size_t c = 0; c < 4 && 4 * k + c < n; ++c)
+          v[int(c)] = float(values[slot * n + 4 * k + c]);
+        parts[k].values.push_back(v);
+      }
+    return parts;
+  }
+
   // --- building the scene ----------------------------------------------------------------------
 
   static glm::mat4 toMat4(const std::vector<double>& m) {
@@ -956,11 +1062,16 @@ class Loader {
       if (src.scale.size() == 3) dst.scale = glm::vec3(src.scale[0], src.scale[1], src.scale[2]);
       if (const Value* d = member(src.extras, "dynamic"))
         dst.dynamic = d->IsBool() && d->Get<bool>();
+      for (double w : src.weights) dst.weights.push_back(float(w));
     }
     for (uint32_t a = 0; a < scene_.animations.size(); ++a)
       for (uint32_t c = 0; c < scene_.animations[a].channels.size(); ++c) {
-        Node& node = scene_.nodes[size_t(scene_.animations[a].channels[c].node)];
-        node.animated = true;
+        const AnimationChannel& ch = scene_.animations[a].channels[c];
+        Node& node = scene_.nodes[size_t(ch.node)];
+        if (ch.path == AnimationPath::Weights)
+          node.weightsAnimated = true;
+        else
+          node.animated = true;
         node.channels.push_back({a, c});
       }
     // The loaded scene: the default one, else scene 0.
@@ -1022,6 +1133,21 @@ class Loader {
           anyNormalMap || scene_.materials[size_t(materialIndex(p.material))].normalTexture.valid();
     }
     std::vector<uint8_t> normalUvSet;  // per triangle: the uv set its normal map reads
+    // Skin and morph data: as many JOINTS_n sets as the primitive with most, the targets'
+    // POSITION (and NORMAL where any primitive has it) deltas.
+    size_t jointSets = 0, targets = 0;
+    bool targetNormals = false;
+    for (const auto& p : mesh.primitives) {
+      while (p.attributes.count("JOINTS_" + std::to_string(jointSets)) &&
+             p.attributes.count("WEIGHTS_" + std::to_string(jointSets)))
+        ++jointSets;
+      targets = std::max(targets, p.targets.size());
+      for (const auto& t : p.targets) targetNormals = targetNormals || t.count("NORMAL");
+    }
+    out.influences = int(4 * jointSets);
+    out.morphPositions.resize(targets);
+    out.morphNormals.resize(targets);
+    for (double w : mesh.weights) out.morphWeights.push_back(float(w));
     for (size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
       const auto& p = mesh.primitives[pi];
       const std::string where =
@@ -1036,7 +1162,6 @@ class Loader {
                ": only TRIANGLES are rendered (first: " + where + ")");
         continue;
       }
-      if (!p.targets.empty()) unsupportedMorph_ = true;
       const auto pos = p.attributes.find("POSITION");
       if (pos == p.attributes.end()) {
         warn("skipping a primitive without POSITION (" + where + ")");
@@ -1117,6 +1242,52 @@ class Loader {
           if (!finite(uv[2 * v]) || !finite(uv[2 * v + 1]))
             fail("TEXCOORD_1 is not finite", where + ", TEXCOORD_1");
           out.uvs1.emplace_back(uv[2 * v], uv[2 * v + 1]);
+        }
+      }
+      if (jointSets > 0) {
+        std::vector<std::vector<double>> js(jointSets), ws(jointSets);
+        for (size_t set = 0; set < jointSets; ++set) {
+          const auto j = p.attributes.find("JOINTS_" + std::to_string(set));
+          const auto w = p.attributes.find("WEIGHTS_" + std::to_string(set));
+          if (j != p.attributes.end() && w != p.attributes.end()) {
+            js[set] = readAccessor(j->second);
+            ws[set] = readAccessor(w->second);
+          }
+        }
+        for (size_t v = 0; v < vcount; ++v) {
+          double sum = 0.0;
+          const size_t first = out.jointWeights.size();
+          for (size_t set = 0; set < jointSets; ++set)
+            for (size_t c = 0; c < 4; ++c) {
+              const bool have = !js[set].empty();
+              const double w = have ? ws[set][4 * v + c] : 0.0;
+              if (!finite(w) || w < 0.0)
+                fail("WEIGHTS_" + std::to_string(set) + " has a negative or non-finite weight",
+                     where);
+              out.joints.push_back(have ? uint32_t(js[set][4 * v + c]) : 0u);
+              out.jointWeights.push_back(float(w));
+              sum += w;
+            }
+          // The spec asks for weights that add to 1; normalise what is given.
+          if (sum > 0.0)
+            for (size_t k = first; k < out.jointWeights.size(); ++k)
+              out.jointWeights[k] = float(out.jointWeights[k] / sum);
+        }
+      }
+      for (size_t ti = 0; ti < targets; ++ti) {
+        const auto* t = ti < p.targets.size() ? &p.targets[ti] : nullptr;
+        std::vector<double> dp, dn;
+        if (t && t->count("POSITION")) dp = readAccessor(t->at("POSITION"));
+        if (t && t->count("NORMAL")) dn = readAccessor(t->at("NORMAL"));
+        for (size_t v = 0; v < vcount; ++v) {
+          glm::vec3 d(0.0f), n(0.0f);
+          if (!dp.empty()) d = glm::vec3(dp[3 * v], dp[3 * v + 1], dp[3 * v + 2]);
+          if (!dn.empty()) n = glm::vec3(dn[3 * v], dn[3 * v + 1], dn[3 * v + 2]);
+          if (!finite(d.x) || !finite(d.y) || !finite(d.z) || !finite(n.x) || !finite(n.y) ||
+              !finite(n.z))
+            fail("morph target " + std::to_string(ti) + " is not finite", where);
+          out.morphPositions[ti].push_back(d);
+          if (targetNormals) out.morphNormals[ti].push_back(n);
         }
       }
       if (anyTangents) {
@@ -1315,6 +1486,49 @@ class Loader {
     return ref;
   }
 
+  void buildSkins() {
+    for (size_t si = 0; si < model_.skins.size(); ++si) {
+      const auto& s = model_.skins[si];
+      Skin k;
+      k.name = s.name;
+      k.joints = s.joints;
+      k.inverseBind.assign(s.joints.size(), glm::mat4(1.0f));
+      if (s.inverseBindMatrices >= 0) {
+        const std::vector<double> m = readAccessor(s.inverseBindMatrices);
+        for (size_t j = 0; j < s.joints.size(); ++j) {
+          const std::vector<double> one(m.begin() + long(16 * j), m.begin() + long(16 * j + 16));
+          if (!allFinite(one))
+            fail("inverse bind matrix " + std::to_string(j) + " is not finite",
+                 named("skin", int(si), s.name));
+          k.inverseBind[j] = toMat4(one);
+        }
+      }
+      scene_.skins.push_back(k);
+    }
+  }
+
+  // A deforming mesh (skinned, or morphed by animated weights): a dynamic mesh of this node
+  // alone, deformed each frame (Scene::deformMesh).
+  void addDeforming(size_t node, const TriangleMesh& mesh, int skin) {
+    const std::string where = named("node", int(node), scene_.nodes[node].name);
+    if (skin >= 0) {
+      const size_t n = scene_.skins[size_t(skin)].joints.size();
+      for (uint32_t j : mesh.joints)
+        if (j >= n)
+          fail(
+              "JOINTS refer to joint " + std::to_string(j) + " of a skin with " + std::to_string(n),
+              where);
+    }
+    const uint32_t index = uint32_t(scene_.dynamicMeshes.size());
+    scene_.dynamicMeshes.push_back(mesh);
+    scene_.dynamicMeshBounds.push_back(mesh.bounds());
+    Deformer d;
+    d.skin = skin;
+    d.node = int(node);
+    scene_.deformers.push_back(d);
+    scene_.instances.push_back({index, int(node), scene_.nodes[node].name});
+  }
+
   void buildDefaultCamera() {
     CameraDef c;
     c.name = "default";
@@ -1340,23 +1554,51 @@ class Loader {
     buildNodes();
     buildMaterials();
     meshCache_.clear();
+    buildSkins();
     std::map<int, uint32_t> dynamicIndex;  // glTF mesh -> dynamic mesh
     std::set<int> staticMeshes;
     for (size_t i = 0; i < scene_.nodes.size(); ++i) {
       const Node& node = scene_.nodes[i];
       if (!node.inScene) continue;
       const auto& src = model_.nodes[i];
-      if (src.skin >= 0) unsupportedSkin_ = true;
       if (node.mesh >= 0) {
-        const TriangleMesh& mesh = objectMesh(node.mesh);
+        const TriangleMesh& shared = objectMesh(node.mesh);
+        const bool skinned = src.skin >= 0 && shared.influences > 0;
+        const bool morphing = !shared.morphPositions.empty() && node.weightsAnimated;
+        if (skinned || morphing) {
+          addDeforming(i, shared, skinned ? src.skin : -1);
+          continue;
+        }
+        // Morph targets at fixed weights: applied once; the mesh is then this node's own.
+        std::optional<TriangleMesh> baked;
+        if (!shared.morphPositions.empty()) {
+          baked = shared;
+          const std::vector<float> w = scene_.morphWeightsAt(int(i), shared, 0.0);
+          for (size_t k = 0; k < w.size(); ++k)
+            for (size_t v = 0; v < baked->vertexCount(); ++v) {
+              baked->positions[v] += w[k] * shared.morphPositions[k][v];
+              if (!shared.morphNormals[k].empty())
+                baked->normals[v] += w[k] * shared.morphNormals[k][v];
+            }
+          for (glm::vec3& n : baked->normals) {
+            const float l = glm::length(n);
+            if (l > 0.0f && std::isfinite(l)) n /= l;
+          }
+          baked->morphPositions.clear();
+          baked->morphNormals.clear();
+        }
+        const TriangleMesh& mesh = baked ? *baked : shared;
         if (node.dynamic) {
-          auto it = dynamicIndex.find(node.mesh);
+          const auto it = baked ? dynamicIndex.end() : dynamicIndex.find(node.mesh);
+          uint32_t index = it != dynamicIndex.end() ? it->second : 0u;
           if (it == dynamicIndex.end()) {
-            it = dynamicIndex.emplace(node.mesh, uint32_t(scene_.dynamicMeshes.size())).first;
+            index = uint32_t(scene_.dynamicMeshes.size());
+            if (!baked) dynamicIndex.emplace(node.mesh, index);
             scene_.dynamicMeshes.push_back(mesh);
             scene_.dynamicMeshBounds.push_back(mesh.bounds());
+            scene_.deformers.emplace_back();
           }
-          scene_.instances.push_back({it->second, int(i), node.name});
+          scene_.instances.push_back({index, int(i), node.name});
         } else {
           flatten(mesh, node.restWorld);
           if (staticMeshes.insert(node.mesh).second)
@@ -1401,13 +1643,6 @@ class Loader {
         scene_.cameras.push_back(d);
       }
     }
-    if (!model_.skins.empty()) unsupportedSkin_ = true;
-    if (unsupportedMorph_ || unsupportedSkin_) {
-      std::string what = unsupportedMorph_ && unsupportedSkin_ ? "morph targets and skins are"
-                         : unsupportedMorph_                   ? "morph targets are"
-                                                               : "skins are";
-      warn(what + " not supported: rendering the bind pose");
-    }
     scene_.bounds = scene_.sceneBounds();
     if (scene_.cameras.empty()) buildDefaultCamera();
   }
@@ -1426,8 +1661,6 @@ class Loader {
   std::map<std::pair<int, bool>, int> textureIndex_;
   int defaultMaterial_ = -1;
   std::set<int> skippedModes_;
-  bool unsupportedMorph_ = false;
-  bool unsupportedSkin_ = false;
 };
 
 }  // namespace

@@ -56,6 +56,8 @@ glm::mat4 Scene::nodeLocalTransform(int node, double t) const {
       case AnimationPath::Scale:
         scale = sampleVec3(s, t);
         break;
+      case AnimationPath::Weights:
+        break;  // the mesh's shape, not the node's transform
     }
   }
   return glm::translate(glm::mat4(1.0f), translation) * glm::mat4_cast(rotation) *
@@ -70,7 +72,83 @@ glm::mat4 Scene::nodeWorldTransform(int node, double t) const {
 }
 
 glm::mat4 Scene::instanceTransform(size_t instance, double t) const {
-  return nodeWorldTransform(instances.at(instance).node, t);
+  const Instance& in = instances.at(instance);
+  // A skinned mesh is placed by its joints alone.
+  if (in.mesh < deformers.size() && deformers[in.mesh].skin >= 0) return glm::mat4(1.0f);
+  return nodeWorldTransform(in.node, t);
+}
+
+std::vector<float> Scene::morphWeightsAt(int node, const TriangleMesh& mesh, double t) const {
+  const size_t n = mesh.morphPositions.size();
+  std::vector<float> w = mesh.morphWeights;
+  if (node >= 0 && !nodes[size_t(node)].weights.empty()) w = nodes[size_t(node)].weights;
+  w.resize(n, 0.0f);
+  if (node < 0 || !nodes[size_t(node)].weightsAnimated) return w;
+  for (const ChannelRef& ref : nodes[size_t(node)].channels) {
+    const Animation& a = animations[ref.animation];
+    const AnimationChannel& c = a.channels[ref.channel];
+    if (c.path != AnimationPath::Weights) continue;
+    const glm::vec4 v = sampleRaw(a.samplers[size_t(c.sampler)], t);
+    for (int k = 0; k < 4; ++k)
+      if (size_t(c.firstWeight + k) < n) w[size_t(c.firstWeight + k)] = v[k];
+  }
+  return w;
+}
+
+void Scene::deformMesh(size_t m, double t, TriangleMesh* out) const {
+  const TriangleMesh& base = dynamicMeshes.at(m);
+  if (!meshDeforms(m)) return;
+  const Deformer& d = deformers[m];
+  const size_t nv = base.vertexCount();
+  out->positions = base.positions;
+  out->normals = base.normals;
+  out->tangents = base.tangents;
+  if (!base.morphPositions.empty()) {
+    const std::vector<float> w = morphWeightsAt(d.node, base, t);
+    for (size_t k = 0; k < w.size(); ++k) {
+      if (w[k] == 0.0f) continue;
+      for (size_t v = 0; v < nv; ++v) out->positions[v] += w[k] * base.morphPositions[k][v];
+      if (!base.morphNormals[k].empty())
+        for (size_t v = 0; v < nv; ++v) out->normals[v] += w[k] * base.morphNormals[k][v];
+    }
+  }
+  if (d.skin >= 0 && base.influences > 0) {
+    const Skin& skin = skins[size_t(d.skin)];
+    std::vector<glm::mat4> joint(skin.joints.size());
+    for (size_t j = 0; j < joint.size(); ++j)
+      joint[j] = nodeWorldTransform(skin.joints[j], t) * skin.inverseBind[j];
+    const size_t k = size_t(base.influences);
+    for (size_t v = 0; v < nv; ++v) {
+      glm::mat4 s(0.0f);
+      float total = 0.0f;
+      for (size_t i = 0; i < k; ++i) {
+        const float w = base.jointWeights[v * k + i];
+        if (w != 0.0f) s += w * joint[base.joints[v * k + i]];
+        total += w;
+      }
+      if (!(total > 0.0f)) s = glm::mat4(1.0f);  // no weights: the bind pose
+      const glm::mat3 lin(s);
+      out->positions[v] = glm::vec3(s * glm::vec4(out->positions[v], 1.0f));
+      // Normals by the cofactor matrix (the inverse transpose up to a positive factor).
+      const float det = glm::determinant(lin);
+      glm::vec3 n = (det != 0.0f ? glm::transpose(glm::inverse(lin)) * det : lin) * out->normals[v];
+      if (det < 0.0f) n = -n;
+      out->normals[v] = n;
+      if (!out->tangents.empty()) {
+        const glm::vec3 tg = lin * glm::vec3(out->tangents[v]);
+        out->tangents[v] = glm::vec4(tg, out->tangents[v].w * (det < 0.0f ? -1.0f : 1.0f));
+      }
+    }
+  }
+  for (size_t v = 0; v < nv; ++v) {
+    const float l = glm::length(out->normals[v]);
+    out->normals[v] = l > 0.0f && std::isfinite(l) ? out->normals[v] / l : base.normals[v];
+    if (!out->tangents.empty()) {
+      const glm::vec3 tg(out->tangents[v]);
+      const float tl = glm::length(tg);
+      if (tl > 0.0f && std::isfinite(tl)) out->tangents[v] = glm::vec4(tg / tl, out->tangents[v].w);
+    }
+  }
 }
 
 namespace {
@@ -118,10 +196,22 @@ PunctualLight Scene::lightAt(size_t light, double t) const {
   return l;
 }
 
+namespace {
+
+// Instance i's world bounds at t: its mesh's bounds placed, or its deformed vertices.
+Bounds instanceBounds(const Scene& s, size_t i, double t) {
+  const uint32_t m = s.instances[i].mesh;
+  if (!s.meshDeforms(m)) return s.dynamicMeshBounds[m].transformed(s.instanceTransform(i, t));
+  TriangleMesh shape = s.dynamicMeshes[m];
+  s.deformMesh(m, t, &shape);
+  return shape.bounds().transformed(s.instanceTransform(i, t));
+}
+
+}  // namespace
+
 Bounds Scene::boundsAt(double t) const {
   Bounds b = staticMesh.bounds();
-  for (size_t i = 0; i < instances.size(); ++i)
-    b.extend(dynamicMeshBounds[instances[i].mesh].transformed(instanceTransform(i, t)));
+  for (size_t i = 0; i < instances.size(); ++i) b.extend(instanceBounds(*this, i, t));
   return b;
 }
 
@@ -133,8 +223,7 @@ Bounds Scene::sceneBounds() const {
   const int samples = 64;
   for (int k = 0; k <= samples; ++k) {
     const double t = duration * k / samples;
-    for (size_t i = 0; i < instances.size(); ++i)
-      b.extend(dynamicMeshBounds[instances[i].mesh].transformed(instanceTransform(i, t)));
+    for (size_t i = 0; i < instances.size(); ++i) b.extend(instanceBounds(*this, i, t));
   }
   return b;
 }
@@ -151,6 +240,13 @@ size_t Scene::frameCount(double fps) const {
   const double d = animationDuration();
   if (!(d > 0.0) || !(fps > 0.0)) return 1;
   return static_cast<size_t>(std::floor(d * fps + 1e-9)) + 1;
+}
+
+size_t Scene::deformingTriangleCount() const {
+  size_t n = 0;
+  for (const Instance& i : instances)
+    if (meshDeforms(i.mesh)) n += dynamicMeshes[i.mesh].triangleCount();
+  return n;
 }
 
 size_t Scene::dynamicTriangleCount() const {

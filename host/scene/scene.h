@@ -48,6 +48,13 @@ struct TriangleMesh {
   std::vector<glm::vec4> tangents;  // empty, or one per vertex (xyz, w = handedness)
   std::vector<uint32_t> indices;    // 3 per triangle
   std::vector<uint32_t> materials;  // one per triangle, index into Scene::materials
+  // Deformation (glTF skins and morph targets); empty for rigid meshes.
+  int influences = 0;               // joint/weight pairs per vertex (4 per JOINTS_n set)
+  std::vector<uint32_t> joints;     // vertexCount * influences, indices into the skin's joints
+  std::vector<float> jointWeights;  // vertexCount * influences
+  std::vector<std::vector<glm::vec3>> morphPositions;  // per target: per-vertex deltas
+  std::vector<std::vector<glm::vec3>> morphNormals;    // per target: empty or per-vertex deltas
+  std::vector<float> morphWeights;                     // the mesh's default weights
 
   size_t triangleCount() const { return indices.size() / 3; }
   size_t vertexCount() const { return positions.size(); }
@@ -177,10 +184,28 @@ struct Node {
   bool animated = false;             // target of a translation/rotation/scale channel
   bool dynamic = false;              // it or an ancestor is animated or marked "dynamic": true
   bool moves = false;                // it or an ancestor is animated: world transform depends on t
+  bool weightsAnimated = false;      // target of a morph weights channel
+  std::vector<float> weights;        // morph weights (empty: the mesh's)
   std::vector<ChannelRef> channels;  // the channels that target it
   glm::mat4 restWorld{1.0f};         // world transform with no animation applied
 
   glm::mat4 restLocal() const;
+};
+
+// A glTF skin: the joints (node indices) and their inverse bind matrices.
+struct Skin {
+  std::string name;
+  std::vector<int> joints;
+  std::vector<glm::mat4> inverseBind;  // one per joint
+};
+
+// How a dynamic mesh deforms, if it does: skinned by a skin's joints (then in world space: the
+// placing node's transform does not apply, as glTF says) and/or blended with the mesh's morph
+// targets by the node's (animated) weights. Such a mesh belongs to one node alone.
+struct Deformer {
+  int skin = -1;  // index into Scene::skins, -1: not skinned
+  int node = -1;  // the node that places the mesh; -1: the mesh does not deform
+  bool deforms() const { return node >= 0; }
 };
 
 // One DSG instance: an object-space mesh placed by an (animated or dynamic) node.
@@ -197,6 +222,8 @@ struct Scene {
   std::vector<TriangleMesh> dynamicMeshes;  // DSG, object space, one per glTF mesh used
   std::vector<Instance> instances;          // DSG instances
   std::vector<Bounds> dynamicMeshBounds;    // object-space bounds of each dynamic mesh
+  std::vector<Deformer> deformers;          // one per dynamic mesh
+  std::vector<Skin> skins;
 
   std::vector<Material> materials;
   std::vector<Texture> textures;
@@ -218,6 +245,13 @@ struct Scene {
   glm::mat4 nodeWorldTransform(int node, double t) const;
   glm::mat4 instanceTransform(size_t instance, double t) const;
   CameraPose cameraAt(int camera, double t) const;
+  // The morph weights of the node's mesh at t (animated, else the node's, else the mesh's).
+  std::vector<float> morphWeightsAt(int node, const TriangleMesh& mesh, double t) const;
+  // Dynamic mesh m as it is at time t: morphed, then skinned (positions, normals, tangents).
+  // `out` starts as a copy of the mesh; a rigid mesh stays as it is.
+  void deformMesh(size_t m, double t, TriangleMesh* out) const;
+  // Whether dynamic mesh m deforms over the animation.
+  bool meshDeforms(size_t m) const { return m < deformers.size() && deformers[m].deforms(); }
   PunctualLight lightAt(size_t light, double t) const;
   Bounds boundsAt(double t) const;  // static geometry and every instance at t
   Bounds sceneBounds() const;       // union of boundsAt over samples of the animation
@@ -236,7 +270,8 @@ struct Scene {
     return staticEmissiveTriangleCount() + dynamicEmissiveTriangleCount();
   }
   size_t dynamicLightCount() const;
-  size_t fileCameraCount() const;  // cameras that come from the file
+  size_t deformingTriangleCount() const;  // of the dynamic meshes that deform
+  size_t fileCameraCount() const;         // cameras that come from the file
 };
 
 }  // namespace pr

@@ -8,6 +8,17 @@ namespace {
 nlohmann::ordered_json vec3Json(const glm::vec3& v) {
   return {v.x, v.y, v.z};
 }
+// Dynamic meshes that deform: skinned ones (morph targets or not), morphing-only ones.
+void deformingCounts(const Scene& scene, size_t* skinned, size_t* morphing) {
+  for (size_t m = 0; m < scene.dynamicMeshes.size(); ++m) {
+    if (!scene.meshDeforms(m)) continue;
+    if (scene.deformers[m].skin >= 0)
+      ++*skinned;
+    else
+      ++*morphing;
+  }
+}
+
 }  // namespace
 
 nlohmann::ordered_json sceneInfoJson(const Scene& scene, double fps) {
@@ -16,8 +27,13 @@ nlohmann::ordered_json sceneInfoJson(const Scene& scene, double fps) {
   j["triangles"] = {{"static", scene.staticTriangleCount()},
                     {"dynamic", scene.dynamicTriangleCount()},
                     {"static_per_mesh", scene.staticMeshTriangles}};
+  size_t skinned = 0, morphing = 0;
+  deformingCounts(scene, &skinned, &morphing);
   j["instances"] = {{"dynamic", scene.instances.size()},
-                    {"dynamic_meshes", scene.dynamicMeshes.size()}};
+                    {"dynamic_meshes", scene.dynamicMeshes.size()},
+                    {"skinned_meshes", skinned},
+                    {"morphing_meshes", morphing},
+                    {"deforming_triangles", scene.deformingTriangleCount()}};
   j["materials"] = scene.materials.size();
   j["textures"] = scene.textures.size();
   j["lights"] = {{"emissive_triangles", scene.emissiveTriangleCount()},
@@ -48,6 +64,11 @@ std::string sceneInfoText(const Scene& scene, double fps) {
   s << "\n";
   s << "instances:  " << scene.instances.size() << " dynamic, of " << scene.dynamicMeshes.size()
     << " meshes\n";
+  size_t skinned = 0, morphing = 0;
+  deformingCounts(scene, &skinned, &morphing);
+  if (skinned + morphing > 0)
+    s << "deforming:  " << skinned << " skinned, " << morphing << " morphing mesh(es), "
+      << scene.deformingTriangleCount() << " triangles (dynamic, deformed every frame)\n";
   s << "materials:  " << scene.materials.size() << ", textures: " << scene.textures.size() << "\n";
   s << "lights:     " << scene.emissiveTriangleCount() << " emissive triangles ("
     << scene.dynamicEmissiveTriangleCount() << " dynamic), " << scene.lights.size() << " punctual ("
