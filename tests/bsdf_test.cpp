@@ -24,6 +24,21 @@ BsdfParams microfacet(float3 base, float metallic, float roughness) {
   m.alpha = std::fmax(roughness * roughness, PR_MIN_ALPHA);
   m.ior = 1.5f;
   m.kind = PR_BSDF_MICROFACET;
+  m.f0 = make_float3(0.04f, 0.04f, 0.04f);
+  m.f90 = 1.0f;
+  m.coat = 0.0f;
+  m.coat_alpha = PR_MIN_ALPHA;
+  return m;
+}
+
+// With KHR_materials_specular's coloured F0 and F90 and a clearcoat.
+BsdfParams layered(float3 base, float metallic, float roughness, float3 f0, float f90, float coat,
+                   float coatRoughness) {
+  BsdfParams m = microfacet(base, metallic, roughness);
+  m.f0 = f0;
+  m.f90 = f90;
+  m.coat = coat;
+  m.coat_alpha = std::fmax(coatRoughness * coatRoughness, PR_MIN_ALPHA);
   return m;
 }
 
@@ -220,6 +235,64 @@ TEST(Bsdf, SampledDirectionsFollowThePdfChiSquare) {
     }
   // The test has the power to see a wrong pdf: a 10% tilt fails it.
   EXPECT_LT(bsdfChiSquarePValue(cases[1], dirFromCos(0.9f, 0.4f), 200000, 30u, 0.1f), 1e-6);
+}
+
+// KHR_materials_specular and KHR_materials_clearcoat: sampling agrees with evaluation, the
+// pdf with the sampled directions, reciprocity holds and no energy is created.
+TEST(Bsdf, SpecularColourAndClearcoatSampleWhatTheyEvaluate) {
+  const BsdfParams cases[] = {layered(make_float3(0.8f, 0.3f, 0.1f), 0.0f, 0.5f,
+                                      make_float3(0.2f, 0.05f, 0.02f), 0.6f, 0.0f, 0.0f),
+                              layered(make_float3(0.7f, 0.7f, 0.7f), 0.0f, 0.8f,
+                                      make_float3(0.04f, 0.04f, 0.04f), 1.0f, 1.0f, 0.05f),
+                              layered(make_float3(0.9f, 0.6f, 0.3f), 1.0f, 0.4f,
+                                      make_float3(0.04f, 0.04f, 0.04f), 1.0f, 0.6f, 0.3f),
+                              layered(make_float3(0.5f, 0.5f, 0.5f), 0.3f, 0.2f,
+                                      make_float3(0.3f, 0.3f, 0.3f), 0.2f, 0.8f, 0.6f)};
+  int k = 0;
+  for (const BsdfParams& m : cases) {
+    for (float cos_o : {0.9f, 0.35f}) {
+      SCOPED_TRACE("case " + std::to_string(k) + " cos_o " + std::to_string(cos_o));
+      const float3 wo = dirFromCos(cos_o, 0.7f);
+      const Estimate s = albedoBySampling(m, wo, 80000, 40u + k);
+      const Estimate e = albedoByEval(m, wo, 80000, 60u + k);
+      const double tol = 5 * std::sqrt(s.stderr_ * s.stderr_ + e.stderr_ * e.stderr_) + 2e-3;
+      EXPECT_NEAR(s.mean, e.mean, tol);
+      EXPECT_LE(s.mean, 1.0 + tol);
+      // (The cells' pdf integrals cannot resolve a near-mirror coat: case 1 is left out.)
+      if (m.coat_alpha > 0.01f || m.coat == 0.0f) {
+        EXPECT_GT(bsdfChiSquarePValue(m, wo, 200000, 80u + k), 1e-4);
+      }
+    }
+    Rng r = rng_make(7, PR_RNG_TEST, 0, 0, k);
+    for (int i = 0; i < 300; ++i) {
+      const float3 a = sample_cosine_hemisphere(rng_next(&r), rng_next(&r));
+      const float3 b = sample_cosine_hemisphere(rng_next(&r), rng_next(&r));
+      float p;
+      const float3 fab = bsdf_eval(&m, a, b, &p), fba = bsdf_eval(&m, b, a, &p);
+      EXPECT_NEAR(fab.y, fba.y, 1e-4f * std::fmax(1.0f, fab.y));
+    }
+    ++k;
+  }
+}
+
+TEST(Bsdf, SpecularFactorZeroLeavesTheDiffuseBaseAndCoatAddsAReflection) {
+  // No dielectric reflection at all: the base is pure Lambert.
+  const BsdfParams bare =
+      layered(make_float3(0.6f, 0.5f, 0.4f), 0.0f, 0.5f, make_float3(0, 0, 0), 0.0f, 0.0f, 0.0f);
+  const float3 wo = dirFromCos(0.7f, 0.2f), wi = dirFromCos(0.5f, 2.5f);
+  float pdf;
+  const float3 f = bsdf_eval(&bare, wo, wi, &pdf);
+  EXPECT_FLOAT_EQ(f.x, 0.6f * PR_INV_PI);
+  EXPECT_FLOAT_EQ(f.z, 0.4f * PR_INV_PI);
+  // A smooth coat over it reflects in the mirror direction far more than the base does.
+  BsdfParams coated = bare;
+  coated.coat = 1.0f;
+  coated.coat_alpha = 0.01f;
+  const float3 mirror = make_float3(-wo.x, -wo.y, wo.z);
+  const float3 fc = bsdf_eval(&coated, wo, mirror, &pdf);
+  EXPECT_GT(fc.x, 10.0f * bsdf_eval(&bare, wo, mirror, &pdf).x);
+  // Its Fresnel takes from the base off the mirror direction.
+  EXPECT_LT(bsdf_eval(&coated, wo, wi, &pdf).x, f.x);
 }
 
 TEST(Bsdf, Reciprocity) {

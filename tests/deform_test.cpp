@@ -51,13 +51,14 @@ struct Buffers {
 // 2 to the child joint at y = 1, row 1 half and half. The child turns 90 degrees about +Z from
 // t = 0 to t = 1. The mesh's node is moved by (5, 0, 0), which skinning ignores. With
 // `withRoom`, a floor and a point light, so that light paths meet the strip.
-std::string skinnedStrip(const std::string& tag, bool withRoom = false) {
+// With `rootTurns`, the root joint turns 90 degrees about +Z too (a nested animated chain).
+std::string skinnedStrip(const std::string& tag, bool withRoom = false, bool rootTurns = false) {
   Buffers b;
   const std::vector<float> pos = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 0, 2, 0, 1, 2, 0};
   const uint16_t idx[] = {0, 1, 3, 0, 3, 2, 2, 3, 5, 2, 5, 4};
   const uint8_t joints[] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
-  const std::vector<float> weights = {1, 0, 0, 0, 1,   0,   0, 0, 0.5f, 0.5f, 0, 0,
-                                      0.5f, 0.5f, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+  const std::vector<float> weights = {1,    0,    0, 0, 1, 0, 0, 0, 0.5f, 0.5f, 0, 0,
+                                      0.5f, 0.5f, 0, 0, 1, 0, 0, 0, 1,    0,    0, 0};
   std::vector<float> ibm(32, 0.0f);
   for (int m = 0; m < 2; ++m)
     for (int d = 0; d < 4; ++d) ibm[16 * m + 5 * d] = 1.0f;
@@ -88,12 +89,12 @@ std::string skinnedStrip(const std::string& tag, bool withRoom = false) {
     const int fp = b.floats(floor, 4, "VEC3");
     b.accessors[size_t(fp)]["min"] = {-3, -0.5, -3};
     b.accessors[size_t(fp)]["max"] = {3, -0.5, 3};
-    meshes.push_back(
-        {{"primitives",
-          {{{"attributes", {{"POSITION", fp}}}, {"indices", b.add(fi, sizeof fi, 5123, 6, "SCALAR")}}}}});
+    meshes.push_back({{"primitives",
+                       {{{"attributes", {{"POSITION", fp}}},
+                         {"indices", b.add(fi, sizeof fi, 5123, 6, "SCALAR")}}}}});
     nodes.push_back({{"mesh", 1}});
-    nodes.push_back({{"translation", {1.5, 3, 2}},
-                     {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+    nodes.push_back(
+        {{"translation", {1.5, 3, 2}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
     nodes.push_back({{"camera", 0}, {"translation", {0.5, 1, 5}}});
     roots = {0, 1, 3, 4, 5};
     doc["extensionsUsed"] = {"KHR_lights_punctual"};
@@ -111,6 +112,8 @@ std::string skinnedStrip(const std::string& tag, bool withRoom = false) {
   json anim;
   anim["samplers"] = json::array({sampler});
   anim["channels"] = json::array({channel});
+  if (rootTurns)
+    anim["channels"].push_back({{"sampler", 0}, {"target", {{"node", 1}, {"path", "rotation"}}}});
   doc["animations"] = json::array({anim});
   return b.write(doc, tag);
 }
@@ -173,9 +176,9 @@ std::string morphQuad(const std::string& tag, bool animated, const char* interpo
   doc["scene"] = 0;
   doc["scenes"] = {{{"nodes", {0}}}};
   doc["nodes"] = {{{"mesh", 0}, {"weights", {0.25, 0.0}}}};
-  doc["meshes"] = {{{"primitives",
-                     {{{"attributes", attrs}, {"indices", indices}, {"targets", targets}}}},
-                    {"weights", {0.5, 0.5}}}};
+  doc["meshes"] = {
+      {{"primitives", {{{"attributes", attrs}, {"indices", indices}, {"targets", targets}}}},
+       {"weights", {0.5, 0.5}}}};
   if (animated) {
     const bool cubic = std::string(interpolation) == "CUBICSPLINE";
     const std::vector<float> times = {0, 1};
@@ -226,14 +229,27 @@ TEST(Morph, FixedWeightsAreAppliedOnce) {
   expectVec(s.staticMesh.positions[3], {0, 1, 0});
 }
 
+TEST(Skin, NestedAnimatedJointsCompose) {
+  // Both joints turn 90 degrees: the child's turn happens about its own origin (0, 1, 0),
+  // then the root's turns everything about the world origin.
+  const Scene s = loadScene(skinnedStrip("skin-nested", false, true), quiet());
+  TriangleMesh m = s.dynamicMeshes[0];
+  s.deformMesh(0, 1.0, &m);
+  expectVec(m.positions[1], {0, 1, 0});    // root only: (1, 0, 0) turned
+  expectVec(m.positions[4], {-1, -1, 0});  // child: (-1, 1, 0) as above, then turned
+  expectVec(m.positions[5], {-2, -1, 0});
+  // Halfway, slerp gives 45 degrees each.
+  s.deformMesh(0, 0.5, &m);
+  const float c = std::sqrt(0.5f);
+  expectVec(m.positions[1], {c, c, 0});
+}
+
 TEST(Skin, BrokenSkinsAreRefused) {
   const std::string path = skinnedStrip("skin-bad");
   json doc;
   std::ifstream(path) >> doc;
   auto refused = [&](const json& d, const std::string& what) {
-    {
-      std::ofstream(path) << d.dump();
-    }
+    { std::ofstream(path) << d.dump(); }
     try {
       loadScene(path, quiet());
       ADD_FAILURE() << "loaded; expected: " << what;
@@ -271,6 +287,17 @@ TEST(Skin, ReuseEqualsRetraceWhileTheMeshBends) {
     else
       EXPECT_EQ(retraced, 0u) << "frame " << f << " is after the animation";
   }
+}
+
+// The skinned demo scene (a swaying tentacle and a morphing ball in the Cornell box): reuse
+// equals retrace over 12 frames.
+TEST(Skin, ReuseEqualsRetraceOnTheSkinnedDemo) {
+  const std::string scene = test::sourcePath("scenes/cornell-skinned.gltf");
+  const std::string args = " --width 24 --height 18 --spp 1";
+  const std::string a = test::renderFrames(scene, "0-11", "--mode reuse" + args, "demo-a");
+  const std::string b = test::renderFrames(scene, "0-11", "--mode retrace" + args, "demo-b");
+  for (int f = 0; f <= 11; ++f)
+    EXPECT_EQ(test::frameImage(a, f).rgba, test::frameImage(b, f).rgba) << "frame " << f;
 }
 
 TEST(Morph, ReuseEqualsRetraceWhileTheTargetsBlend) {

@@ -295,13 +295,12 @@ TEST(SceneLoader, QuadDefaultsAndComputedNormals) {
 // An optional extension we do not support is named once in a warning; the file still loads.
 TEST(SceneLoader, UnsupportedOptionalExtensionsAreNamedOnce) {
   Quad q;
-  q.doc["extensionsUsed"] = {"KHR_materials_clearcoat", "KHR_materials_ior", "EXT_foo"};
+  q.doc["extensionsUsed"] = {"KHR_materials_sheen", "KHR_materials_ior", "EXT_foo"};
   Scene s;
   ASSERT_EQ(tryLoad(q.write(), &s), "");
   EXPECT_EQ(s.staticTriangleCount(), 2u);
   ASSERT_EQ(s.warnings.size(), 2u);
-  EXPECT_NE(s.warnings[0].find("extension KHR_materials_clearcoat is not supported"),
-            std::string::npos)
+  EXPECT_NE(s.warnings[0].find("extension KHR_materials_sheen is not supported"), std::string::npos)
       << s.warnings[0];
   EXPECT_NE(s.warnings[1].find("extension EXT_foo is not supported"), std::string::npos)
       << s.warnings[1];
@@ -401,6 +400,52 @@ TEST(SceneLoader, TextureTransformOnEveryTexture) {
   const std::string err = tryLoad(q.write("broken.gltf"), &s);
   EXPECT_NE(err.find("emissiveTexture"), std::string::npos) << err;
   EXPECT_NE(err.find("scale must be 2 finite numbers"), std::string::npos) << err;
+}
+
+// KHR_materials_specular (over KHR_materials_ior) and KHR_materials_clearcoat reach the
+// device material; their textures are named in a warning; bad factors are refused.
+TEST(SceneLoader, SpecularAndClearcoat) {
+  Quad q;
+  q.doc["extensionsUsed"] = {"KHR_materials_specular", "KHR_materials_clearcoat",
+                             "KHR_materials_ior"};
+  q.doc["materials"] = {{{"extensions",
+                          {{"KHR_materials_specular",
+                            {{"specularFactor", 0.5}, {"specularColorFactor", {1.0, 0.5, 40.0}}}},
+                           {"KHR_materials_ior", {{"ior", 2.0}}},
+                           {"KHR_materials_clearcoat",
+                            {{"clearcoatFactor", 0.8},
+                             {"clearcoatRoughnessFactor", 0.1},
+                             {"clearcoatTexture", {{"index", 0}}}}}}}}};
+  q.doc["meshes"][0]["primitives"][0]["material"] = 0;
+  q.doc["images"] = {{{"uri",
+                       "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAIAAAACCAIAAAD91JpzAAAAEkl"
+                       "EQVR4nGP4z8DAAMIM/4EAAB/uBfsL2WiLAAAAAElFTkSuQmCC"}}};
+  q.doc["textures"] = {{{"source", 0}}};
+  Scene s;
+  ASSERT_EQ(tryLoad(q.write(), &s), "");
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_NE(s.warnings[0].find("clearcoatTexture is not applied"), std::string::npos)
+      << s.warnings[0];
+  const dev::Material d = toDeviceMaterial(s.materials[0]);
+  // ((2 - 1) / (2 + 1))^2 = 1/9, times the colour (clamped at 1), times the factor.
+  EXPECT_NEAR(d.spec_f0[0], 0.5f / 9.0f, 1e-6f);
+  EXPECT_NEAR(d.spec_f0[1], 0.25f / 9.0f, 1e-6f);
+  EXPECT_NEAR(d.spec_f0[2], 0.5f, 1e-6f);
+  EXPECT_FLOAT_EQ(d.spec_f90, 0.5f);
+  EXPECT_FLOAT_EQ(d.coat, 0.8f);
+  EXPECT_FLOAT_EQ(d.coat_roughness, 0.1f);
+  // Defaults: F0 0.04 exactly, F90 1, no coat.
+  const dev::Material plain = toDeviceMaterial(Material{});
+  EXPECT_EQ(plain.spec_f0[0], 0.04f);
+  EXPECT_EQ(plain.spec_f90, 1.0f);
+  EXPECT_EQ(plain.coat, 0.0f);
+  q.doc["materials"][0]["extensions"]["KHR_materials_clearcoat"]["clearcoatFactor"] = 1.5;
+  EXPECT_NE(tryLoad(q.write("bad.gltf")).find("KHR_materials_clearcoat clearcoatFactor"),
+            std::string::npos);
+  q.doc["materials"][0]["extensions"]["KHR_materials_clearcoat"]["clearcoatFactor"] = 0.5;
+  q.doc["materials"][0]["extensions"]["KHR_materials_specular"]["specularColorFactor"] = {1, -1, 1};
+  EXPECT_NE(tryLoad(q.write("bad2.gltf")).find("specularColorFactor must be 3 numbers >= 0"),
+            std::string::npos);
 }
 
 TEST(SceneLoader, TextureTransformMath) {

@@ -829,7 +829,7 @@ def main():
     ap.add_argument("--max-depth", type=int, default=8)
     ap.add_argument("--exposure", type=float, default=0.0, help="EV for the contact sheets")
     ap.add_argument("--equal-time-rounds", type=int, default=2)
-    ap.add_argument("--scenes", default="cornell-dynamic,cornell-orbit,atrium")
+    ap.add_argument("--scenes", default="cornell-dynamic,cornell-orbit,cornell-skinned,atrium")
     ap.add_argument("--atrium", default=str(ATRIUM), help="atrium glTF (generated if absent)")
     ap.add_argument("--build", default="build", help="folder holding pathreuse and exr_compare")
     ap.add_argument("--cache", default=None, help="reference cache (default out/evaluate-cache)")
@@ -863,9 +863,9 @@ def main():
     wanted = args.scenes.split(",")
     scenes = []
     for key in wanted:
-        if key in ("cornell-dynamic", "cornell-orbit"):
+        if key in ("cornell-dynamic", "cornell-orbit", "cornell-skinned"):
             scenes.append({"key": key, "path": REPO / "scenes" / f"{key}.gltf",
-                           "camera": "still" if key == "cornell-dynamic" else "moving",
+                           "camera": "moving" if key == "cornell-orbit" else "still",
                            "frames": list(range(args.frames)), "ref_spp": args.ref_spp,
                            "timing_frames": (0, args.timing_frames - 1), "sweep": sweep})
         elif key == "atrium":

@@ -544,6 +544,11 @@ def build(size, light, normal_maps=False):
                                          normal_texture=bumps)
         mats["dark_tiles"] = g.material("dark_tiles", (0.32, 0.3, 0.27), roughness=0.8,
                                         normal_texture=bumps)
+        # polished dark tiles: a clear coat and a tinted specular layer
+        g.doc["materials"][mats["dark_tiles"]]["extensions"] = {
+            "KHR_materials_clearcoat": {"clearcoatFactor": 0.8, "clearcoatRoughnessFactor": 0.15},
+            "KHR_materials_specular": {"specularColorFactor": [1.0, 0.9, 0.8]}}
+        g.extensions.update(("KHR_materials_clearcoat", "KHR_materials_specular"))
     emitters = 0
     static = build_static(c, normal_maps)
     roots = [g.node("atrium", mesh=g.mesh("atrium", [(static[k], mats[k]) for k in mats]))]
@@ -611,7 +616,8 @@ def main():
                     help="emissive sky quad over the opening (default), a KHR_lights_punctual "
                     "sun, or night lit by several hundred small emissive lanterns")
     ap.add_argument("--normal-maps", action="store_true",
-                    help="bevelled courtyard tiles: a normal map (and uvs) on the floor tiles")
+                    help="bevelled courtyard tiles: a normal map (and uvs) on the floor tiles, "
+                    "the dark ones clear-coated")
     args = ap.parse_args()
     if not args.size > 0:
         ap.error("--size must be positive")

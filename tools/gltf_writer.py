@@ -14,7 +14,7 @@ import re
 import struct
 import zlib
 
-FLOAT, USHORT, UINT = 5126, 5123, 5125
+FLOAT, UBYTE, USHORT, UINT = 5126, 5121, 5123, 5125
 ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER = 34962, 34963
 COMPONENTS = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT4": 16}
 CTYPE = {5120: ("b", 1), 5121: ("B", 1), 5122: ("h", 2), 5123: ("H", 2),
@@ -103,6 +103,10 @@ class Mesh:
         self.nrm = []
         self.idx = []
         self.uv = []  # empty, or 2 per vertex
+        self.joints = []   # empty, or 4 joint indices per vertex (a skin's)
+        self.weights = []  # with joints: 4 weights per vertex, adding to 1
+        self.targets = []  # morph targets: per target a list of 3 position deltas per vertex
+        self.target_weights = []  # the mesh's default morph weights
 
     @property
     def vertex_count(self):
@@ -326,14 +330,34 @@ class Gltf:
             attrs = {"POSITION": pos, "NORMAL": nrm}
             if m.uv:
                 attrs["TEXCOORD_0"] = self.accessor(m.uv, FLOAT, "VEC2", ARRAY_BUFFER)
-            prims.append({"attributes": attrs, "indices": idx, "material": mat, "mode": 4})
-        return self._append("meshes", {"name": name, "primitives": prims})
+            if m.joints:
+                attrs["JOINTS_0"] = self.accessor(m.joints, UBYTE, "VEC4", ARRAY_BUFFER)
+                attrs["WEIGHTS_0"] = self.accessor(m.weights, FLOAT, "VEC4", ARRAY_BUFFER)
+            prim = {"attributes": attrs, "indices": idx, "material": mat, "mode": 4}
+            if m.targets:
+                prim["targets"] = [{"POSITION": self.accessor(d, FLOAT, "VEC3", ARRAY_BUFFER,
+                                                              minmax=True)}
+                                   for d in m.targets]
+            prims.append(prim)
+        mesh = {"name": name, "primitives": prims}
+        weights = next((m.target_weights for m, _ in primitives if m.target_weights), None)
+        if weights:
+            mesh["weights"] = f32s(weights)
+        return self._append("meshes", mesh)
+
+    def skin(self, name, joints, inverse_binds):
+        """joints: node indices; inverse_binds: a column-major 4x4 (16 floats) per joint."""
+        ibm = self.accessor([f32(x) for m in inverse_binds for x in m], FLOAT, "MAT4")
+        return self._append("skins", {"name": name, "joints": list(joints),
+                                      "inverseBindMatrices": ibm})
 
     def node(self, name, mesh=None, camera=None, translation=None, rotation=None,
-             children=None, extras=None, extensions=None):
+             children=None, extras=None, extensions=None, skin=None):
         n = {"name": name}
         if mesh is not None:
             n["mesh"] = mesh
+        if skin is not None:
+            n["skin"] = skin
         if camera is not None:
             n["camera"] = camera
         if children:
@@ -364,7 +388,8 @@ class Gltf:
         return len(ext["lights"]) - 1
 
     def animation(self, name, channels):
-        """channels: [(node, path, times, values), ...], LINEAR; values are tuples."""
+        """channels: [(node, path, times, values), ...], LINEAR; values are tuples (for
+        "weights", one weight per morph target)."""
         samplers, chans = [], []
         for node, path, times, values in channels:
             key = tuple(times)
@@ -373,7 +398,8 @@ class Gltf:
             if path == "rotation":
                 values = [normalize4(q) for q in values]
             flat = [c for v in values for c in v]
-            out = self.accessor(flat, FLOAT, "VEC4" if path == "rotation" else "VEC3")
+            kind = {"rotation": "VEC4", "weights": "SCALAR"}.get(path, "VEC3")
+            out = self.accessor(flat, FLOAT, kind)
             samplers.append({"input": self._inputs[key], "output": out,
                              "interpolation": "LINEAR"})
             chans.append({"sampler": len(samplers) - 1,
@@ -390,7 +416,7 @@ class Gltf:
         if self.extensions:
             self.doc["extensionsUsed"] = sorted(self.extensions)
         order = ["asset", "extensionsUsed", "extensions", "scene", "scenes", "nodes",
-                 "cameras", "meshes", "materials", "textures", "images", "samplers",
+                 "cameras", "meshes", "skins", "materials", "textures", "images", "samplers",
                  "animations", "accessors",
                  "bufferViews", "buffers"]
         return {k: self.doc[k] for k in order if k in self.doc}
@@ -596,7 +622,7 @@ def validate(path):
             smp = anim["samplers"][ch["sampler"]]
             target = ch["target"]
             _check(0 <= target["node"] < len(nodes), where + ": bad node")
-            _check(target["path"] in ("translation", "rotation", "scale"),
+            _check(target["path"] in ("translation", "rotation", "scale", "weights"),
                    where + ": unexpected path")
             animated.add(target["node"])
             iacc, t = get(smp["input"])
@@ -607,6 +633,13 @@ def validate(path):
             oacc, out = get(smp["output"])
             _check(smp.get("interpolation", "LINEAR") == "LINEAR",
                    where + ": only LINEAR is written")
+            if target["path"] == "weights":
+                mesh = doc["meshes"][nodes[target["node"]]["mesh"]]
+                n = len(mesh["primitives"][0].get("targets", []))
+                _check(n > 0 and oacc["count"] == n * iacc["count"],
+                       where + ": weights output count != targets x input count")
+                duration = max(duration, t[-1])
+                continue
             _check(oacc["count"] == iacc["count"], where + ": output count != input count")
             if target["path"] == "rotation":
                 _check(oacc["type"] == "VEC4", where + ": rotation output not VEC4")
@@ -618,6 +651,8 @@ def validate(path):
             duration = max(duration, t[-1])
 
     def dynamic(n):
+        if "skin" in nodes[n]:
+            return True  # placed by its joints
         while True:
             if n in animated or nodes[n].get("extras", {}).get("dynamic"):
                 return True

@@ -40,6 +40,8 @@ for mode in pathtrace reuse retrace; do
   run "cornell-dynamic-$mode" scenes/cornell-dynamic.gltf --frames 0-2 --mode "$mode"
 done
 run "cornell-orbit-reuse" scenes/cornell-orbit.gltf --frames 0-1 --mode reuse
+# A skinned and a morphing mesh: deformed, BVH rebuilt and shading vertices uploaded per frame.
+run "cornell-skinned-reuse" scenes/cornell-skinned.gltf --frames 0-2 --mode reuse
 # The light BVH's kernels (the demo scenes have too few lights for --light-sampler auto to take
 # it), on the many-lights atrium too: a deep tree, point and spot lights, a moving emitter.
 run "cornell-dynamic-pathtrace-lightbvh" scenes/cornell-dynamic.gltf --frames 0-1 --mode pathtrace \

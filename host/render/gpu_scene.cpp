@@ -1,6 +1,7 @@
 #include "render/gpu_scene.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <cstring>
@@ -66,6 +67,14 @@ dev::Material toDeviceMaterial(const Material& m, bool forceDiffuse) {
   d.metallic = m.metallicFactor;
   d.roughness = m.roughnessFactor;
   d.ior = m.ior > 0.0f ? m.ior : 1.5f;
+  // KHR_materials_specular over KHR_materials_ior: F0 = min(((ior-1)/(ior+1))^2 colour, 1) x
+  // factor, F90 = factor (0.04 and 1 by default).
+  const double r = (double(d.ior) - 1.0) / (double(d.ior) + 1.0);
+  for (int c = 0; c < 3; ++c)
+    d.spec_f0[c] = float(std::min(r * r * double(m.specularColor[c]), 1.0) * double(m.specular));
+  d.spec_f90 = m.specular;
+  d.coat = m.clearcoat;
+  d.coat_roughness = m.clearcoatRoughness;
   d.transmission = m.transmission;
   d.alpha_cutoff = m.alphaCutoff;
   d.base_texture = m.baseColorTexture.valid() ? m.baseColorTexture.texture : PR_NO_TEXTURE;
@@ -298,6 +307,7 @@ void GpuScene::uploadShading() {
 }
 
 bool GpuScene::deformMeshes(double t, std::vector<bool>* changed) {
+  const auto start = std::chrono::steady_clock::now();
   bool any = false;
   changed->assign(scene_.dynamicMeshes.size(), false);
   for (size_t m = 0; m < scene_.dynamicMeshes.size(); ++m) {
@@ -320,6 +330,7 @@ bool GpuScene::deformMeshes(double t, std::vector<bool>* changed) {
         verts.size() * sizeof(dev::ShadingVertex), verts.data()));
   }
   if (any) deviceAccel_.uploadMeshes(ctx_, dsg_, true);
+  deformSeconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return any;
 }
 

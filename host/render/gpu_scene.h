@@ -64,6 +64,8 @@ class GpuScene {
   const std::vector<dev::Light>& lights() const { return lights_; }
   const std::vector<dev::ShadingInstance>& instances() const { return instances_; }
   bool anyInstanceMoved() const { return anyMoved_; }
+  // Host seconds the last setTime spent deforming meshes and rebuilding their BVHs.
+  double lastDeformSeconds() const { return deformSeconds_; }
   bool hasAlphaMaterials() const { return hasAlpha_; }
   uint64_t deviceBytes() const;
   int bvhWidth() const { return bvhWidth_; }
@@ -93,6 +95,7 @@ class GpuScene {
   std::vector<uint32_t> meshFirstVertex_;    // per dynamic mesh, in the shading vertex array
   std::vector<TriangleMesh> deformed_;       // per dynamic mesh: its shape this frame
   std::vector<std::vector<glm::vec3>> lastPositions_, lastNormals_;
+  double deformSeconds_ = 0.0;
   std::vector<dev::ShadingInstance> instances_;
   std::vector<glm::mat4> lastTransforms_;
   bool firstFrame_ = true;

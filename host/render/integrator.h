@@ -13,8 +13,11 @@ struct FrameStats {
   int frame = 0;
   double wallSeconds = 0.0;
   std::map<std::string, double> stageSeconds;  // kernel time per stage
-  std::map<std::string, uint64_t> rays;        // rays by kind
-  std::map<std::string, uint64_t> counters;    // mode-specific counts (slots reused, ...)
+  // Host time: "scene" (animation, deformation, BVH builds, uploads), "deform" (its part
+  // deforming meshes and rebuilding their BVHs).
+  std::map<std::string, double> hostSeconds;
+  std::map<std::string, uint64_t> rays;      // rays by kind
+  std::map<std::string, uint64_t> counters;  // mode-specific counts (slots reused, ...)
   uint64_t deviceBytes = 0;
   uint64_t badSamples = 0;
 };

@@ -149,6 +149,7 @@ int runRender(const RenderOptions& o) {
       j["mode"] = renderModeName(o.mode);
       j["wall_s"] = fs.wallSeconds;
       j["stages_s"] = fs.stageSeconds;
+      j["host_s"] = fs.hostSeconds;
       j["rays"] = fs.rays;
       if (!fs.counters.empty()) j["counters"] = fs.counters;
       j["device_bytes"] = fs.deviceBytes;

@@ -1,5 +1,6 @@
 #include "render/session.h"
 
+#include <chrono>
 #include <cmath>
 
 #include "render/path_reuse.h"
@@ -133,10 +134,14 @@ FrameRange RenderSession::frameRange() const {
 
 Image RenderSession::renderFrame(int frame, FrameStats* stats) {
   const double time = frame / options_.fps;
-  gpu_->setTime(time);
-  film_->clear();
   FrameStats local;
   FrameStats* fs = stats ? stats : &local;
+  const auto t0 = std::chrono::steady_clock::now();
+  gpu_->setTime(time);
+  fs->hostSeconds["scene"] =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  fs->hostSeconds["deform"] = gpu_->lastDeformSeconds();
+  film_->clear();
   fs->frame = frame;
   integrator_->renderFrame(frame, gpu_->camera(camera_, time, width_, height_), fs);
   Image img = film_->read(&fs->badSamples);

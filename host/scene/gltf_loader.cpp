@@ -612,6 +612,25 @@ class Loader {
         if (const Value* s = member(*e, "transmissionFactor"))
           checkFactor(s->IsNumber() ? s->GetNumberAsDouble() : -1.0, 0.0, 1.0,
                       "KHR_materials_transmission transmissionFactor", where);
+      auto number = [&](const Value* e, const char* key, double lo, double hi, const char* ext) {
+        if (const Value* s = member(*e, key))
+          checkFactor(s->IsNumber() ? s->GetNumberAsDouble() : -1.0, lo, hi,
+                      std::string(ext) + " " + key, where);
+      };
+      if (const Value* e = extension(m.extensions, "KHR_materials_specular")) {
+        number(e, "specularFactor", 0.0, 1.0, "KHR_materials_specular");
+        if (const Value* c = member(*e, "specularColorFactor")) {
+          bool ok = c->IsArray() && c->ArrayLen() == 3;
+          for (int k = 0; ok && k < 3; ++k)
+            ok = c->Get(k).IsNumber() && finite(c->Get(k).GetNumberAsDouble()) &&
+                 c->Get(k).GetNumberAsDouble() >= 0.0;
+          if (!ok) fail("KHR_materials_specular specularColorFactor must be 3 numbers >= 0", where);
+        }
+      }
+      if (const Value* e = extension(m.extensions, "KHR_materials_clearcoat")) {
+        number(e, "clearcoatFactor", 0.0, 1.0, "KHR_materials_clearcoat");
+        number(e, "clearcoatRoughnessFactor", 0.0, 1.0, "KHR_materials_clearcoat");
+      }
       // KHR_texture_transform on every texture the material uses.
       const std::pair<const char*, const tinygltf::ExtensionMap*> textures[] = {
           {"baseColorTexture", &pbr.baseColorTexture.extensions},
@@ -1406,6 +1425,22 @@ class Loader {
           m.transmission = float(s->GetNumberAsDouble());
       if (const Value* e = extension(src.extensions, "KHR_materials_ior"))
         if (const Value* s = member(*e, "ior")) m.ior = float(s->GetNumberAsDouble());
+      if (const Value* e = extension(src.extensions, "KHR_materials_specular")) {
+        if (const Value* s = member(*e, "specularFactor"))
+          m.specular = float(s->GetNumberAsDouble());
+        if (const Value* c = member(*e, "specularColorFactor"))
+          m.specularColor = glm::vec3(c->Get(0).GetNumberAsDouble(), c->Get(1).GetNumberAsDouble(),
+                                      c->Get(2).GetNumberAsDouble());
+        warnTextures(*e, {"specularTexture", "specularColorTexture"}, where);
+      }
+      if (const Value* e = extension(src.extensions, "KHR_materials_clearcoat")) {
+        if (const Value* s = member(*e, "clearcoatFactor"))
+          m.clearcoat = float(s->GetNumberAsDouble());
+        if (const Value* s = member(*e, "clearcoatRoughnessFactor"))
+          m.clearcoatRoughness = float(s->GetNumberAsDouble());
+        warnTextures(
+            *e, {"clearcoatTexture", "clearcoatRoughnessTexture", "clearcoatNormalTexture"}, where);
+      }
       scene_.materials.push_back(m);
     }
   }
@@ -1416,6 +1451,14 @@ class Loader {
     warn("only TEXCOORD_0 and TEXCOORD_1 are supported; texCoord " + std::to_string(texCoord) +
          " reads TEXCOORD_0 (" + where + ")");
     return 0;
+  }
+
+  // Textures of a material extension that only its factors are applied of: one warning each.
+  void warnTextures(const Value& ext, std::initializer_list<const char*> names,
+                    const std::string& where) {
+    for (const char* n : names)
+      if (member(ext, n))
+        warn(std::string(n) + " is not applied, only the extension's factors (" + where + ")");
   }
 
   // A texture's KHR_texture_transform (validated in checkMaterials), if it has one; its
@@ -1667,8 +1710,12 @@ class Loader {
 
 bool isSupportedExtension(const std::string& name) {
   static const std::set<std::string> supported = {"KHR_materials_emissive_strength",
-                                                  "KHR_materials_transmission", "KHR_materials_ior",
-                                                  "KHR_texture_transform", "KHR_lights_punctual"};
+                                                  "KHR_materials_transmission",
+                                                  "KHR_materials_ior",
+                                                  "KHR_materials_specular",
+                                                  "KHR_materials_clearcoat",
+                                                  "KHR_texture_transform",
+                                                  "KHR_lights_punctual"};
   return supported.count(name) > 0;
 }
 

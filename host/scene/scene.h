@@ -91,6 +91,10 @@ struct Material {
   float emissiveStrength = 1.0f;  // KHR_materials_emissive_strength
   float transmission = 0.0f;      // KHR_materials_transmission factor
   float ior = 1.5f;               // KHR_materials_ior
+  float specular = 1.0f;          // KHR_materials_specular: specularFactor
+  glm::vec3 specularColor{1.0f};  // specularColorFactor
+  float clearcoat = 0.0f;         // KHR_materials_clearcoat: clearcoatFactor
+  float clearcoatRoughness = 0.0f;
   AlphaMode alphaMode = AlphaMode::Opaque;
   float alphaCutoff = 0.5f;
   bool doubleSided = false;

@@ -1,6 +1,8 @@
 // BSDFs in a local shading frame (normal = +Z): glTF metallic-roughness as Lambert + GGX
 // (glTF 2.0 specification, appendix B: fresnel_mix of a dielectric layer over diffuse, and a
-// conductor with Schlick's Fresnel on baseColor), a delta mirror and a delta dielectric.
+// conductor with Schlick's Fresnel on baseColor), with KHR_materials_specular's F0 colour and
+// F90 and KHR_materials_clearcoat's GGX coat layered on top as those extensions define it;
+// a delta mirror and a delta dielectric.
 // wo points towards the previous vertex (camera side on eye paths), wi towards the next.
 // Values returned by eval are f (no cosine); pdfs are per solid angle.
 #pragma once
@@ -25,11 +27,20 @@ PR_NAMESPACE_BEGIN
 
 typedef struct {
   float3 base;  // linear base colour
+  float3 f0;    // the dielectric layer's Fresnel at normal incidence (0.04: ior 1.5)
+  float f90;    // ... and at grazing incidence (1)
   float metallic;
   float alpha;  // GGX alpha = roughness^2, >= PR_MIN_ALPHA
   float ior;
-  u32 kind;  // PR_BSDF_*
+  float coat;        // clearcoat weight; 0: none
+  float coat_alpha;  // the coat's GGX alpha, >= PR_MIN_ALPHA
+  u32 kind;          // PR_BSDF_*
 } BsdfParams;
+
+// The coat's Fresnel (an ior 1.5 dielectric, as KHR_materials_clearcoat fixes it).
+PR_INLINE float coat_fresnel(float w5) {
+  return 0.04f + 0.96f * w5;
+}
 
 PR_INLINE int bsdf_is_delta(const BsdfParams* m) {
   return m->kind == PR_BSDF_MIRROR || m->kind == PR_BSDF_GLASS;
@@ -58,13 +69,31 @@ PR_INLINE float schlick_weight(float c) {
 // eval and sample agree on the mixture pdf.
 PR_INLINE float bsdf_spec_probability(const BsdfParams* m, float cos_o) {
   const float w5 = schlick_weight(cos_o);
-  const float fd = 0.04f + 0.96f * w5;
+  // (A grey F0, as most materials have, by its one value: luminance would round it.)
+  const float fd = (m->f0.x == m->f0.y && m->f0.y == m->f0.z)
+                       ? m->f0.x + (m->f90 - m->f0.x) * w5
+                       : luminance(m->f0 + (make_float3(m->f90, m->f90, m->f90) - m->f0) * w5);
   const float3 fm = m->base + (make_float3(1.0f, 1.0f, 1.0f) - m->base) * w5;
   const float ws = m->metallic * luminance(fm) + (1.0f - m->metallic) * fd;
   const float wd = (1.0f - m->metallic) * (1.0f - fd) * luminance(m->base);
   if (wd <= 0.0f) return 1.0f;
   if (ws <= 0.0f) return 0.0f;
   return clamp(ws / (ws + wd), 0.1f, 0.9f);
+}
+
+// Probability of sampling the clearcoat lobe (0 without a coat); a function of (material, wo).
+PR_INLINE float bsdf_coat_probability(const BsdfParams* m, float cos_o) {
+  if (!(m->coat > 0.0f)) return 0.0f;
+  return clamp(2.0f * m->coat * coat_fresnel(schlick_weight(cos_o)), 0.05f, 0.5f);
+}
+
+// GGX specular reflection D G2 / (4 cos_o cos_i) for alpha^2 = a2 at half vector h, and the
+// visible-normal pdf of wi (G1(wo) D / (4 cos_o)).
+PR_INLINE float ggx_reflection(float3 wo, float3 wi, float3 h, float a2, float* pdf) {
+  const float d = ggx_d(h.z, a2);
+  const float lo = ggx_lambda(wo.z, a2), li = ggx_lambda(wi.z, a2);
+  *pdf = d / ((1.0f + lo) * 4.0f * wo.z);
+  return d / (1.0f + lo + li) / (4.0f * wo.z * wi.z);
 }
 
 // f(wo, wi) and the pdf of sampling wi given wo, for the microfacet model.
@@ -86,16 +115,27 @@ PR_INLINE float3 bsdf_eval(const BsdfParams* m, float3 wo, float3 wi, float* pdf
   const float g2 = 1.0f / (1.0f + lo + li);
   const float spec = d * g2 / (4.0f * wo.z * wi.z);
   const float w5 = schlick_weight(voh);
-  const float fd = 0.04f + 0.96f * w5;
+  // fresnel_mix with a coloured F: specular where reflected, diffuse where not.
+  const float3 fd = m->f0 + (make_float3(m->f90, m->f90, m->f90) - m->f0) * w5;
   const float3 fm = m->base + (make_float3(1.0f, 1.0f, 1.0f) - m->base) * w5;
   const float3 dielectric =
-      make_float3(fd * spec, fd * spec, fd * spec) + m->base * ((1.0f - fd) * PR_INV_PI);
-  const float3 f = dielectric * (1.0f - m->metallic) + fm * (spec * m->metallic);
+      fd * spec + m->base * ((make_float3(1.0f, 1.0f, 1.0f) - fd) * PR_INV_PI);
+  float3 f = dielectric * (1.0f - m->metallic) + fm * (spec * m->metallic);
   // VNDF pdf: G1(wo) D(h) / (4 cos_o).
   const float ps = bsdf_spec_probability(m, wo.z);
   const float pdf_spec = d / ((1.0f + lo) * 4.0f * wo.z);
   const float pdf_diff = wi.z * PR_INV_PI;
   *pdf = ps * pdf_spec + (1.0f - ps) * pdf_diff;
+  if (m->coat > 0.0f) {
+    // The coat over the rest: mix(base, coat specular, coat x its Fresnel).
+    const float fc = m->coat * coat_fresnel(w5);
+    float pdf_coat;
+    const float coat_spec =
+        ggx_reflection(wo, wi, h, m->coat_alpha * m->coat_alpha, &pdf_coat) * fc;
+    f = f * (1.0f - fc) + make_float3(coat_spec, coat_spec, coat_spec);
+    const float pc = bsdf_coat_probability(m, wo.z);
+    *pdf = pc * pdf_coat + (1.0f - pc) * *pdf;
+  }
   return f;
 }
 
@@ -170,13 +210,21 @@ PR_INLINE int bsdf_sample(const BsdfParams* m, float3 wo, float u0, float u1, fl
     *weight = m->base;
     return 1;
   }
-  const float ps = bsdf_spec_probability(m, wo.z);
+  const float pc = bsdf_coat_probability(m, wo.z);
   float3 dir;
-  if (u0 < ps) {
-    const float3 h = ggx_sample_vndf(wo, m->alpha, u1, u2);
+  if (u0 < pc) {
+    const float3 h = ggx_sample_vndf(wo, m->coat_alpha, u1, u2);
     dir = h * (2.0f * dot(wo, h)) - wo;
   } else {
-    dir = sample_cosine_hemisphere(u1, u2);
+    // The rest of u0 chooses between the base's lobes.
+    const float ub = pc > 0.0f ? (u0 - pc) / (1.0f - pc) : u0;
+    const float ps = bsdf_spec_probability(m, wo.z);
+    if (ub < ps) {
+      const float3 h = ggx_sample_vndf(wo, m->alpha, u1, u2);
+      dir = h * (2.0f * dot(wo, h)) - wo;
+    } else {
+      dir = sample_cosine_hemisphere(u1, u2);
+    }
   }
   if (dir.z <= 0.0f) return 0;
   float p = 0.0f;

@@ -68,6 +68,8 @@
   F(Material, normal_texture)         \
   F(Material, normal_uv)              \
   F(Material, uv_sets)                \
+  F(Material, spec_f0)                \
+  F(Material, coat_roughness)         \
   F(TextureInfo, flags)               \
   F(CameraParams, fx)                 \
   F(CameraParams, aspect)             \

@@ -17,7 +17,7 @@ PR_NAMESPACE_BEGIN
 
 #define PR_NO_TEXTURE (-1)
 
-// 176 bytes.
+// 208 bytes.
 typedef struct {
   float base_r, base_g, base_b, base_a;  // linear baseColorFactor
   float emit_r, emit_g, emit_b;          // emissiveFactor * emissive_strength (radiance)
@@ -34,8 +34,12 @@ typedef struct {
   i32 normal_texture;  // tangent-space normal map (linear), or PR_NO_TEXTURE
   float normal_scale;  // scales the map's x and y
   float normal_uv[6];
-  u32 uv_sets;  // bit PR_UV_*: that texture reads TEXCOORD_1, else TEXCOORD_0
-  float pad0;
+  u32 uv_sets;           // bit PR_UV_*: that texture reads TEXCOORD_1, else TEXCOORD_0
+  float spec_f90;        // KHR_materials_specular: F90 of the dielectric layer (1)
+  float spec_f0[3];      // its F0 colour: ((ior-1)/(ior+1))^2 x colour x factor (0.04)
+  float coat;            // KHR_materials_clearcoat factor (0: none)
+  float coat_roughness;  // its roughness
+  float pad0, pad1, pad2;
 } Material;
 
 #define PR_UV_BASE 1u
@@ -58,10 +62,11 @@ typedef struct {
 
 PR_NAMESPACE_END
 
-PR_STATIC_ASSERT(sizeof(pr::dev::Material) == 176, "Material layout");
+PR_STATIC_ASSERT(sizeof(pr::dev::Material) == 208, "Material layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::Material, flags) == 28, "Material layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::Material, alpha_cutoff) == 48, "Material layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::Material, base_uv) == 64, "Material layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::Material, emission_uv) == 112, "Material layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::Material, normal_uv) == 144, "Material layout");
+PR_STATIC_ASSERT(offsetof(pr::dev::Material, spec_f0) == 176, "Material layout");
 PR_STATIC_ASSERT(sizeof(pr::dev::TextureInfo) == 16, "TextureInfo layout");

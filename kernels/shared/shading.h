@@ -238,6 +238,11 @@ PR_INLINE BsdfParams material_bsdf(const ShadingData* sd, const SurfaceHit* s) {
   roughness = clamp(roughness, 0.0f, 1.0f);
   p.alpha = fmax(roughness * roughness, PR_MIN_ALPHA);
   p.ior = m->ior;
+  p.f0 = make_float3(m->spec_f0[0], m->spec_f0[1], m->spec_f0[2]);
+  p.f90 = m->spec_f90;
+  p.coat = m->coat;
+  const float cr = clamp(m->coat_roughness, 0.0f, 1.0f);
+  p.coat_alpha = fmax(cr * cr, PR_MIN_ALPHA);
   if (m->flags & PR_MAT_GLASS)
     p.kind = PR_BSDF_GLASS;
   else if (m->flags & PR_MAT_MIRROR)

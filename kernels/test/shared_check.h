@@ -51,6 +51,10 @@ PR_INLINE void shared_check_case(u32 i, PR_GLOBAL const float* cdf, u32 cdf_coun
   m.alpha = fmax(rng_next(&rng), PR_MIN_ALPHA);
   m.ior = 1.5f;
   m.kind = PR_BSDF_MICROFACET;
+  m.f0 = make_float3(0.04f + 0.3f * rng_next(&rng), 0.04f, 0.1f);
+  m.f90 = rng_next(&rng);
+  m.coat = rng_next(&rng);
+  m.coat_alpha = fmax(rng_next(&rng), PR_MIN_ALPHA);
   const float o1 = rng_next(&rng), o2 = rng_next(&rng);
   const float3 wo = sample_cosine_hemisphere(o1, o2);
   const float u0 = rng_next(&rng), u1 = rng_next(&rng), u2 = rng_next(&rng);
