@@ -13,6 +13,7 @@
 #include "io/image.h"
 #include "render/options.h"
 #include "scene/environment.h"
+#include "scene/gltf_loader.h"
 #include "shared/environment.h"
 #include "support/chi_square.h"
 #include "support/gltf_builder.h"
@@ -312,6 +313,89 @@ TEST(Environment, CoatedAndSpecularMaterialsAgreeInBothModes) {
       EXPECT_NEAR(a.mean, b.mean, 4.5 * std::hypot(a.stderr_, b.stderr_) + 1e-4)
           << "region " << x0 << "," << y0;
     }
+}
+
+// KHR_materials_volume: seen through a slab of clear (ior 1) glass 0.5 thick whose
+// attenuation colour (0.5, 0.25, 1) holds at distance 0.5, an emitter of radiance 1 reads that
+// colour exactly, in both modes; light paths through an absorbing box agree with the path
+// tracer.
+TEST(Environment, VolumeAttenuatesInsideTransmissiveObjects) {
+  test::GltfBuilder g;
+  const int glass = g.addMaterial({glm::vec4(1.0f), 0.0f, 0.0f, glm::vec3(0.0f), 1.0f, 1.0f, 1.0f});
+  const int lamp = g.addMaterial({glm::vec4(0, 0, 0, 1), 0.0f, 1.0f, glm::vec3(1.0f), 1.0f});
+  g.addNode(g.addBox({-0.5f, -0.5f, -0.25f}, {0.5f, 0.5f, 0.25f}, glass));
+  g.addNode(g.addQuad({-3, -3, -1}, {3, -3, -1}, {3, 3, -1}, {-3, 3, -1}, lamp));
+  g.addCamera({0, 0, 3}, {0, 0, 0}, 0.2f, 1.0f);
+  const std::string scene = g.write(test::tempDir("volume"), "slab");
+  nlohmann::json doc;
+  std::ifstream(scene) >> doc;
+  doc["extensionsUsed"] = {"KHR_materials_transmission", "KHR_materials_ior",
+                           "KHR_materials_volume"};
+  doc["materials"][glass]["extensions"]["KHR_materials_volume"] = {
+      {"thicknessFactor", 0.5}, {"attenuationDistance", 0.5}, {"attenuationColor", {0.5, 0.25, 1}}};
+  doc["materials"][glass]["extensions"]["KHR_materials_ior"] = {{"ior", 1.0}};
+  { std::ofstream(scene) << doc.dump(); }
+  for (const char* mode : {"pathtrace", "reuse"}) {
+    SCOPED_TRACE(mode);
+    const Image img =
+        test::frameImage(test::renderFrames(scene, "0",
+                                            std::string("--mode ") + mode +
+                                                " --width 16 --height 16 --spp 4 --env none",
+                                            "volume-r"),
+                         0);
+    const float* c = img.pixel(8, 8);
+    EXPECT_NEAR(c[0], 0.5f, 1e-4f);
+    EXPECT_NEAR(c[1], 0.25f, 1e-4f);
+    EXPECT_NEAR(c[2], 1.0f, 1e-4f);
+  }
+  // Refused: a colour above 1, a distance of 0.
+  doc["materials"][glass]["extensions"]["KHR_materials_volume"]["attenuationColor"] = {1.5, 1, 1};
+  { std::ofstream(scene) << doc.dump(); }
+  EXPECT_THROW(loadScene(scene), InputError);
+  doc["materials"][glass]["extensions"]["KHR_materials_volume"]["attenuationColor"] = {1, 1, 1};
+  doc["materials"][glass]["extensions"]["KHR_materials_volume"]["attenuationDistance"] = 0;
+  { std::ofstream(scene) << doc.dump(); }
+  EXPECT_THROW(loadScene(scene), InputError);
+}
+
+// A floor and a wall under a wide roof of absorbing clear glass: next-event estimation cannot
+// see the environment through the glass, so in reuse the light the wall sends the floor comes
+// from light paths that crossed the roof (the path tracer finds it by BSDF samples through
+// it). They must agree.
+TEST(Environment, LightPathsThroughAnAbsorbingRoofAgreeWithThePathTracer) {
+  test::GltfBuilder g;
+  const int grey = g.addMaterial({glm::vec4(0.6f, 0.6f, 0.6f, 1.0f)});
+  const int glass = g.addMaterial({glm::vec4(1.0f), 0.0f, 0.0f, glm::vec3(0.0f), 1.0f, 1.0f, 1.0f});
+  g.addNode(g.addQuad({-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, {-3, 0, -3}, grey));
+  g.addNode(g.addBox({-8, 1.0f, -8}, {8, 1.3f, 8}, glass));
+  // A wall that the floor sees: light paths through the roof reach it, then the floor.
+  g.addNode(g.addQuad({-3, 0, -1.5f}, {3, 0, -1.5f}, {3, 0.99f, -1.5f}, {-3, 0.99f, -1.5f}, grey));
+  g.addCamera({0, 0.6f, 2.0f}, {0, 0, -0.5f}, 0.8f, 1.0f);
+  const std::string scene = g.write(test::tempDir("envroof"), "roof");
+  nlohmann::json doc;
+  std::ifstream(scene) >> doc;
+  doc["extensionsUsed"] = {"KHR_materials_transmission", "KHR_materials_ior",
+                           "KHR_materials_volume"};
+  doc["materials"][glass]["extensions"]["KHR_materials_volume"] = {
+      {"thicknessFactor", 0.3},
+      {"attenuationDistance", 0.3},
+      {"attenuationColor", {0.9, 0.5, 0.2}}};
+  doc["materials"][glass]["extensions"]["KHR_materials_ior"] = {{"ior", 1.0}};
+  { std::ofstream(scene) << doc.dump(); }
+  const std::string args = " --width 24 --height 24 --spp 64 --light-paths " +
+                           std::to_string(24 * 24 * 64 * 4) + " --env-color 1,1,1 --max-depth 6";
+  const Image pt =
+      test::frameImage(test::renderFrames(scene, "0", "--mode pathtrace" + args, "roofpt"), 0);
+  const Image re =
+      test::frameImage(test::renderFrames(scene, "0", "--mode reuse" + args, "roofre"), 0);
+  for (int c : {0, 2})
+    for (int y0 = 0; y0 < 24; y0 += 8)
+      for (int x0 = 0; x0 < 24; x0 += 8) {
+        const test::Moments a = test::regionMean(pt, x0, y0, x0 + 8, y0 + 8, c);
+        const test::Moments b = test::regionMean(re, x0, y0, x0 + 8, y0 + 8, c);
+        EXPECT_NEAR(a.mean, b.mean, 4.5 * std::hypot(a.stderr_, b.stderr_) + 1e-4)
+            << "channel " << c << " region " << x0 << "," << y0;
+      }
 }
 
 TEST(Environment, ReuseEqualsRetraceWithAnEnvironment) {

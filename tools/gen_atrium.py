@@ -580,6 +580,12 @@ def build(size, light, normal_maps=False):
                            emissive=(1.0, 0.75, 0.4), strength=LANTERN_GLASS_STRENGTH)
     else:
         glass = g.material("lantern_glass", (0.9, 0.8, 0.5), roughness=0.5)
+        if normal_maps:  # with the polished tiles: the lantern in tinted, absorbing glass
+            g.doc["materials"][glass]["extensions"] = {
+                "KHR_materials_transmission": {"transmissionFactor": 1.0},
+                "KHR_materials_volume": {"thicknessFactor": 0.05, "attenuationDistance": 0.1,
+                                         "attenuationColor": [0.9, 0.7, 0.4]}}
+            g.extensions.update(("KHR_materials_transmission", "KHR_materials_volume"))
     lm, lg = lantern_meshes(c)
     lantern = g.node("lantern", mesh=g.mesh("lantern", [(lm, metal), (lg, glass)]),
                      extras={"dynamic": True})
@@ -617,7 +623,7 @@ def main():
                     "sun, or night lit by several hundred small emissive lanterns")
     ap.add_argument("--normal-maps", action="store_true",
                     help="bevelled courtyard tiles: a normal map (and uvs) on the floor tiles, "
-                    "the dark ones clear-coated")
+                    "the dark ones clear-coated; the lantern in tinted, absorbing glass")
     args = ap.parse_args()
     if not args.size > 0:
         ap.error("--size must be positive")

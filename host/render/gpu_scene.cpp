@@ -75,6 +75,13 @@ dev::Material toDeviceMaterial(const Material& m, bool forceDiffuse) {
   d.spec_f90 = m.specular;
   d.coat = m.clearcoat;
   d.coat_roughness = m.clearcoatRoughness;
+  // KHR_materials_volume: Beer-Lambert inside a transmissive object that is not thin-walled.
+  const bool volume = m.transmission > 0.0f && m.thickness > 0.0f &&
+                      std::isfinite(m.attenuationDistance) && m.attenuationDistance > 0.0f;
+  for (int c = 0; c < 3; ++c)
+    d.sigma_a[c] = volume ? float(-std::log(std::max(double(m.attenuationColor[c]), 1e-6)) /
+                                  double(m.attenuationDistance))
+                          : 0.0f;
   d.transmission = m.transmission;
   d.alpha_cutoff = m.alphaCutoff;
   d.base_texture = m.baseColorTexture.valid() ? m.baseColorTexture.texture : PR_NO_TEXTURE;

@@ -627,6 +627,19 @@ class Loader {
           if (!ok) fail("KHR_materials_specular specularColorFactor must be 3 numbers >= 0", where);
         }
       }
+      if (const Value* e = extension(m.extensions, "KHR_materials_volume")) {
+        number(e, "thicknessFactor", 0.0, 3.0e38, "KHR_materials_volume");
+        if (const Value* d = member(*e, "attenuationDistance"))
+          if (!d->IsNumber() || !finite(d->GetNumberAsDouble()) || d->GetNumberAsDouble() <= 0.0)
+            fail("KHR_materials_volume attenuationDistance must be a number > 0", where);
+        if (const Value* c = member(*e, "attenuationColor")) {
+          bool ok = c->IsArray() && c->ArrayLen() == 3;
+          for (int k = 0; ok && k < 3; ++k)
+            ok = c->Get(k).IsNumber() && c->Get(k).GetNumberAsDouble() >= 0.0 &&
+                 c->Get(k).GetNumberAsDouble() <= 1.0;
+          if (!ok) fail("KHR_materials_volume attenuationColor must be 3 numbers in 0..1", where);
+        }
+      }
       if (const Value* e = extension(m.extensions, "KHR_materials_clearcoat")) {
         number(e, "clearcoatFactor", 0.0, 1.0, "KHR_materials_clearcoat");
         number(e, "clearcoatRoughnessFactor", 0.0, 1.0, "KHR_materials_clearcoat");
@@ -1433,6 +1446,17 @@ class Loader {
                                       c->Get(2).GetNumberAsDouble());
         warnTextures(*e, {"specularTexture", "specularColorTexture"}, where);
       }
+      if (const Value* e = extension(src.extensions, "KHR_materials_volume")) {
+        if (const Value* s = member(*e, "thicknessFactor"))
+          m.thickness = float(s->GetNumberAsDouble());
+        if (const Value* s = member(*e, "attenuationDistance"))
+          m.attenuationDistance = float(s->GetNumberAsDouble());
+        if (const Value* c = member(*e, "attenuationColor"))
+          m.attenuationColor =
+              glm::vec3(c->Get(0).GetNumberAsDouble(), c->Get(1).GetNumberAsDouble(),
+                        c->Get(2).GetNumberAsDouble());
+        warnTextures(*e, {"thicknessTexture"}, where);
+      }
       if (const Value* e = extension(src.extensions, "KHR_materials_clearcoat")) {
         if (const Value* s = member(*e, "clearcoatFactor"))
           m.clearcoat = float(s->GetNumberAsDouble());
@@ -1709,13 +1733,10 @@ class Loader {
 }  // namespace
 
 bool isSupportedExtension(const std::string& name) {
-  static const std::set<std::string> supported = {"KHR_materials_emissive_strength",
-                                                  "KHR_materials_transmission",
-                                                  "KHR_materials_ior",
-                                                  "KHR_materials_specular",
-                                                  "KHR_materials_clearcoat",
-                                                  "KHR_texture_transform",
-                                                  "KHR_lights_punctual"};
+  static const std::set<std::string> supported = {
+      "KHR_materials_emissive_strength", "KHR_materials_transmission", "KHR_materials_ior",
+      "KHR_materials_specular",          "KHR_materials_clearcoat",    "KHR_materials_volume",
+      "KHR_texture_transform",           "KHR_lights_punctual"};
   return supported.count(name) > 0;
 }
 

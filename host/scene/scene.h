@@ -95,6 +95,9 @@ struct Material {
   glm::vec3 specularColor{1.0f};  // specularColorFactor
   float clearcoat = 0.0f;         // KHR_materials_clearcoat: clearcoatFactor
   float clearcoatRoughness = 0.0f;
+  float thickness = 0.0f;  // KHR_materials_volume: thicknessFactor (0: thin-walled)
+  float attenuationDistance = std::numeric_limits<float>::infinity();
+  glm::vec3 attenuationColor{1.0f};
   AlphaMode alphaMode = AlphaMode::Opaque;
   float alphaCutoff = 0.5f;
   bool doubleSided = false;

@@ -38,7 +38,7 @@ __kernel void pt_shade(PR_SCENE_PARAMS, __global PathState* states, __global con
   const float3 d = make_float3(p.ray.dx, p.ray.dy, p.ray.dz);
   const float3 wo = -d;
   const SurfaceHit h = surface_at(&s.sd, hit.prim, hit.inst, hit.u, hit.v);
-  float3 tp = make_float3(p.tp_r, p.tp_g, p.tp_b);
+  float3 tp = make_float3(p.tp_r, p.tp_g, p.tp_b) * volume_transmittance(&s, &h, d, hit.t);
 
   PR_GLOBAL const Material* mat = s.sd.materials + h.material;
   if (mat->flags & PR_MAT_EMISSIVE) {

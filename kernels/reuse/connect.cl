@@ -371,6 +371,7 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
         break;
       }
       const SurfaceHit h = surface_at(&s.sd, hit.prim, hit.inst, hit.u, hit.v);
+      t2 = t2 * volume_transmittance(&s, &h, d, hit.t);
       const EyePoint y = eye_point(&s, &h, -d, t2, depth + 1u);
       const int is_delta = bsdf_is_delta(&y.f.bsdf);
       // An emitter met by the sample from x: its MIS share against next-event estimation at x.

@@ -27,6 +27,7 @@ __kernel void eye_hit(PR_SCENE_PARAMS, ReuseParams rp, CameraParams cam, uint sa
     }
     const SurfaceHit h = surface_at(&s.sd, hit.prim, hit.inst, hit.u, hit.v);
     const float3 wo = -d;
+    tp = tp * volume_transmittance(&s, &h, d, hit.t);
     if (s.sd.materials[h.material].flags & PR_MAT_EMISSIVE) L += tp * surface_emission(&s, &h);
     if (depth >= rp.max_depth) break;
     const ShadingFrame f = shading_frame(&s, &h, wo);

@@ -118,6 +118,7 @@ __kernel void light_trace(PR_SCENE_PARAMS, ReuseParams rp, __global const float*
       break;
     }
     const SurfaceHit sh = surface_at(&s.sd, hit.prim, hit.inst, hit.u, hit.v);
+    tp = tp * volume_transmittance(&s, &sh, dir, hit.t);
     v.px = sh.p.x;
     v.py = sh.p.y;
     v.pz = sh.p.z;

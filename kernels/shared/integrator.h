@@ -105,6 +105,19 @@ PR_INLINE float emitter_pdf(const SceneData* s, const SurfaceHit* h, float3 ref,
   return light_pdf_triangle(pmf, ref, n_ref, h->p, v0, e1, e2);
 }
 
+// KHR_materials_volume: the Beer-Lambert transmittance of a segment of length t (direction
+// dir) that ended on surface h from behind, inside a closed transmissive object; 1 elsewhere.
+// Applied where a segment leaves such an object, so paths need carry no medium: objects
+// nested inside one are not attenuated on their way out.
+PR_INLINE float3 volume_transmittance(const SceneData* s, const SurfaceHit* h, float3 dir,
+                                      float t) {
+  PR_GLOBAL const Material* m = s->sd.materials + h->material;
+  if (!(m->flags & PR_MAT_GLASS) || !(dot(dir, h->ng) > 0.0f)) return make_float3(1.0f, 1.0f, 1.0f);
+  const float3 sigma = make_float3(m->sigma_a[0], m->sigma_a[1], m->sigma_a[2]);
+  if (!(max3(sigma) > 0.0f)) return make_float3(1.0f, 1.0f, 1.0f);
+  return make_float3(exp(-sigma.x * t), exp(-sigma.y * t), exp(-sigma.z * t));
+}
+
 // Radiance from the environment along dir, for a ray that leaves the scene (0 without one).
 PR_INLINE float3 environment_radiance(const SceneData* s, float3 dir) {
   if (s->lights.env_light == PR_INVALID_INDEX) return make_float3(0.0f, 0.0f, 0.0f);

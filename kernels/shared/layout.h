@@ -70,6 +70,7 @@
   F(Material, uv_sets)                \
   F(Material, spec_f0)                \
   F(Material, coat_roughness)         \
+  F(Material, sigma_a)                \
   F(TextureInfo, flags)               \
   F(CameraParams, fx)                 \
   F(CameraParams, aspect)             \

@@ -39,7 +39,9 @@ typedef struct {
   float spec_f0[3];      // its F0 colour: ((ior-1)/(ior+1))^2 x colour x factor (0.04)
   float coat;            // KHR_materials_clearcoat factor (0: none)
   float coat_roughness;  // its roughness
-  float pad0, pad1, pad2;
+  // KHR_materials_volume inside a transmissive object: attenuation per unit length per channel
+  // (-ln(attenuationColor) / attenuationDistance); 0: none (thin-walled or clear).
+  float sigma_a[3];
 } Material;
 
 #define PR_UV_BASE 1u
