@@ -9,6 +9,7 @@
 #include <random>
 
 #include <nlohmann/json.hpp>
+#include <stb_image_write.h>
 
 #include "io/image.h"
 #include "render/options.h"
@@ -396,6 +397,45 @@ TEST(Environment, LightPathsThroughAnAbsorbingRoofAgreeWithThePathTracer) {
         EXPECT_NEAR(a.mean, b.mean, 4.5 * std::hypot(a.stderr_, b.stderr_) + 1e-4)
             << "channel " << c << " region " << x0 << "," << y0;
       }
+}
+
+// The extensions' textures scale their factors: a clearcoat texture whose R is 0 and a specular
+// texture whose alpha is 0 give exactly the images of clearcoat 0 and specular 0.
+TEST(Environment, ExtensionTexturesScaleTheirFactors) {
+  const std::string scene = boxScene("exttex", true);
+  const std::string dir = scene.substr(0, scene.rfind('/'));
+  const unsigned char zero[4] = {0, 255, 255, 0};  // R 0 (coat), A 0 (specular)
+  stbi_write_png((dir + "/zero.png").c_str(), 1, 1, 4, zero, 4);
+  nlohmann::json base;
+  std::ifstream(scene) >> base;
+  base["extensionsUsed"] = {"KHR_materials_specular", "KHR_materials_clearcoat"};
+  base["materials"][0]["pbrMetallicRoughness"]["roughnessFactor"] = 0.5;
+  auto render = [&](const nlohmann::json& ext, bool textured, const std::string& tag) {
+    nlohmann::json doc = base;
+    doc["materials"][0]["extensions"] = ext;
+    if (textured) {
+      doc["images"] = {{{"uri", "zero.png"}}};
+      doc["textures"] = {{{"source", 0}}};
+    }
+    { std::ofstream(scene) << doc.dump(); }
+    return test::frameImage(
+        test::renderFrames(scene, "0", "--mode pathtrace --width 16 --height 16 --spp 2", tag), 0);
+  };
+  const nlohmann::json tex = {{"index", 0}};
+  const Image coatTex =
+      render({{"KHR_materials_clearcoat", {{"clearcoatFactor", 1.0}, {"clearcoatTexture", tex}}}},
+             true, "exttex-a");
+  const Image noCoat =
+      render({{"KHR_materials_clearcoat", {{"clearcoatFactor", 0.0}}}}, false, "exttex-b");
+  EXPECT_EQ(coatTex.rgba, noCoat.rgba);
+  const Image specTex =
+      render({{"KHR_materials_specular", {{"specularFactor", 1.0}, {"specularTexture", tex}}}},
+             true, "exttex-c");
+  const Image noSpec =
+      render({{"KHR_materials_specular", {{"specularFactor", 0.0}}}}, false, "exttex-d");
+  EXPECT_EQ(specTex.rgba, noSpec.rgba);
+  const Image plain = render(nlohmann::json::object(), false, "exttex-e");
+  EXPECT_NE(plain.rgba, noSpec.rgba);  // the specular layer shows where it is on
 }
 
 TEST(Environment, ReuseEqualsRetraceWithAnEnvironment) {

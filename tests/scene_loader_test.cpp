@@ -423,22 +423,28 @@ TEST(SceneLoader, SpecularAndClearcoat) {
   q.doc["textures"] = {{{"source", 0}}};
   Scene s;
   ASSERT_EQ(tryLoad(q.write(), &s), "");
-  ASSERT_EQ(s.warnings.size(), 1u);
-  EXPECT_NE(s.warnings[0].find("clearcoatTexture is not applied"), std::string::npos)
-      << s.warnings[0];
+  EXPECT_TRUE(s.warnings.empty());
   const dev::Material d = toDeviceMaterial(s.materials[0]);
-  // ((2 - 1) / (2 + 1))^2 = 1/9, times the colour (clamped at 1), times the factor.
-  EXPECT_NEAR(d.spec_f0[0], 0.5f / 9.0f, 1e-6f);
-  EXPECT_NEAR(d.spec_f0[1], 0.25f / 9.0f, 1e-6f);
-  EXPECT_NEAR(d.spec_f0[2], 0.5f, 1e-6f);
+  // ((2 - 1) / (2 + 1))^2 = 1/9 times the colour; the kernel clamps at 1 after the texture and
+  // multiplies by the factor (F90).
+  EXPECT_NEAR(d.spec_f0[0], 1.0f / 9.0f, 1e-6f);
+  EXPECT_NEAR(d.spec_f0[1], 0.5f / 9.0f, 1e-6f);
+  EXPECT_NEAR(d.spec_f0[2], 40.0f / 9.0f, 1e-5f);
   EXPECT_FLOAT_EQ(d.spec_f90, 0.5f);
   EXPECT_FLOAT_EQ(d.coat, 0.8f);
   EXPECT_FLOAT_EQ(d.coat_roughness, 0.1f);
-  // Defaults: F0 0.04 exactly, F90 1, no coat.
+  EXPECT_EQ(d.coat_texture, 0);  // linear: a texture of its own besides any sRGB use
+  EXPECT_EQ(d.spec_texture, PR_NO_TEXTURE);
+  EXPECT_FALSE(s.textures[0].srgb);
+  // Defaults: F0 0.04 exactly (times F90 1), no coat.
   const dev::Material plain = toDeviceMaterial(Material{});
   EXPECT_EQ(plain.spec_f0[0], 0.04f);
   EXPECT_EQ(plain.spec_f90, 1.0f);
   EXPECT_EQ(plain.coat, 0.0f);
+  q.doc["materials"][0]["extensions"]["KHR_materials_clearcoat"]["clearcoatTexture"]["index"] = 7;
+  EXPECT_NE(tryLoad(q.write("bad0.gltf")).find("clearcoatTexture refers to texture 7"),
+            std::string::npos);
+  q.doc["materials"][0]["extensions"]["KHR_materials_clearcoat"]["clearcoatTexture"]["index"] = 0;
   q.doc["materials"][0]["extensions"]["KHR_materials_clearcoat"]["clearcoatFactor"] = 1.5;
   EXPECT_NE(tryLoad(q.write("bad.gltf")).find("KHR_materials_clearcoat clearcoatFactor"),
             std::string::npos);

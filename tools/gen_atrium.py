@@ -546,7 +546,9 @@ def build(size, light, normal_maps=False):
                                         normal_texture=bumps)
         # polished dark tiles: a clear coat and a tinted specular layer
         g.doc["materials"][mats["dark_tiles"]]["extensions"] = {
-            "KHR_materials_clearcoat": {"clearcoatFactor": 0.8, "clearcoatRoughnessFactor": 0.15},
+            # the coat thinner on the bevels (the normal map's red channel)
+            "KHR_materials_clearcoat": {"clearcoatFactor": 0.8, "clearcoatRoughnessFactor": 0.15,
+                                        "clearcoatTexture": {"index": bumps}},
             "KHR_materials_specular": {"specularColorFactor": [1.0, 0.9, 0.8]}}
         g.extensions.update(("KHR_materials_clearcoat", "KHR_materials_specular"))
     emitters = 0

@@ -70,8 +70,7 @@ dev::Material toDeviceMaterial(const Material& m, bool forceDiffuse) {
   // KHR_materials_specular over KHR_materials_ior: F0 = min(((ior-1)/(ior+1))^2 colour, 1) x
   // factor, F90 = factor (0.04 and 1 by default).
   const double r = (double(d.ior) - 1.0) / (double(d.ior) + 1.0);
-  for (int c = 0; c < 3; ++c)
-    d.spec_f0[c] = float(std::min(r * r * double(m.specularColor[c]), 1.0) * double(m.specular));
+  for (int c = 0; c < 3; ++c) d.spec_f0[c] = float(r * r * double(m.specularColor[c]));
   d.spec_f90 = m.specular;
   d.coat = m.clearcoat;
   d.coat_roughness = m.clearcoatRoughness;
@@ -117,6 +116,19 @@ dev::Material toDeviceMaterial(const Material& m, bool forceDiffuse) {
   transform(m.metallicRoughnessTexture, d.mr_uv);
   transform(m.emissiveTexture, d.emission_uv);
   transform(m.normalTexture, d.normal_uv);
+  auto texture = [](const TextureRef& t) { return t.valid() ? t.texture : PR_NO_TEXTURE; };
+  d.spec_texture = texture(m.specularTexture);
+  d.spec_color_texture = texture(m.specularColorTexture);
+  d.coat_texture = texture(m.clearcoatTexture);
+  d.coat_roughness_texture = texture(m.clearcoatRoughnessTexture);
+  transform(m.specularTexture, d.spec_uv);
+  transform(m.specularColorTexture, d.spec_color_uv);
+  transform(m.clearcoatTexture, d.coat_uv);
+  transform(m.clearcoatRoughnessTexture, d.coat_roughness_uv);
+  d.uv_sets |= (m.specularTexture.texCoord == 1 ? PR_UV_SPEC : 0u) |
+               (m.specularColorTexture.texCoord == 1 ? PR_UV_SPEC_COLOR : 0u) |
+               (m.clearcoatTexture.texCoord == 1 ? PR_UV_COAT : 0u) |
+               (m.clearcoatRoughnessTexture.texCoord == 1 ? PR_UV_COAT_ROUGHNESS : 0u);
   return d;
 }
 

@@ -1444,7 +1444,8 @@ class Loader {
         if (const Value* c = member(*e, "specularColorFactor"))
           m.specularColor = glm::vec3(c->Get(0).GetNumberAsDouble(), c->Get(1).GetNumberAsDouble(),
                                       c->Get(2).GetNumberAsDouble());
-        warnTextures(*e, {"specularTexture", "specularColorTexture"}, where);
+        m.specularTexture = extensionTexture(*e, "specularTexture", false, where);
+        m.specularColorTexture = extensionTexture(*e, "specularColorTexture", true, where);
       }
       if (const Value* e = extension(src.extensions, "KHR_materials_volume")) {
         if (const Value* s = member(*e, "thicknessFactor"))
@@ -1462,8 +1463,11 @@ class Loader {
           m.clearcoat = float(s->GetNumberAsDouble());
         if (const Value* s = member(*e, "clearcoatRoughnessFactor"))
           m.clearcoatRoughness = float(s->GetNumberAsDouble());
-        warnTextures(
-            *e, {"clearcoatTexture", "clearcoatRoughnessTexture", "clearcoatNormalTexture"}, where);
+        m.clearcoatTexture = extensionTexture(*e, "clearcoatTexture", false, where);
+        m.clearcoatRoughnessTexture =
+            extensionTexture(*e, "clearcoatRoughnessTexture", false, where);
+        // The coat shades with the surface's normal (and its normal map).
+        warnTextures(*e, {"clearcoatNormalTexture"}, where);
       }
       scene_.materials.push_back(m);
     }
@@ -1489,14 +1493,58 @@ class Loader {
   // texCoord overrides the texture's.
   void readTransform(const tinygltf::ExtensionMap& extensions, TextureRef* ref,
                      const std::string& where) {
-    const Value* t = extension(extensions, "KHR_texture_transform");
-    if (!t) return;
-    if (const Value* v = member(*t, "texCoord")) ref->texCoord = uvSet(v->GetNumberAsInt(), where);
-    if (const Value* v = member(*t, "offset"))
-      ref->offset = glm::vec2(v->Get(0).GetNumberAsDouble(), v->Get(1).GetNumberAsDouble());
-    if (const Value* v = member(*t, "scale"))
-      ref->scale = glm::vec2(v->Get(0).GetNumberAsDouble(), v->Get(1).GetNumberAsDouble());
-    if (const Value* v = member(*t, "rotation")) ref->rotation = float(v->GetNumberAsDouble());
+    if (const Value* t = extension(extensions, "KHR_texture_transform"))
+      readTransformValue(*t, ref, where);
+  }
+
+  // KHR_texture_transform's members, checked as they are read (the extensions' textures are
+  // not among those checkMaterials validates).
+  void readTransformValue(const Value& t, TextureRef* ref, const std::string& where) {
+    auto pair = [&](const char* key, glm::vec2* out) {
+      const Value* v = member(t, key);
+      if (!v) return;
+      bool ok = v->IsArray() && v->ArrayLen() == 2;
+      for (int k = 0; ok && k < 2; ++k)
+        ok = v->Get(k).IsNumber() && finite(v->Get(k).GetNumberAsDouble());
+      if (!ok)
+        fail(std::string("KHR_texture_transform ") + key + " must be 2 finite numbers", where);
+      *out = glm::vec2(v->Get(0).GetNumberAsDouble(), v->Get(1).GetNumberAsDouble());
+    };
+    if (const Value* v = member(t, "texCoord")) {
+      if (!v->IsInt() || v->GetNumberAsInt() < 0)
+        fail("KHR_texture_transform texCoord must be a non-negative integer", where);
+      ref->texCoord = uvSet(v->GetNumberAsInt(), where);
+    }
+    pair("offset", &ref->offset);
+    pair("scale", &ref->scale);
+    if (const Value* v = member(t, "rotation")) {
+      if (!v->IsNumber() || !finite(v->GetNumberAsDouble()))
+        fail("KHR_texture_transform rotation must be a finite number", where);
+      ref->rotation = float(v->GetNumberAsDouble());
+    }
+  }
+
+  // A texture of a material extension (a textureInfo inside the extension's object).
+  TextureRef extensionTexture(const Value& ext, const char* name, bool srgb,
+                              const std::string& where) {
+    const Value* t = member(ext, name);
+    if (!t) return TextureRef{};
+    const std::string twhere = where + ", " + name;
+    const Value* index = member(*t, "index");
+    if (!t->IsObject() || !index || !index->IsInt())
+      fail(std::string(name) + " needs an integer index", where);
+    checkTextureInfo(index->GetNumberAsInt(), name, where);
+    int texCoord = 0;
+    if (const Value* c = member(*t, "texCoord")) {
+      if (!c->IsInt() || c->GetNumberAsInt() < 0)
+        fail(std::string(name) + " texCoord must be a non-negative integer", where);
+      texCoord = c->GetNumberAsInt();
+    }
+    TextureRef ref = textureRef(index->GetNumberAsInt(), texCoord, srgb, twhere);
+    if (const Value* ex = member(*t, "extensions"))
+      if (const Value* tt = member(*ex, "KHR_texture_transform"))
+        readTransformValue(*tt, &ref, twhere);
+    return ref;
   }
 
   // A scene texture for (glTF texture, colour space), decoded once.

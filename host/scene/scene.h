@@ -95,7 +95,11 @@ struct Material {
   glm::vec3 specularColor{1.0f};  // specularColorFactor
   float clearcoat = 0.0f;         // KHR_materials_clearcoat: clearcoatFactor
   float clearcoatRoughness = 0.0f;
-  float thickness = 0.0f;  // KHR_materials_volume: thicknessFactor (0: thin-walled)
+  TextureRef specularTexture;            // linear, A scales specularFactor
+  TextureRef specularColorTexture;       // sRGB
+  TextureRef clearcoatTexture;           // linear, R
+  TextureRef clearcoatRoughnessTexture;  // linear, G
+  float thickness = 0.0f;                // KHR_materials_volume: thicknessFactor (0: thin-walled)
   float attenuationDistance = std::numeric_limits<float>::infinity();
   glm::vec3 attenuationColor{1.0f};
   AlphaMode alphaMode = AlphaMode::Opaque;

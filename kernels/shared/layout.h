@@ -71,6 +71,8 @@
   F(Material, spec_f0)                \
   F(Material, coat_roughness)         \
   F(Material, sigma_a)                \
+  F(Material, spec_texture)           \
+  F(Material, coat_roughness_uv)      \
   F(TextureInfo, flags)               \
   F(CameraParams, fx)                 \
   F(CameraParams, aspect)             \

@@ -17,7 +17,7 @@ PR_NAMESPACE_BEGIN
 
 #define PR_NO_TEXTURE (-1)
 
-// 208 bytes.
+// 320 bytes.
 typedef struct {
   float base_r, base_g, base_b, base_a;  // linear baseColorFactor
   float emit_r, emit_g, emit_b;          // emissiveFactor * emissive_strength (radiance)
@@ -36,18 +36,29 @@ typedef struct {
   float normal_uv[6];
   u32 uv_sets;           // bit PR_UV_*: that texture reads TEXCOORD_1, else TEXCOORD_0
   float spec_f90;        // KHR_materials_specular: F90 of the dielectric layer (1)
-  float spec_f0[3];      // its F0 colour: ((ior-1)/(ior+1))^2 x colour x factor (0.04)
+  float spec_f0[3];      // ((ior-1)/(ior+1))^2 x colour: F0 = min(this x texture, 1) x F90
   float coat;            // KHR_materials_clearcoat factor (0: none)
   float coat_roughness;  // its roughness
   // KHR_materials_volume inside a transmissive object: attenuation per unit length per channel
   // (-ln(attenuationColor) / attenuationDistance); 0: none (thin-walled or clear).
   float sigma_a[3];
+  // The extensions' textures (PR_NO_TEXTURE: none), each with its transform: specular (A
+  // scales the factor), specular colour (RGB, sRGB), clearcoat (R), clearcoat roughness (G).
+  i32 spec_texture, spec_color_texture, coat_texture, coat_roughness_texture;
+  float spec_uv[6];
+  float spec_color_uv[6];
+  float coat_uv[6];
+  float coat_roughness_uv[6];
 } Material;
 
 #define PR_UV_BASE 1u
 #define PR_UV_MR 2u
 #define PR_UV_EMISSION 4u
 #define PR_UV_NORMAL 8u
+#define PR_UV_SPEC 16u
+#define PR_UV_SPEC_COLOR 32u
+#define PR_UV_COAT 64u
+#define PR_UV_COAT_ROUGHNESS 128u
 
 // One texture in the shared texel buffer (RGBA8 packed in u32, row-major). 16 bytes.
 typedef struct {
@@ -64,7 +75,7 @@ typedef struct {
 
 PR_NAMESPACE_END
 
-PR_STATIC_ASSERT(sizeof(pr::dev::Material) == 208, "Material layout");
+PR_STATIC_ASSERT(sizeof(pr::dev::Material) == 320, "Material layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::Material, flags) == 28, "Material layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::Material, alpha_cutoff) == 48, "Material layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::Material, base_uv) == 64, "Material layout");

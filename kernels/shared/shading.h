@@ -238,10 +238,33 @@ PR_INLINE BsdfParams material_bsdf(const ShadingData* sd, const SurfaceHit* s) {
   roughness = clamp(roughness, 0.0f, 1.0f);
   p.alpha = fmax(roughness * roughness, PR_MIN_ALPHA);
   p.ior = m->ior;
-  p.f0 = make_float3(m->spec_f0[0], m->spec_f0[1], m->spec_f0[2]);
-  p.f90 = m->spec_f90;
-  p.coat = m->coat;
-  const float cr = clamp(m->coat_roughness, 0.0f, 1.0f);
+  // KHR_materials_specular: F0 = min(((ior-1)/(ior+1))^2 colour, 1) x factor, F90 = factor.
+  float3 f0 = make_float3(m->spec_f0[0], m->spec_f0[1], m->spec_f0[2]);
+  float f90 = m->spec_f90;
+  if (m->spec_color_texture != PR_NO_TEXTURE) {
+    const float4 t =
+        texture_sample(sd, m->spec_color_texture,
+                       material_uv(m, PR_UV_SPEC_COLOR, m->spec_color_uv, s->uv, s->uv1));
+    f0 = f0 * make_float3(t.x, t.y, t.z);
+  }
+  if (m->spec_texture != PR_NO_TEXTURE)
+    f90 *=
+        texture_sample(sd, m->spec_texture, material_uv(m, PR_UV_SPEC, m->spec_uv, s->uv, s->uv1))
+            .w;
+  p.f0 = make_float3(fmin(f0.x, 1.0f), fmin(f0.y, 1.0f), fmin(f0.z, 1.0f)) * f90;
+  p.f90 = f90;
+  float coat = m->coat, coat_roughness = m->coat_roughness;
+  if (m->coat_texture != PR_NO_TEXTURE)
+    coat *=
+        texture_sample(sd, m->coat_texture, material_uv(m, PR_UV_COAT, m->coat_uv, s->uv, s->uv1))
+            .x;
+  if (m->coat_roughness_texture != PR_NO_TEXTURE)
+    coat_roughness *=
+        texture_sample(sd, m->coat_roughness_texture,
+                       material_uv(m, PR_UV_COAT_ROUGHNESS, m->coat_roughness_uv, s->uv, s->uv1))
+            .y;
+  p.coat = coat;
+  const float cr = clamp(coat_roughness, 0.0f, 1.0f);
   p.coat_alpha = fmax(cr * cr, PR_MIN_ALPHA);
   if (m->flags & PR_MAT_GLASS)
     p.kind = PR_BSDF_GLASS;
