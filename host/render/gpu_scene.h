@@ -9,6 +9,7 @@
 #include "accel/device_accel.h"
 #include "accel/scene_accel.h"
 #include "cl/context.h"
+#include "render/device_materials.h"
 #include "render/light_bvh.h"
 #include "render/options.h"
 #include "scene/environment.h"
@@ -29,8 +30,7 @@ struct GpuSceneOptions {
   Environment environment;  // the environment light; none where !present()
 };
 
-// Host-side conversions, exposed for tests.
-dev::Material toDeviceMaterial(const Material& m, bool forceDiffuse = false);
+// The camera as the kernels see it, exposed for tests (materials: render/device_materials.h).
 dev::CameraParams toCameraParams(const CameraPose& pose, int width, int height);
 
 class GpuScene {

@@ -1,0 +1,29 @@
+// Scene materials, textures and vertices as the kernels see them (kernels/shared/material.h,
+// geometry.h): the conversions GpuScene uploads, exposed for tests.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "scene/scene.h"
+#include "shared/geometry.h"
+#include "shared/material.h"
+
+namespace pr {
+
+// The device material: factors, texture slots with their transforms and uv sets, the
+// extensions' parameters. forceDiffuse makes every non-delta material pure Lambert.
+dev::Material toDeviceMaterial(const Material& m, bool forceDiffuse = false);
+
+// All textures in one texel buffer (RGBA8 packed in u32) with a table of where each starts.
+struct DeviceTextures {
+  std::vector<dev::TextureInfo> infos;
+  std::vector<uint32_t> texels;
+};
+DeviceTextures packTextures(const std::vector<Texture>& textures);
+
+// Vertex v of a mesh: position, normal, both uv sets (TEXCOORD_0 standing in for a missing
+// TEXCOORD_1) and tangent.
+dev::ShadingVertex shadingVertex(const TriangleMesh& m, size_t v);
+
+}  // namespace pr
