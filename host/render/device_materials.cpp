@@ -96,7 +96,7 @@ DeviceTextures packTextures(const std::vector<Texture>& textures) {
       for (size_t i = 0; i < size_t(t.width) * t.height; ++i) {
         const uint8_t* p = &t.rgba8[i * 4];
         out.texels.push_back(uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 |
-                         uint32_t(p[3]) << 24);
+                             uint32_t(p[3]) << 24);
       }
     } else {
       out.texels.push_back(0xffffffffu);  // a white texel stands in for an undecodable image
