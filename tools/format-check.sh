@@ -5,8 +5,10 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 command -v clang-format >/dev/null || { echo "format-check: clang-format is not installed (apt-get install clang-format)" >&2; exit 1; }
-mapfile -t files < <(git ls-files 'host/*.cpp' 'host/*.h' 'kernels/*.cl' 'kernels/*.h' 'tests/*.cpp' \
-  'tests/*.h' 'tools/*.cpp' 'tools/fuzz/*.cpp')
+# Tracked files and new ones not yet added (but not ignored ones), so a check before the
+# first commit of a file sees it too.
+mapfile -t files < <(git ls-files --cached --others --exclude-standard 'host/*.cpp' 'host/*.h' \
+  'kernels/*.cl' 'kernels/*.h' 'tests/*.cpp' 'tests/*.h' 'tools/*.cpp' 'tools/fuzz/*.cpp')
 if [ "${1:-}" = --fix ]; then
   clang-format -i "${files[@]}"
   exit 0
