@@ -237,6 +237,19 @@ TEST(Bsdf, SampledDirectionsFollowThePdfChiSquare) {
   EXPECT_LT(bsdfChiSquarePValue(cases[1], dirFromCos(0.9f, 0.4f), 200000, 30u, 0.1f), 1e-6);
 }
 
+// f(a, b) = f(b, a) for n pairs of directions drawn with r.
+void expectReciprocal(const BsdfParams& m, Rng r, int n) {
+  for (int i = 0; i < n; ++i) {
+    const float3 a = sample_cosine_hemisphere(rng_next(&r), rng_next(&r));
+    const float3 b = sample_cosine_hemisphere(rng_next(&r), rng_next(&r));
+    float p;
+    const float3 fab = bsdf_eval(&m, a, b, &p), fba = bsdf_eval(&m, b, a, &p);
+    EXPECT_NEAR(fab.x, fba.x, 1e-4f * std::fmax(1.0f, fab.x));
+    EXPECT_NEAR(fab.y, fba.y, 1e-4f * std::fmax(1.0f, fab.y));
+    EXPECT_NEAR(fab.z, fba.z, 1e-4f * std::fmax(1.0f, fab.z));
+  }
+}
+
 // KHR_materials_specular and KHR_materials_clearcoat: sampling agrees with evaluation, the
 // pdf with the sampled directions, reciprocity holds and no energy is created.
 TEST(Bsdf, SpecularColourAndClearcoatSampleWhatTheyEvaluate) {
@@ -263,14 +276,7 @@ TEST(Bsdf, SpecularColourAndClearcoatSampleWhatTheyEvaluate) {
         EXPECT_GT(bsdfChiSquarePValue(m, wo, 200000, 80u + k), 1e-4);
       }
     }
-    Rng r = rng_make(7, PR_RNG_TEST, 0, 0, k);
-    for (int i = 0; i < 300; ++i) {
-      const float3 a = sample_cosine_hemisphere(rng_next(&r), rng_next(&r));
-      const float3 b = sample_cosine_hemisphere(rng_next(&r), rng_next(&r));
-      float p;
-      const float3 fab = bsdf_eval(&m, a, b, &p), fba = bsdf_eval(&m, b, a, &p);
-      EXPECT_NEAR(fab.y, fba.y, 1e-4f * std::fmax(1.0f, fab.y));
-    }
+    expectReciprocal(m, rng_make(7, PR_RNG_TEST, 0, 0, k), 300);
     ++k;
   }
 }
@@ -296,16 +302,8 @@ TEST(Bsdf, SpecularFactorZeroLeavesTheDiffuseBaseAndCoatAddsAReflection) {
 }
 
 TEST(Bsdf, Reciprocity) {
-  Rng r = rng_make(6, PR_RNG_TEST, 0, 0, 0);
-  const BsdfParams m = microfacet(make_float3(0.6f, 0.4f, 0.2f), 0.4f, 0.5f);
-  for (int i = 0; i < 1000; ++i) {
-    const float3 a = sample_cosine_hemisphere(rng_next(&r), rng_next(&r));
-    const float3 b = sample_cosine_hemisphere(rng_next(&r), rng_next(&r));
-    float p;
-    const float3 fab = bsdf_eval(&m, a, b, &p), fba = bsdf_eval(&m, b, a, &p);
-    EXPECT_NEAR(fab.x, fba.x, 1e-4f * std::fmax(1.0f, fab.x));
-    EXPECT_NEAR(fab.z, fba.z, 1e-4f * std::fmax(1.0f, fab.z));
-  }
+  expectReciprocal(microfacet(make_float3(0.6f, 0.4f, 0.2f), 0.4f, 0.5f),
+                   rng_make(6, PR_RNG_TEST, 0, 0, 0), 1000);
 }
 
 TEST(Bsdf, GlassConservesEnergyAndRefractsBySnell) {

@@ -223,6 +223,25 @@ TEST(Environment, ColoursParseOrAreRefused) {
 // ---------------------------------------------------------------------------------------------
 // Renders
 
+// The path tracer and reuse render `scene` (frame 0, 24 x 24) with `args`; in every 8 x 8
+// region and each of `channels`, their means agree within 4.5 standard errors.
+void expectModesAgree(const std::string& scene, const std::string& args,
+                      std::initializer_list<int> channels, const std::string& tag) {
+  const Image pt = test::frameImage(
+      test::renderFrames(scene, "0", "--mode pathtrace --width 24 --height 24" + args, tag + "pt"),
+      0);
+  const Image re = test::frameImage(
+      test::renderFrames(scene, "0", "--mode reuse --width 24 --height 24" + args, tag + "re"), 0);
+  for (int c : channels)
+    for (int y0 = 0; y0 < 24; y0 += 8)
+      for (int x0 = 0; x0 < 24; x0 += 8) {
+        const test::Moments a = test::regionMean(pt, x0, y0, x0 + 8, y0 + 8, c);
+        const test::Moments b = test::regionMean(re, x0, y0, x0 + 8, y0 + 8, c);
+        EXPECT_NEAR(a.mean, b.mean, 4.5 * std::hypot(a.stderr_, b.stderr_) + 1e-4)
+            << "channel " << c << " region " << x0 << "," << y0;
+      }
+}
+
 // A Lambert box of albedo 0.5 seen from +Z, nothing else, no lights; optionally a floor and a
 // moving second box.
 std::string boxScene(const std::string& tag, bool floorAndMover = false) {
@@ -272,20 +291,10 @@ TEST(Environment, ReuseConvergesToThePathTracerUnderAMap) {
   const std::string scene = boxScene("envmove", true);
   // Independent light paths for every pixel sample: the estimate's variance is then all in
   // the standard errors.
-  const std::string args = " --width 24 --height 24 --spp 128 --light-paths " +
-                           std::to_string(24 * 24 * 128 * 4) + " --force-diffuse --env " + dir +
+  const std::string args = " --spp 128 --light-paths " + std::to_string(24 * 24 * 128 * 4) +
+                           " --force-diffuse --env " + dir +
                            "/sky.exr --env-rotate 30 --max-depth 6";
-  const Image pt =
-      test::frameImage(test::renderFrames(scene, "0", "--mode pathtrace" + args, "envpt"), 0);
-  const Image re =
-      test::frameImage(test::renderFrames(scene, "0", "--mode reuse" + args, "envre"), 0);
-  for (int y0 = 0; y0 < 24; y0 += 8)
-    for (int x0 = 0; x0 < 24; x0 += 8) {
-      const test::Moments a = test::regionMean(pt, x0, y0, x0 + 8, y0 + 8, 1);
-      const test::Moments b = test::regionMean(re, x0, y0, x0 + 8, y0 + 8, 1);
-      const double se = std::hypot(a.stderr_, b.stderr_);
-      EXPECT_NEAR(a.mean, b.mean, 4.5 * se + 1e-4) << "region " << x0 << "," << y0;
-    }
+  expectModesAgree(scene, args, {1}, "env");
 }
 
 // KHR_materials_specular and KHR_materials_clearcoat in every kernel: the path tracer and
@@ -300,20 +309,9 @@ TEST(Environment, CoatedAndSpecularMaterialsAgreeInBothModes) {
       {"KHR_materials_specular", {{"specularFactor", 0.8}, {"specularColorFactor", {1, 0.6, 0.3}}}},
       {"KHR_materials_clearcoat", {{"clearcoatFactor", 0.7}, {"clearcoatRoughnessFactor", 0.3}}}};
   { std::ofstream(scene) << doc.dump(); }
-  const std::string args = " --width 24 --height 24 --spp 128 --light-paths " +
-                           std::to_string(24 * 24 * 128 * 4) +
+  const std::string args = " --spp 128 --light-paths " + std::to_string(24 * 24 * 128 * 4) +
                            " --env-color 0.9,1,1.1 --max-depth 5";
-  const Image pt =
-      test::frameImage(test::renderFrames(scene, "0", "--mode pathtrace" + args, "coatpt"), 0);
-  const Image re =
-      test::frameImage(test::renderFrames(scene, "0", "--mode reuse" + args, "coatre"), 0);
-  for (int y0 = 0; y0 < 24; y0 += 8)
-    for (int x0 = 0; x0 < 24; x0 += 8) {
-      const test::Moments a = test::regionMean(pt, x0, y0, x0 + 8, y0 + 8, 0);
-      const test::Moments b = test::regionMean(re, x0, y0, x0 + 8, y0 + 8, 0);
-      EXPECT_NEAR(a.mean, b.mean, 4.5 * std::hypot(a.stderr_, b.stderr_) + 1e-4)
-          << "region " << x0 << "," << y0;
-    }
+  expectModesAgree(scene, args, {0}, "coat");
 }
 
 // KHR_materials_volume: seen through a slab of clear (ior 1) glass 0.5 thick whose
@@ -383,20 +381,9 @@ TEST(Environment, LightPathsThroughAnAbsorbingRoofAgreeWithThePathTracer) {
       {"attenuationColor", {0.9, 0.5, 0.2}}};
   doc["materials"][glass]["extensions"]["KHR_materials_ior"] = {{"ior", 1.0}};
   { std::ofstream(scene) << doc.dump(); }
-  const std::string args = " --width 24 --height 24 --spp 64 --light-paths " +
-                           std::to_string(24 * 24 * 64 * 4) + " --env-color 1,1,1 --max-depth 6";
-  const Image pt =
-      test::frameImage(test::renderFrames(scene, "0", "--mode pathtrace" + args, "roofpt"), 0);
-  const Image re =
-      test::frameImage(test::renderFrames(scene, "0", "--mode reuse" + args, "roofre"), 0);
-  for (int c : {0, 2})
-    for (int y0 = 0; y0 < 24; y0 += 8)
-      for (int x0 = 0; x0 < 24; x0 += 8) {
-        const test::Moments a = test::regionMean(pt, x0, y0, x0 + 8, y0 + 8, c);
-        const test::Moments b = test::regionMean(re, x0, y0, x0 + 8, y0 + 8, c);
-        EXPECT_NEAR(a.mean, b.mean, 4.5 * std::hypot(a.stderr_, b.stderr_) + 1e-4)
-            << "channel " << c << " region " << x0 << "," << y0;
-      }
+  const std::string args = " --spp 64 --light-paths " + std::to_string(24 * 24 * 64 * 4) +
+                           " --env-color 1,1,1 --max-depth 6";
+  expectModesAgree(scene, args, {0, 2}, "roof");
 }
 
 // The extensions' textures scale their factors: a clearcoat texture whose R is 0 and a specular

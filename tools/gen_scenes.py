@@ -88,14 +88,14 @@ def check_clearance(times):
                 raise gw.Invalid("moving sphere path collides near t=%.3f" % times[k])
 
 
-def build(orbit):
-    g = gw.Gltf("pathreuse tools/gen_scenes.py")
+def cornell_box(g):
+    """The box's materials, walls and light. Returns the white material and the walls' and
+    light's nodes."""
     white = g.material("white", (0.73, 0.73, 0.73))
     red = g.material("red", (0.63, 0.065, 0.05))
     green = g.material("green", (0.14, 0.45, 0.091))
     light = g.material("light", (0.0, 0.0, 0.0), emissive=(1.0, 1.0, 1.0),
                        strength=LIGHT_STRENGTH)
-    gold = g.material("sphere", (0.8, 0.7, 0.2), roughness=0.3)
     t = WALL
 
     # interior x in [-1,1], y in [0,2], z in [-1,1]; the front (+z) is open
@@ -111,19 +111,27 @@ def build(orbit):
     if lamp.nrm[1::3] != [-1.0] * lamp.vertex_count:
         raise gw.Invalid("light quad does not face down")
     lamp_mesh = g.mesh("light", [(lamp, light)])
+    return white, [g.node("walls", mesh=walls), g.node("light", mesh=lamp_mesh)]
 
-    def block(name, spec):
-        sx, sy, sz = spec["size"]
-        m = g.mesh(name, [(gw.box((-sx / 2, 0, -sz / 2), (sx / 2, sy, sz / 2)), white)])
-        return g.node(name, mesh=m, translation=spec["at"],
-                      rotation=gw.quat_axis_angle((0, 1, 0), math.radians(spec["yaw"])))
+
+def block(g, white, name, spec):
+    """A white block as SHORT_BOX or TALL_BOX gives it, standing on the floor."""
+    sx, sy, sz = spec["size"]
+    m = g.mesh(name, [(gw.box((-sx / 2, 0, -sz / 2), (sx / 2, sy, sz / 2)), white)])
+    return g.node(name, mesh=m, translation=spec["at"],
+                  rotation=gw.quat_axis_angle((0, 1, 0), math.radians(spec["yaw"])))
+
+
+def build(orbit):
+    g = gw.Gltf("pathreuse tools/gen_scenes.py")
+    white, roots = cornell_box(g)
+    gold = g.material("sphere", (0.8, 0.7, 0.2), roughness=0.3)
 
     sphere = g.mesh("sphere", [(gw.uv_sphere(SPHERE_R, SPHERE_SEG, SPHERE_RINGS), gold)])
     times = key_times()
     check_clearance(times)
 
-    roots = [g.node("walls", mesh=walls), g.node("light", mesh=lamp_mesh),
-             block("short_block", SHORT_BOX), block("tall_block", TALL_BOX)]
+    roots += [block(g, white, "short_block", SHORT_BOX), block(g, white, "tall_block", TALL_BOX)]
     ball = g.node("moving_sphere", mesh=sphere, translation=sphere_centre(0.0),
                   rotation=sphere_rotation(0.0), extras={"dynamic": True})
     roots.append(ball)
@@ -197,28 +205,10 @@ def blob_mesh():
 
 def build_skinned(rings=TENTACLE_RINGS, segments=TENTACLE_SEG):
     g = gw.Gltf("pathreuse tools/gen_scenes.py")
-    white = g.material("white", (0.73, 0.73, 0.73))
-    red = g.material("red", (0.63, 0.065, 0.05))
-    green = g.material("green", (0.14, 0.45, 0.091))
-    light = g.material("light", (0.0, 0.0, 0.0), emissive=(1.0, 1.0, 1.0),
-                       strength=LIGHT_STRENGTH)
+    white, roots = cornell_box(g)
     skin_mat = g.material("tentacle", (0.55, 0.25, 0.45), roughness=0.5)
     blob_mat = g.material("blob", (0.2, 0.45, 0.7), roughness=0.35)
-    t = WALL
-    shell = gw.Mesh()
-    shell.add(gw.box((-1 - t, -t, -1 - t), (1 + t, 0, 1)))
-    shell.add(gw.box((-1 - t, 2, -1 - t), (1 + t, 2 + t, 1)))
-    shell.add(gw.box((-1 - t, 0, -1 - t), (1 + t, 2, -1)))
-    walls = g.mesh("walls", [(shell, white), (gw.box((-1 - t, 0, -1), (-1, 2, 1)), red),
-                             (gw.box((1, 0, -1), (1 + t, 2, 1)), green)])
-    lamp = gw.quad((-LIGHT_W / 2, LIGHT_Y, -LIGHT_D / 2), (LIGHT_W, 0, 0), (0, 0, LIGHT_D))
-    sx, sy, sz = SHORT_BOX["size"]
-    block = g.mesh("short_block",
-                   [(gw.box((-sx / 2, 0, -sz / 2), (sx / 2, sy, sz / 2)), white)])
-    roots = [g.node("walls", mesh=walls),
-             g.node("light", mesh=g.mesh("light", [(lamp, light)])),
-             g.node("short_block", mesh=block, translation=SHORT_BOX["at"],
-                    rotation=gw.quat_axis_angle((0, 1, 0), math.radians(SHORT_BOX["yaw"])))]
+    roots.append(block(g, white, "short_block", SHORT_BOX))
     # the joint chain: the root at the tentacle's foot, each next one `step` above
     times = key_times()
     step = TENTACLE_H / (JOINTS - 1)

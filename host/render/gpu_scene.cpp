@@ -205,6 +205,7 @@ bool GpuScene::deformMeshes(double t, std::vector<bool>* changed) {
         vertices_, CL_TRUE, meshFirstVertex_[m] * sizeof(dev::ShadingVertex),
         verts.size() * sizeof(dev::ShadingVertex), verts.data()));
   }
+  deformedAt_ = t;
   if (any) deviceAccel_.uploadMeshes(ctx_, dsg_, true);
   deformSeconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return any;
@@ -273,7 +274,9 @@ std::vector<dev::Light> GpuScene::lightsAt(double t) const {
     const glm::mat4& x = xforms[e.instance];
     const uint32_t mesh = scene_.instances[e.instance].mesh;
     const TriangleMesh* shape = &scene_.dynamicMeshes[mesh];
-    if (scene_.meshDeforms(mesh)) {
+    if (scene_.meshDeforms(mesh) && deformedAt_ == t) {
+      shape = &deformed_[mesh];  // setTime deformed it already
+    } else if (scene_.meshDeforms(mesh)) {
       auto it = shapes.find(mesh);
       if (it == shapes.end()) {
         it = shapes.emplace(mesh, scene_.dynamicMeshes[mesh]).first;

@@ -2,6 +2,7 @@
 // materials, textures, the light table (rebuilt when lights move) and the camera.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -96,6 +97,7 @@ class GpuScene {
   std::vector<TriangleMesh> deformed_;       // per dynamic mesh: its shape this frame
   std::vector<std::vector<glm::vec3>> lastPositions_, lastNormals_;
   double deformSeconds_ = 0.0;
+  double deformedAt_ = std::nan("");  // the time deformed_ holds (NaN: none yet)
   std::vector<dev::ShadingInstance> instances_;
   std::vector<glm::mat4> lastTransforms_;
   bool firstFrame_ = true;

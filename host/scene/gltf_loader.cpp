@@ -985,15 +985,15 @@ class Loader {
     }
   }
 
-  AnimationSampler readSampler(const tinygltf::Animation& anim, int index,
-                               const std::string& where) {
-    const auto& s = anim.samplers[size_t(index)];
+  // A sampler's interpolation and key times (finite, strictly increasing; CUBICSPLINE needs 2
+  // keys, as the glTF spec and its validator's ANIMATION_SAMPLER_INPUT_ACCESSOR_TOO_FEW_ELEMENTS
+  // say), without its values.
+  AnimationSampler samplerKeys(const tinygltf::AnimationSampler& s, const std::string& where) {
     AnimationSampler out;
     out.interpolation = s.interpolation == "STEP"          ? Interpolation::Step
                         : s.interpolation == "CUBICSPLINE" ? Interpolation::CubicSpline
                                                            : Interpolation::Linear;
     const std::vector<double> in = readAccessor(s.input);
-    // The glTF spec (and its validator: ANIMATION_SAMPLER_INPUT_ACCESSOR_TOO_FEW_ELEMENTS).
     if (out.interpolation == Interpolation::CubicSpline && in.size() < 2)
       fail("CUBICSPLINE needs at least 2 keys, the input has " + std::to_string(in.size()), where);
     for (size_t i = 0; i < in.size(); ++i) {
@@ -1002,6 +1002,14 @@ class Loader {
         fail("input times are not strictly increasing at key " + std::to_string(i), where);
       out.times.push_back(float(in[i]));
     }
+    return out;
+  }
+
+  AnimationSampler readSampler(const tinygltf::Animation& anim, int index,
+                               const std::string& where) {
+    const auto& s = anim.samplers[size_t(index)];
+    AnimationSampler out = samplerKeys(s, where);
+    const std::vector<float>& in = out.times;
     const auto& oa = model_.accessors[size_t(s.output)];
     const size_t perKey = out.interpolation == Interpolation::CubicSpline ? 3 : 1;
     if (oa.count != in.size() * perKey)
@@ -1028,19 +1036,8 @@ class Loader {
   std::vector<AnimationSampler> readWeightSamplers(const tinygltf::Animation& anim, int index,
                                                    const std::string& where) {
     const auto& s = anim.samplers[size_t(index)];
-    AnimationSampler proto;
-    proto.interpolation = s.interpolation == "STEP"          ? Interpolation::Step
-                          : s.interpolation == "CUBICSPLINE" ? Interpolation::CubicSpline
-                                                             : Interpolation::Linear;
-    const std::vector<double> in = readAccessor(s.input);
-    if (proto.interpolation == Interpolation::CubicSpline && in.size() < 2)
-      fail("CUBICSPLINE needs at least 2 keys, the input has " + std::to_string(in.size()), where);
-    for (size_t i = 0; i < in.size(); ++i) {
-      if (!finite(in[i])) fail("input time " + std::to_string(i) + " is not finite", where);
-      if (i > 0 && !(float(in[i]) > float(in[i - 1])))
-        fail("input times are not strictly increasing at key " + std::to_string(i), where);
-      proto.times.push_back(float(in[i]));
-    }
+    const AnimationSampler proto = samplerKeys(s, where);
+    const std::vector<float>& in = proto.times;
     const size_t perKey = proto.interpolation == Interpolation::CubicSpline ? 3 : 1;
     const std::vector<double> values = readAccessor(s.output);
     const size_t slots = in.size() * perKey;
