@@ -101,8 +101,8 @@ int main(int argc, char** argv) {
   std::string bvhWidthText = "auto";
   render
       ->add_option("--bvh-width", bvhWidthText,
-                   "Children per BVH node: 8 (float8 slab tests, for CPUs), 2 (both children's "
-                   "boxes in one node, for GPUs), 4, or auto (8 on CPUs, 2 on GPUs)")
+                   "Children per BVH node: 8 (float8 slab tests, for CPUs), 4 (for GPUs), 2, or "
+                   "auto (8 on CPUs, 4 on GPUs)")
       ->check(CLI::IsMember({"auto", "2", "4", "8"}))
       ->capture_default_str();
   render->add_option("--light-paths", ro.lightPaths,

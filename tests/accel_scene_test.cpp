@@ -51,7 +51,10 @@ void expectSceneMatchesBruteForce(const std::string& path, const std::vector<dou
                                   size_t rays) {
   const Scene scene = loadScene(path);
   Context& ctx = test::testContext();
-  GpuScene gpu(ctx, scene);
+  // Built as wide as the host's CPU reference traverses, whatever the device's default.
+  GpuSceneOptions referenceLayout;
+  referenceLayout.bvhWidth = PR_BVH_WIDTH;
+  GpuScene gpu(ctx, scene, referenceLayout);
   // The same scene in every layout a device may get, traced on the test device.
   std::vector<std::unique_ptr<GpuScene>> layouts;
   for (int width : {2, 4, 8}) {

@@ -114,7 +114,7 @@ if ref:
 else:
     print()
 print()
-print("BVH width (children per node; `--bvh-width`, 8 is a CPU's default, 2 a GPU's), our Mrays/s:")
+print("BVH width (children per node; `--bvh-width`, 8 is a CPU's default, 4 a GPU's), our Mrays/s:")
 print()
 print("| width | camera | shadow | bounce | SSG device MiB |")
 print("|---:|---:|---:|---:|---:|")

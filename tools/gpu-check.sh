@@ -2,7 +2,8 @@
 # The checks for a machine with a GPU and no package registry, in one call (a few minutes):
 # lists the OpenCL devices, runs the test suite on the GPU, compares the GPU's portability
 # suite with the reference frames rendered on the CPU, times the demo on the GPU, and (where
-# the bundle has ray_bench) measures ray throughput of each BVH width there.
+# the bundle has ray_bench) measures ray throughput and frame times of each BVH width there, on
+# the demo and on the atrium, and runs a short form of the evaluation.
 # Everything goes to OUT. The programs come from a bundle made by tools/gpu-bundle.sh on the
 # build machine and carried along (default: .gpu in the repository root).
 # Usage: tools/gpu-check.sh OUT [BUNDLE] [DEVICE]   (DEVICE: a --device spec, default gpu)
@@ -48,6 +49,13 @@ if [ -d "$bundle/shared-scenes" ] && [ ! -e "$(dirname "$src")/shared/scenes" ];
 fi
 if [ ! -x "$src/build/pathreuse" ]; then mkdir -p "$src/build" && cp "$bundle"/bin/* "$src/build/"; fi
 
+# The evaluation's smoke test and the short evaluation need a Python with numpy and matplotlib;
+# a GPU machine's system Python may lack them where another one has them.
+for py in /usr/bin/python3 python3; do
+  if "$py" -c 'import numpy, matplotlib' 2>/dev/null; then export PATHREUSE_PYTHON="$py"; break; fi
+done
+say "python for the evaluation: ${PATHREUSE_PYTHON:-none with numpy and matplotlib}"
+
 rm -f /tmp/gpu-check-rc
 say "== tests on --device $device"
 tests=("$src"/build/*_test)
@@ -76,7 +84,7 @@ for mode in pathtrace reuse; do
   say "$mode: exit $?, median frame wall seconds $(python3 -c 'import json,sys,statistics; print(statistics.median(json.loads(l)["wall_s"] for l in open(sys.argv[1])))' "$out/stats-$mode.jsonl" 2>/dev/null)"
 done
 
-# Which BVH layout suits the GPU: ray throughput at each width (auto gives a GPU width 2).
+# Which BVH layout suits the GPU: ray throughput at each width (auto gives a GPU width 4).
 if [ -x "$bundle/bin/ray_bench" ]; then
   scene="$(dirname "$src")/shared/scenes/cornell-nvpro/cornellBox.gltf"
   [ -f "$scene" ] || scene=scenes/cornell-dynamic.gltf
@@ -85,4 +93,40 @@ if [ -x "$bundle/bin/ray_bench" ]; then
     "$bundle/bin/ray_bench" "$scene" --device "$device" --repeats 3 --bvh-width "$w" >"$out/rays-w$w.txt" 2>&1
     say "width $w: exit $?, $(awk '/^(camera|shadow|bounce) /{printf "%s ", $6}' "$out/rays-w$w.txt")"
   done
+fi
+
+# The atrium (generated here: 7 MB) at each BVH width: ray throughput and frame times.
+atrium=/tmp/pathreuse-atrium-gpu/atrium.gltf
+${PATHREUSE_PYTHON:-python3} tools/gen_atrium.py --size 1 --out "$atrium" >/dev/null 2>>"$summary"
+if [ -f "$atrium" ]; then
+  if [ -x "$bundle/bin/ray_bench" ]; then
+    say "== ray throughput on --device $device by BVH width (atrium, 1280x720, Mrays/s camera shadow bounce)"
+    for w in 2 4 8; do
+      "$bundle/bin/ray_bench" "$atrium" --device "$device" --repeats 5 --width 1280 --height 720 \
+        --bvh-width "$w" >"$out/rays-atrium-w$w.txt" 2>&1
+      say "width $w: exit $?, $(awk '/^(camera|shadow|bounce) /{printf "%s ", $6}' "$out/rays-atrium-w$w.txt")"
+    done
+  fi
+  say "== atrium frame times on --device $device by BVH width (640x360, 16 spp, frames 0-11, median wall s)"
+  for w in 2 4 8; do
+    line="width $w:"
+    for mode in pathtrace reuse; do
+      "$src/build/pathreuse" render "$atrium" --device "$device" --mode "$mode" --bvh-width "$w" \
+        --width 640 --height 360 --spp 16 --frames 0-11 --quiet --out "/tmp/pathreuse-atrium-gpu/$mode-%04d.exr" \
+        --stats "$out/stats-atrium-$mode-w$w.jsonl" 2>>"$summary"
+      line="$line $mode $(python3 -c 'import json,sys,statistics; print(round(statistics.median(json.loads(l)["wall_s"] for l in open(sys.argv[1])), 4))' "$out/stats-atrium-$mode-w$w.jsonl" 2>/dev/null)"
+    done
+    say "$line"
+  done
+fi
+
+# A short form of the evaluation (relMSE against a reference, equal-time comparisons) on the GPU.
+if [ -n "${PATHREUSE_PYTHON:-}" ]; then
+  say "== short evaluation on the default device (the first GPU), results in evaluation/"
+  PATHREUSE_DEVICE="$device" timeout 200 "$PATHREUSE_PYTHON" tools/evaluate.py --quiet --out-dir "$out/evaluation" \
+    --build "$src/build" --cache /tmp/pathreuse-eval-cache --atrium "$atrium" --frames 9 --atrium-frames 9 \
+    --timing-frames 25 --atrium-timing-frames 13 --seeds 1,2 --repeats 2 --ref-spp 256 --atrium-ref-spp 128 \
+    --equal-time-rounds 1 >"$out/evaluation.log" 2>&1
+  say "evaluation: exit $?"
+  sed -n '/^## Goals/,/^## /p' "$out/evaluation/results.md" 2>/dev/null | head -n 30 >>"$summary"
 fi

@@ -46,8 +46,9 @@ run "cornell-skinned-reuse" scenes/cornell-skinned.gltf --frames 0-2 --mode reus
 # it), on the many-lights atrium too: a deep tree, point and spot lights, a moving emitter.
 run "cornell-dynamic-pathtrace-lightbvh" scenes/cornell-dynamic.gltf --frames 0-1 --mode pathtrace \
   --light-sampler bvh
-# The other BVH layouts (8 is what a CPU gets by default): 2, a GPU's, and 4.
+# Resampled connections (two shadow rays per eye vertex).
 run "cornell-dynamic-reuse-ris" scenes/cornell-dynamic.gltf --frames 0-1 --mode reuse --connections 2
+# The other BVH layouts (8 is what a CPU gets by default): 4, a GPU's, and 2.
 for width in 2 4; do
   run "cornell-dynamic-reuse-bvh$width" scenes/cornell-dynamic.gltf --frames 0-1 --mode reuse \
     --bvh-width "$width"
