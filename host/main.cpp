@@ -123,13 +123,14 @@ int main(int argc, char** argv) {
           "path is shared with a connection from that sample (fewer fireflies near "
           "corners; 0 = off)")
       ->capture_default_str();
-  std::string connectionsText = "all";
+  std::string connectionsText = "auto";
   render
       ->add_option("--connections", connectionsText,
                    "Connections to the stored light vertices per eye vertex (reuse/retrace): "
                    "1 to 4 shadow rays, each to a candidate chosen in proportion to its "
-                   "unshadowed contribution, or all (one shadow ray per candidate)")
-      ->check(CLI::IsMember({"1", "2", "3", "4", "all"}))
+                   "unshadowed contribution, all (one shadow ray per candidate), or auto (all "
+                   "on CPUs, 2 on GPUs)")
+      ->check(CLI::IsMember({"1", "2", "3", "4", "all", "auto"}))
       ->capture_default_str();
   render->add_option(
       "--env", ro.env,
@@ -246,7 +247,9 @@ int main(int argc, char** argv) {
                         : lightSamplerText == "power" ? pr::LightSampler::Power
                                                       : pr::LightSampler::Auto;
       ro.bvhWidth = bvhWidthText == "auto" ? 0 : std::stoi(bvhWidthText);
-      ro.connections = connectionsText == "all" ? 0 : std::stoi(connectionsText);
+      ro.connections = connectionsText == "auto"  ? -1
+                       : connectionsText == "all" ? 0
+                                                  : std::stoi(connectionsText);
       return pr::runRender(ro);
     }
     if (*portability) {

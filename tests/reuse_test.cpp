@@ -284,6 +284,25 @@ TEST(Reuse, ResampledConnectionsTraceOneRayPerEyeVertex) {
   EXPECT_GT(double(r["counters"]["connections_unoccluded"]), 0.0);
 }
 
+// --connections auto (the default) is the measured choice for the device: every candidate on
+// CPUs, two resampled connections on GPUs; the same frame as asking for it.
+TEST(Reuse, AutoConnectionsFollowTheDeviceKind) {
+  const std::string scene = test::sourcePath("scenes/cornell-dynamic.gltf");
+  const bool gpu = (test::testContext().device().type & CL_DEVICE_TYPE_GPU) != 0;
+  const std::string args = "--mode reuse --width 32 --height 24 --spp 2";
+  const std::string autoDir = test::renderFrames(scene, "0", args, "conn-auto");
+  const std::string fixedDir =
+      test::renderFrames(scene, "0", args + " --connections " + (gpu ? "2" : "all"), "conn-fixed");
+  const std::string otherDir =
+      test::renderFrames(scene, "0", args + " --connections " + (gpu ? "all" : "2"), "conn-other");
+  const auto rays = [](const std::string& dir) {
+    return double(nlohmann::json::parse(test::statsLines(dir).at(0))["rays"]["connection"]);
+  };
+  EXPECT_EQ(rays(autoDir), rays(fixedDir));
+  EXPECT_NE(rays(autoDir), rays(otherDir));
+  EXPECT_EQ(test::frameImage(autoDir, 0).rgba, test::frameImage(fixedDir, 0).rgba);
+}
+
 TEST(Reuse, ConvergesToThePathTracerOnCornellNvpro) {
   const std::string scene = test::sharedScene("cornell-nvpro/cornellBox.gltf");
   if (scene.empty()) GTEST_SKIP() << "../shared/scenes/cornell-nvpro is absent";

@@ -120,6 +120,15 @@ if [ -f "$atrium" ]; then
   done
 fi
 
+# Connection strategies against the path tracer on the GPU (frames large enough to fill it).
+if [ -f "$atrium" ]; then
+  say "== connection strategies on --device $device (tools/bench_connections.py, 640 wide, 16 spp)"
+  timeout 150 python3 tools/bench_connections.py --build "$src/build" --device "$device" --width 640 \
+    --atrium "$atrium" >"$out/connections.md" 2>>"$summary"
+  say "bench_connections: exit $?"
+  grep '^|\|^##' "$out/connections.md" >>"$summary"
+fi
+
 # A short form of the evaluation (relMSE against a reference, equal-time comparisons) on the GPU.
 if [ -n "${PATHREUSE_PYTHON:-}" ]; then
   say "== short evaluation on the default device (the first GPU), results in evaluation/"

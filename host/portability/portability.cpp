@@ -284,6 +284,9 @@ int runPortability(const PortabilityOptions& o) {
   base.spp = o.spp;
   base.seed = o.seed;
   base.quiet = true;
+  // One estimator on every device (auto would resample connections on GPUs only): the suite
+  // compares implementations, not per-device defaults.
+  base.connections = 0;
   validateRenderOptions(base);
 
   // Against saved frames every device is compared; else every device but the first.

@@ -16,6 +16,8 @@ constexpr int kAutoLightBvhMin = 16;
 // Children per BVH node for a device (0: auto): CPUs 8 (float8 slab tests), GPUs 2 (a binary
 // node holding both children's boxes). Measured in docs/ray-benchmark.md.
 int defaultBvhWidth(bool gpu);
+// Resampled connections per eye vertex where --connections is auto; 0: every candidate.
+int defaultConnections(bool gpu);
 
 const char* renderModeName(RenderMode m);
 
@@ -55,7 +57,8 @@ struct RenderOptions {
   int pathsPerPixel = 4;       // C: light paths each pixel sample connects to
   float clamp = 0.0f;          // clamp on the geometry term; 0 = off
   float connectionMis = 4.0f;  // MIS threshold on p_E / p_L (kernels/reuse/connect.cl); 0 = off
-  int connections = 0;         // RIS-chosen connections per eye vertex (1-4); 0: every candidate
+  int connections = -1;        // RIS-chosen connections per eye vertex (1-4); 0: every candidate;
+                               // -1: defaultConnections of the device
   // The environment light (scene/environment.h): a map file, "none", or "" (a uniform one of
   // envColor where --env-color is given, else white where the scene has no lights, else none).
   std::string env;

@@ -1,0 +1,87 @@
+#!/usr/bin/env python3
+"""Connection strategies against the path tracer: relMSE and relMSE x kernel seconds of one
+frame against a path-traced reference, for `reuse` with every connection traced
+(`--connections all`) and with K resampled ones, on the demo scenes and the atrium.
+
+  python3 tools/bench_connections.py                   # 160-wide frames, 16 spp, PoCL or the default device
+  python3 tools/bench_connections.py --width 640 --device gpu   # a GPU wants larger frames
+
+Each scene's reference is pathtrace at --ref-spp (seed 999); each configuration renders frame 0
+with --seeds seeds, interleaved, and the table gives medians over the seeds: relMSE (eps 0.01,
+as exr_compare), kernel seconds (the sum of the frame's stages), their product (lower is
+better: the error reached per unit of time), and shadow rays per camera sample (connection and
+next-event). Standard library only, so that a GPU machine's Python runs it too.
+"""
+
+import argparse
+import json
+import statistics
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import benchlib  # noqa: E402
+
+CONFIGS = [("pathtrace", ["--mode", "pathtrace"]),
+           ("reuse all", ["--mode", "reuse", "--connections", "all"]),
+           ("reuse K=1", ["--mode", "reuse", "--connections", "1"]),
+           ("reuse K=2", ["--mode", "reuse", "--connections", "2"])]
+ASPECT = {"cornell-dynamic": 0.75, "cornell-skinned": 0.75, "atrium": 0.5625}
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--build", default=str(benchlib.REPO / "build"))
+    ap.add_argument("--scenes", default="cornell-dynamic,cornell-skinned,atrium")
+    ap.add_argument("--atrium", default=str(benchlib.ATRIUM), help="atrium glTF (generated if absent)")
+    ap.add_argument("--width", type=int, default=160, help="height from the scene's aspect")
+    ap.add_argument("--spp", type=int, default=16)
+    ap.add_argument("--ref-spp", type=int, default=1024)
+    ap.add_argument("--seeds", type=int, default=3)
+    ap.add_argument("--device", help="--device of every render (default: the renderer's)")
+    a = ap.parse_args()
+    exe, compare = Path(a.build) / "pathreuse", Path(a.build) / "exr_compare"
+    device = ["--device", a.device] if a.device else []
+    work = Path(tempfile.mkdtemp(prefix="pathreuse-connections-"))
+
+    def render(scene, w, h, spp, seed, opts, tag):
+        out = work / f"{tag}_%04d.exr"
+        stats = work / f"{tag}.jsonl"
+        subprocess.run([str(exe), "render", str(scene), "--frames", "0", "--width", str(w), "--height",
+                        str(h), "--spp", str(spp), "--seed", str(seed), "--quiet", "--exr-float", "--out",
+                        str(out), "--stats", str(stats)] + device + opts, check=True)
+        rec = json.loads(stats.read_text().splitlines()[-1])
+        return work / f"{tag}_0000.exr", rec
+
+    print("# Connection strategies against the path tracer\n")
+    print("\n".join(benchlib.machine_lines(exe)))
+    print(f"- command: `{' '.join(sys.argv)}`\n", flush=True)
+    for name in a.scenes.split(","):
+        scene = benchlib.ensure_atrium(a.atrium) if name == "atrium" else benchlib.REPO / "scenes" / f"{name}.gltf"
+        w = a.width
+        h = max(1, round(w * ASPECT.get(name, 0.75)))
+        ref, _ = render(scene, w, h, a.ref_spp, 999, ["--mode", "pathtrace"], f"{name}_ref")
+        rows = {}
+        for seed in range(1, a.seeds + 1):
+            for label, opts in CONFIGS:
+                img, rec = render(scene, w, h, a.spp, seed, opts, f"{name}_{seed}")
+                out = subprocess.run([str(compare), str(ref), str(img)], capture_output=True, text=True,
+                                     check=True).stdout
+                rel = json.loads(out.strip().splitlines()[-1])["relmse"]
+                rays, cam = rec["rays"], max(1, rec["rays"]["camera"])
+                rows.setdefault(label, []).append(
+                    (rel, benchlib.kernel_s(rec), rays.get("connection", 0) / cam, rays.get("shadow", 0) / cam))
+        print(f"## {name}, {w}x{h}, {a.spp} spp, frame 0, medians of {a.seeds} seeds; "
+              f"reference: pathtrace {a.ref_spp} spp\n")
+        print("| config | relMSE | kernel s | relMSE x s | connection rays / sample | NEE rays / sample |")
+        print("|---|---:|---:|---:|---:|---:|")
+        for label, v in rows.items():
+            med = [statistics.median(x[i] for x in v) for i in range(4)]
+            print(f"| {label} | {med[0]:.4f} | {med[1]:.4f} | {med[0] * med[1]:.3g} | {med[2]:.2f} | {med[3]:.2f} |")
+        print(flush=True)
+
+
+if __name__ == "__main__":
+    main()
