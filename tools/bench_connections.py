@@ -10,11 +10,14 @@ Each scene's reference is pathtrace at --ref-spp (seed 999); each configuration 
 with --seeds seeds, interleaved, and the table gives medians over the seeds: relMSE (eps 0.01,
 as exr_compare), kernel seconds (the sum of the frame's stages), their product (lower is
 better: the error reached per unit of time), and shadow rays per camera sample (connection and
-next-event). Standard library only, so that a GPU machine's Python runs it too.
+next-event). --baseline-kernels DIR adds the reuse rows rendered with another kernels/ folder
+(PATHREUSE_KERNEL_DIR; e.g. `git archive` of an older commit), side by side in the same run.
+Standard library only, so that a GPU machine's Python runs it too.
 """
 
 import argparse
 import json
+import os
 import statistics
 import subprocess
 import sys
@@ -41,17 +44,26 @@ def main():
     ap.add_argument("--ref-spp", type=int, default=1024)
     ap.add_argument("--seeds", type=int, default=3)
     ap.add_argument("--device", help="--device of every render (default: the renderer's)")
+    ap.add_argument("--baseline-kernels", help="another kernels/ folder for the reuse rows")
+    ap.add_argument("--configs", help="comma-separated labels of the rows to run (default: all)")
     a = ap.parse_args()
+    configs = [(label, opts, None) for label, opts in CONFIGS]
+    if a.baseline_kernels:
+        configs += [(label + " (baseline)", opts, a.baseline_kernels) for label, opts in CONFIGS
+                    if label != "pathtrace"]
+    if a.configs:
+        configs = [c for c in configs if c[0] in a.configs.split(",")]
     exe, compare = Path(a.build) / "pathreuse", Path(a.build) / "exr_compare"
     device = ["--device", a.device] if a.device else []
     work = Path(tempfile.mkdtemp(prefix="pathreuse-connections-"))
 
-    def render(scene, w, h, spp, seed, opts, tag):
+    def render(scene, w, h, spp, seed, opts, tag, kernels=None):
         out = work / f"{tag}_%04d.exr"
         stats = work / f"{tag}.jsonl"
         subprocess.run([str(exe), "render", str(scene), "--frames", "0", "--width", str(w), "--height",
                         str(h), "--spp", str(spp), "--seed", str(seed), "--quiet", "--exr-float", "--out",
-                        str(out), "--stats", str(stats)] + device + opts, check=True)
+                        str(out), "--stats", str(stats)] + device + opts, check=True,
+                       env=dict(os.environ, PATHREUSE_KERNEL_DIR=kernels) if kernels else None)
         rec = json.loads(stats.read_text().splitlines()[-1])
         return work / f"{tag}_0000.exr", rec
 
@@ -65,8 +77,8 @@ def main():
         ref, _ = render(scene, w, h, a.ref_spp, 999, ["--mode", "pathtrace"], f"{name}_ref")
         rows = {}
         for seed in range(1, a.seeds + 1):
-            for label, opts in CONFIGS:
-                img, rec = render(scene, w, h, a.spp, seed, opts, f"{name}_{seed}")
+            for label, opts, kernels in configs:
+                img, rec = render(scene, w, h, a.spp, seed, opts, f"{name}_{seed}", kernels)
                 out = subprocess.run([str(compare), str(ref), str(img)], capture_output=True, text=True,
                                      check=True).stdout
                 rel = json.loads(out.strip().splitlines()[-1])["relmse"]
