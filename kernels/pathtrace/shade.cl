@@ -71,40 +71,23 @@ __kernel void pt_shade(PR_SCENE_PARAMS, __global PathState* states, __global con
     }
     const float u0 = rng_next(&rng);
     const float2 u12 = rng_next2(&rng);
-    float3 wil, weight;
-    float pdf;
-    int delta;
-    const float3 wol = to_local(wo, f.t, f.b, f.n);
-    if (!bsdf_sample(&f.bsdf, wol, u0, u12.x, u12.y, PR_RADIANCE, &wil, &weight, &pdf, &delta)) {
+    PathStep step;
+    if (!path_step(&f, wo, u0, u12.x, u12.y, PR_RADIANCE, &step)) {
       p.alive = 0u;
     } else {
-      const float3 wi = to_world(wil, f.t, f.b, f.n);
-      // Reflection must leave on wo's side of the geometric surface, refraction the other.
-      const int reflect = wil.z * wol.z > 0.0f;
-      const float side = dot(wi, f.ng) * dot(wo, f.ng);
-      if ((reflect && side <= 0.0f) || (!reflect && side >= 0.0f)) {
-        p.alive = 0u;
-      } else {
-        tp = tp * weight;
-        // Russian roulette (pbrt-v4's rule): from the third vertex, a path whose throughput
-        // fell below 1 survives with that probability; brighter paths always go on.
-        const float rr = rng_next(&rng), q = max3(tp);
-        if (p.depth >= 3u && q < 1.0f) {
-          if (rr >= q)
-            p.alive = 0u;
-          else
-            tp = tp / q;
-        }
-        p.ray = spawn_ray(h.p, f.ng, wi, PR_INF_F);
-        p.prev_x = h.p.x;
-        p.prev_y = h.p.y;
-        p.prev_z = h.p.z;
-        p.prev_nx = f.n.x;
-        p.prev_ny = f.n.y;
-        p.prev_nz = f.n.z;
-        p.last_pdf = pdf;
-        p.flags = delta ? PR_PATH_SPECULAR : 0u;
-      }
+      tp = tp * step.weight;
+      // From the third vertex on (the camera's throughput starts at 1).
+      const float rr = rng_next(&rng);
+      if (p.depth >= 3u && !russian_roulette(max3(tp), rr, &tp)) p.alive = 0u;
+      p.ray = spawn_ray(h.p, f.ng, step.wi, PR_INF_F);
+      p.prev_x = h.p.x;
+      p.prev_y = h.p.y;
+      p.prev_z = h.p.z;
+      p.prev_nx = f.n.x;
+      p.prev_ny = f.n.y;
+      p.prev_nz = f.n.z;
+      p.last_pdf = step.pdf;
+      p.flags = step.delta ? PR_PATH_SPECULAR : 0u;
     }
   }
   if (!(max3(tp) < PR_INF_F)) p.alive = 0u;  // NaN or Inf throughput ends the path

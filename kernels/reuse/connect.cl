@@ -348,14 +348,12 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
     const float u0 = rng_next(&rng);
     const float2 u12 = rng_next2(&rng);
     if (x.depth + 1u >= rp.max_depth) break;
-    float3 wil, weight;
-    float pdf;
-    int delta;
-    if (!bsdf_sample(&x.f.bsdf, x.wol, u0, u12.x, u12.y, PR_RADIANCE, &wil, &weight, &pdf, &delta))
-      break;
-    float3 d = normalize(to_world(wil, x.f.t, x.f.b, x.f.n));
-    if (dot(d, x.f.ng) * dot(x.wo, x.f.ng) <= 0.0f) break;
-    float3 t2 = x.tp * weight;
+    PathStep step;
+    if (!path_step(&x.f, x.wo, u0, u12.x, u12.y, PR_RADIANCE, &step)) break;
+    float3 d = step.wi;
+    const float pdf = step.pdf;
+    const int delta = step.delta;
+    float3 t2 = x.tp * step.weight;
     uint depth = x.depth;
     Ray ray = spawn_ray(x.h.p, x.f.ng, d, PR_INF_F);
     int found = 0;
@@ -396,11 +394,10 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
       if (depth >= rp.max_depth) break;
       const float w0 = rng_next(&rng);
       const float2 w12 = rng_next2(&rng);
-      if (!bsdf_sample(&y.f.bsdf, y.wol, w0, w12.x, w12.y, PR_RADIANCE, &wil, &weight, &pdf,
-                       &delta))
-        break;
-      d = normalize(to_world(wil, y.f.t, y.f.b, y.f.n));
-      t2 = t2 * weight;
+      PathStep chained;
+      if (!path_step(&y.f, y.wo, w0, w12.x, w12.y, PR_RADIANCE, &chained)) break;
+      d = chained.wi;
+      t2 = t2 * chained.weight;
       ray = spawn_ray(h.p, y.f.ng, d, PR_INF_F);
     }
     if (!found || !(max3(x.tp) < PR_INF_F)) break;

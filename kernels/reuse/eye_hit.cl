@@ -52,14 +52,10 @@ __kernel void eye_hit(PR_SCENE_PARAMS, ReuseParams rp, CameraParams cam, uint sa
     }
     const float u0 = rng_next(&rng);
     const float2 u12 = rng_next2(&rng);
-    float3 wil, weight;
-    float pdf;
-    int delta;
-    const float3 wol = to_local(wo, f.t, f.b, f.n);
-    if (!bsdf_sample(&f.bsdf, wol, u0, u12.x, u12.y, PR_RADIANCE, &wil, &weight, &pdf, &delta))
-      break;
-    d = normalize(to_world(wil, f.t, f.b, f.n));
-    tp = tp * weight;
+    PathStep step;
+    if (!path_step(&f, wo, u0, u12.x, u12.y, PR_RADIANCE, &step)) break;
+    d = step.wi;
+    tp = tp * step.weight;
     ray = spawn_ray(h.p, f.ng, d, PR_INF_F);
     ++bounces;
   }

@@ -154,25 +154,14 @@ __kernel void light_trace(PR_SCENE_PARAMS, ReuseParams rp, __global const float*
     q.ns = oct_decode(v.ns_oct);
     const float3 wo = -dir;
     const ShadingFrame f = shading_frame(&s, &q, wo);
-    float3 wil, weight;
-    float pdf;
-    int delta;
-    const float3 wol = to_local(wo, f.t, f.b, f.n);
-    if (!bsdf_sample(&f.bsdf, wol, u0, v1, v2, PR_IMPORTANCE, &wil, &weight, &pdf, &delta)) break;
-    const float3 wi = normalize(to_world(wil, f.t, f.b, f.n));
-    const int reflect = wil.z * wol.z > 0.0f;
-    const float side = dot(wi, f.ng) * dot(wo, f.ng);
-    if ((reflect && side <= 0.0f) || (!reflect && side >= 0.0f)) break;
-    float3 w = weight * shading_normal_correction(wo, wi, f.n, f.ng);
-    // Russian roulette (pbrt-v4's rule) on the throughput relative to what left the light.
-    const float qk = max3(tp * w) / tp0;
-    if (k >= 2u && qk < 1.0f) {
-      if (rr >= qk) break;
-      w = w / qk;
-    }
+    PathStep step;
+    if (!path_step(&f, wo, u0, v1, v2, PR_IMPORTANCE, &step)) break;
+    float3 w = step.weight * shading_normal_correction(wo, step.wi, f.n, f.ng);
+    // On the throughput relative to what left the light, from the third vertex on.
+    if (k >= 2u && !russian_roulette(max3(tp * w) / tp0, rr, &w)) break;
     tp = tp * w;
     if (!(max3(tp) > 0.0f) || !(max3(tp) < PR_INF_F)) break;
-    dir = wi;
+    dir = step.wi;
     ray = light_segment_ray(sh.p, v.ng_oct, hit.prim, dir);
   }
   h.vertex_count = count;

@@ -83,6 +83,41 @@ PR_INLINE ShadingFrame shading_frame(const SceneData* s, const SurfaceHit* h, fl
   return f;
 }
 
+// One step of a path from a shaded point (every kernel continues its paths through this): the
+// BSDF in frame f sampled with (u0, u1, u2) from wo (towards the previous vertex), the new
+// direction in world space with the BSDF weight f cos / pdf, the pdf and whether the lobe was
+// delta. 0 where the BSDF gives no direction or where the direction is on the wrong side of the
+// geometric surface (reflection must stay on wo's side, refraction cross it): a shading normal
+// must not let a path through a surface it only reflects from, or back off one it enters.
+typedef struct {
+  float3 wi;
+  float3 weight;
+  float pdf;
+  int delta;
+} PathStep;
+
+PR_INLINE int path_step(const ShadingFrame* f, float3 wo, float u0, float u1, float u2, int mode,
+                        PathStep* step) {
+  const float3 wol = to_local(wo, f->t, f->b, f->n);
+  float3 wil;
+  if (!bsdf_sample(&f->bsdf, wol, u0, u1, u2, mode, &wil, &step->weight, &step->pdf, &step->delta))
+    return 0;
+  step->wi = normalize(to_world(wil, f->t, f->b, f->n));
+  const int reflect = wil.z * wol.z > 0.0f;
+  const float side = dot(step->wi, f->ng) * dot(wo, f->ng);
+  return reflect ? side > 0.0f : side < 0.0f;
+}
+
+// Russian roulette (pbrt-v4's rule) where q, the path's throughput relative to its start, fell
+// below 1: the path survives with probability q (u uniform), and *w is divided by q so the
+// estimate keeps its expectation. Brighter paths always go on.
+PR_INLINE int russian_roulette(float q, float u, float3* w) {
+  if (q >= 1.0f) return 1;
+  if (u >= q) return 0;
+  *w = *w / q;
+  return 1;
+}
+
 // Emitted radiance leaving the surface at h (two-sided emitters).
 PR_INLINE float3 surface_emission(const SceneData* s, const SurfaceHit* h) {
   return material_emission(&s->sd, h);
