@@ -2,1065 +2,38 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
-#include <filesystem>
-#include <fstream>
-#include <iostream>
 #include <map>
 #include <optional>
 #include <set>
-#include <sstream>
 
-#include <tiny_gltf.h>
-
-#include "scene/gltf_schema.h"
+#include "scene/gltf_accessors.h"
+#include "scene/gltf_document.h"
+#include "scene/gltf_validate.h"
 #include "scene/image_decode.h"
 #include "scene/tangents.h"
 #include "util/error.h"
 
 namespace pr {
 
+namespace gltf {
+
 namespace {
 
-namespace fs = std::filesystem;
-using tinygltf::Value;
-
-constexpr double kPi = 3.14159265358979323846;
-
-// Encoded bytes of images given by uri (data: or file), keyed by image index. Images in
-// buffer views are read by us after their ranges are checked: tinygltf would read them
-// without checking.
-struct ImageBytes {
-  std::map<int, std::vector<uint8_t>> encoded;
-};
-
-bool keepImageBytes(tinygltf::Image* image, const int index, std::string*, std::string*, int, int,
-                    const unsigned char* bytes, int size, void* user) {
-  if (image->bufferView >= 0 || !bytes || size <= 0) return true;
-  static_cast<ImageBytes*>(user)->encoded[index].assign(bytes, bytes + size);
-  return true;
-}
-
-// One line: newlines and other control characters become spaces, runs collapse.
-std::string oneLine(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    const bool ctl = static_cast<unsigned char>(c) < 0x20 || c == 0x7f;
-    if (ctl) c = ' ';
-    if (c == ' ' && (out.empty() || out.back() == ' ')) continue;
-    out += c;
-  }
-  while (!out.empty() && out.back() == ' ') out.pop_back();
-  return out;
-}
-
-std::string named(const char* kind, int index, const std::string& name) {
-  std::string s = std::string(kind) + " " + std::to_string(index);
-  if (!name.empty()) s += " \"" + name + "\"";
-  return s;
-}
-
-bool finite(double v) {
-  return std::isfinite(v);
-}
-
-bool allFinite(const std::vector<double>& v) {
-  return std::all_of(v.begin(), v.end(), finite);
-}
-
-const Value* member(const Value& obj, const char* key) {
-  if (!obj.IsObject() || !obj.Has(key)) return nullptr;
-  return &obj.Get(key);
-}
-
-const Value* extension(const tinygltf::ExtensionMap& ext, const char* name) {
-  const auto it = ext.find(name);
-  return it == ext.end() ? nullptr : &it->second;
-}
-
-size_t componentSize(int componentType) {
-  switch (componentType) {
-    case TINYGLTF_COMPONENT_TYPE_BYTE:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
-      return 1;
-    case TINYGLTF_COMPONENT_TYPE_SHORT:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
-      return 2;
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
-    case TINYGLTF_COMPONENT_TYPE_FLOAT:
-      return 4;
-    default:
-      return 0;
-  }
-}
-
-size_t componentCount(int type) {
-  switch (type) {
-    case TINYGLTF_TYPE_SCALAR:
-      return 1;
-    case TINYGLTF_TYPE_VEC2:
-      return 2;
-    case TINYGLTF_TYPE_VEC3:
-      return 3;
-    case TINYGLTF_TYPE_VEC4:
-      return 4;
-    case TINYGLTF_TYPE_MAT2:
-      return 4;
-    case TINYGLTF_TYPE_MAT3:
-      return 9;
-    case TINYGLTF_TYPE_MAT4:
-      return 16;
-    default:
-      return 0;
-  }
-}
-
-const char* typeName(int type) {
-  switch (type) {
-    case TINYGLTF_TYPE_SCALAR:
-      return "SCALAR";
-    case TINYGLTF_TYPE_VEC2:
-      return "VEC2";
-    case TINYGLTF_TYPE_VEC3:
-      return "VEC3";
-    case TINYGLTF_TYPE_VEC4:
-      return "VEC4";
-    case TINYGLTF_TYPE_MAT2:
-      return "MAT2";
-    case TINYGLTF_TYPE_MAT3:
-      return "MAT3";
-    case TINYGLTF_TYPE_MAT4:
-      return "MAT4";
-    default:
-      return "unknown type";
-  }
-}
-
-const char* componentName(int componentType) {
-  switch (componentType) {
-    case TINYGLTF_COMPONENT_TYPE_BYTE:
-      return "BYTE";
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
-      return "UNSIGNED_BYTE";
-    case TINYGLTF_COMPONENT_TYPE_SHORT:
-      return "SHORT";
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
-      return "UNSIGNED_SHORT";
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
-      return "UNSIGNED_INT";
-    case TINYGLTF_COMPONENT_TYPE_FLOAT:
-      return "FLOAT";
-    default:
-      return "unknown component type";
-  }
-}
-
-// One component as a number, normalised integers mapped to [0,1] or [-1,1].
-double readComponent(const uint8_t* p, int componentType, bool normalized) {
-  switch (componentType) {
-    case TINYGLTF_COMPONENT_TYPE_FLOAT: {
-      float f;
-      std::memcpy(&f, p, 4);
-      return f;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
-      uint32_t v;
-      std::memcpy(&v, p, 4);
-      return v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
-      uint16_t v;
-      std::memcpy(&v, p, 2);
-      return normalized ? v / 65535.0 : v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_SHORT: {
-      int16_t v;
-      std::memcpy(&v, p, 2);
-      return normalized ? std::max(v / 32767.0, -1.0) : v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
-      return normalized ? *p / 255.0 : *p;
-    case TINYGLTF_COMPONENT_TYPE_BYTE: {
-      const int8_t v = static_cast<int8_t>(*p);
-      return normalized ? std::max(v / 127.0, -1.0) : v;
-    }
-    default:
-      return 0.0;
-  }
-}
-
-// a + b * c <= limit, without overflow.
-bool fits(uint64_t a, uint64_t b, uint64_t c, uint64_t limit) {
-  uint64_t bc = 0, sum = 0;
-  if (__builtin_mul_overflow(b, c, &bc) || __builtin_add_overflow(a, bc, &sum)) return false;
-  return sum <= limit;
-}
-
-// What an attribute or animation accessor may be.
-struct AccessorRule {
-  std::vector<int> types;
-  std::vector<int> componentTypes;
-  bool normalizedIntegers = false;  // integer component types must be normalized
-};
-
-class Loader {
+// Converts a validated document into the renderer's Scene.
+class Converter : Stage {
  public:
-  Loader(std::string path, const LoadOptions& options)
-      : path_(std::move(path)), options_(options) {}
-  // In memory: `bytes` stand for the file at `path_` (named in errors; external URIs resolve
-  // beside it).
-  Loader(std::string path, const std::string& bytes, const LoadOptions& options)
-      : path_(std::move(path)),
-        options_(options),
-        bytes_(bytes.begin(), bytes.end()),
-        inMemory_(true) {}
+  Converter(Document& doc, Validated validated)
+      : Stage(doc), parents_(std::move(validated.parents)) {
+    scene_.animations = std::move(validated.animations);
+  }
 
-  Scene load() {
-    parse();
-    checkAssetAndExtensions();
-    checkBuffersAndViews();
-    checkAccessors();
-    checkTexturesAndImages();
-    checkMaterials();
-    checkCamerasAndLights();
-    checkMeshes();
-    checkNodesAndScenes();
-    checkSkins();
-    checkAnimations();
+  Scene convert() {
     build();
+    scene_.warnings = std::move(doc_.warnings);
     return std::move(scene_);
   }
 
  private:
-  [[noreturn]] void fail(const std::string& what, const std::string& where = "") const {
-    std::string msg = path_ + ": " + what;
-    if (!where.empty()) msg += " (" + where + ")";
-    throw InputError(oneLine(msg));
-  }
-
-  void warn(const std::string& line) {
-    const std::string w = oneLine(path_ + ": warning: " + line);
-    if (std::find(scene_.warnings.begin(), scene_.warnings.end(), w) != scene_.warnings.end())
-      return;
-    scene_.warnings.push_back(w);
-    std::ostream* out = options_.warningStream;
-    if (!out && options_.printWarnings) out = &std::cerr;
-    if (out) *out << w << "\n";
-  }
-
-  // --- parsing -------------------------------------------------------------------------------
-
-  void readFileBytes() {
-    std::error_code ec;
-    const fs::file_status st = fs::status(path_, ec);
-    if (ec || !fs::exists(st)) fail("no such file");
-    if (fs::is_directory(st)) fail("is a directory, not a glTF file");
-    std::ifstream in(path_, std::ios::binary);
-    if (!in) fail("cannot open file");
-    bytes_.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-    if (in.bad()) fail("cannot read file");
-  }
-
-  void parse() {
-    if (!inMemory_) readFileBytes();
-    const std::vector<uint8_t>& bytes = bytes_;
-    if (bytes.empty()) fail("file is empty");
-
-    std::string ext = fs::path(path_).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(),
-                   [](unsigned char c) { return std::tolower(c); });
-    binary_ = ext == ".glb" || (bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0);
-
-    std::string baseDir = fs::path(path_).parent_path().string();
-    if (baseDir.empty()) baseDir = ".";
-
-    preflight(bytes);
-    tinygltf::TinyGLTF gltf;
-    gltf.SetImageLoader(&keepImageBytes, &images_);
-    std::string err, warnText;
-    bool ok = false;
-    try {
-      if (binary_) {
-        if (bytes.size() > 0xffffffffu) fail("file is too large for GLB");
-        ok = gltf.LoadBinaryFromMemory(&model_, &err, &warnText, bytes.data(),
-                                       static_cast<unsigned int>(bytes.size()), baseDir);
-      } else {
-        ok = gltf.LoadASCIIFromString(&model_, &err, &warnText,
-                                      reinterpret_cast<const char*>(bytes.data()),
-                                      static_cast<unsigned int>(bytes.size()), baseDir);
-      }
-    } catch (const InputError&) {
-      throw;
-    } catch (const std::exception& e) {
-      fail(std::string("not a valid glTF file: ") + e.what());
-    }
-    if (!ok) {
-      std::string why = oneLine(err.empty() ? warnText : err);
-      if (why.empty()) why = "unknown reason";
-      fail("not a valid glTF file: " + why);
-    }
-    std::vector<uint8_t>().swap(bytes_);  // the model holds what is needed now
-  }
-
-  // Before tinygltf: the JSON's types (tinygltf silently drops a property of the wrong type),
-  // the version and the required extensions, so these get precise messages.
-  void preflight(const std::vector<uint8_t>& bytes) {
-    const uint8_t* json = bytes.data();
-    size_t length = bytes.size();
-    if (binary_) {
-      // Header (magic, version, length) then the JSON chunk (length, type). A broken container
-      // is left to tinygltf's checks, which name the problem.
-      if (bytes.size() < 20 || std::memcmp(bytes.data(), "glTF", 4) != 0) return;
-      uint32_t chunkLength = 0, chunkType = 0;
-      std::memcpy(&chunkLength, bytes.data() + 12, 4);
-      std::memcpy(&chunkType, bytes.data() + 16, 4);
-      if (chunkType != 0x4E4F534Au || chunkLength > bytes.size() - 20) return;
-      json = bytes.data() + 20;
-      length = chunkLength;
-    }
-    nlohmann::json j;
-    try {
-      j = nlohmann::json::parse(json, json + length);
-    } catch (const nlohmann::json::exception& e) {
-      fail(std::string("invalid JSON: ") + e.what());
-    }
-    const std::string problem = checkGltfSchema(j);
-    if (!problem.empty()) fail(problem);
-    const std::string version = j["asset"]["version"].get<std::string>();
-    const auto dot = version.find('.');
-    if (dot == std::string::npos || version.substr(0, dot) != "2")
-      fail("unsupported glTF version \"" + version + "\" (asset.version; only 2.x is supported)");
-    if (j.contains("extensionsRequired"))
-      for (const auto& e : j["extensionsRequired"])
-        if (!isSupportedExtension(e.get<std::string>()))
-          fail("requires extension " + e.get<std::string>() + ", which is not supported",
-               "extensionsRequired");
-  }
-
-  void checkAssetAndExtensions() {
-    const std::string& v = model_.asset.version;
-    const auto dot = v.find('.');
-    if (dot == std::string::npos || v.substr(0, dot) != "2")
-      fail("unsupported glTF version \"" + v + "\" (asset.version; only 2.x is supported)");
-    const std::string& minV = model_.asset.minVersion;
-    if (!minV.empty() && minV != "2.0")
-      fail("requires glTF version " + minV + " (asset.minVersion; only 2.0 is supported)");
-    for (const std::string& e : model_.extensionsRequired)
-      if (!isSupportedExtension(e))
-        fail("requires extension " + e + ", which is not supported", "extensionsRequired");
-    // Optional ones: named once each, and rendered without what they add.
-    for (const std::string& e : model_.extensionsUsed)
-      if (!isSupportedExtension(e))
-        warn("extension " + e + " is not supported; what it adds is ignored (extensionsUsed)");
-  }
-
-  // --- buffers, views, accessors ---------------------------------------------------------------
-
-  void checkBuffersAndViews() {
-    for (size_t i = 0; i < model_.buffers.size(); ++i) {
-      const auto& b = model_.buffers[i];
-      if (b.data.empty()) fail("buffer has no data", named("buffer", int(i), b.name));
-    }
-    for (size_t i = 0; i < model_.bufferViews.size(); ++i) {
-      const auto& v = model_.bufferViews[i];
-      const std::string where = named("bufferView", int(i), v.name);
-      if (v.buffer < 0 || size_t(v.buffer) >= model_.buffers.size())
-        fail("refers to buffer " + std::to_string(v.buffer) + ", which does not exist", where);
-      if (v.byteLength == 0) fail("byteLength is 0", where);
-      const size_t size = model_.buffers[size_t(v.buffer)].data.size();
-      if (!fits(v.byteOffset, v.byteLength, 1, size))
-        fail("bytes " + std::to_string(v.byteOffset) + ".." +
-                 std::to_string(v.byteOffset + v.byteLength) + " lie past the end of buffer " +
-                 std::to_string(v.buffer) + " (" + std::to_string(size) + " bytes)",
-             where);
-      if (v.byteStride != 0 && (v.byteStride < 4 || v.byteStride > 252 || v.byteStride % 4 != 0))
-        fail("byteStride " + std::to_string(v.byteStride) + " is not a multiple of 4 in 4..252",
-             where);
-    }
-  }
-
-  // Checks accessor `index` once; `where` names its use for the message.
-  void checkAccessor(int index, const std::string& where) {
-    if (index < 0 || size_t(index) >= model_.accessors.size())
-      fail("accessor " + std::to_string(index) + " does not exist", where);
-    if (accessorChecked_.count(index)) return;
-    const auto& a = model_.accessors[size_t(index)];
-    const std::string self = named("accessor", index, a.name);
-    const std::string at = where.empty() ? self : where;
-    const std::string who = where.empty() ? "" : self + " ";
-    const size_t cs = componentSize(a.componentType), nc = componentCount(a.type);
-    if (cs == 0) fail(who + "has invalid componentType " + std::to_string(a.componentType), at);
-    if (nc == 0) fail(who + "has invalid type", at);
-    if (a.count == 0) fail(who + "has count 0", at);
-    if (a.normalized && (a.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT ||
-                         a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
-      fail(who + "is normalized but its components are " + componentName(a.componentType), at);
-    const size_t elem = cs * nc;
-    if (a.bufferView >= 0) {
-      if (size_t(a.bufferView) >= model_.bufferViews.size())
-        fail(
-            who + "refers to bufferView " + std::to_string(a.bufferView) + ", which does not exist",
-            at);
-      const auto& v = model_.bufferViews[size_t(a.bufferView)];
-      size_t stride = elem;
-      if (v.byteStride != 0) {
-        stride = v.byteStride;
-        if (stride < elem || stride % cs != 0)
-          fail(who + "has byteStride " + std::to_string(stride) + ", which does not suit its " +
-                   std::to_string(elem) + "-byte elements (bufferView " +
-                   std::to_string(a.bufferView) + ")",
-               at);
-      }
-      if (!fits(a.byteOffset + elem, stride, a.count - 1, v.byteLength) ||
-          a.byteOffset > v.byteLength)
-        fail((where.empty() ? self : self) + " reads past the end of bufferView " +
-                 std::to_string(a.bufferView),
-             where);
-    } else if (!a.sparse.isSparse) {
-      // No buffer view and no sparse data: all zeros, as the spec says.
-    }
-    if (a.sparse.isSparse) checkSparse(index, at);
-    accessorChecked_.insert(index);
-  }
-
-  void checkSparse(int index, const std::string& at) {
-    const auto& a = model_.accessors[size_t(index)];
-    const auto& sp = a.sparse;
-    const std::string self = "sparse accessor " + std::to_string(index);
-    if (sp.count <= 0 || size_t(sp.count) > a.count)
-      fail(self + " has sparse count " + std::to_string(sp.count) + " outside 1.." +
-               std::to_string(a.count),
-           at);
-    const size_t is = componentSize(sp.indices.componentType);
-    if (is == 0 || sp.indices.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT ||
-        sp.indices.componentType == TINYGLTF_COMPONENT_TYPE_BYTE ||
-        sp.indices.componentType == TINYGLTF_COMPONENT_TYPE_SHORT)
-      fail(self + " has invalid sparse index componentType", at);
-    auto view = [&](int bv, int offset, size_t bytes, const char* what) {
-      if (bv < 0 || size_t(bv) >= model_.bufferViews.size())
-        fail(self + " refers to " + what + " bufferView " + std::to_string(bv) +
-                 ", which does not exist",
-             at);
-      if (offset < 0) fail(self + " has a negative " + what + " byteOffset", at);
-      const auto& v = model_.bufferViews[size_t(bv)];
-      if (v.byteStride != 0)
-        fail(self + " " + what + " bufferView " + std::to_string(bv) + " has a byteStride", at);
-      if (!fits(size_t(offset), bytes, 1, v.byteLength))
-        fail(self + " " + what + " read past the end of bufferView " + std::to_string(bv), at);
-    };
-    view(sp.indices.bufferView, sp.indices.byteOffset, is * size_t(sp.count), "indices");
-    view(sp.values.bufferView, sp.values.byteOffset,
-         componentSize(a.componentType) * componentCount(a.type) * size_t(sp.count), "values");
-    // Indices strictly increasing and in range.
-    const auto& v = model_.bufferViews[size_t(sp.indices.bufferView)];
-    const uint8_t* p =
-        model_.buffers[size_t(v.buffer)].data.data() + v.byteOffset + size_t(sp.indices.byteOffset);
-    double prev = -1.0;
-    for (int i = 0; i < sp.count; ++i) {
-      const double k = readComponent(p + size_t(i) * is, sp.indices.componentType, false);
-      if (k <= prev || k >= double(a.count))
-        fail(self + " has sparse index " + std::to_string(uint64_t(k)) +
-                 " out of order or out of range",
-             at);
-      prev = k;
-    }
-  }
-
-  void checkAccessors() {
-    for (size_t i = 0; i < model_.accessors.size(); ++i) checkAccessor(int(i), "");
-  }
-
-  void checkRule(int index, const AccessorRule& rule, const std::string& where) {
-    checkAccessor(index, where);
-    const auto& a = model_.accessors[size_t(index)];
-    const bool typeOk = std::find(rule.types.begin(), rule.types.end(), a.type) != rule.types.end();
-    const bool compOk = std::find(rule.componentTypes.begin(), rule.componentTypes.end(),
-                                  a.componentType) != rule.componentTypes.end();
-    const bool normOk = !rule.normalizedIntegers ||
-                        a.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT || a.normalized;
-    if (!typeOk || !compOk || !normOk)
-      fail("accessor " + std::to_string(index) + " is " + (a.normalized ? "normalized " : "") +
-               typeName(a.type) + " " + componentName(a.componentType) +
-               ", which is not allowed here",
-           where);
-  }
-
-  // Every element of a checked accessor, components flattened (count * components values).
-  std::vector<double> readAccessor(int index) const {
-    const auto& a = model_.accessors[size_t(index)];
-    const size_t cs = componentSize(a.componentType), nc = componentCount(a.type), elem = cs * nc;
-    std::vector<double> out(a.count * nc, 0.0);
-    if (a.bufferView >= 0) {
-      const auto& v = model_.bufferViews[size_t(a.bufferView)];
-      const size_t stride = v.byteStride ? v.byteStride : elem;
-      const uint8_t* base =
-          model_.buffers[size_t(v.buffer)].data.data() + v.byteOffset + a.byteOffset;
-      for (size_t i = 0; i < a.count; ++i)
-        for (size_t c = 0; c < nc; ++c)
-          out[i * nc + c] =
-              readComponent(base + i * stride + c * cs, a.componentType, a.normalized);
-    }
-    if (a.sparse.isSparse) {
-      const auto& sp = a.sparse;
-      const auto& iv = model_.bufferViews[size_t(sp.indices.bufferView)];
-      const auto& vv = model_.bufferViews[size_t(sp.values.bufferView)];
-      const uint8_t* ip = model_.buffers[size_t(iv.buffer)].data.data() + iv.byteOffset +
-                          size_t(sp.indices.byteOffset);
-      const uint8_t* vp = model_.buffers[size_t(vv.buffer)].data.data() + vv.byteOffset +
-                          size_t(sp.values.byteOffset);
-      const size_t is = componentSize(sp.indices.componentType);
-      for (int i = 0; i < sp.count; ++i) {
-        const size_t k =
-            size_t(readComponent(ip + size_t(i) * is, sp.indices.componentType, false));
-        for (size_t c = 0; c < nc; ++c)
-          out[k * nc + c] =
-              readComponent(vp + size_t(i) * elem + c * cs, a.componentType, a.normalized);
-      }
-    }
-    return out;
-  }
-
-  // --- textures, materials ---------------------------------------------------------------------
-
-  void checkTexturesAndImages() {
-    for (size_t i = 0; i < model_.images.size(); ++i) {
-      const auto& im = model_.images[i];
-      const std::string where = named("image", int(i), im.name);
-      if (im.bufferView >= 0) {
-        if (size_t(im.bufferView) >= model_.bufferViews.size())
-          fail("refers to bufferView " + std::to_string(im.bufferView) + ", which does not exist",
-               where);
-      } else if (im.uri.empty() && !images_.encoded.count(int(i))) {
-        fail("has neither uri nor bufferView", where);
-      }
-    }
-    for (size_t i = 0; i < model_.samplers.size(); ++i) {
-      const auto& s = model_.samplers[i];
-      for (int w : {s.wrapS, s.wrapT})
-        if (w != TINYGLTF_TEXTURE_WRAP_REPEAT && w != TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE &&
-            w != TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT)
-          fail("invalid wrap mode " + std::to_string(w), named("sampler", int(i), s.name));
-    }
-    std::set<int> used;  // textures that materials use
-    for (const auto& m : model_.materials)
-      for (int t : {m.pbrMetallicRoughness.baseColorTexture.index,
-                    m.pbrMetallicRoughness.metallicRoughnessTexture.index, m.emissiveTexture.index,
-                    m.normalTexture.index, m.occlusionTexture.index})
-        used.insert(t);
-    for (size_t i = 0; i < model_.textures.size(); ++i) {
-      auto& t = model_.textures[i];
-      const std::string where = named("texture", int(i), t.name);
-      std::string problem;
-      if (t.source >= 0 && size_t(t.source) >= model_.images.size())
-        problem = "refers to image " + std::to_string(t.source) + ", which does not exist";
-      if (t.sampler >= 0 && size_t(t.sampler) >= model_.samplers.size())
-        problem = "refers to sampler " + std::to_string(t.sampler) + ", which does not exist";
-      if (problem.empty()) continue;
-      // Real exporters leave dangling unused textures behind (cornell-nvpro does): harmless.
-      if (used.count(int(i))) fail(problem, where);
-      warn(problem + "; the texture is unused and ignored (" + where + ")");
-      t.source = -1;
-      t.sampler = -1;
-    }
-  }
-
-  void checkFactor(double v, double lo, double hi, const std::string& what,
-                   const std::string& where) {
-    if (!finite(v) || v < lo || v > hi)
-      fail(what + " " + std::to_string(v) + " is outside " + std::to_string(lo) + ".." +
-               std::to_string(hi),
-           where);
-  }
-
-  void checkTextureInfo(int index, const std::string& what, const std::string& where) {
-    if (index < 0 && index != -1) fail(what + " has invalid texture index", where);
-    if (index >= 0 && size_t(index) >= model_.textures.size())
-      fail(what + " refers to texture " + std::to_string(index) + ", which does not exist", where);
-  }
-
-  void checkMaterials() {
-    for (size_t i = 0; i < model_.materials.size(); ++i) {
-      const auto& m = model_.materials[i];
-      const std::string where = named("material", int(i), m.name);
-      const auto& pbr = m.pbrMetallicRoughness;
-      if (pbr.baseColorFactor.size() != 4) fail("baseColorFactor must have 4 numbers", where);
-      for (double c : pbr.baseColorFactor)
-        checkFactor(c, 0.0, 1.0, "baseColorFactor component", where);
-      checkFactor(pbr.metallicFactor, 0.0, 1.0, "metallicFactor", where);
-      checkFactor(pbr.roughnessFactor, 0.0, 1.0, "roughnessFactor", where);
-      if (m.emissiveFactor.size() != 3) fail("emissiveFactor must have 3 numbers", where);
-      // Above 1 is against the spec but common (exporters predating emissive_strength): allowed.
-      for (double c : m.emissiveFactor)
-        checkFactor(c, 0.0, 3.0e38, "emissiveFactor component", where);
-      if (m.alphaMode != "OPAQUE" && m.alphaMode != "MASK" && m.alphaMode != "BLEND")
-        fail("unknown alphaMode \"" + m.alphaMode + "\"", where);
-      if (!finite(m.alphaCutoff) || m.alphaCutoff < 0.0) fail("alphaCutoff must be >= 0", where);
-      checkTextureInfo(pbr.baseColorTexture.index, "baseColorTexture", where);
-      checkTextureInfo(pbr.metallicRoughnessTexture.index, "metallicRoughnessTexture", where);
-      checkTextureInfo(m.emissiveTexture.index, "emissiveTexture", where);
-      checkTextureInfo(m.normalTexture.index, "normalTexture", where);
-      checkTextureInfo(m.occlusionTexture.index, "occlusionTexture", where);
-      if (const Value* e = extension(m.extensions, "KHR_materials_emissive_strength"))
-        if (const Value* s = member(*e, "emissiveStrength"))
-          if (!s->IsNumber() || !finite(s->GetNumberAsDouble()) || s->GetNumberAsDouble() < 0.0)
-            fail("KHR_materials_emissive_strength emissiveStrength must be a number >= 0", where);
-      if (const Value* e = extension(m.extensions, "KHR_materials_ior"))
-        if (const Value* s = member(*e, "ior"))
-          if (!s->IsNumber() || !finite(s->GetNumberAsDouble()) || s->GetNumberAsDouble() <= 0.0)
-            fail("KHR_materials_ior ior must be a number > 0", where);
-      if (const Value* e = extension(m.extensions, "KHR_materials_transmission"))
-        if (const Value* s = member(*e, "transmissionFactor"))
-          checkFactor(s->IsNumber() ? s->GetNumberAsDouble() : -1.0, 0.0, 1.0,
-                      "KHR_materials_transmission transmissionFactor", where);
-      auto number = [&](const Value* e, const char* key, double lo, double hi, const char* ext) {
-        if (const Value* s = member(*e, key))
-          checkFactor(s->IsNumber() ? s->GetNumberAsDouble() : -1.0, lo, hi,
-                      std::string(ext) + " " + key, where);
-      };
-      if (const Value* e = extension(m.extensions, "KHR_materials_specular")) {
-        number(e, "specularFactor", 0.0, 1.0, "KHR_materials_specular");
-        if (const Value* c = member(*e, "specularColorFactor")) {
-          bool ok = c->IsArray() && c->ArrayLen() == 3;
-          for (int k = 0; ok && k < 3; ++k)
-            ok = c->Get(k).IsNumber() && finite(c->Get(k).GetNumberAsDouble()) &&
-                 c->Get(k).GetNumberAsDouble() >= 0.0;
-          if (!ok) fail("KHR_materials_specular specularColorFactor must be 3 numbers >= 0", where);
-        }
-      }
-      if (const Value* e = extension(m.extensions, "KHR_materials_volume")) {
-        number(e, "thicknessFactor", 0.0, 3.0e38, "KHR_materials_volume");
-        if (const Value* d = member(*e, "attenuationDistance"))
-          if (!d->IsNumber() || !finite(d->GetNumberAsDouble()) || d->GetNumberAsDouble() <= 0.0)
-            fail("KHR_materials_volume attenuationDistance must be a number > 0", where);
-        if (const Value* c = member(*e, "attenuationColor")) {
-          bool ok = c->IsArray() && c->ArrayLen() == 3;
-          for (int k = 0; ok && k < 3; ++k)
-            ok = c->Get(k).IsNumber() && c->Get(k).GetNumberAsDouble() >= 0.0 &&
-                 c->Get(k).GetNumberAsDouble() <= 1.0;
-          if (!ok) fail("KHR_materials_volume attenuationColor must be 3 numbers in 0..1", where);
-        }
-      }
-      if (const Value* e = extension(m.extensions, "KHR_materials_clearcoat")) {
-        number(e, "clearcoatFactor", 0.0, 1.0, "KHR_materials_clearcoat");
-        number(e, "clearcoatRoughnessFactor", 0.0, 1.0, "KHR_materials_clearcoat");
-      }
-      // KHR_texture_transform on every texture the material uses.
-      const std::pair<const char*, const tinygltf::ExtensionMap*> textures[] = {
-          {"baseColorTexture", &pbr.baseColorTexture.extensions},
-          {"metallicRoughnessTexture", &pbr.metallicRoughnessTexture.extensions},
-          {"emissiveTexture", &m.emissiveTexture.extensions},
-          {"normalTexture", &m.normalTexture.extensions},
-          {"occlusionTexture", &m.occlusionTexture.extensions}};
-      for (const auto& [name, extensions] : textures) {
-        const Value* t = extension(*extensions, "KHR_texture_transform");
-        if (!t) continue;
-        const std::string twhere = where + ", " + name;
-        auto arr2 = [&](const char* key) {
-          if (const Value* v = member(*t, key)) {
-            bool ok = v->IsArray() && v->ArrayLen() == 2;
-            for (int k = 0; ok && k < 2; ++k)
-              ok = v->Get(k).IsNumber() && finite(v->Get(k).GetNumberAsDouble());
-            if (!ok)
-              fail(std::string("KHR_texture_transform ") + key + " must be 2 finite numbers",
-                   twhere);
-          }
-        };
-        arr2("offset");
-        arr2("scale");
-        if (const Value* r = member(*t, "rotation"))
-          if (!r->IsNumber() || !finite(r->GetNumberAsDouble()))
-            fail("KHR_texture_transform rotation must be a finite number", twhere);
-        if (const Value* c = member(*t, "texCoord"))
-          if (!c->IsInt() || c->GetNumberAsInt() < 0)
-            fail("KHR_texture_transform texCoord must be a non-negative integer", twhere);
-      }
-    }
-  }
-
-  // --- cameras, lights -------------------------------------------------------------------------
-
-  void checkCamerasAndLights() {
-    for (size_t i = 0; i < model_.cameras.size(); ++i) {
-      const auto& c = model_.cameras[i];
-      const std::string where = named("camera", int(i), c.name);
-      if (c.type == "perspective") {
-        const auto& p = c.perspective;
-        if (!finite(p.yfov) || p.yfov <= 0.0 || p.yfov >= kPi)
-          fail("yfov must be in (0, pi)", where);
-        if (!finite(p.znear) || p.znear <= 0.0) fail("znear must be > 0", where);
-        if (!finite(p.aspectRatio) || p.aspectRatio < 0.0) fail("aspectRatio must be > 0", where);
-        if (!finite(p.zfar) || (p.zfar != 0.0 && p.zfar <= p.znear))
-          fail("zfar must be > znear", where);
-      } else if (c.type == "orthographic") {
-        const auto& o = c.orthographic;
-        if (!finite(o.xmag) || !finite(o.ymag) || o.xmag == 0.0 || o.ymag == 0.0)
-          fail("xmag and ymag must be finite and non-zero", where);
-        if (!finite(o.znear) || !finite(o.zfar) || o.znear < 0.0 || o.zfar <= o.znear)
-          fail("orthographic needs 0 <= znear < zfar", where);
-      } else {
-        fail("unknown camera type \"" + c.type + "\"", where);
-      }
-    }
-    for (size_t i = 0; i < model_.lights.size(); ++i) {
-      const auto& l = model_.lights[i];
-      const std::string where = "KHR_lights_punctual " + named("light", int(i), l.name);
-      if (l.type != "point" && l.type != "spot" && l.type != "directional")
-        fail("unknown light type \"" + l.type + "\"", where);
-      if (!l.color.empty() && l.color.size() != 3) fail("color must have 3 numbers", where);
-      for (double c : l.color)
-        if (!finite(c) || c < 0.0) fail("color must be finite and >= 0", where);
-      if (!finite(l.intensity) || l.intensity < 0.0)
-        fail("intensity must be finite and >= 0", where);
-      if (!finite(l.range) || l.range < 0.0) fail("range must be > 0", where);
-      if (l.type == "spot") {
-        const double in = l.spot.innerConeAngle, out = l.spot.outerConeAngle;
-        if (!finite(in) || !finite(out) || in < 0.0 || in >= out || out > kPi / 2 + 1e-9)
-          fail("spot cone angles must satisfy 0 <= innerConeAngle < outerConeAngle <= pi/2", where);
-      }
-    }
-  }
-
-  // --- meshes ----------------------------------------------------------------------------------
-
-  void checkMeshes() {
-    const AccessorRule position{{TINYGLTF_TYPE_VEC3}, {TINYGLTF_COMPONENT_TYPE_FLOAT}};
-    const AccessorRule normal = position;
-    const AccessorRule tangent{{TINYGLTF_TYPE_VEC4}, {TINYGLTF_COMPONENT_TYPE_FLOAT}};
-    const AccessorRule texcoord{
-        {TINYGLTF_TYPE_VEC2},
-        {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
-         TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
-        true};
-    const AccessorRule indices{
-        {TINYGLTF_TYPE_SCALAR},
-        {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
-         TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT}};
-    const AccessorRule joints{
-        {TINYGLTF_TYPE_VEC4},
-        {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT}};
-    const AccessorRule weights{
-        {TINYGLTF_TYPE_VEC4},
-        {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
-         TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
-        true};
-    for (size_t mi = 0; mi < model_.meshes.size(); ++mi) {
-      const auto& mesh = model_.meshes[mi];
-      for (size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
-        const auto& p = mesh.primitives[pi];
-        const std::string where =
-            named("mesh", int(mi), mesh.name) + ", primitive " + std::to_string(pi);
-        if (p.material >= 0 ? size_t(p.material) >= model_.materials.size() : p.material != -1)
-          fail("material " + std::to_string(p.material) + " does not exist", where);
-        if (p.mode < -1 || p.mode > 6) fail("invalid mode " + std::to_string(p.mode), where);
-        size_t count = 0;
-        bool first = true;
-        for (const auto& [name, acc] : p.attributes) {
-          const std::string at = where + ", " + name;
-          if (name == "POSITION")
-            checkRule(acc, position, at);
-          else if (name == "NORMAL")
-            checkRule(acc, normal, at);
-          else if (name == "TANGENT")
-            checkRule(acc, tangent, at);
-          else if (name == "TEXCOORD_0" || name == "TEXCOORD_1")
-            checkRule(acc, texcoord, at);
-          else if (name.rfind("JOINTS_", 0) == 0)
-            checkRule(acc, joints, at);
-          else if (name.rfind("WEIGHTS_", 0) == 0)
-            checkRule(acc, weights, at);
-          else
-            checkAccessor(acc, at);
-          const size_t c = model_.accessors[size_t(acc)].count;
-          if (!first && c != count)
-            fail("attributes have different counts (" + std::to_string(count) + " and " +
-                     std::to_string(c) + ")",
-                 at);
-          count = c;
-          first = false;
-        }
-        if (p.indices >= 0 || p.indices < -1) checkRule(p.indices, indices, where + ", indices");
-        if (p.targets.size() != mesh.primitives[0].targets.size())
-          fail("primitives have different numbers of morph targets", where);
-        for (size_t ti = 0; ti < p.targets.size(); ++ti)
-          for (const auto& [name, acc] : p.targets[ti]) {
-            const std::string at = where + ", morph target " + std::to_string(ti) + " " + name;
-            if (name == "POSITION" || name == "NORMAL")
-              checkRule(acc, position, at);
-            else
-              checkAccessor(acc, at);
-            if (model_.accessors[size_t(acc)].count != count)
-              fail("has " + std::to_string(model_.accessors[size_t(acc)].count) + " values for " +
-                       std::to_string(count) + " vertices",
-                   at);
-          }
-        if (!mesh.weights.empty() && mesh.weights.size() != p.targets.size())
-          fail("weights has " + std::to_string(mesh.weights.size()) + " numbers for " +
-                   std::to_string(p.targets.size()) + " morph targets",
-               named("mesh", int(mi), mesh.name));
-      }
-    }
-  }
-
-  // --- skins -----------------------------------------------------------------------------------
-
-  void checkSkins() {
-    const AccessorRule mat4{{TINYGLTF_TYPE_MAT4}, {TINYGLTF_COMPONENT_TYPE_FLOAT}};
-    for (size_t si = 0; si < model_.skins.size(); ++si) {
-      const auto& s = model_.skins[si];
-      const std::string where = named("skin", int(si), s.name);
-      if (s.joints.empty()) fail("has no joints", where);
-      for (int j : s.joints)
-        if (j < 0 || size_t(j) >= model_.nodes.size())
-          fail("joint node " + std::to_string(j) + " does not exist", where);
-      if (s.inverseBindMatrices >= 0 || s.inverseBindMatrices < -1) {
-        checkRule(s.inverseBindMatrices, mat4, where + ", inverseBindMatrices");
-        if (model_.accessors[size_t(s.inverseBindMatrices)].count < s.joints.size())
-          fail("inverseBindMatrices has fewer matrices than the " +
-                   std::to_string(s.joints.size()) + " joints",
-               where);
-      }
-    }
-  }
-
-  // --- nodes, scenes ---------------------------------------------------------------------------
-
-  int nodeLight(const tinygltf::Node& n) const {
-    const Value* e = extension(n.extensions, "KHR_lights_punctual");
-    if (!e) return -1;
-    const Value* l = member(*e, "light");
-    return l && l->IsNumber() ? l->GetNumberAsInt() : -2;
-  }
-
-  void checkNodesAndScenes() {
-    const size_t n = model_.nodes.size();
-    parents_.assign(n, -1);
-    for (size_t i = 0; i < n; ++i) {
-      const auto& node = model_.nodes[i];
-      const std::string where = named("node", int(i), node.name);
-      for (int c : node.children) {
-        if (c < 0 || size_t(c) >= n) fail("child " + std::to_string(c) + " does not exist", where);
-        if (c == int(i)) fail("is its own child", where);
-        if (parents_[size_t(c)] >= 0)
-          fail("node " + std::to_string(c) + " has two parents (nodes " +
-                   std::to_string(parents_[size_t(c)]) + " and " + std::to_string(i) + ")",
-               where);
-        parents_[size_t(c)] = int(i);
-      }
-      if (node.mesh >= 0 ? size_t(node.mesh) >= model_.meshes.size() : node.mesh != -1)
-        fail("mesh " + std::to_string(node.mesh) + " does not exist", where);
-      if (node.camera >= 0 ? size_t(node.camera) >= model_.cameras.size() : node.camera != -1)
-        fail("camera " + std::to_string(node.camera) + " does not exist", where);
-      if (node.skin >= 0 ? size_t(node.skin) >= model_.skins.size() : node.skin != -1)
-        fail("skin " + std::to_string(node.skin) + " does not exist", where);
-      const int light = nodeLight(node);
-      if (light != -1 && (light < 0 || size_t(light) >= model_.lights.size()))
-        fail("KHR_lights_punctual light " + std::to_string(light) + " does not exist", where);
-      auto checkArray = [&](const std::vector<double>& v, size_t size, const char* what) {
-        if (!v.empty() && v.size() != size)
-          fail(std::string(what) + " must have " + std::to_string(size) + " numbers", where);
-        if (!allFinite(v)) fail(std::string(what) + " is not finite", where);
-      };
-      checkArray(node.translation, 3, "translation");
-      checkArray(node.rotation, 4, "rotation");
-      checkArray(node.scale, 3, "scale");
-      checkArray(node.matrix, 16, "matrix");
-      if (!allFinite(node.weights)) fail("weights is not finite", where);
-      if (node.rotation.size() == 4) {
-        const double len2 =
-            node.rotation[0] * node.rotation[0] + node.rotation[1] * node.rotation[1] +
-            node.rotation[2] * node.rotation[2] + node.rotation[3] * node.rotation[3];
-        if (!(len2 > 1e-12)) fail("rotation is not a unit quaternion", where);
-      }
-    }
-    // Unique parents make the graph a forest unless a walk upwards comes back: find cycles.
-    std::vector<uint8_t> state(n, 0);  // 0 unvisited, 1 on the current walk, 2 done
-    for (size_t i = 0; i < n; ++i) {
-      std::vector<size_t> walk;
-      for (size_t k = i; state[k] != 2;) {
-        if (state[k] == 1)
-          fail("node hierarchy has a cycle", named("node", int(k), model_.nodes[k].name));
-        state[k] = 1;
-        walk.push_back(k);
-        if (parents_[k] < 0) break;
-        k = size_t(parents_[k]);
-      }
-      for (size_t w : walk) state[w] = 2;
-    }
-    for (size_t s = 0; s < model_.scenes.size(); ++s) {
-      const auto& sc = model_.scenes[s];
-      std::set<int> seen;
-      for (int r : sc.nodes) {
-        const std::string where = named("scene", int(s), sc.name);
-        if (r < 0 || size_t(r) >= n) fail("node " + std::to_string(r) + " does not exist", where);
-        if (parents_[size_t(r)] >= 0)
-          fail("root node " + std::to_string(r) + " is also a child of node " +
-                   std::to_string(parents_[size_t(r)]),
-               where);
-        if (!seen.insert(r).second) fail("node " + std::to_string(r) + " is listed twice", where);
-      }
-    }
-    if (model_.defaultScene >= 0 ? size_t(model_.defaultScene) >= model_.scenes.size()
-                                 : model_.defaultScene != -1)
-      fail("default scene " + std::to_string(model_.defaultScene) + " does not exist", "scene");
-  }
-
-  // --- animations ------------------------------------------------------------------------------
-
-  void checkAnimations() {
-    const AccessorRule times{{TINYGLTF_TYPE_SCALAR}, {TINYGLTF_COMPONENT_TYPE_FLOAT}};
-    const AccessorRule vec3{{TINYGLTF_TYPE_VEC3}, {TINYGLTF_COMPONENT_TYPE_FLOAT}};
-    const AccessorRule weightValues{
-        {TINYGLTF_TYPE_SCALAR},
-        {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE,
-         TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_SHORT,
-         TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
-        true};
-    const AccessorRule quat{{TINYGLTF_TYPE_VEC4},
-                            {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE,
-                             TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_SHORT,
-                             TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
-                            true};
-    for (size_t ai = 0; ai < model_.animations.size(); ++ai) {
-      const auto& anim = model_.animations[ai];
-      const std::string aname = named("animation", int(ai), anim.name);
-      Animation out;
-      out.name = anim.name;
-      std::vector<int> samplerIndex(anim.samplers.size(), -1);  // glTF sampler -> ours
-      for (size_t ci = 0; ci < anim.channels.size(); ++ci) {
-        const auto& ch = anim.channels[ci];
-        const std::string where = aname + ", channel " + std::to_string(ci);
-        if (ch.sampler < 0 || size_t(ch.sampler) >= anim.samplers.size())
-          fail("sampler " + std::to_string(ch.sampler) + " does not exist", where);
-        if (ch.target_node < -1 || ch.target_node >= int(model_.nodes.size()))
-          fail("target node " + std::to_string(ch.target_node) + " does not exist", where);
-        const std::string& path = ch.target_path;
-        if (path != "translation" && path != "rotation" && path != "scale" && path != "weights")
-          fail("unknown target path \"" + path + "\"", where);
-        const auto& s = anim.samplers[size_t(ch.sampler)];
-        const std::string swhere = aname + ", sampler " + std::to_string(ch.sampler);
-        if (s.interpolation != "LINEAR" && s.interpolation != "STEP" &&
-            s.interpolation != "CUBICSPLINE")
-          fail("unknown interpolation \"" + s.interpolation + "\"", swhere);
-        checkRule(s.input, times, swhere + ", input");
-        checkAccessor(s.output, swhere + ", output");
-        if (ch.target_node < 0) continue;  // target given by an extension we do not know
-        if (path == "weights") {
-          checkRule(s.output, weightValues, swhere + ", output");
-          // One sampler per 4 targets, each a vec4 channel of its own.
-          const std::vector<AnimationSampler> parts = readWeightSamplers(anim, ch.sampler, swhere);
-          for (size_t k = 0; k < parts.size(); ++k) {
-            AnimationChannel c;
-            c.sampler = int(out.samplers.size());
-            c.node = ch.target_node;
-            c.path = AnimationPath::Weights;
-            c.firstWeight = int(4 * k);
-            out.samplers.push_back(parts[k]);
-            out.channels.push_back(c);
-          }
-          continue;
-        }
-        const auto& node = model_.nodes[size_t(ch.target_node)];
-        if (!node.matrix.empty())
-          fail("node " + std::to_string(ch.target_node) + " is animated but has a matrix", where);
-        checkRule(s.output, path == "rotation" ? quat : vec3, swhere + ", output");
-        if (samplerIndex[size_t(ch.sampler)] < 0) {
-          samplerIndex[size_t(ch.sampler)] = int(out.samplers.size());
-          out.samplers.push_back(readSampler(anim, ch.sampler, swhere));
-        }
-        AnimationChannel c;
-        c.sampler = samplerIndex[size_t(ch.sampler)];
-        c.node = ch.target_node;
-        c.path = path == "translation" ? AnimationPath::Translation
-                 : path == "rotation"  ? AnimationPath::Rotation
-                                       : AnimationPath::Scale;
-        out.channels.push_back(c);
-      }
-      // Samplers no channel uses still get their references checked.
-      for (size_t si = 0; si < anim.samplers.size(); ++si) {
-        const std::string swhere = aname + ", sampler " + std::to_string(si);
-        checkAccessor(anim.samplers[si].input, swhere + ", input");
-        checkAccessor(anim.samplers[si].output, swhere + ", output");
-      }
-      if (!out.channels.empty()) scene_.animations.push_back(std::move(out));
-    }
-  }
-
-  // A sampler's interpolation and key times (finite, strictly increasing; CUBICSPLINE needs 2
-  // keys, as the glTF spec and its validator's ANIMATION_SAMPLER_INPUT_ACCESSOR_TOO_FEW_ELEMENTS
-  // say), without its values.
-  AnimationSampler samplerKeys(const tinygltf::AnimationSampler& s, const std::string& where) {
-    AnimationSampler out;
-    out.interpolation = s.interpolation == "STEP"          ? Interpolation::Step
-                        : s.interpolation == "CUBICSPLINE" ? Interpolation::CubicSpline
-                                                           : Interpolation::Linear;
-    const std::vector<double> in = readAccessor(s.input);
-    if (out.interpolation == Interpolation::CubicSpline && in.size() < 2)
-      fail("CUBICSPLINE needs at least 2 keys, the input has " + std::to_string(in.size()), where);
-    for (size_t i = 0; i < in.size(); ++i) {
-      if (!finite(in[i])) fail("input time " + std::to_string(i) + " is not finite", where);
-      if (i > 0 && !(float(in[i]) > float(in[i - 1])))
-        fail("input times are not strictly increasing at key " + std::to_string(i), where);
-      out.times.push_back(float(in[i]));
-    }
-    return out;
-  }
-
-  AnimationSampler readSampler(const tinygltf::Animation& anim, int index,
-                               const std::string& where) {
-    const auto& s = anim.samplers[size_t(index)];
-    AnimationSampler out = samplerKeys(s, where);
-    const std::vector<float>& in = out.times;
-    const auto& oa = model_.accessors[size_t(s.output)];
-    const size_t perKey = out.interpolation == Interpolation::CubicSpline ? 3 : 1;
-    if (oa.count != in.size() * perKey)
-      fail("output has " + std::to_string(oa.count) + " values for " + std::to_string(in.size()) +
-               " keys" + (perKey == 3 ? " (CUBICSPLINE needs 3 per key)" : ""),
-           where);
-    const size_t nc = componentCount(oa.type);
-    const std::vector<double> values = readAccessor(s.output);
-    for (size_t i = 0; i < oa.count; ++i) {
-      glm::vec4 v(0.0f);
-      for (size_t c = 0; c < nc && c < 4; ++c) {
-        const double x = values[i * nc + c];
-        if (!finite(x) || std::abs(x) > 3.0e38)
-          fail("output value " + std::to_string(i) + " is not finite", where);
-        v[int(c)] = float(x);
-      }
-      out.values.push_back(v);
-    }
-    return out;
-  }
-
-  // A morph weights sampler (n scalars per key, 3n for CUBICSPLINE) as ceil(n / 4) samplers of
-  // vec4s, targets 4k .. 4k + 3 in part k.
-  std::vector<AnimationSampler> readWeightSamplers(const tinygltf::Animation& anim, int index,
-                                                   const std::string& where) {
-    const auto& s = anim.samplers[size_t(index)];
-    const AnimationSampler proto = samplerKeys(s, where);
-    const std::vector<float>& in = proto.times;
-    const size_t perKey = proto.interpolation == Interpolation::CubicSpline ? 3 : 1;
-    const std::vector<double> values = readAccessor(s.output);
-    const size_t slots = in.size() * perKey;
-    if (slots == 0 || values.size() % slots != 0 || values.empty())
-      fail("output has " + std::to_string(values.size()) + " weights, not a multiple of the " +
-               std::to_string(slots) + " key values",
-           where);
-    const size_t n = values.size() / slots;
-    for (double v : values)
-      if (!finite(v)) fail("output has a weight that is not finite", where);
-    std::vector<AnimationSampler> parts((n + 3) / 4, proto);
-    for (size_t k = 0; k < parts.size(); ++k)
-      for (size_t slot = 0; slot < slots; ++slot) {
-        glm::vec4 v(0.0f);
-        for (size_t c = 0; c < 4 && 4 * k + c < n; ++c)
-          v[int(c)] = float(values[slot * n + 4 * k + c]);
-        parts[k].values.push_back(v);
-      }
-    return parts;
-  }
-
-  // --- building the scene ----------------------------------------------------------------------
-
   static glm::mat4 toMat4(const std::vector<double>& m) {
     glm::mat4 r(1.0f);
     for (int c = 0; c < 4; ++c)
@@ -1196,14 +169,14 @@ class Loader {
         warn("skipping a primitive without POSITION (" + where + ")");
         continue;
       }
-      const std::vector<double> positions = readAccessor(pos->second);
+      const std::vector<double> positions = readAccessor(model_, pos->second);
       const size_t vcount = positions.size() / 3;
       for (double x : positions)
         if (!finite(x) || std::abs(x) > 3.0e38)
           fail("POSITION has a value that is not finite", where + ", POSITION");
       std::vector<uint32_t> idx;
       if (p.indices >= 0) {
-        const std::vector<double> raw = readAccessor(p.indices);
+        const std::vector<double> raw = readAccessor(model_, p.indices);
         idx.reserve(raw.size());
         for (size_t i = 0; i < raw.size(); ++i) {
           if (raw[i] >= double(vcount))
@@ -1237,7 +210,7 @@ class Loader {
       }
       std::vector<double> normals;
       if (const auto it = p.attributes.find("NORMAL"); it != p.attributes.end())
-        normals = readAccessor(it->second);
+        normals = readAccessor(model_, it->second);
       for (size_t v = 0; v < vcount; ++v) {
         glm::vec3 n(0.0f);
         if (!normals.empty()) n = glm::vec3(normals[3 * v], normals[3 * v + 1], normals[3 * v + 2]);
@@ -1250,7 +223,7 @@ class Loader {
                                                                : glm::vec3(0.0f, 0.0f, 1.0f));
       }
       if (const auto it = p.attributes.find("TEXCOORD_0"); it != p.attributes.end()) {
-        const std::vector<double> uv = readAccessor(it->second);
+        const std::vector<double> uv = readAccessor(model_, it->second);
         for (size_t v = 0; v < vcount; ++v) {
           if (!finite(uv[2 * v]) || !finite(uv[2 * v + 1]))
             fail("TEXCOORD_0 is not finite", where + ", TEXCOORD_0");
@@ -1262,7 +235,7 @@ class Loader {
       if (anyUv1) {
         std::vector<double> uv;
         if (const auto it = p.attributes.find("TEXCOORD_1"); it != p.attributes.end())
-          uv = readAccessor(it->second);
+          uv = readAccessor(model_, it->second);
         for (size_t v = 0; v < vcount; ++v) {
           if (uv.empty()) {
             out.uvs1.push_back(out.uvs[base + v]);  // TEXCOORD_0 stands in
@@ -1279,8 +252,8 @@ class Loader {
           const auto j = p.attributes.find("JOINTS_" + std::to_string(set));
           const auto w = p.attributes.find("WEIGHTS_" + std::to_string(set));
           if (j != p.attributes.end() && w != p.attributes.end()) {
-            js[set] = readAccessor(j->second);
-            ws[set] = readAccessor(w->second);
+            js[set] = readAccessor(model_, j->second);
+            ws[set] = readAccessor(model_, w->second);
           }
         }
         for (size_t v = 0; v < vcount; ++v) {
@@ -1306,8 +279,8 @@ class Loader {
       for (size_t ti = 0; ti < targets; ++ti) {
         const auto* t = ti < p.targets.size() ? &p.targets[ti] : nullptr;
         std::vector<double> dp, dn;
-        if (t && t->count("POSITION")) dp = readAccessor(t->at("POSITION"));
-        if (t && t->count("NORMAL")) dn = readAccessor(t->at("NORMAL"));
+        if (t && t->count("POSITION")) dp = readAccessor(model_, t->at("POSITION"));
+        if (t && t->count("NORMAL")) dn = readAccessor(model_, t->at("NORMAL"));
         for (size_t v = 0; v < vcount; ++v) {
           glm::vec3 d(0.0f), n(0.0f);
           if (!dp.empty()) d = glm::vec3(dp[3 * v], dp[3 * v + 1], dp[3 * v + 2]);
@@ -1322,7 +295,7 @@ class Loader {
       if (anyTangents) {
         std::vector<double> tan;
         if (const auto it = p.attributes.find("TANGENT"); it != p.attributes.end())
-          tan = readAccessor(it->second);
+          tan = readAccessor(model_, it->second);
         for (size_t v = 0; v < vcount; ++v) {
           glm::vec4 t(1.0f, 0.0f, 0.0f, 1.0f);
           if (!tan.empty()) {
@@ -1530,7 +503,7 @@ class Loader {
     const Value* index = member(*t, "index");
     if (!t->IsObject() || !index || !index->IsInt())
       fail(std::string(name) + " needs an integer index", where);
-    checkTextureInfo(index->GetNumberAsInt(), name, where);
+    checkTextureInfo(doc_, index->GetNumberAsInt(), name, where);
     int texCoord = 0;
     if (const Value* c = member(*t, "texCoord")) {
       if (!c->IsInt() || c->GetNumberAsInt() < 0)
@@ -1567,7 +540,8 @@ class Loader {
       const auto& v = model_.bufferViews[size_t(im.bufferView)];  // range checked already
       const uint8_t* p = model_.buffers[size_t(v.buffer)].data.data() + v.byteOffset;
       encoded.assign(p, p + v.byteLength);
-    } else if (const auto it = images_.encoded.find(t.source); it != images_.encoded.end()) {
+    } else if (const auto it = doc_.images.encoded.find(t.source);
+               it != doc_.images.encoded.end()) {
       encoded = it->second;
     } else {
       fail("cannot read image \"" + im.uri + "\"", iwhere);
@@ -1606,7 +580,7 @@ class Loader {
       k.joints = s.joints;
       k.inverseBind.assign(s.joints.size(), glm::mat4(1.0f));
       if (s.inverseBindMatrices >= 0) {
-        const std::vector<double> m = readAccessor(s.inverseBindMatrices);
+        const std::vector<double> m = readAccessor(model_, s.inverseBindMatrices);
         for (size_t j = 0; j < s.joints.size(); ++j) {
           const std::vector<double> one(m.begin() + long(16 * j), m.begin() + long(16 * j + 16));
           if (!allFinite(one))
@@ -1662,7 +636,7 @@ class Loader {
   }
 
   void build() {
-    scene_.path = path_;
+    scene_.path = doc_.path;
     buildNodes();
     buildMaterials();
     meshCache_.clear();
@@ -1759,23 +733,23 @@ class Loader {
     if (scene_.cameras.empty()) buildDefaultCamera();
   }
 
-  std::string path_;
-  LoadOptions options_;
-  std::vector<uint8_t> bytes_;  // the whole file, until parsed
-  bool inMemory_ = false;
-  bool binary_ = false;
-  tinygltf::Model model_;
-  ImageBytes images_;
+  const std::vector<int> parents_;
   Scene scene_;
-  std::set<int> accessorChecked_;
-  std::vector<int> parents_;
   std::map<int, std::optional<TriangleMesh>> meshCache_;
   std::map<std::pair<int, bool>, int> textureIndex_;
   int defaultMaterial_ = -1;
   std::set<int> skippedModes_;
 };
 
+// A parsed document validated, then converted.
+Scene load(Document& doc) {
+  Validated validated = validate(doc);
+  return Converter(doc, std::move(validated)).convert();
+}
+
 }  // namespace
+
+}  // namespace gltf
 
 bool isSupportedExtension(const std::string& name) {
   static const std::set<std::string> supported = {
@@ -1786,12 +760,16 @@ bool isSupportedExtension(const std::string& name) {
 }
 
 Scene loadScene(const std::string& path, const LoadOptions& options) {
-  return Loader(path, options).load();
+  gltf::Document doc(path, options);
+  gltf::parseFile(doc);
+  return gltf::load(doc);
 }
 
 Scene loadSceneFromMemory(const std::string& bytes, const std::string& path,
                           const LoadOptions& options) {
-  return Loader(path, bytes, options).load();
+  gltf::Document doc(path, options);
+  gltf::parseBytes(doc, bytes);
+  return gltf::load(doc);
 }
 
 }  // namespace pr
