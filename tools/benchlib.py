@@ -1,6 +1,6 @@
-"""Helpers shared by the benchmark scripts (bench_reuse.py, evaluate.py, bench_sampling.py):
-statistics of the renderer's per-frame stats, the machine description for a report, and the
-large atrium (its sky-lit default and its night, many-lights variant).
+"""Helpers shared by the benchmark scripts (bench_reuse.py, bench_sampling.py, evaluate.py and
+its evaluation/ package): statistics of the renderer's per-frame stats, the machine description
+for a report, and the large atrium (its sky-lit default and its night, many-lights variant).
 Standard library only, so that any Python 3 can import it."""
 
 import os
