@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs the Debian packages that pathreuse's build, tests and PoCL need (python3-venv for
 # tools/intel-opencl.sh, the second platform of the tests; oclgrind for tools/oclgrind-check.sh;
-# clang-format for tools/format-check.sh).
+# clang-format for tools/format-check.sh; Slurm and munge for tools/slurm/'s single-node test
+# cluster).
 # Idempotent: runs apt-get only when something is missing.
 set -euo pipefail
 
@@ -13,6 +14,7 @@ packages=(
   assimp-testmodels python3
   python3-matplotlib python3-numpy
   python3-venv oclgrind clang-format
+  slurmctld slurmd slurm-client munge
 )
 
 missing=()
