@@ -13,8 +13,8 @@ enum class RenderMode { Reuse, Retrace, PathTrace };
 enum class LightSampler { Auto, Bvh, Power };
 constexpr int kAutoLightBvhMin = 16;
 
-// Children per BVH node for a device (0: auto): CPUs 8 (float8 slab tests), GPUs 2 (a binary
-// node holding both children's boxes). Measured in docs/ray-benchmark.md.
+// Children per BVH node for a device (0: auto): CPUs 8 (float8 slab tests), GPUs 4. Measured in
+// docs/ray-benchmark.md (CPU) and docs/design.md section 3 (an H200).
 int defaultBvhWidth(bool gpu);
 // Resampled connections per eye vertex where --connections is auto; 0: every candidate.
 int defaultConnections(bool gpu);

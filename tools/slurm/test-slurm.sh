@@ -29,6 +29,7 @@ PATHREUSE_BIN="$build/pathreuse" timeout 600 sbatch --wait --quiet --array=0-2 \
   "${opts[@]}" || { cat "$work"/task-*.log >&2; echo "test-slurm: the job array failed" >&2; exit 1; }
 t1=$(date +%s.%N)
 "$build/pathreuse" render "$scene" --frames "$frames" --out "$work/single/frame_%04d.exr" \
+  --stats "$work/single/stats.jsonl" \
   --exr-float --quiet "${opts[@]}"
 t2=$(date +%s.%N)
 
