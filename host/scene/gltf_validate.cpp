@@ -113,12 +113,9 @@ class Validator : Stage {
       }
       if (!fits(a.byteOffset + elem, stride, a.count - 1, v.byteLength) ||
           a.byteOffset > v.byteLength)
-        fail((where.empty() ? self : self) + " reads past the end of bufferView " +
-                 std::to_string(a.bufferView),
-             where);
-    } else if (!a.sparse.isSparse) {
-      // No buffer view and no sparse data: all zeros, as the spec says.
+        fail(self + " reads past the end of bufferView " + std::to_string(a.bufferView), where);
     }
+    // No buffer view and no sparse data reads as zeros, as the specification says.
     if (a.sparse.isSparse) checkSparse(index, at);
     accessorChecked_.insert(index);
   }
