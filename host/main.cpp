@@ -79,9 +79,11 @@ int main(int argc, char** argv) {
       ->add_option("--seed", ro.seed, "Random seed; the same seed reproduces a frame on one device")
       ->capture_default_str();
   render
-      ->add_option("--device", ro.device,
+      ->add_option("--device", ro.devices,
                    "OpenCL device: index, P:D, cpu, gpu or part of its name (default: "
-                   "$PATHREUSE_DEVICE, else the first GPU, else the first CPU)")
+                   "$PATHREUSE_DEVICE, else the first GPU, else the first CPU); repeatable, "
+                   "each device renders a share of every frame's rows; 'all': every device")
+      ->allow_extra_args(false)
       ->envname("PATHREUSE_DEVICE");
   render
       ->add_option("--mode", modeText,

@@ -210,9 +210,10 @@ void Context::zero(const cl::Buffer& buffer, uint64_t bytes) {
   }
 }
 
-void Context::launch1D(const cl::Kernel& kernel, size_t global, const char* stage,
+void Context::launch1D(const cl::Kernel& kernel, size_t first, size_t end, const char* stage,
                        StageTimer* timer) {
-  if (global == 0) return;
+  if (end <= first) return;
+  const size_t global = end - first;
   size_t local = 0;
   CL_CHECK(kernel.getWorkGroupInfo(device_.device, CL_KERNEL_WORK_GROUP_SIZE, &local));
   size_t preferred = 0;
@@ -229,9 +230,9 @@ void Context::launch1D(const cl::Kernel& kernel, size_t global, const char* stag
   const size_t chunk = std::max(local, kMaxLaunchItems / local * local);
   for (size_t offset = 0; offset < padded; offset += chunk) {
     const size_t n = std::min(chunk, padded - offset);
-    const cl_int err =
-        queue_.enqueueNDRangeKernel(kernel, cl::NDRange(offset), cl::NDRange(n), cl::NDRange(local),
-                                    nullptr, timer ? timer->next(stage) : nullptr);
+    const cl_int err = queue_.enqueueNDRangeKernel(kernel, cl::NDRange(first + offset),
+                                                   cl::NDRange(n), cl::NDRange(local), nullptr,
+                                                   timer ? timer->next(stage) : nullptr);
     if (err != CL_SUCCESS)
       throw ClError(std::string("launch of ") + stage, err, __FILE__, __LINE__);
   }

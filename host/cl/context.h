@@ -58,6 +58,12 @@ class Context {
   // are split into chunks of kMaxLaunchItems (with a global offset) so that no single launch
   // runs long enough to trip a GPU watchdog. With a timer, each chunk's time counts for `stage`.
   void launch1D(const cl::Kernel& kernel, size_t global, const char* stage,
+                StageTimer* timer = nullptr) {
+    launch1D(kernel, 0, global, stage, timer);
+  }
+  // Work-items [first, end) only: get_global_id(0) runs over the global indices (a device's
+  // part of an image keeps each pixel's index); kernels guard with end as their count.
+  void launch1D(const cl::Kernel& kernel, size_t first, size_t end, const char* stage,
                 StageTimer* timer = nullptr);
   static constexpr size_t kMaxLaunchItems = size_t(1) << 18;
 

@@ -149,6 +149,30 @@ const DeviceEntry& selectDevice(const std::vector<DeviceEntry>& devices, const s
   return refuse("no device or platform whose name contains '" + spec + "'");
 }
 
+std::vector<const DeviceEntry*> selectDevices(const std::vector<DeviceEntry>& devices,
+                                              const std::vector<std::string>& specs) {
+  if (devices.empty()) throw NoDeviceError();
+  if (specs.empty()) return {&selectDevice(devices, "")};
+  std::vector<const DeviceEntry*> out;
+  for (const auto& spec : specs) {
+    if (lower(trimmed(spec)) == "all") {
+      if (specs.size() > 1)
+        throw InputError(
+            "--device all: names every device; it cannot be combined with another "
+            "--device");
+      for (const auto& d : devices) out.push_back(&d);
+      return out;
+    }
+    const DeviceEntry& d = selectDevice(devices, spec);
+    for (const DeviceEntry* e : out)
+      if (e == &d)
+        throw InputError("--device " + spec + ": names device [" + std::to_string(d.index) + "] " +
+                         d.name + ", which another --device already names");
+    out.push_back(&d);
+  }
+  return out;
+}
+
 std::string describeDevice(const DeviceEntry& d) {
   std::ostringstream os;
   os << "[" << d.index << "] " << d.platformIndex << ":" << d.deviceIndex << "  " << d.name << "  ("

@@ -49,6 +49,12 @@ class NoDeviceError : public RuntimeError {
 // empty and InputError when SPEC matches nothing.
 const DeviceEntry& selectDevice(const std::vector<DeviceEntry>& devices, const std::string& spec);
 
+// The devices of several SPECs, in order: each as selectDevice picks it (no SPEC: the default
+// one), or "all" alone for every device. Throws InputError naming the SPEC that matches nothing,
+// names a device another SPEC names, or combines "all" with others.
+std::vector<const DeviceEntry*> selectDevices(const std::vector<DeviceEntry>& devices,
+                                              const std::vector<std::string>& specs);
+
 // One line describing a device, as `pathreuse devices` prints it.
 std::string describeDevice(const DeviceEntry& d);
 

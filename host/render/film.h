@@ -1,4 +1,6 @@
 // The film: per pixel, the sum of sample radiance and the number of samples, on the device.
+// A device rendering part of the image (render/multi_device.h) owns a range of whole rows;
+// its integrator launches its pixel kernels over that range alone.
 #pragma once
 
 #include <cstdint>
@@ -14,10 +16,20 @@ class Film {
   Film(Context& ctx, int width, int height);
 
   void clear();
-  // Adds `count` samples' radiance (float4 each; sample i goes to pixel i % pixels).
-  void accumulate(const cl::Buffer& radiance, uint32_t count, StageTimer* timer);
+  // Adds the radiance (float4 per pixel, indexed by pixel) of the range's pixels.
+  void accumulate(const cl::Buffer& radiance, StageTimer* timer);
   // The mean radiance per pixel (alpha 1), and how many samples were non-finite and dropped.
   Image read(uint64_t* badSamples = nullptr);
+  // The same for the range's rows only, written into `image` (of the film's size).
+  void readRows(Image* image, uint64_t* badSamples = nullptr);
+
+  // Rows [rowBegin, rowEnd) are rendered (default: all).
+  void setRows(int rowBegin, int rowEnd);
+  int rowBegin() const { return rowBegin_; }
+  int rowEnd() const { return rowEnd_; }
+  // The range as pixel indices [first, end).
+  uint32_t first() const { return static_cast<uint32_t>(rowBegin_) * width_; }
+  uint32_t end() const { return static_cast<uint32_t>(rowEnd_) * width_; }
 
   int width() const { return width_; }
   int height() const { return height_; }
@@ -26,6 +38,7 @@ class Film {
  private:
   Context& ctx_;
   int width_, height_;
+  int rowBegin_ = 0, rowEnd_ = 0;
   cl::Buffer film_, bad_;
   cl::Kernel accumulate_;
 };

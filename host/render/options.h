@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace pr {
 
@@ -36,7 +37,8 @@ struct RenderOptions {
   int spp = 4;
   int maxDepth = 8;
   uint32_t seed = 1;
-  std::string device;
+  // --device SPECs, repeatable; "all" for every device; none: the default device.
+  std::vector<std::string> devices;
   RenderMode mode = RenderMode::Reuse;
   int camera = -1;  // -1: the scene's first camera
   std::string outPattern = "out/frame_%04d.exr";

@@ -52,7 +52,7 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
   rp.max_depth = static_cast<uint32_t>(settings_.maxDepth);
   rp.paths_per_pixel = settings_.pathsPerPixel;
   rp.spp = static_cast<uint32_t>(settings_.spp);
-  rp.pixel_count = film_.pixels();
+  rp.pixel_count = film_.end();  // the bound of the film's pixels [first, end)
   rp.frame = settings_.fixedNoise ? 0u : static_cast<uint32_t>(frame);  // RNG key only
   rp.clamp = settings_.clamp;
   rp.mis_threshold = settings_.misThreshold;
@@ -89,13 +89,13 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
   setKernelArgs(eyeHit_, eyeSample + 1, eye_, radiance_, counters_);
   const cl_uint connectSample = setKernelArgs(connect_, scene_.setKernelArgs(connect_, 0), rp);
   setKernelArgs(connect_, connectSample + 1, eye_, headers_, vertices_, radiance_, counters_);
-  const cl_uint n = film_.pixels();
+  const cl_uint first = film_.first(), n = film_.end();
   for (int s = 0; s < settings_.spp; ++s) {
     CL_CHECK(eyeHit_.setArg(eyeSample, cl_uint(s)));
     CL_CHECK(connect_.setArg(connectSample, cl_uint(s)));
-    ctx_.launch1D(eyeHit_, n, "eye_hit", &timer);
-    ctx_.launch1D(connect_, n, "connect", &timer);
-    film_.accumulate(radiance_, n, &timer);
+    ctx_.launch1D(eyeHit_, first, n, "eye_hit", &timer);
+    ctx_.launch1D(connect_, first, n, "connect", &timer);
+    film_.accumulate(radiance_, &timer);
     // Wait for each pass, so that an interrupt stops a frame of many samples within one pass.
     ctx_.finish();
     if (interrupted()) return;

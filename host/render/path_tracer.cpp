@@ -32,7 +32,8 @@ PathTracer::PathTracer(Context& ctx, GpuScene& scene, Film& film,
 
 void PathTracer::renderFrame(int frame, const dev::CameraParams& camera, FrameStats* stats) {
   StageTimer timer;
-  const cl_uint n = film_.pixels();
+  // The film's pixels [first, n) only; buffers are indexed by pixel over the whole image.
+  const cl_uint first = film_.first(), n = film_.end();
   const cl_uint rngFrame = settings_.fixedNoise ? 0 : cl_uint(frame);
   ctx_.zero(rays_, 16);
   // Each kernel's own arguments follow the scene's (PR_SCENE_PARAMS); `sample` changes per pass.
@@ -46,13 +47,13 @@ void PathTracer::renderFrame(int frame, const dev::CameraParams& camera, FrameSt
   for (int s = 0; s < settings_.spp; ++s) {
     CL_CHECK(generate_.setArg(generateSample, cl_uint(s)));
     CL_CHECK(shade_.setArg(shadeSample, cl_uint(s)));
-    ctx_.launch1D(generate_, n, "generate", &timer);
+    ctx_.launch1D(generate_, first, n, "generate", &timer);
     for (int d = 0; d < settings_.maxDepth; ++d) {
-      ctx_.launch1D(extend_, n, "extend", &timer);
-      ctx_.launch1D(shade_, n, "shade", &timer);
-      ctx_.launch1D(shadow_, n, "shadow", &timer);
+      ctx_.launch1D(extend_, first, n, "extend", &timer);
+      ctx_.launch1D(shade_, first, n, "shade", &timer);
+      ctx_.launch1D(shadow_, first, n, "shadow", &timer);
     }
-    film_.accumulate(radiance_, n, &timer);
+    film_.accumulate(radiance_, &timer);
     // Wait for each pass, so that an interrupt stops a frame of many samples within one pass.
     ctx_.finish();
     if (interrupted()) return;

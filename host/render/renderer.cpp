@@ -19,6 +19,7 @@
 #include "io/image.h"
 #include "render/film.h"
 #include "render/gpu_scene.h"
+#include "render/multi_device.h"
 #include "render/path_reuse.h"
 #include "render/path_tracer.h"
 #include "render/session.h"
@@ -107,14 +108,15 @@ int runRender(const RenderOptions& o) {
   std::unique_ptr<StatsFile> stats;
   if (!o.statsFile.empty()) stats = std::make_unique<StatsFile>(o.statsFile, o.resume);
   const auto devices = enumerateDevices();
-  const DeviceEntry& device = selectDevice(devices, o.device);
-  RenderSession session(scene, device, o);
+  MultiDeviceSession session(scene, selectDevices(devices, o.devices), o);
   const FrameRange range = session.frameRange();
   if (!o.quiet) {
     std::cerr << "rendering " << o.scene << " frames " << range.first << "-" << range.last << " at "
               << session.width() << "x" << session.height() << ", " << o.spp << " spp, mode "
-              << renderModeName(o.mode) << ", on " << device.name;
-    if (auto* reuse = dynamic_cast<PathReuse*>(&session.integrator()))
+              << renderModeName(o.mode) << ", on ";
+    for (size_t i = 0; i < session.deviceCount(); ++i)
+      std::cerr << (i ? " + " : "") << session.device(i).name;
+    if (auto* reuse = dynamic_cast<PathReuse*>(&session.session(0).integrator()))
       std::cerr << "; arena " << reuse->slots() << " slots x " << reuse->stride()
                 << " vertices = " << (reuse->arenaBytes() >> 20) << " MiB";
     std::cerr << "\n";
@@ -134,7 +136,8 @@ int runRender(const RenderOptions& o) {
     }
     const auto t0 = std::chrono::steady_clock::now();
     FrameStats fs;
-    const Image img = session.renderFrame(f, &fs);
+    std::vector<DeviceFrame> parts;
+    const Image img = session.renderFrame(f, &fs, &parts);
     if (interrupted()) break;  // the film may be partial: drop the frame
     writeExr(exr, img, o.exrFloat ? ExrPixels::Float : ExrPixels::Half);
     if (o.png) writePng(withExtension(exr, ".png"), img, o.exposure);
@@ -154,6 +157,21 @@ int runRender(const RenderOptions& o) {
       if (!fs.counters.empty()) j["counters"] = fs.counters;
       j["device_bytes"] = fs.deviceBytes;
       j["bad_samples"] = fs.badSamples;
+      // Per device: its rows, their share of the image, its wall and kernel times.
+      nlohmann::ordered_json list = nlohmann::ordered_json::array();
+      for (const DeviceFrame& p : parts) {
+        nlohmann::ordered_json d;
+        d["index"] = p.index;
+        d["name"] = p.name;
+        d["row_begin"] = p.rowBegin;
+        d["rows"] = p.rowEnd - p.rowBegin;
+        d["share"] = double(p.rowEnd - p.rowBegin) / session.height();
+        d["wall_s"] = p.wallSeconds;
+        d["stages_s"] = p.stats.stageSeconds;
+        d["rays"] = p.stats.rays;
+        list.push_back(std::move(d));
+      }
+      j["devices"] = std::move(list);
       stats->writeLine(j.dump());
     }
     if (fs.badSamples > 0) {

@@ -135,6 +135,12 @@ FrameRange RenderSession::frameRange() const {
 }
 
 Image RenderSession::renderFrame(int frame, FrameStats* stats) {
+  Image img(width_, height_);
+  renderRows(frame, &img, stats);
+  return img;
+}
+
+void RenderSession::renderRows(int frame, Image* image, FrameStats* stats) {
   const double time = frame / options_.fps;
   FrameStats local;
   FrameStats* fs = stats ? stats : &local;
@@ -146,9 +152,8 @@ Image RenderSession::renderFrame(int frame, FrameStats* stats) {
   film_->clear();
   fs->frame = frame;
   integrator_->renderFrame(frame, gpu_->camera(camera_, time, width_, height_), fs);
-  Image img = film_->read(&fs->badSamples);
+  film_->readRows(image, &fs->badSamples);
   fs->deviceBytes = ctx_.bytesInUse();
-  return img;
 }
 
 }  // namespace pr

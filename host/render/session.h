@@ -36,6 +36,11 @@ class RenderSession {
   // Renders frame f (time f / fps). Frames must come in increasing order for reuse to apply;
   // any order gives correct images.
   Image renderFrame(int frame, FrameStats* stats);
+  // The same, writing only the rows setRows() chose into `image` (of the session's size).
+  void renderRows(int frame, Image* image, FrameStats* stats);
+  // Rows [rowBegin, rowEnd) of each frame are rendered (default: all). The light paths of
+  // path reuse cover every slot whatever the rows (render/multi_device.h).
+  void setRows(int rowBegin, int rowEnd) { film_->setRows(rowBegin, rowEnd); }
 
   int width() const { return width_; }
   int height() const { return height_; }

@@ -1,0 +1,153 @@
+#include "render/multi_device.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <functional>
+#include <set>
+#include <thread>
+
+#include "util/check.h"
+
+namespace pr {
+
+namespace {
+
+// Runs fn(0..n-1) on a thread each (inline for one), then rethrows the lowest index's error.
+void forEachDevice(size_t n, const std::function<void(size_t)>& fn) {
+  std::vector<std::exception_ptr> errors(n);
+  auto run = [&](size_t i) {
+    try {
+      fn(i);
+    } catch (...) {
+      errors[i] = std::current_exception();
+    }
+  };
+  if (n == 1) {
+    run(0);
+  } else {
+    std::vector<std::thread> threads;
+    threads.reserve(n);
+    for (size_t i = 0; i < n; ++i) threads.emplace_back(run, i);
+    for (auto& t : threads) t.join();
+  }
+  for (const auto& e : errors)
+    if (e) std::rethrow_exception(e);
+}
+
+// Counters of the light paths, which every device traces alike: reported once, not summed.
+bool replicatedCounter(const std::string& key) {
+  static const std::set<std::string> keys = {
+      "slots",       "slots_retraced",     "slots_invalidated", "slots_reused",
+      "arena_bytes", "light_vertices_ssg", "light_vertices_dsg"};
+  return keys.count(key) != 0;
+}
+
+}  // namespace
+
+std::vector<int> splitRows(int height, const std::vector<double>& weights) {
+  const size_t n = weights.size();
+  PR_CHECK(n > 0 && height >= 0);
+  std::vector<double> w(weights);
+  double sum = 0.0;
+  for (double x : w) sum += x > 0.0 && std::isfinite(x) ? x : 0.0;
+  for (double& x : w) x = sum > 0.0 ? (x > 0.0 && std::isfinite(x) ? x / sum : 0.0) : 1.0 / n;
+  std::vector<int> rows(n, 0);
+  std::vector<std::pair<double, size_t>> remainders;
+  int given = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const double exact = height * w[i];
+    rows[i] = std::min(height - given, static_cast<int>(std::floor(exact)));
+    given += rows[i];
+    remainders.push_back({exact - rows[i], i});
+  }
+  std::stable_sort(remainders.begin(), remainders.end(),
+                   [](const auto& a, const auto& b) { return a.first > b.first; });
+  for (size_t k = 0; given < height; ++k, ++given) ++rows[remainders[k % n].second];
+  if (static_cast<size_t>(height) >= n)
+    for (size_t i = 0; i < n; ++i)
+      if (rows[i] == 0) {
+        --*std::max_element(rows.begin(), rows.end());
+        rows[i] = 1;
+      }
+  return rows;
+}
+
+MultiDeviceSession::MultiDeviceSession(const Scene& scene,
+                                       const std::vector<const DeviceEntry*>& devices,
+                                       const RenderOptions& options)
+    : devices_(devices), sessions_(devices.size()), throughput_(devices.size(), 0.0) {
+  PR_CHECK(!devices.empty());
+  forEachDevice(devices.size(), [&](size_t i) {
+    sessions_[i] = std::make_unique<RenderSession>(scene, *devices[i], options);
+  });
+  // The first frame: an even split.
+  setRows(splitRows(height(), std::vector<double>(devices.size(), 1.0)));
+}
+
+void MultiDeviceSession::setRows(const std::vector<int>& rows) {
+  rows_ = rows;
+  int begin = 0;
+  for (size_t i = 0; i < sessions_.size(); ++i) {
+    sessions_[i]->setRows(begin, begin + rows[i]);
+    begin += rows[i];
+  }
+  PR_CHECK(begin == height());
+}
+
+Image MultiDeviceSession::renderFrame(int frame, FrameStats* total,
+                                      std::vector<DeviceFrame>* parts) {
+  const size_t n = sessions_.size();
+  Image img(width(), height());
+  std::vector<DeviceFrame> local(n);
+  std::vector<DeviceFrame>& p = parts ? *parts : local;
+  p.assign(n, DeviceFrame{});
+  int begin = 0;
+  for (size_t i = 0; i < n; ++i) {
+    p[i].index = devices_[i]->index;
+    p[i].name = devices_[i]->name;
+    p[i].rowBegin = begin;
+    p[i].rowEnd = begin += rows_[i];
+  }
+  // Each thread writes only its own rows of `img`.
+  forEachDevice(n, [&](size_t i) {
+    const auto t0 = std::chrono::steady_clock::now();
+    sessions_[i]->renderRows(frame, &img, &p[i].stats);
+    p[i].wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  });
+
+  if (total) {
+    FrameStats& t = *total;
+    t.frame = frame;
+    for (size_t i = 0; i < n; ++i) {
+      const FrameStats& s = p[i].stats;
+      for (const auto& [k, v] : s.stageSeconds) t.stageSeconds[k] += v;
+      for (const auto& [k, v] : s.hostSeconds) t.hostSeconds[k] += v;
+      for (const auto& [k, v] : s.rays) t.rays[k] += v;
+      for (const auto& [k, v] : s.counters)
+        if (i == 0 || !replicatedCounter(k)) t.counters[k] += v;
+      t.deviceBytes += s.deviceBytes;
+      t.badSamples += s.badSamples;
+    }
+  }
+
+  // The next frame's split: rows in proportion to rows per second of each device's part.
+  if (n > 1) {
+    double known = 0.0;
+    int counted = 0;
+    for (size_t i = 0; i < n; ++i)
+      if (rows_[i] > 0 && p[i].wallSeconds > 0.0) {
+        throughput_[i] = rows_[i] / p[i].wallSeconds;
+        known += throughput_[i];
+        ++counted;
+      }
+    // A device that has not rendered rows yet is taken to be as fast as the mean.
+    for (double& t : throughput_)
+      if (!(t > 0.0)) t = counted > 0 ? known / counted : 1.0;
+    setRows(splitRows(height(), throughput_));
+  }
+  return img;
+}
+
+}  // namespace pr

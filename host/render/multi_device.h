@@ -1,0 +1,66 @@
+// Several OpenCL devices rendering each frame together. Every device has its own RenderSession
+// (device scene, arena, film) of the same scene and options, and renders a range of whole rows;
+// the ranges tile the image, so each pixel is computed by exactly one device as a single device
+// would compute it. Path reuse's light paths (invalidation and light tracing of every slot) are
+// replicated on every device: the same slots and keys give the same light paths, so no arena
+// moves between devices. The devices render concurrently, one host thread each; the rows of a
+// frame are split in proportion to each device's throughput in the previous frame.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "cl/device.h"
+#include "io/image.h"
+#include "render/integrator.h"
+#include "render/options.h"
+#include "render/session.h"
+#include "scene/scene.h"
+
+namespace pr {
+
+// One device's part of a frame.
+struct DeviceFrame {
+  int index = 0;  // the device's index in `pathreuse devices`
+  std::string name;
+  int rowBegin = 0, rowEnd = 0;
+  double wallSeconds = 0.0;  // its thread: scene update, kernels, reading its rows
+  FrameStats stats;
+};
+
+// `height` rows split in proportion to `weights` (positive), largest remainders first; while
+// there are as many rows as weights, every part gets at least one. Returns the rows per part.
+std::vector<int> splitRows(int height, const std::vector<double>& weights);
+
+class MultiDeviceSession {
+ public:
+  // Builds one RenderSession per device (concurrently); `scene` must outlive this. Throws as
+  // RenderSession does (the first device's error where several fail).
+  MultiDeviceSession(const Scene& scene, const std::vector<const DeviceEntry*>& devices,
+                     const RenderOptions& options);
+
+  // Renders frame f on every device and merges the rows. `total` sums the devices' stats
+  // (counters of the replicated light paths are every device's and counted once); `parts`
+  // gets each device's. Then splits the next frame's rows by the measured throughput.
+  Image renderFrame(int frame, FrameStats* total, std::vector<DeviceFrame>* parts);
+
+  size_t deviceCount() const { return sessions_.size(); }
+  RenderSession& session(size_t i) { return *sessions_[i]; }
+  const DeviceEntry& device(size_t i) const { return *devices_[i]; }
+  int width() const { return sessions_[0]->width(); }
+  int height() const { return sessions_[0]->height(); }
+  FrameRange frameRange() const { return sessions_[0]->frameRange(); }
+  // Rows of each device for the next frame.
+  const std::vector<int>& rows() const { return rows_; }
+
+ private:
+  void setRows(const std::vector<int>& rows);
+
+  std::vector<const DeviceEntry*> devices_;
+  std::vector<std::unique_ptr<RenderSession>> sessions_;
+  std::vector<int> rows_;
+  std::vector<double> throughput_;  // rows per second of the last frame each device rendered
+};
+
+}  // namespace pr
