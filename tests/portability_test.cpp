@@ -25,24 +25,8 @@
 namespace pr {
 namespace {
 
-const char* const kTwoDrivers = "POCL_DEVICES='pthread basic'";
-
-// " --device I --device J" for PoCL's two drivers under kTwoDrivers (named pthread or cpu, and
-// basic, by PoCL's version), whatever other platforms are listed.
-std::string twoPoclDevices() {
-  const auto r = test::runPathreuse("devices --json", kTwoDrivers);
-  std::string args;
-  int found = 0;
-  const auto list = r.exitCode == 0 ? nlohmann::json::parse(r.out) : nlohmann::json::object();
-  if (list.contains("devices"))
-    for (const auto& d : list["devices"])
-      if (d["platform_vendor"] == "The pocl project") {
-        args += " --device " + std::to_string(d["index"].get<int>());
-        ++found;
-      }
-  EXPECT_EQ(found, 2) << r.out << r.err;
-  return args;
-}
+const char* const kTwoDrivers = test::kTwoPoclDrivers;
+using test::twoPoclDevices;
 
 size_t lineCount(const std::string& s) {
   size_t n = 0;

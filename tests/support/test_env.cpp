@@ -10,6 +10,10 @@
 #include <sstream>
 #include <vector>
 
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
 #include "cl/device.h"
 
 namespace pr::test {
@@ -84,6 +88,23 @@ CommandResult runPathreuse(const std::string& args, const std::string& env) {
   r.out = slurp(outFile);
   r.err = slurp(errFile);
   return r;
+}
+
+const char* const kTwoPoclDrivers = "POCL_DEVICES='pthread basic'";
+
+std::string twoPoclDevices() {
+  const auto r = runPathreuse("devices --json", kTwoPoclDrivers);
+  std::string args;
+  int found = 0;
+  const auto list = r.exitCode == 0 ? nlohmann::json::parse(r.out) : nlohmann::json::object();
+  if (list.contains("devices"))
+    for (const auto& d : list["devices"])
+      if (d["platform_vendor"] == "The pocl project") {
+        args += " --device " + std::to_string(d["index"].get<int>());
+        ++found;
+      }
+  EXPECT_EQ(found, 2) << r.out << r.err;
+  return args;
 }
 
 }  // namespace pr::test

@@ -31,4 +31,12 @@ struct CommandResult {
 // $PATHREUSE_TEST_DEVICE its renders use that device (as $PATHREUSE_DEVICE) unless `env` names one.
 CommandResult runPathreuse(const std::string& args, const std::string& env = "");
 
+// PoCL's two drivers as `pathreuse devices` lists them under kTwoPoclDrivers.
+extern const char* const kTwoPoclDrivers;
+
+// " --device I --device J" for PoCL's two drivers under kTwoPoclDrivers (named pthread or cpu,
+// and basic, by PoCL's version), whatever other platforms are listed; fails the test unless
+// there are exactly two.
+std::string twoPoclDevices();
+
 }  // namespace pr::test

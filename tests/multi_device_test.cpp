@@ -1,0 +1,196 @@
+// Several devices in one render (render/multi_device.h): the row split and its balancing, and
+// frames byte-identical to a single device's with PoCL's two drivers, which compute alike.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <numeric>
+
+#include <nlohmann/json.hpp>
+
+#include "io/image.h"
+#include "render/multi_device.h"
+#include "support/test_env.h"
+
+namespace pr {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kScene = test::sourcePath("scenes/cornell-dynamic.gltf");
+constexpr int kWidth = 64, kHeight = 48, kFrames = 5;
+
+size_t lineCount(const std::string& s) {
+  size_t n = 0;
+  for (char c : s) n += c == '\n';
+  return n;
+}
+
+int sum(const std::vector<int>& v) {
+  return std::accumulate(v.begin(), v.end(), 0);
+}
+
+TEST(SplitRows, EvenThenProportional) {
+  EXPECT_EQ(splitRows(48, {1.0, 1.0}), (std::vector<int>{24, 24}));
+  EXPECT_EQ(splitRows(7, {1.0, 1.0}), (std::vector<int>{4, 3}));
+  EXPECT_EQ(splitRows(48, {3.0, 1.0}), (std::vector<int>{36, 12}));
+  EXPECT_EQ(splitRows(10, {1.0, 1.0, 1.0}), (std::vector<int>{4, 3, 3}));
+  // Largest remainders: 100 x (0.505, 0.495) = 50.5, 49.5.
+  EXPECT_EQ(splitRows(100, {0.505, 0.495}), (std::vector<int>{51, 49}));
+}
+
+TEST(SplitRows, EveryDeviceGetsARowWhileThereAreEnough) {
+  EXPECT_EQ(splitRows(48, {1000.0, 1e-9}), (std::vector<int>{47, 1}));
+  EXPECT_EQ(splitRows(3, {1e-9, 1.0, 1e-9}), (std::vector<int>{1, 1, 1}));
+  EXPECT_EQ(splitRows(1, {1.0, 1.0}), (std::vector<int>{1, 0}));
+  EXPECT_EQ(splitRows(0, {1.0, 1.0}), (std::vector<int>{0, 0}));
+  // Weights that are not usable count as none; all unusable: an even split.
+  EXPECT_EQ(splitRows(10, {0.0, 0.0}), (std::vector<int>{5, 5}));
+  EXPECT_EQ(splitRows(10, {std::nan(""), 1.0}), (std::vector<int>{1, 9}));
+  for (int h : {1, 2, 5, 48, 1079})
+    for (const auto& w : std::vector<std::vector<double>>{{1, 2, 3}, {0.3, 0.3, 0.4}, {5, 1}})
+      EXPECT_EQ(sum(splitRows(h, w)), h);
+}
+
+bool samePixels(const std::string& a, const std::string& b) {
+  const Image x = readExr(a), y = readExr(b);
+  return x.width == y.width && x.height == y.height &&
+         std::memcmp(x.rgba.data(), y.rgba.data(), x.rgba.size() * sizeof(float)) == 0;
+}
+
+std::string frameFile(const std::string& dir, int f) {
+  char name[32];
+  std::snprintf(name, sizeof name, "/f_%04d.exr", f);
+  return dir + name;
+}
+
+std::string common(const std::string& mode) {
+  return "render '" + kScene + "' --quiet --exr-float --width " + std::to_string(kWidth) +
+         " --height " + std::to_string(kHeight) + " --spp 2 --mode " + mode;
+}
+
+// The first PoCL device alone: the reference every split must equal.
+std::string oneDevice() {
+  const std::string two = test::twoPoclDevices();
+  return two.substr(0, two.find(" --device", 1));
+}
+
+// Each stats line names both devices, whose rows tile the image; the top-level rays are the
+// devices' sums.
+void checkStats(const std::string& file, int frames) {
+  std::ifstream in(file);
+  std::string line;
+  int lines = 0;
+  while (std::getline(in, line)) {
+    ++lines;
+    const auto j = nlohmann::json::parse(line);
+    ASSERT_EQ(j["devices"].size(), 2u) << line;
+    int rows = 0;
+    double share = 0.0;
+    std::map<std::string, uint64_t> rays;
+    for (const auto& d : j["devices"]) {
+      EXPECT_EQ(d["row_begin"].get<int>(), rows) << line;
+      rows += d["rows"].get<int>();
+      share += d["share"].get<double>();
+      EXPECT_GT(d["rows"].get<int>(), 0) << line;
+      EXPECT_GT(d["wall_s"].get<double>(), 0.0) << line;
+      EXPECT_FALSE(d["stages_s"].empty()) << line;
+      for (const auto& [k, v] : d["rays"].items()) rays[k] += v.get<uint64_t>();
+    }
+    EXPECT_EQ(rows, kHeight) << line;
+    EXPECT_NEAR(share, 1.0, 1e-12) << line;
+    for (const auto& [k, v] : rays) EXPECT_EQ(j["rays"][k].get<uint64_t>(), v) << k;
+    if (lines == 1) {
+      EXPECT_EQ(j["devices"][0]["rows"].get<int>(), kHeight / 2) << line;
+    }
+  }
+  EXPECT_EQ(lines, frames);
+}
+
+// Frames of a scene with moving objects, two devices against one, byte for byte.
+TEST(MultiDeviceCli, TwoDevicesEqualOne) {
+  const std::string two = test::twoPoclDevices();
+  const std::string range = " --frames 0-" + std::to_string(kFrames - 1);
+  for (const char* mode : {"reuse", "pathtrace"}) {
+    SCOPED_TRACE(mode);
+    const std::string dir = test::tempDir("multi");
+    auto r = test::runPathreuse(
+        common(mode) + range + oneDevice() + " --out '" + dir + "/one/f_%04d.exr'",
+        test::kTwoPoclDrivers);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    r = test::runPathreuse(common(mode) + range + two + " --out '" + dir +
+                               "/two/f_%04d.exr' --stats '" + dir + "/two.jsonl'",
+                           test::kTwoPoclDrivers);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    for (int f = 0; f < kFrames; ++f)
+      EXPECT_TRUE(samePixels(frameFile(dir + "/one", f), frameFile(dir + "/two", f)))
+          << "frame " << f;
+    checkStats(dir + "/two.jsonl", kFrames);
+  }
+}
+
+// --device all with only PoCL's platform listed: its two drivers.
+TEST(MultiDeviceCli, AllDevicesEqualOne) {
+  const std::string icd = "/etc/OpenCL/vendors/pocl.icd";
+  if (!fs::exists(icd)) GTEST_SKIP() << icd << " absent";
+  const std::string vendors = test::tempDir("icd");
+  fs::copy_file(icd, vendors + "/pocl.icd");
+  const std::string env = std::string(test::kTwoPoclDrivers) + " OCL_ICD_VENDORS='" + vendors + "'";
+  const std::string dir = test::tempDir("all");
+  auto r = test::runPathreuse(
+      common("reuse") + " --frames 0-2" + oneDevice() + " --out '" + dir + "/one/f_%04d.exr'", env);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  r = test::runPathreuse(common("reuse") + " --frames 0-2 --device all --out '" + dir +
+                             "/all/f_%04d.exr' --stats '" + dir + "/all.jsonl'",
+                         env);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  for (int f = 0; f <= 2; ++f)
+    EXPECT_TRUE(samePixels(frameFile(dir + "/one", f), frameFile(dir + "/all", f))) << f;
+  checkStats(dir + "/all.jsonl", 3);
+}
+
+// A two-device run cut short (frame 1 truncated), resumed on two devices: every frame equals
+// the single device's uninterrupted run.
+TEST(MultiDeviceCli, ResumeEqualsOne) {
+  const std::string two = test::twoPoclDevices();
+  for (const char* mode : {"reuse", "pathtrace"}) {
+    SCOPED_TRACE(mode);
+    const std::string dir = test::tempDir("multiresume");
+    auto r = test::runPathreuse(
+        common(mode) + " --frames 0-4" + oneDevice() + " --out '" + dir + "/whole/f_%04d.exr'",
+        test::kTwoPoclDrivers);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    r = test::runPathreuse(
+        common(mode) + " --frames 0-2" + two + " --out '" + dir + "/cut/f_%04d.exr'",
+        test::kTwoPoclDrivers);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const std::string truncated = frameFile(dir + "/cut", 1);
+    fs::resize_file(truncated, fs::file_size(truncated) / 2);
+    r = test::runPathreuse(common(mode) + " --frames 0-4 --resume" + two + " --out '" + dir +
+                               "/cut/f_%04d.exr' --stats '" + dir + "/cut.jsonl'",
+                           test::kTwoPoclDrivers);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    for (int f = 0; f <= 4; ++f)
+      EXPECT_TRUE(samePixels(frameFile(dir + "/whole", f), frameFile(dir + "/cut", f)))
+          << "frame " << f;
+    checkStats(dir + "/cut.jsonl", 3);  // frames 1, 3 and 4
+  }
+}
+
+TEST(MultiDeviceCli, BadDeviceAmongSeveralIsOneLineAndExitTwo) {
+  const std::string dir = test::tempDir("baddevice");
+  const std::string render = common("reuse") + " --frames 0 --out '" + dir + "/f_%04d.exr'";
+  for (const std::string& devices : {oneDevice() + " --device nosuch", oneDevice() + oneDevice(),
+                                     std::string(" --device 999"), " --device all" + oneDevice()}) {
+    SCOPED_TRACE(devices);
+    const auto r = test::runPathreuse(render + devices, test::kTwoPoclDrivers);
+    EXPECT_EQ(r.exitCode, 2) << r.err;
+    EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find("--device"), std::string::npos) << r.err;
+    EXPECT_TRUE(fs::is_empty(dir)) << devices;
+  }
+}
+
+}  // namespace
+}  // namespace pr
