@@ -87,8 +87,9 @@ def main():
     exe = Path(args.exe)
     if not exe.is_file():
         die(f"{exe}: not built (cmake --build build)")
-    env = dict(os.environ, POCL_DEVICES="pthread basic")
-    env.pop("PATHREUSE_DEVICE", None)
+    os.environ["POCL_DEVICES"] = "pthread basic"  # machine_lines lists the devices too
+    os.environ.pop("PATHREUSE_DEVICE", None)
+    env = dict(os.environ)
     devs = pocl_devices(exe, env)
     configs = {"basic": [devs["basic"]["index"]], "pthread": [devs["pthread"]["index"]],
                "both": [devs["basic"]["index"], devs["pthread"]["index"]]}
@@ -114,7 +115,9 @@ def main():
     L = ["# Several devices: PoCL's two drivers against each alone", ""]
     L += machine_lines(exe) + [
         f"- scene `{Path(args.scene).name}`, {args.width}x{args.height}, {args.spp} spp, frames "
-        f"0-{args.frames} (frame 0 left out), {args.repeats} runs per configuration, interleaved",
+        f"0-{args.frames} (frame 0 left out), {args.repeats} runs per configuration, interleaved;"
+        " wall = the renderer's per-frame wall time; 'vs' = median over repeats of the ratio of "
+        "per-run medians (runs of one repeat ran back to back)",
         f"- command: `python3 tools/bench_multidevice.py"
         f"{' --quick' if args.quick else ''}`", ""]
     for mode, runs in results.items():
@@ -128,8 +131,9 @@ def main():
               "| devices | wall s/frame (median) | per-run medians | process s | vs " + best + " alone |",
               "|---|---|---|---|---|"]
         for c in configs:
+            paired = median([x / y for x, y in zip(run_meds[c], run_meds[best])])
             L.append(f"| {c} | {wall[c]:.4f} | {' '.join(f'{x:.4f}' for x in run_meds[c])} | "
-                     f"{proc[c]:.2f} | {wall[c] / wall[best]:.2f}x |")
+                     f"{proc[c]:.2f} | {paired:.2f}x |")
         both = body["both"]
         L += ["", "Two devices, per device (median over frames >= 1):", "",
               "| device | rows (share) | wall s of its part | kernel s | light paths s "
@@ -152,6 +156,7 @@ def main():
             L += [f"Replicated light paths: invalidate + light_trace summed over both devices "
                   f"{total_two:.4f} s/frame, against {single['basic']:.4f} s (basic alone) and "
                   f"{single['pthread']:.4f} s (pthread alone).", ""]
+    L += [f"Load average (1 min) at the end: {os.getloadavg()[0]:.2f} on {os.cpu_count()} CPUs.", ""]
     print("\n".join(L))
 
 
