@@ -129,6 +129,23 @@ if [ -f "$atrium" ]; then
   grep '^|\|^##' "$out/connections.md" >>"$summary"
 fi
 
+# Several devices in one render: the GPU, the machine's CPU (PoCL) and both, rows balanced by
+# throughput (README: several devices).
+say "== several devices: demo 640x480, 8 spp, frames 0-8, median wall s per frame (frames 1-8)"
+for mode in pathtrace reuse; do
+  line="$mode:"
+  for devs in "$device" cpu "$device cpu"; do
+    args=()
+    for d in $devs; do args+=(--device "$d"); done
+    tag=$(echo "$devs" | tr ' ' '+')
+    timeout 120 "$src/build/pathreuse" render scenes/cornell-dynamic.gltf "${args[@]}" --mode "$mode" \
+      --width 640 --height 480 --spp 8 --frames 0-8 --quiet --out "/tmp/pathreuse-multi/$mode-$tag-%04d.exr" \
+      --stats "$out/stats-multi-$mode-$tag.jsonl" 2>>"$summary"
+    line="$line $tag $(python3 -c 'import json,sys,statistics; L=[json.loads(l) for l in open(sys.argv[1])][1:]; print(round(statistics.median(l["wall_s"] for l in L), 4), "rows", "/".join(str(d["rows"]) for d in L[-1].get("devices", [])))' "$out/stats-multi-$mode-$tag.jsonl" 2>/dev/null);"
+  done
+  say "$line"
+done
+
 # A short form of the evaluation (relMSE against a reference, equal-time comparisons) on the GPU.
 if [ -n "${PATHREUSE_PYTHON:-}" ]; then
   say "== short evaluation on the default device (the first GPU), results in evaluation/"
