@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
-# The checks for a machine with a GPU and no package registry, in one call (a few minutes):
+# The checks for a machine with a GPU and no package registry, in one call:
 # lists the OpenCL devices, runs the test suite on the GPU, compares the GPU's portability
 # suite with the reference frames rendered on the CPU, times the demo on the GPU, and (where
 # the bundle has ray_bench) measures ray throughput and frame times of each BVH width there, on
-# the demo and on the atrium, and runs a short form of the evaluation.
+# the demo and on the atrium; then the connection strategies (tools/bench_connections.py), the
+# GPU with the CPU in one render, and a short form of the evaluation. About 7 minutes on an
+# H200 (the tests 2-3 of them); later steps have time limits of their own.
 # Everything goes to OUT. The programs come from a bundle made by tools/gpu-bundle.sh on the
 # build machine and carried along (default: .gpu in the repository root).
 # Usage: tools/gpu-check.sh OUT [BUNDLE] [DEVICE]   (DEVICE: a --device spec, default gpu)
@@ -60,7 +62,7 @@ rm -f /tmp/gpu-check-rc
 say "== tests on --device $device"
 tests=("$src"/build/*_test)
 export PATHREUSE_TEST_DEVICE="$device"
-printf '%s\n' "${tests[@]}" | xargs -P 4 -I{} sh -c \
+printf '%s\n' "${tests[@]}" | xargs -P 8 -I{} sh -c \
   'timeout 240 "{}" --gtest_brief=1 >"/tmp/$(basename "{}").log" 2>&1; echo "$? $(basename "{}")" >>/tmp/gpu-check-rc'
 for t in "${tests[@]}"; do
   n=$(basename "$t")
