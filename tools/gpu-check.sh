@@ -4,8 +4,8 @@
 # suite with the reference frames rendered on the CPU, times the demo on the GPU, and (where
 # the bundle has ray_bench) measures ray throughput and frame times of each BVH width there, on
 # the demo and on the atrium; then the connection strategies (tools/bench_connections.py), the
-# GPU with the CPU in one render, and a short form of the evaluation. About 7 minutes on an
-# H200 (the tests 2-3 of them); later steps have time limits of their own.
+# GPU with the CPU in one render, and a short form of the evaluation. On an H200 it took 4 min
+# 16 s before those last three were added; they have time limits of their own.
 # Everything goes to OUT. The programs come from a bundle made by tools/gpu-bundle.sh on the
 # build machine and carried along (default: .gpu in the repository root).
 # Usage: tools/gpu-check.sh OUT [BUNDLE] [DEVICE]   (DEVICE: a --device spec, default gpu)
