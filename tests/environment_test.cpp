@@ -314,6 +314,23 @@ TEST(Environment, CoatedAndSpecularMaterialsAgreeInBothModes) {
   expectModesAgree(scene, args, {0}, "coat");
 }
 
+// Rewrites the glTF at `scene` so that material `glass` (transmissive) has ior 1 and
+// KHR_materials_volume with these values; returns the document written.
+nlohmann::json withVolume(const std::string& scene, int glass, double thickness, double distance,
+                          const std::vector<double>& color) {
+  nlohmann::json doc;
+  std::ifstream(scene) >> doc;
+  doc["extensionsUsed"] = {"KHR_materials_transmission", "KHR_materials_ior",
+                           "KHR_materials_volume"};
+  doc["materials"][glass]["extensions"]["KHR_materials_volume"] = {
+      {"thicknessFactor", thickness},
+      {"attenuationDistance", distance},
+      {"attenuationColor", color}};
+  doc["materials"][glass]["extensions"]["KHR_materials_ior"] = {{"ior", 1.0}};
+  std::ofstream(scene) << doc.dump();
+  return doc;
+}
+
 // KHR_materials_volume: seen through a slab of clear (ior 1) glass 0.5 thick whose
 // attenuation colour (0.5, 0.25, 1) holds at distance 0.5, an emitter of radiance 1 reads that
 // colour exactly, in both modes; light paths through an absorbing box agree with the path
@@ -326,14 +343,7 @@ TEST(Environment, VolumeAttenuatesInsideTransmissiveObjects) {
   g.addNode(g.addQuad({-3, -3, -1}, {3, -3, -1}, {3, 3, -1}, {-3, 3, -1}, lamp));
   g.addCamera({0, 0, 3}, {0, 0, 0}, 0.2f, 1.0f);
   const std::string scene = g.write(test::tempDir("volume"), "slab");
-  nlohmann::json doc;
-  std::ifstream(scene) >> doc;
-  doc["extensionsUsed"] = {"KHR_materials_transmission", "KHR_materials_ior",
-                           "KHR_materials_volume"};
-  doc["materials"][glass]["extensions"]["KHR_materials_volume"] = {
-      {"thicknessFactor", 0.5}, {"attenuationDistance", 0.5}, {"attenuationColor", {0.5, 0.25, 1}}};
-  doc["materials"][glass]["extensions"]["KHR_materials_ior"] = {{"ior", 1.0}};
-  { std::ofstream(scene) << doc.dump(); }
+  nlohmann::json doc = withVolume(scene, glass, 0.5, 0.5, {0.5, 0.25, 1});
   for (const char* mode : {"pathtrace", "reuse"}) {
     SCOPED_TRACE(mode);
     const Image img =
@@ -371,16 +381,7 @@ TEST(Environment, LightPathsThroughAnAbsorbingRoofAgreeWithThePathTracer) {
   g.addNode(g.addQuad({-3, 0, -1.5f}, {3, 0, -1.5f}, {3, 0.99f, -1.5f}, {-3, 0.99f, -1.5f}, grey));
   g.addCamera({0, 0.6f, 2.0f}, {0, 0, -0.5f}, 0.8f, 1.0f);
   const std::string scene = g.write(test::tempDir("envroof"), "roof");
-  nlohmann::json doc;
-  std::ifstream(scene) >> doc;
-  doc["extensionsUsed"] = {"KHR_materials_transmission", "KHR_materials_ior",
-                           "KHR_materials_volume"};
-  doc["materials"][glass]["extensions"]["KHR_materials_volume"] = {
-      {"thicknessFactor", 0.3},
-      {"attenuationDistance", 0.3},
-      {"attenuationColor", {0.9, 0.5, 0.2}}};
-  doc["materials"][glass]["extensions"]["KHR_materials_ior"] = {{"ior", 1.0}};
-  { std::ofstream(scene) << doc.dump(); }
+  withVolume(scene, glass, 0.3, 0.3, {0.9, 0.5, 0.2});
   const std::string args = " --spp 64 --light-paths " + std::to_string(24 * 24 * 64 * 4) +
                            " --env-color 1,1,1 --max-depth 6";
   expectModesAgree(scene, args, {0, 2}, "roof");

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <map>
+#include <set>
 #include <string>
 
 #include "shared/camera.h"
@@ -18,6 +19,9 @@ struct FrameStats {
   std::map<std::string, double> hostSeconds;
   std::map<std::string, uint64_t> rays;      // rays by kind
   std::map<std::string, uint64_t> counters;  // mode-specific counts (slots reused, ...)
+  // Those of `counters` that describe the light paths, which every device of a several-device
+  // render holds alike (render/multi_device.h counts them once).
+  std::set<std::string> lightPathCounters;
   uint64_t deviceBytes = 0;
   uint64_t badSamples = 0;
 };

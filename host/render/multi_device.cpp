@@ -5,7 +5,6 @@
 #include <cmath>
 #include <exception>
 #include <functional>
-#include <set>
 #include <thread>
 
 #include "util/check.h"
@@ -34,14 +33,6 @@ void forEachDevice(size_t n, const std::function<void(size_t)>& fn) {
   }
   for (const auto& e : errors)
     if (e) std::rethrow_exception(e);
-}
-
-// Counters of the light paths, which every device traces alike: reported once, not summed.
-bool replicatedCounter(const std::string& key) {
-  static const std::set<std::string> keys = {
-      "slots",       "slots_retraced",     "slots_invalidated", "slots_reused",
-      "arena_bytes", "light_vertices_ssg", "light_vertices_dsg"};
-  return keys.count(key) != 0;
 }
 
 }  // namespace
@@ -126,7 +117,8 @@ Image MultiDeviceSession::renderFrame(int frame, FrameStats* total,
       for (const auto& [k, v] : s.hostSeconds) t.hostSeconds[k] += v;
       for (const auto& [k, v] : s.rays) t.rays[k] += v;
       for (const auto& [k, v] : s.counters)
-        if (i == 0 || !replicatedCounter(k)) t.counters[k] += v;
+        if (i == 0 || !s.lightPathCounters.count(k)) t.counters[k] += v;
+      t.lightPathCounters.insert(s.lightPathCounters.begin(), s.lightPathCounters.end());
       t.deviceBytes += s.deviceBytes;
       t.badSamples += s.badSamples;
     }

@@ -11,6 +11,16 @@
 
 namespace pr {
 
+namespace {
+
+// A counter of the light paths (the same on every device that holds them).
+void setLightPathCounter(FrameStats* stats, const char* key, uint64_t value) {
+  stats->counters[key] = value;
+  stats->lightPathCounters.insert(key);
+}
+
+}  // namespace
+
 PathReuse::PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseSettings& settings)
     : ctx_(ctx), scene_(scene), film_(film), settings_(settings) {
   if (settings_.maxDepth < 2) throw InputError("--max-depth: path reuse needs at least 2");
@@ -108,18 +118,21 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
     // Every counter where kernels/shared/reuse.h's list says.
 #define PR_REPORT_rays(key, value) stats->rays[key] += value;
 #define PR_REPORT_counters(key, value) stats->counters[key] = value;
+#define PR_REPORT_paths(key, value) setLightPathCounter(stats, key, value);
 #define PR_REPORT_internal(key, value)
 #define PR_REPORT(name, group, key) PR_REPORT_##group(key, c[dev::PR_C_##name])
   PR_REUSE_COUNTERS(PR_REPORT)
 #undef PR_REPORT
 #undef PR_REPORT_rays
 #undef PR_REPORT_counters
+#undef PR_REPORT_paths
 #undef PR_REPORT_internal
-  stats->counters["slots"] = slots_;
-  stats->counters["slots_retraced"] = toTrace;
-  stats->counters["slots_invalidated"] = settings_.retraceAll ? slots_ : c[dev::PR_C_LIST];
-  stats->counters["slots_reused"] = slots_ - toTrace;
-  stats->counters["arena_bytes"] = arenaBytes();
+  setLightPathCounter(stats, "slots", slots_);
+  setLightPathCounter(stats, "slots_retraced", toTrace);
+  setLightPathCounter(stats, "slots_invalidated",
+                      settings_.retraceAll ? slots_ : c[dev::PR_C_LIST]);
+  setLightPathCounter(stats, "slots_reused", slots_ - toTrace);
+  setLightPathCounter(stats, "arena_bytes", arenaBytes());
 }
 
 void PathReuse::readArena(std::vector<dev::PathHeader>* headers,

@@ -40,9 +40,9 @@ typedef struct {
   X(CAMERA_RAYS, rays, "camera")                                                       \
   X(SHADOW_RAYS, rays, "shadow") /* next-event estimation */                           \
   X(CONNECT_RAYS, rays, "connection")                                                  \
-  X(BOUNCE_RAYS, rays, "bounce")                  /* eye rays after the first hit */   \
-  X(SSG_VERTICES, counters, "light_vertices_ssg") /* light vertices k >= 1 */          \
-  X(DSG_VERTICES, counters, "light_vertices_dsg")                                      \
+  X(BOUNCE_RAYS, rays, "bounce")               /* eye rays after the first hit */      \
+  X(SSG_VERTICES, paths, "light_vertices_ssg") /* light vertices k >= 1 */             \
+  X(DSG_VERTICES, paths, "light_vertices_dsg")                                         \
   X(CLAMPED, counters, "connections_clamped")      /* geometry term clamped */         \
   X(MIS_RAYS, counters, "connections_mis")         /* connection rays of strategy E */ \
   X(CANDIDATES, counters, "connection_candidates") /* each a ray without resampling */ \
