@@ -96,9 +96,11 @@ int main(int argc, char** argv) {
   render
       ->add_option("--light-sampler", lightSamplerText,
                    "How a shaded point chooses the light it samples: bvh (by the light it can "
-                   "get from each, through a light BVH), power (by power alone) or auto (bvh "
-                   "where the scene has more than 16 lights)")
-      ->check(CLI::IsMember({"auto", "bvh", "power"}))
+                   "get from each, through a light BVH), exhaustive (by the light it can get "
+                   "from each, every light weighed: for few lights), power (by power alone) or "
+                   "auto (bvh where the scene has more than 16 lights, exhaustive where it has "
+                   "at most 4, power between)")
+      ->check(CLI::IsMember({"auto", "bvh", "exhaustive", "power"}))
       ->capture_default_str();
   std::string bvhWidthText = "auto";
   render
@@ -245,9 +247,10 @@ int main(int argc, char** argv) {
       ro.mode = modeText == "pathtrace" ? pr::RenderMode::PathTrace
                 : modeText == "retrace" ? pr::RenderMode::Retrace
                                         : pr::RenderMode::Reuse;
-      ro.lightSampler = lightSamplerText == "bvh"     ? pr::LightSampler::Bvh
-                        : lightSamplerText == "power" ? pr::LightSampler::Power
-                                                      : pr::LightSampler::Auto;
+      ro.lightSampler = lightSamplerText == "bvh"          ? pr::LightSampler::Bvh
+                        : lightSamplerText == "exhaustive" ? pr::LightSampler::Exhaustive
+                        : lightSamplerText == "power"      ? pr::LightSampler::Power
+                                                           : pr::LightSampler::Auto;
       ro.bvhWidth = bvhWidthText == "auto" ? 0 : std::stoi(bvhWidthText);
       ro.connections = connectionsText == "auto"  ? -1
                        : connectionsText == "all" ? 0

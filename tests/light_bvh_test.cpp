@@ -2,7 +2,9 @@
 // the choice it makes follows the pmf it reports (chi-square), the pmfs of all lights add to
 // at most one, no light that can reach a point (above its normal) is given probability 0, the cones
 // and boxes of every node hold their children's after build and after refit, and a point next to
-// one of many lights chooses that one far more often than power alone would.
+// one of many lights chooses that one far more often than power alone would. The exhaustive
+// choice for few lights (light_exhaustive_sample) is held to the same pmf tests, and its
+// weights to the irradiance they estimate.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -28,6 +30,7 @@ dev::Light triangle(float3 v0, float3 e1, float3 e2, float power) {
   l.e2x = e2.x, l.e2y = e2.y, l.e2z = e2.z;
   l.area = 0.5f * dev::length(dev::cross(e1, e2));
   l.power = power;
+  l.le_r = l.le_g = l.le_b = power / (PR_PI * std::max(l.area, 1e-12f));
   l.inst = l.prim = PR_INVALID_INDEX;
   return l;
 }
@@ -40,6 +43,7 @@ dev::Light punctual(uint32_t type, float3 p, float3 axis, float cosOuter, float 
   l.cos_inner = std::min(1.0f, cosOuter + 0.05f);
   l.cos_outer = cosOuter;
   l.power = power;
+  l.le_r = l.le_g = l.le_b = power / (4.0f * PR_PI);
   l.inst = l.prim = PR_INVALID_INDEX;
   return l;
 }
@@ -255,6 +259,133 @@ TEST(LightBvh, ANearLightIsChosenMoreThanItsPowerShare) {
   const float3 p = c + nl * 0.05f;
   const float pmf = dev::light_bvh_pmf(bvh.nodes().data(), near.leaf, p, -nl);
   EXPECT_GT(pmf, 20.0 * near.power / total);
+}
+
+// The exhaustive choice (few lights: every one weighed from the receiver) over the same kinds of
+// lights: the choice follows light_exhaustive_pmf, the pmfs add to one where any light reaches
+// the point, and no light that reaches the point has probability 0.
+double exhaustivePValue(const std::vector<dev::Light>& lights, const Receiver& r, int n,
+                        uint32_t seed, int* mismatches) {
+  const uint32_t count = uint32_t(lights.size());
+  std::vector<double> expected(count), observed(count, 0.0);
+  for (uint32_t i = 0; i < count; ++i)
+    expected[i] = dev::light_exhaustive_pmf(lights.data(), count, i, r.p, r.n) * double(n);
+  dev::Rng rng = dev::rng_make(seed, PR_RNG_TEST, 0u, 0u, 0u);
+  for (int s = 0; s < n; ++s) {
+    float pmf;
+    const uint32_t l =
+        dev::light_exhaustive_sample(lights.data(), count, r.p, r.n, dev::rng_next(&rng), &pmf);
+    if (l == PR_INVALID_INDEX) continue;
+    observed[l] += 1.0;
+    const float expect = dev::light_exhaustive_pmf(lights.data(), count, l, r.p, r.n);
+    if (!(std::fabs(pmf - expect) <= 1e-5f * expect)) ++*mismatches;
+  }
+  return test::chiSquarePValue(observed, expected);
+}
+
+TEST(LightExhaustive, ChoicesFollowTheReportedPmf) {
+  const std::vector<dev::Light> lights = randomLights(11u, 4);  // 4 triangles, 12 punctual
+  int mismatches = 0;
+  const std::vector<Receiver> receivers = randomReceivers(12u, 8);
+  for (size_t k = 0; k < receivers.size(); ++k)
+    EXPECT_GT(exhaustivePValue(lights, receivers[k], 200000, uint32_t(k), &mismatches), 1e-4)
+        << "receiver " << k;
+  EXPECT_EQ(mismatches, 0) << "the pmf light_exhaustive_sample returns is not the one it reports";
+}
+
+// A point on light l (barycentrics b1, b2 for triangles), and whether it sends r anything.
+bool reachesFrom(const dev::Light& l, const Receiver& r, float b1, float b2) {
+  float3 q = make_float3(l.p0x, l.p0y, l.p0z);
+  if (l.type == PR_LIGHT_TRIANGLE)
+    q = q + make_float3(l.e1x, l.e1y, l.e1z) * b1 + make_float3(l.e2x, l.e2y, l.e2z) * b2;
+  const float3 wi = dev::normalize(q - r.p);
+  if ((r.n.x != 0 || r.n.y != 0 || r.n.z != 0) && !(dev::dot(wi, r.n) > 1e-4f)) return false;
+  if (l.type == PR_LIGHT_SPOT)
+    return -dev::dot(wi, make_float3(l.e1x, l.e1y, l.e1z)) > l.cos_outer + 1e-4f;
+  if (l.type == PR_LIGHT_TRIANGLE) {
+    const float3 nl = dev::normalize(
+        dev::cross(make_float3(l.e1x, l.e1y, l.e1z), make_float3(l.e2x, l.e2y, l.e2z)));
+    return std::fabs(dev::dot(wi, nl)) > 1e-4f;
+  }
+  return true;
+}
+
+TEST(LightExhaustive, PmfsAddToOneAndNoReachableLightIsImpossible) {
+  const std::vector<dev::Light> lights = randomLights(13u, 12);
+  const uint32_t count = uint32_t(lights.size());
+  std::mt19937 g(14u);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  for (const Receiver& r : randomReceivers(15u, 300)) {
+    double sum = 0.0;
+    bool anyReaches = false;
+    for (uint32_t i = 0; i < count; ++i) {
+      const float pmf = dev::light_exhaustive_pmf(lights.data(), count, i, r.p, r.n);
+      ASSERT_GE(pmf, 0.0f);
+      sum += pmf;
+      // A few points of the light (its corners' neighbourhood included).
+      bool reaches = false;
+      for (int k = 0; k < 16 && !reaches; ++k) {
+        float b1 = u(g), b2 = u(g);
+        if (b1 + b2 > 1.0f) b1 = 1.0f - b1, b2 = 1.0f - b2;
+        reaches = reachesFrom(lights[i], r, b1, b2);
+      }
+      anyReaches = anyReaches || reaches;
+      if (reaches) {
+        EXPECT_GT(pmf, 0.0f) << "a light that reaches the point is never chosen: light " << i;
+      }
+    }
+    // One where any light gets a share (16 points may miss a corner that reaches the point).
+    if (anyReaches || sum > 0.0) {
+      EXPECT_NEAR(sum, 1.0, 1e-5);
+    }
+  }
+}
+
+// The importance is the luminance of the unshadowed irradiance: exact for point and spot lights,
+// within 25% for a triangle wholly above the receiver (numerical integration over its area).
+TEST(LightExhaustive, ImportanceIsTheIrradiance) {
+  std::mt19937 g(16u);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  const std::vector<dev::Light> lights = randomLights(17u, 40);
+  int triangles = 0;
+  for (const Receiver& r : randomReceivers(18u, 60)) {
+    if (r.n.x == 0 && r.n.y == 0 && r.n.z == 0) continue;
+    for (const dev::Light& l : lights) {
+      const float lum = dev::luminance(make_float3(l.le_r, l.le_g, l.le_b));
+      const float importance = dev::light_receiver_importance(&l, r.p, r.n);
+      const float3 q = make_float3(l.p0x, l.p0y, l.p0z);
+      if (l.type != PR_LIGHT_TRIANGLE) {
+        const float3 d = q - r.p;
+        const float3 wi = dev::normalize(d);
+        float e = lum * std::max(0.0f, dev::dot(wi, r.n)) / dev::dot(d, d);
+        if (l.type == PR_LIGHT_SPOT)
+          e *= dev::spot_attenuation(-dev::dot(wi, make_float3(l.e1x, l.e1y, l.e1z)), l.cos_inner,
+                                     l.cos_outer);
+        EXPECT_NEAR(importance, e, 1e-4f * e + 1e-12f);
+        continue;
+      }
+      const float3 e1 = make_float3(l.e1x, l.e1y, l.e1z), e2 = make_float3(l.e2x, l.e2y, l.e2z);
+      const float3 cr = dev::cross(e1, e2);
+      const float3 nl = dev::normalize(cr);
+      bool above = true;
+      for (const float3& v : {q, q + e1, q + e2}) above = above && dev::dot(v - r.p, r.n) > 0.0f;
+      if (!above) continue;
+      double e = 0.0;
+      const int n = 20000;
+      for (int k = 0; k < n; ++k) {
+        float b1 = u(g), b2 = u(g);
+        if (b1 + b2 > 1.0f) b1 = 1.0f - b1, b2 = 1.0f - b2;
+        const float3 d = q + e1 * b1 + e2 * b2 - r.p;
+        const float d2 = dev::dot(d, d);
+        const float3 wi = d / std::sqrt(d2);
+        e += double(dev::dot(wi, r.n)) * std::fabs(dev::dot(wi, nl)) / d2;
+      }
+      e *= double(lum) * 0.5 * dev::length(cr) / n;
+      ++triangles;
+      EXPECT_NEAR(importance / e, 1.0, 0.25) << "triangle importance " << importance << " vs " << e;
+    }
+  }
+  EXPECT_GT(triangles, 50);
 }
 
 TEST(LightBvh, NoLightsGiveOneLeafThatIsNeverChosen) {

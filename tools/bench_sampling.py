@@ -46,12 +46,16 @@ REPO = benchlib.REPO
 # the one reference (rendered with the case's options alone); a line after the table gives
 # the relMSE of the second variant over the first
 SAMPLERS = [("bvh", ["--light-sampler", "bvh"]), ("power", ["--light-sampler", "power"])]
+FEW = [("exhaustive", ["--light-sampler", "exhaustive"]), ("power", ["--light-sampler", "power"])]
 CYCLES_CASES = {0, 1, 2}  # --force-diffuse, no punctual lights: the same transport in Cycles
 CASES = [
-    ("atrium direct (--max-depth 2)", "atrium", 320, 180, ["--force-diffuse", "--max-depth", "2"]),
-    ("atrium full (--max-depth 64)", "atrium", 320, 180, ["--force-diffuse", "--max-depth", "64"]),
-    ("cornell-nvpro (--max-depth 64)", "cornell-nvpro", 320, 240, ["--force-diffuse", "--max-depth", "64"]),
-    ("cornell-dynamic (default depth)", "cornell-dynamic", 320, 240, []),
+    ("atrium direct (--max-depth 2)", "atrium", 320, 180, ["--force-diffuse", "--max-depth", "2"],
+     FEW),
+    ("atrium full (--max-depth 64)", "atrium", 320, 180, ["--force-diffuse", "--max-depth", "64"],
+     FEW),
+    ("cornell-nvpro (--max-depth 64)", "cornell-nvpro", 320, 240,
+     ["--force-diffuse", "--max-depth", "64"], FEW),
+    ("cornell-dynamic (default depth)", "cornell-dynamic", 320, 240, [], FEW),
     ("atrium lanterns direct (--max-depth 2)", "atrium-lanterns", 320, 180,
      ["--force-diffuse", "--max-depth", "2"], SAMPLERS),
 ]

@@ -106,10 +106,15 @@ GpuScene::GpuScene(Context& ctx, const Scene& scene, const GpuSceneOptions& opti
     if (l.dynamic) lightsAnimated_ = true;
     if (l.type != LightType::Directional) ++treeLights;
   }
-  // With few lights, choosing by power was as good on every scene measured and costs less
+  // Weighing each light from the shaded point pays with a few lights and costs too much with a
+  // dozen; below the tree's threshold, power chose as well as the tree for less
   // (docs/design.md section 6).
-  useLightBvh_ = options_.lightSampler == LightSampler::Bvh ||
-                 (options_.lightSampler == LightSampler::Auto && treeLights > kAutoLightBvhMin);
+  lightChoice_ = options_.lightSampler;
+  if (lightChoice_ == LightSampler::Auto)
+    lightChoice_ = treeLights > kAutoLightBvhMin      ? LightSampler::Bvh
+                   : treeLights <= kAutoExhaustiveMax ? LightSampler::Exhaustive
+                                                      : LightSampler::Power;
+  useLightBvh_ = lightChoice_ == LightSampler::Bvh;
   const Bounds b = scene.bounds;
   if (!b.empty()) {
     sceneRadius_ = std::max(1e-3f, 0.5f * glm::length(b.extent()));
@@ -375,7 +380,8 @@ cl_uint GpuScene::setKernelArgs(cl::Kernel& kernel, cl_uint first) {
 std::string GpuScene::buildOptions() const {
   std::string o = "-DPR_BVH_WIDTH=" + std::to_string(bvhWidth_) + " ";
   if (hasAlpha_) o += "-DPR_HAS_ALPHA=1 ";
-  if (!useLightBvh_) o += "-DPR_LIGHT_SAMPLER_POWER=1 ";
+  if (lightChoice_ == LightSampler::Power) o += "-DPR_LIGHT_SAMPLER_POWER=1 ";
+  if (lightChoice_ == LightSampler::Exhaustive) o += "-DPR_LIGHT_SAMPLER_EXHAUSTIVE=1 ";
   if (!o.empty()) o.pop_back();
   return o;
 }

@@ -115,6 +115,7 @@ class GpuScene {
   std::vector<uint32_t> primLight_;           // per shading triangle, see LightData.prim_light
   LightBvh lightBvh_;
   bool lightBvhBuilt_ = false;
+  LightSampler lightChoice_ = LightSampler::Bvh;  // never Auto
   bool useLightBvh_ = true;
   // Lights in the tree: all but the directional ones and the environment, which are last.
   uint32_t treeLights_ = 0;

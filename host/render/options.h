@@ -9,10 +9,13 @@ namespace pr {
 
 enum class RenderMode { Reuse, Retrace, PathTrace };
 
-// How a shaded point chooses the light it samples: through the light BVH, by power alone, or
-// (auto) the light BVH where the scene has more lights than kAutoLightBvhMin.
-enum class LightSampler { Auto, Bvh, Power };
+// How a shaded point chooses the light it samples: through the light BVH, by weighing every
+// light from the point (exhaustive), by power alone, or (auto) the light BVH where the scene
+// has more lights than kAutoLightBvhMin, exhaustive where it has at most kAutoExhaustiveMax and
+// power between (measured: docs/design.md section 6).
+enum class LightSampler { Auto, Bvh, Exhaustive, Power };
 constexpr int kAutoLightBvhMin = 16;
+constexpr int kAutoExhaustiveMax = 4;
 
 // Children per BVH node for a device (0: auto): CPUs 8 (float8 slab tests), GPUs 4. Measured in
 // docs/ray-benchmark.md (CPU) and docs/design.md section 3 (an H200).

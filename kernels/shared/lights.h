@@ -1,7 +1,8 @@
 // Lights: emissive triangles (world space, rebuilt by the host whenever a dynamic emitter moves)
 // and KHR_lights_punctual lights. A receiving point chooses a light with the light BVH
-// (shared/light_bvh.h), or by power alone with PR_LIGHT_SAMPLER_POWER; light paths, whose
-// origin knows no receiver, choose by power (docs/design.md section 6).
+// (shared/light_bvh.h), by weighing every light from the point with PR_LIGHT_SAMPLER_EXHAUSTIVE,
+// or by power alone with PR_LIGHT_SAMPLER_POWER; light paths, whose origin knows no receiver,
+// choose by power (docs/design.md section 6).
 #pragma once
 
 #include "shared/light_bvh.h"
@@ -326,6 +327,98 @@ PR_INLINE float light_pdf_triangle(float pmf, float3 ref, float3 n_ref, float3 p
   return pmf * bilinear_pdf(u, cw.w00, cw.w10, cw.w01, cw.w11) / omega;
 }
 
+// What a receiver at p with shading normal n (zero: none) can expect from light l were nothing
+// in between, as the luminance of its irradiance. For a triangle, the radiance times the solid
+// angle it subtends times the receiver's cosine: near it (the squared distance to its centroid
+// under twice the sum of two edges' squares), the exact solid angle times the cosine averaged
+// over its corners and centroid; farther, its area projected from the centroid, which is close
+// to the solid angle there and costs a fraction of it. For a point or spot light, the intensity
+// (spot falloff included) times the cosine over the squared distance. Exact for punctual lights and
+// close for triangles. Zero only where l sends p nothing: behind the receiver's normal (every
+// non-delta BSDF only reflects) or in the triangle's plane.
+PR_INLINE float light_receiver_importance(PR_GLOBAL const Light* l, float3 p, float3 n) {
+  const float lum = luminance(make_float3(l->le_r, l->le_g, l->le_b));
+  const int normal = has_normal(n);
+  const float3 v0 = make_float3(l->p0x, l->p0y, l->p0z);
+  if (l->type == PR_LIGHT_TRIANGLE) {
+    const float3 e1 = make_float3(l->e1x, l->e1y, l->e1z), e2 = make_float3(l->e2x, l->e2y, l->e2z);
+    const float3 d = v0 + (e1 + e2) * (1.0f / 3.0f) - p;  // to the centroid
+    const float d2 = dot(d, d);
+    if (!(d2 > 0.0f)) return 0.0f;
+    if (normal) {  // the whole triangle below n (its points are blends of its corners)
+      const float h0 = dot(n, v0 - p);
+      if (!(fmax(h0, fmax(h0 + dot(n, e1), h0 + dot(n, e2))) > 0.0f)) return 0.0f;
+    }
+    float omega = 0.0f, cos_r = 1.0f;
+    if (d2 < 2.0f * (dot(e1, e1) + dot(e2, e2))) {
+      SphericalTriangle st;
+      omega = spherical_triangle(p, v0, e1, e2, &st);
+      if (omega > 0.0f && normal)
+        cos_r = 0.25f * (fmax(dot(n, st.a), 0.0f) + fmax(dot(n, st.b), 0.0f) +
+                         fmax(dot(n, st.c), 0.0f) + fmax(dot(n, d) * rsqrt(d2), 0.0f));
+    }
+    if (!(omega > 0.0f)) {
+      omega = 0.5f * fabs(dot(cross(e1, e2), d)) / (d2 * sqrt(d2));
+      // A corner above n where the centroid is not: a small cosine keeps the light possible.
+      if (normal) {
+        const float c = dot(n, d) * rsqrt(d2);
+        cos_r = c > 0.0f ? c : 0.01f;
+      }
+    }
+    return omega > 0.0f && isfinite_f(omega) ? fmax(lum * omega * cos_r, 0.0f) : 0.0f;
+  }
+  if (l->type != PR_LIGHT_POINT && l->type != PR_LIGHT_SPOT) return 0.0f;
+  const float3 d = v0 - p;
+  const float d2 = dot(d, d);
+  if (!(d2 > 0.0f)) return 0.0f;
+  const float3 wi = d * rsqrt(d2);
+  float importance = lum / d2;
+  if (l->type == PR_LIGHT_SPOT)
+    importance *=
+        spot_attenuation(dot(-wi, make_float3(l->e1x, l->e1y, l->e1z)), l->cos_inner, l->cos_outer);
+  if (normal) importance *= fmax(dot(n, wi), 0.0f);
+  return isfinite_f(importance) ? importance : 0.0f;
+}
+
+// Chooses one of lights[0, count) for the receiver (p, n) in proportion to
+// light_receiver_importance, in one pass (weighted reservoir sampling with u rescaled at each
+// step); *pmf is the probability of the choice. Every light is weighed, so this is for few
+// lights. PR_INVALID_INDEX where none reaches p.
+PR_INLINE u32 light_exhaustive_sample(PR_GLOBAL const Light* lights, u32 count, float3 p, float3 n,
+                                      float u, float* pmf) {
+  u32 chosen = PR_INVALID_INDEX;
+  float sum = 0.0f, chosen_w = 0.0f;
+  for (u32 i = 0u; i < count; ++i) {
+    const float w = light_receiver_importance(lights + i, p, n);
+    if (!(w > 0.0f)) continue;
+    sum += w;
+    const float keep = w / sum;
+    if (u < keep) {
+      chosen = i;
+      chosen_w = w;
+      u = fmin(u / keep, PR_ONE_MINUS_EPSILON);
+    } else {
+      u = fmin((u - keep) / (1.0f - keep), PR_ONE_MINUS_EPSILON);
+    }
+  }
+  *pmf = chosen != PR_INVALID_INDEX && sum > 0.0f && isfinite_f(sum) ? chosen_w / sum : 0.0f;
+  return *pmf > 0.0f ? chosen : PR_INVALID_INDEX;
+}
+
+// The probability that light_exhaustive_sample chooses `light` for the receiver (p, n).
+PR_INLINE float light_exhaustive_pmf(PR_GLOBAL const Light* lights, u32 count, u32 light, float3 p,
+                                     float3 n) {
+  if (light >= count) return 0.0f;
+  float sum = 0.0f, w = 0.0f;
+  for (u32 i = 0u; i < count; ++i) {
+    const float wi = light_receiver_importance(lights + i, p, n);
+    if (!(wi > 0.0f)) continue;
+    sum += wi;
+    if (i == light) w = wi;
+  }
+  return sum > 0.0f && isfinite_f(sum) ? w / sum : 0.0f;
+}
+
 // The light table as kernels see it (built from PR_LIGHT_PARAMS).
 typedef struct {
   PR_GLOBAL const Light* lights;
@@ -351,8 +444,12 @@ PR_INLINE u32 light_choose(const LightData* d, float3 p, float3 n, float u, floa
   const float share = d->tree_count > 0u ? d->cdf[d->tree_count - 1u] / d->total_power : 0.0f;
   if (u < share) {
     float tree_pmf;
-    const u32 j =
-        light_bvh_sample(d->nodes, p, n, fmin(u / share, PR_ONE_MINUS_EPSILON), &tree_pmf);
+    const float ut = fmin(u / share, PR_ONE_MINUS_EPSILON);
+#ifdef PR_LIGHT_SAMPLER_EXHAUSTIVE
+    const u32 j = light_exhaustive_sample(d->lights, d->tree_count, p, n, ut, &tree_pmf);
+#else
+    const u32 j = light_bvh_sample(d->nodes, p, n, ut, &tree_pmf);
+#endif
     *pmf = share * tree_pmf;
     return j;
   }
@@ -372,9 +469,14 @@ PR_INLINE u32 light_choose(const LightData* d, float3 p, float3 n, float u, floa
 PR_INLINE float light_choice_pmf(const LightData* d, u32 light, float3 p, float3 n) {
   if (light >= d->count || !(d->total_power > 0.0f)) return 0.0f;
 #ifndef PR_LIGHT_SAMPLER_POWER
-  if (light < d->tree_count)
-    return d->cdf[d->tree_count - 1u] / d->total_power *
-           light_bvh_pmf(d->nodes, d->lights[light].leaf, p, n);
+  if (light < d->tree_count) {
+    const float share = d->cdf[d->tree_count - 1u] / d->total_power;
+#ifdef PR_LIGHT_SAMPLER_EXHAUSTIVE
+    return share * light_exhaustive_pmf(d->lights, d->tree_count, light, p, n);
+#else
+    return share * light_bvh_pmf(d->nodes, d->lights[light].leaf, p, n);
+#endif
+  }
 #else
   (void)p;
   (void)n;
