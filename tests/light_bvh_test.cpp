@@ -388,6 +388,47 @@ TEST(LightExhaustive, ImportanceIsTheIrradiance) {
   EXPECT_GT(triangles, 50);
 }
 
+// The resampled choice through the tree: for every light that can reach the point, the mean of
+// 1{chosen = l} / weight over many draws is 1 (what makes next-event estimation with it
+// unbiased), and the tree pmf it reports for MIS is light_bvh_pmf's.
+TEST(LightBvh, ResampledChoiceIsUnbiasedForEveryLight) {
+  std::vector<dev::Light> lights = randomLights(19u, 60);
+  LightBvh bvh;
+  bvh.build(&lights, uint32_t(lights.size()));
+  const auto& nodes = bvh.nodes();
+  int mismatches = 0, checked = 0;
+  for (const Receiver& r : randomReceivers(20u, 4)) {
+    std::vector<double> sum(lights.size(), 0.0), sum2(lights.size(), 0.0);
+    dev::Rng rng = dev::rng_make(21u, PR_RNG_TEST, 0u, 0u, 0u);
+    const int n = 400000;
+    for (int s = 0; s < n; ++s) {
+      const float ut = dev::rng_next(&rng), ur = dev::rng_next(&rng);
+      float weight, treePmf;
+      const uint32_t l = dev::light_tree_resample(nodes.data(), lights.data(), r.p, r.n, ut, ur,
+                                                  &weight, &treePmf);
+      if (l == PR_INVALID_INDEX) continue;
+      ASSERT_GT(weight, 0.0f);
+      const double v = 1.0 / weight;
+      sum[l] += v;
+      sum2[l] += v * v;
+      const float expect = dev::light_bvh_pmf(nodes.data(), lights[l].leaf, r.p, r.n);
+      if (!(std::fabs(treePmf - expect) <= 1e-4f * expect)) ++mismatches;
+    }
+    for (size_t i = 0; i < lights.size(); ++i) {
+      if (!(dev::light_receiver_importance(&lights[i], r.p, r.n) > 0.0f) ||
+          !(dev::light_bvh_pmf(nodes.data(), lights[i].leaf, r.p, r.n) > 0.0f))
+        continue;
+      const double mean = sum[i] / n, var = std::max(0.0, sum2[i] / n - mean * mean);
+      // Five standard errors; lights chosen too rarely to judge are left out.
+      if (sum[i] == 0.0 || var / n > 0.04) continue;
+      ++checked;
+      EXPECT_NEAR(mean, 1.0, 5.0 * std::sqrt(var / n) + 1e-3) << "light " << i;
+    }
+  }
+  EXPECT_GT(checked, 60);
+  EXPECT_EQ(mismatches, 0) << "the tree pmf light_tree_resample reports is not light_bvh_pmf's";
+}
+
 TEST(LightBvh, NoLightsGiveOneLeafThatIsNeverChosen) {
   std::vector<dev::Light> lights;
   LightBvh bvh;

@@ -42,10 +42,13 @@ done
 run "cornell-orbit-reuse" scenes/cornell-orbit.gltf --frames 0-1 --mode reuse
 # A skinned and a morphing mesh: deformed, BVH rebuilt and shading vertices uploaded per frame.
 run "cornell-skinned-reuse" scenes/cornell-skinned.gltf --frames 0-2 --mode reuse
-# The light BVH's kernels (the demo scenes have too few lights for --light-sampler auto to take
-# it), on the many-lights atrium too: a deep tree, point and spot lights, a moving emitter.
+# The light BVH's kernels and the choice by power (on the demo scenes --light-sampler auto
+# weighs every light), the tree on the many-lights atrium too: a deep tree, point and spot
+# lights, a moving emitter.
 run "cornell-dynamic-pathtrace-lightbvh" scenes/cornell-dynamic.gltf --frames 0-1 --mode pathtrace \
   --light-sampler bvh
+run "cornell-dynamic-pathtrace-power" scenes/cornell-dynamic.gltf --frames 0-1 --mode pathtrace \
+  --light-sampler power
 # Resampled connections (two shadow rays per eye vertex).
 run "cornell-dynamic-reuse-ris" scenes/cornell-dynamic.gltf --frames 0-1 --mode reuse --connections 2
 # The other BVH layouts (8 is what a CPU gets by default): 4, a GPU's, and 2.

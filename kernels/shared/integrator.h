@@ -179,11 +179,11 @@ PR_INLINE float environment_pdf(const SceneData* s, float3 ref, float3 n_ref, fl
 
 PR_INLINE int next_event(const SceneData* s, const SurfaceHit* h, const ShadingFrame* f, float3 wo,
                          int use_mis, Rng* rng, Ray* shadow, float3* contribution) {
-  const float us = rng_next(rng);
+  const float2 us = rng_next2(rng);  // the light; the tree's resampling
   const float2 ul = rng_next2(rng);
   const float u1 = ul.x, u2 = ul.y;
-  float pmf;
-  const u32 idx = light_choose(&s->lights, h->p, f->n, us, &pmf);
+  float pmf, mis_pmf;
+  const u32 idx = light_choose(&s->lights, h->p, f->n, us.x, us.y, &pmf, &mis_pmf);
   if (idx == PR_INVALID_INDEX || !(pmf > 0.0f)) return 0;
   const Light l = s->lights.lights[idx];
   LightSample ls;
@@ -207,7 +207,9 @@ PR_INLINE int next_event(const SceneData* s, const SurfaceHit* h, const ShadingF
   const float3 wol = to_local(wo, f->t, f->b, f->n), wil = to_local(ls.wi, f->t, f->b, f->n);
   const float3 fr = bsdf_eval(&f->bsdf, wol, wil, &bsdf_pdf);
   const float cos_i = fabs(wil.z);
-  const float w = (ls.delta || !use_mis) ? 1.0f : power_heuristic(ls.pdf, bsdf_pdf);
+  // MIS from the pmf that BSDF-sampled emitter hits see (light_choice_pmf).
+  const float w =
+      (ls.delta || !use_mis) ? 1.0f : power_heuristic(ls.pdf * (mis_pmf / pmf), bsdf_pdf);
   *contribution = fr * le * (cos_i * w / ls.pdf);
   if (max3(*contribution) <= 0.0f) return 0;
   if (l.type == PR_LIGHT_TRIANGLE) {

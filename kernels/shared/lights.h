@@ -419,6 +419,50 @@ PR_INLINE float light_exhaustive_pmf(PR_GLOBAL const Light* lights, u32 count, u
   return sum > 0.0f && isfinite_f(sum) ? w / sum : 0.0f;
 }
 
+// Tree candidates per choice: the light BVH's bounds are loose where a point is among many
+// lights, so PR_LIGHT_CANDIDATES lights are drawn through it (stratified in u) and one is kept in
+// proportion to light_receiver_importance over its tree pmf (resampled importance sampling,
+// Talbot 2005). Measured on the many-lights atrium: docs/design.md section 6.
+#ifndef PR_LIGHT_CANDIDATES
+#define PR_LIGHT_CANDIDATES 2u
+#endif
+
+// The resampled choice through the tree: ut draws the candidates, ur keeps one (one uniform,
+// rescaled at each step). Returns the light and, in *weight, the inverse of its contribution
+// weight: an estimate over which 1 / *weight is unbiased for the light's share (*weight is
+// not a pmf, but 1{chosen = l} / *weight has expectation 1 for every light l that can reach
+// p). *tree_pmf is the tree's own pmf of the chosen light, for MIS weights.
+PR_INLINE u32 light_tree_resample(PR_GLOBAL const LightNode* nodes, PR_GLOBAL const Light* lights,
+                                  float3 p, float3 n, float ut, float ur, float* weight,
+                                  float* tree_pmf) {
+  u32 chosen = PR_INVALID_INDEX;
+  float w_sum = 0.0f, chosen_importance = 0.0f, chosen_pmf = 0.0f;
+  for (u32 m = 0u; m < PR_LIGHT_CANDIDATES; ++m) {
+    float pm;
+    const float um =
+        fmin(((float)m + ut) * (1.0f / (float)PR_LIGHT_CANDIDATES), PR_ONE_MINUS_EPSILON);
+    const u32 c = light_bvh_sample(nodes, p, n, um, &pm);
+    if (c == PR_INVALID_INDEX || !(pm > 0.0f)) continue;
+    const float importance = light_receiver_importance(lights + c, p, n);
+    if (!(importance > 0.0f)) continue;
+    const float w = importance / pm;
+    w_sum += w;
+    const float keep = w / w_sum;
+    if (ur < keep) {
+      chosen = c;
+      chosen_importance = importance;
+      chosen_pmf = pm;
+      ur = fmin(ur / keep, PR_ONE_MINUS_EPSILON);
+    } else {
+      ur = fmin((ur - keep) / (1.0f - keep), PR_ONE_MINUS_EPSILON);
+    }
+  }
+  const int ok = chosen != PR_INVALID_INDEX && w_sum > 0.0f && isfinite_f(w_sum);
+  *weight = ok ? chosen_importance * (float)PR_LIGHT_CANDIDATES / w_sum : 0.0f;
+  *tree_pmf = ok ? chosen_pmf : 0.0f;
+  return ok && *weight > 0.0f ? chosen : PR_INVALID_INDEX;
+}
+
 // The light table as kernels see it (built from PR_LIGHT_PARAMS).
 typedef struct {
   PR_GLOBAL const Light* lights;
@@ -434,23 +478,32 @@ typedef struct {
   u32 env_light;  // the environment's index, or PR_INVALID_INDEX
 } LightData;
 
-// Chooses a light for the receiver at p with shading normal n (zero: none) with u; *pmf is the
-// probability of the choice. A directional light is chosen by its share of the power, the
-// tree as a whole by the share of the others. PR_INVALID_INDEX where no light can reach p.
-PR_INLINE u32 light_choose(const LightData* d, float3 p, float3 n, float u, float* pmf) {
+// Chooses a light for the receiver at p with shading normal n (zero: none) with u (and ur, for
+// the tree's resampling). *pmf divides the light's contribution: the probability of the choice,
+// or through the tree the inverse contribution weight of its resampling. *mis_pmf is what
+// light_choice_pmf gives the light, for MIS weights against BSDF sampling (any pmf that both
+// sides use keeps the weights adding to 1). A directional light is chosen by its share of the
+// power, the tree (or the exhaustive choice) as a whole by the share of the others.
+// PR_INVALID_INDEX where no light can reach p.
+PR_INLINE u32 light_choose(const LightData* d, float3 p, float3 n, float u, float ur, float* pmf,
+                           float* mis_pmf) {
   *pmf = 0.0f;
+  *mis_pmf = 0.0f;
   if (d->count == 0u || !(d->total_power > 0.0f)) return PR_INVALID_INDEX;
 #ifndef PR_LIGHT_SAMPLER_POWER
   const float share = d->tree_count > 0u ? d->cdf[d->tree_count - 1u] / d->total_power : 0.0f;
   if (u < share) {
-    float tree_pmf;
     const float ut = fmin(u / share, PR_ONE_MINUS_EPSILON);
+    float choice, tree_pmf;
 #ifdef PR_LIGHT_SAMPLER_EXHAUSTIVE
-    const u32 j = light_exhaustive_sample(d->lights, d->tree_count, p, n, ut, &tree_pmf);
+    (void)ur;
+    const u32 j = light_exhaustive_sample(d->lights, d->tree_count, p, n, ut, &choice);
+    tree_pmf = choice;
 #else
-    const u32 j = light_bvh_sample(d->nodes, p, n, ut, &tree_pmf);
+    const u32 j = light_tree_resample(d->nodes, d->lights, p, n, ut, ur, &choice, &tree_pmf);
 #endif
-    *pmf = share * tree_pmf;
+    *pmf = share * choice;
+    *mis_pmf = share * tree_pmf;
     return j;
   }
   // A directional light (the rounding of u * total at the boundary aside).
@@ -459,9 +512,10 @@ PR_INLINE u32 light_choose(const LightData* d, float3 p, float3 n, float u, floa
 #else
   (void)p;
   (void)n;
+  (void)ur;
   const u32 i = light_select(d->cdf, d->count, u);
 #endif
-  *pmf = d->lights[i].power / d->total_power;
+  *pmf = *mis_pmf = d->lights[i].power / d->total_power;
   return i;
 }
 
