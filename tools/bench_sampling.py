@@ -93,7 +93,10 @@ def render_cycles(scene, w, h, spp, seed, opts, out_exr):
     cmd = ["blender", "-b", "--factory-startup", "--python", str(REPO / "tools" / "cycles_peer.py"),
            "--", str(scene), str(out_exr), "--width", str(w), "--height", str(h), "--spp", str(spp),
            "--max-depth", str(depth), "--seed", str(seed)]
-    run = subprocess.run(cmd, capture_output=True, text=True)
+    # Debian's Blender takes its Python home from the first python3 on PATH: put Debian's first,
+    # so that a pyenv or virtualenv interpreter running this tool leaves Blender its numpy.
+    env = dict(os.environ, PATH="/usr/bin:" + os.environ.get("PATH", ""))
+    run = subprocess.run(cmd, capture_output=True, text=True, env=env)
     lines = [l for l in run.stdout.splitlines() if l.startswith('{"render_s"')]
     if run.returncode or not lines or not Path(out_exr).is_file():
         raise RenderFailed((run.stderr.strip().splitlines() or ["blender failed"])[-1])
