@@ -89,6 +89,25 @@ std::vector<Receiver> randomReceivers(uint32_t seed, int count) {
   return r;
 }
 
+// Whether the point of light l at barycentrics (b1, b2) (triangles; punctual lights: the light)
+// sends r anything, with margin eps on each cosine. Only light above the receiver's normal
+// counts (every non-delta BSDF reflects).
+bool reachesFrom(const dev::Light& l, const Receiver& r, float b1, float b2, float eps) {
+  float3 q = make_float3(l.p0x, l.p0y, l.p0z);
+  if (l.type == PR_LIGHT_TRIANGLE)
+    q = q + make_float3(l.e1x, l.e1y, l.e1z) * b1 + make_float3(l.e2x, l.e2y, l.e2z) * b2;
+  const float3 wi = dev::normalize(q - r.p);
+  if ((r.n.x != 0 || r.n.y != 0 || r.n.z != 0) && !(dev::dot(wi, r.n) > eps)) return false;
+  if (l.type == PR_LIGHT_SPOT)
+    return -dev::dot(wi, make_float3(l.e1x, l.e1y, l.e1z)) > l.cos_outer + eps;
+  if (l.type == PR_LIGHT_TRIANGLE) {
+    const float3 nl = dev::normalize(
+        dev::cross(make_float3(l.e1x, l.e1y, l.e1z), make_float3(l.e2x, l.e2y, l.e2z)));
+    return std::fabs(dev::dot(wi, nl)) > eps;
+  }
+  return true;
+}
+
 // Chi-square tail probability of n choices from (p, normal) against light_bvh_pmf.
 double choicePValue(const LightBvh& bvh, const std::vector<dev::Light>& lights, const Receiver& r,
                     int n, uint32_t seed, int* mismatches) {
@@ -134,20 +153,8 @@ TEST(LightBvh, PmfsAddToOneAndNoReachableLightIsImpossible) {
       const float pmf = dev::light_bvh_pmf(nodes.data(), l.leaf, r.p, r.n);
       ASSERT_GE(pmf, 0.0f);
       sum += pmf;
-      // Can this light send anything to r? Its centre (and a vertex), seen from r.
-      const float3 c = make_float3(l.p0x, l.p0y, l.p0z);
-      const float3 d = c - r.p;
-      const float3 wi = dev::normalize(d);
-      bool reaches = true;
-      // Only light above the receiver's normal counts (every non-delta BSDF reflects).
-      if (r.n.x != 0 || r.n.y != 0 || r.n.z != 0) reaches = dev::dot(wi, r.n) > 1e-3f;
-      if (l.type == PR_LIGHT_SPOT)
-        reaches = reaches && -dev::dot(wi, make_float3(l.e1x, l.e1y, l.e1z)) > l.cos_outer + 1e-3f;
-      if (l.type == PR_LIGHT_TRIANGLE) {
-        const float3 nl = dev::normalize(
-            dev::cross(make_float3(l.e1x, l.e1y, l.e1z), make_float3(l.e2x, l.e2y, l.e2z)));
-        reaches = reaches && std::fabs(dev::dot(wi, nl)) > 1e-3f;
-      }
+      // Can this light send anything to r? Its vertex 0 (a punctual light's position).
+      const bool reaches = reachesFrom(l, r, 0.0f, 0.0f, 1e-3f);
       anyReaches = anyReaches || reaches;
       if (reaches) {
         EXPECT_GT(pmf, 0.0f) << "a light that reaches the point is never chosen";
@@ -293,23 +300,6 @@ TEST(LightExhaustive, ChoicesFollowTheReportedPmf) {
   EXPECT_EQ(mismatches, 0) << "the pmf light_exhaustive_sample returns is not the one it reports";
 }
 
-// A point on light l (barycentrics b1, b2 for triangles), and whether it sends r anything.
-bool reachesFrom(const dev::Light& l, const Receiver& r, float b1, float b2) {
-  float3 q = make_float3(l.p0x, l.p0y, l.p0z);
-  if (l.type == PR_LIGHT_TRIANGLE)
-    q = q + make_float3(l.e1x, l.e1y, l.e1z) * b1 + make_float3(l.e2x, l.e2y, l.e2z) * b2;
-  const float3 wi = dev::normalize(q - r.p);
-  if ((r.n.x != 0 || r.n.y != 0 || r.n.z != 0) && !(dev::dot(wi, r.n) > 1e-4f)) return false;
-  if (l.type == PR_LIGHT_SPOT)
-    return -dev::dot(wi, make_float3(l.e1x, l.e1y, l.e1z)) > l.cos_outer + 1e-4f;
-  if (l.type == PR_LIGHT_TRIANGLE) {
-    const float3 nl = dev::normalize(
-        dev::cross(make_float3(l.e1x, l.e1y, l.e1z), make_float3(l.e2x, l.e2y, l.e2z)));
-    return std::fabs(dev::dot(wi, nl)) > 1e-4f;
-  }
-  return true;
-}
-
 TEST(LightExhaustive, PmfsAddToOneAndNoReachableLightIsImpossible) {
   const std::vector<dev::Light> lights = randomLights(13u, 12);
   const uint32_t count = uint32_t(lights.size());
@@ -327,7 +317,7 @@ TEST(LightExhaustive, PmfsAddToOneAndNoReachableLightIsImpossible) {
       for (int k = 0; k < 16 && !reaches; ++k) {
         float b1 = u(g), b2 = u(g);
         if (b1 + b2 > 1.0f) b1 = 1.0f - b1, b2 = 1.0f - b2;
-        reaches = reachesFrom(lights[i], r, b1, b2);
+        reaches = reachesFrom(lights[i], r, b1, b2, 1e-4f);
       }
       anyReaches = anyReaches || reaches;
       if (reaches) {

@@ -114,7 +114,6 @@ GpuScene::GpuScene(Context& ctx, const Scene& scene, const GpuSceneOptions& opti
     lightChoice_ = treeLights > kAutoLightBvhMin      ? LightSampler::Bvh
                    : treeLights <= kAutoExhaustiveMax ? LightSampler::Exhaustive
                                                       : LightSampler::Power;
-  useLightBvh_ = lightChoice_ == LightSampler::Bvh;
   const Bounds b = scene.bounds;
   if (!b.empty()) {
     sceneRadius_ = std::max(1e-3f, 0.5f * glm::length(b.extent()));
@@ -332,14 +331,15 @@ void GpuScene::buildLights(double t) {
     while (treeLights_ < lights_.size() && lights_[treeLights_].type != PR_LIGHT_DIRECTIONAL &&
            lights_[treeLights_].type != PR_LIGHT_ENV)
       ++treeLights_;
-    lightBvh_.build(&lights_, useLightBvh_ ? treeLights_ : 0u);
+    lightBvh_.build(&lights_, lightChoice_ == LightSampler::Bvh ? treeLights_ : 0u);
     lightBvhBuilt_ = true;
     lightNodeBytes_ = lightBvh_.nodes().size() * sizeof(dev::LightNode);
     lightNodeBuffer_ = ctx_.allocate("light BVH", lightNodeBytes_, CL_MEM_READ_ONLY);
     CL_CHECK(ctx_.queue().enqueueWriteBuffer(lightNodeBuffer_, CL_TRUE, 0, lightNodeBytes_,
                                              lightBvh_.nodes().data()));
-  } else if (useLightBvh_ && std::any_of(lights_.begin(), lights_.end(),
-                                         [](const dev::Light& l) { return l.moved != 0u; })) {
+  } else if (lightChoice_ == LightSampler::Bvh &&
+             std::any_of(lights_.begin(), lights_.end(),
+                         [](const dev::Light& l) { return l.moved != 0u; })) {
     lightBvh_.refit(&lights_);
     CL_CHECK(ctx_.queue().enqueueWriteBuffer(lightNodeBuffer_, CL_TRUE, 0, lightNodeBytes_,
                                              lightBvh_.nodes().data()));

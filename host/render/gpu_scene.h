@@ -116,7 +116,6 @@ class GpuScene {
   LightBvh lightBvh_;
   bool lightBvhBuilt_ = false;
   LightSampler lightChoice_ = LightSampler::Bvh;  // never Auto
-  bool useLightBvh_ = true;
   // Lights in the tree: all but the directional ones and the environment, which are last.
   uint32_t treeLights_ = 0;
   std::vector<dev::Light> lights_;

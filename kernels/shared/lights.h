@@ -380,9 +380,23 @@ PR_INLINE float light_receiver_importance(PR_GLOBAL const Light* l, float3 p, fl
   return isfinite_f(importance) ? importance : 0.0f;
 }
 
+// One step of weighted reservoir sampling driven by a single uniform *u: adds w (> 0) to *w_sum
+// and says whether this item replaces the kept one (probability w / *w_sum), rescaling *u so
+// that it stays uniform for the next step.
+PR_INLINE int reservoir_keep(float w, float* w_sum, float* u) {
+  *w_sum += w;
+  const float keep = w / *w_sum;
+  if (*u < keep) {
+    *u = fmin(*u / keep, PR_ONE_MINUS_EPSILON);
+    return 1;
+  }
+  *u = fmin((*u - keep) / (1.0f - keep), PR_ONE_MINUS_EPSILON);
+  return 0;
+}
+
 // Chooses one of lights[0, count) for the receiver (p, n) in proportion to
-// light_receiver_importance, in one pass (weighted reservoir sampling with u rescaled at each
-// step); *pmf is the probability of the choice. Every light is weighed, so this is for few
+// light_receiver_importance, in one pass (reservoir_keep); *pmf is the probability of the
+// choice. Every light is weighed, so this is for few
 // lights. PR_INVALID_INDEX where none reaches p.
 PR_INLINE u32 light_exhaustive_sample(PR_GLOBAL const Light* lights, u32 count, float3 p, float3 n,
                                       float u, float* pmf) {
@@ -390,15 +404,9 @@ PR_INLINE u32 light_exhaustive_sample(PR_GLOBAL const Light* lights, u32 count, 
   float sum = 0.0f, chosen_w = 0.0f;
   for (u32 i = 0u; i < count; ++i) {
     const float w = light_receiver_importance(lights + i, p, n);
-    if (!(w > 0.0f)) continue;
-    sum += w;
-    const float keep = w / sum;
-    if (u < keep) {
+    if (w > 0.0f && reservoir_keep(w, &sum, &u)) {
       chosen = i;
       chosen_w = w;
-      u = fmin(u / keep, PR_ONE_MINUS_EPSILON);
-    } else {
-      u = fmin((u - keep) / (1.0f - keep), PR_ONE_MINUS_EPSILON);
     }
   }
   *pmf = chosen != PR_INVALID_INDEX && sum > 0.0f && isfinite_f(sum) ? chosen_w / sum : 0.0f;
@@ -427,8 +435,8 @@ PR_INLINE float light_exhaustive_pmf(PR_GLOBAL const Light* lights, u32 count, u
 #define PR_LIGHT_CANDIDATES 2u
 #endif
 
-// The resampled choice through the tree: ut draws the candidates, ur keeps one (one uniform,
-// rescaled at each step). Returns the light and, in *weight, the inverse of its contribution
+// The resampled choice through the tree: ut draws the candidates, ur keeps one
+// (reservoir_keep). Returns the light and, in *weight, the inverse of its contribution
 // weight: an estimate over which 1 / *weight is unbiased for the light's share (*weight is
 // not a pmf, but 1{chosen = l} / *weight has expectation 1 for every light l that can reach
 // p). *tree_pmf is the tree's own pmf of the chosen light, for MIS weights.
@@ -445,16 +453,10 @@ PR_INLINE u32 light_tree_resample(PR_GLOBAL const LightNode* nodes, PR_GLOBAL co
     if (c == PR_INVALID_INDEX || !(pm > 0.0f)) continue;
     const float importance = light_receiver_importance(lights + c, p, n);
     if (!(importance > 0.0f)) continue;
-    const float w = importance / pm;
-    w_sum += w;
-    const float keep = w / w_sum;
-    if (ur < keep) {
+    if (reservoir_keep(importance / pm, &w_sum, &ur)) {
       chosen = c;
       chosen_importance = importance;
       chosen_pmf = pm;
-      ur = fmin(ur / keep, PR_ONE_MINUS_EPSILON);
-    } else {
-      ur = fmin((ur - keep) / (1.0f - keep), PR_ONE_MINUS_EPSILON);
     }
   }
   const int ok = chosen != PR_INVALID_INDEX && w_sum > 0.0f && isfinite_f(w_sum);
