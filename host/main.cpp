@@ -136,6 +136,13 @@ int main(int argc, char** argv) {
                    "on CPUs, 2 on GPUs)")
       ->check(CLI::IsMember({"1", "2", "3", "4", "all", "auto"}))
       ->capture_default_str();
+  render
+      ->add_option("--connection-history", ro.connectionHistory,
+                   "Carry each pixel's reservoir of connections at its first eye vertex from "
+                   "one sample pass to the next and across frames (reuse/retrace; generalized "
+                   "RIS), standing for at most this many times C candidates; 0 = off")
+      ->check(CLI::Range(0, 1000))
+      ->capture_default_str();
   render->add_option(
       "--env", ro.env,
       "Environment light: an equirectangular map (.exr or .hdr; +Y up, its centre looking along "

@@ -88,6 +88,15 @@ TEST(Reuse, EqualsRetraceWhenObjectsSweepThroughLightBeams) {
   expectReuseEqualsRetrace(sweepScene(), "0-7", 0, 7, "--fps 8");
 }
 
+// Retrace learns the slots reuse traces again, so that carried reservoirs drop the same vertices
+// and the frames agree over 12 frames.
+TEST(Reuse, EqualsRetraceWithAConnectionHistory) {
+  expectReuseEqualsRetrace(test::sourcePath("scenes/cornell-dynamic.gltf"), "20-31", 20, 31,
+                           "--connections 1 --connection-history 20");
+  expectReuseEqualsRetrace(sweepScene(), "0-7", 0, 7,
+                           "--fps 8 --connections 2 --connection-history 20");
+}
+
 // Resampled connections choose among the same candidates with the same numbers in both modes.
 TEST(Reuse, EqualsRetraceWithResampledConnections) {
   expectReuseEqualsRetrace(test::sourcePath("scenes/cornell-dynamic.gltf"), "20-31", 20, 31,
@@ -167,8 +176,9 @@ TEST(Reuse, CameraMotionAloneInvalidatesNothing) {
   EXPECT_NE(test::frameImage(dir, 0).rgba, test::frameImage(dir, 5).rgba);
 }
 
+// The furnace's frame `frame` (all frames alike; a connection history carries over frames 0 to it).
 void expectFurnace(int spp, int depth, int lightPaths, const std::string& extra,
-                   const std::string& name) {
+                   const std::string& name, int frame = 0) {
   const float albedo = 0.5f, le = 1.0f;
   test::GltfBuilder b;
   const int mat = b.addMaterial({glm::vec4(albedo, albedo, albedo, 1), 0, 1, glm::vec3(le), 1.0f});
@@ -176,12 +186,12 @@ void expectFurnace(int spp, int depth, int lightPaths, const std::string& extra,
   b.addCamera(glm::vec3(0.1f, 0.2f, 0.3f), glm::vec3(1, 0.5f, -1), 1.2f, 1.0f);
   const std::string scene = b.write(test::tempDir("furnace"), "furnace");
   const std::string dir =
-      test::renderFrames(scene, "0",
+      test::renderFrames(scene, "0-" + std::to_string(frame),
                          "--width 32 --height 32 --spp " + std::to_string(spp) + " --max-depth " +
                              std::to_string(depth) + " --light-paths " +
                              std::to_string(lightPaths) + " --force-diffuse " + extra,
                          name);
-  const Image img = test::frameImage(dir, 0);
+  const Image img = test::frameImage(dir, frame);
   const double expected = le / (1.0 - albedo);
   for (int c = 0; c < 3; ++c) {
     const Moments m = regionMean(img, 0, 0, 32, 32, c);
@@ -208,21 +218,29 @@ TEST(Reuse, WhiteFurnaceConvergesWithOneResampledConnection) {
   expectFurnace(64, 40, 65536, "--connections 1", "furnace-ris");
 }
 
+// The connection history's merged weights (generalized RIS over this frame's candidates and the
+// reservoir carried from the frames before) must be exact too: a carried weight 10% off fails.
+TEST(Reuse, WhiteFurnaceConvergesWithAConnectionHistory) {
+  expectFurnace(64, 40, 65536, "--connections 1 --connection-history 20", "furnace-history", 4);
+}
+
 // Reuse and the path tracer estimate the same image: 4x4 region means agree within their
 // statistical error. Light paths are not shared between pixel samples here (one slot per
 // connection), so pixels are independent and per-pixel spread gives the error.
+// At frame `frame`, reuse rendering frames 0 to it (a connection history's warm-up).
 void expectSameImage(const std::string& scene, const std::string& args, int w, int h, int spp,
-                     int c) {
+                     int c, int frame = 0) {
   const std::string size = "--width " + std::to_string(w) + " --height " + std::to_string(h) +
                            " --spp " + std::to_string(spp) + " " + args;
+  const std::string f = std::to_string(frame);
   const std::string a =
-      test::renderFrames(scene, "0",
+      test::renderFrames(scene, "0-" + f,
                          size + " --mode reuse --paths-per-pixel " + std::to_string(c) +
                              " --light-paths " + std::to_string(w * h * spp * c),
                          "conv-reuse");
   const std::string b =
-      test::renderFrames(scene, "0", size + " --mode pathtrace --seed 77", "conv-pt");
-  const Image ia = test::frameImage(a, 0), ib = test::frameImage(b, 0);
+      test::renderFrames(scene, f, size + " --mode pathtrace --seed 77", "conv-pt");
+  const Image ia = test::frameImage(a, frame), ib = test::frameImage(b, frame);
   int worstRegion = -1;
   double worst = 0;
   for (int ry = 0; ry < 4; ++ry)
@@ -261,6 +279,62 @@ TEST(Reuse, ResampledConnectionsConvergeOnGlossyAndDeltaMaterials) {
 // Resampled connections trace one shadow ray per eye vertex (the first hit, and each vertex a
 // delta chain leads to, each found by a bounce ray), whatever the candidates; tracing them all
 // costs one ray per candidate. Both count the same candidates.
+// The connection history (reservoirs carried over frames, generalized RIS) estimates the same
+// image: on a still scene, and where moving objects disturb many light paths, so that carried
+// vertices are dropped, with glossy and delta materials, area and point lights and an emitter
+// among the light vertices.
+TEST(Reuse, AConnectionHistoryConvergesToThePathTracer) {
+  expectSameImage(test::sourcePath("scenes/cornell-dynamic.gltf"),
+                  "--force-diffuse --max-depth 6 --connections 1 --connection-history 20", 48, 36,
+                  32, 2, 3);
+}
+
+TEST(Reuse, AConnectionHistoryConvergesWhereMovingObjectsDisturbThePaths) {
+  expectSameImage(sweepScene(), "--fps 4 --max-depth 6 --connections 1 --connection-history 20", 48,
+                  36, 32, 2, 3);
+}
+
+// Sums of a counter over a render's frames from `first` on.
+double counterSum(const std::string& dir, const char* group, const char* key, int first) {
+  double sum = 0;
+  for (const auto& line : test::statsLines(dir)) {
+    const auto j = nlohmann::json::parse(line);
+    if (j["frame"].get<int>() >= first) sum += j[group][key].get<double>();
+  }
+  return sum;
+}
+
+// A carried vertex whose slot was traced again is dropped; where nothing moves none is, and the
+// history is chosen again often. Each pixel sample traces one connection ray at its first eye
+// vertex, whatever its candidates.
+TEST(Reuse, AConnectionHistoryDropsTheVerticesOfRetracedSlots) {
+  const std::string args =
+      "--mode reuse --width 48 --height 36 --spp 2 --connections 1 --connection-history 20";
+  const std::string moving = test::renderFrames(sweepScene(), "0-5", args + " --fps 4", "hist-mv");
+  EXPECT_EQ(counterSum(moving, "counters", "history_kept", 0),
+            counterSum(moving, "counters", "history_kept", 1))
+      << "frame 0 has no history";
+  EXPECT_GT(counterSum(moving, "counters", "history_kept", 1), 0.0);
+  const double dropped = counterSum(moving, "counters", "history_dropped", 1);
+  EXPECT_GT(dropped, 0.0) << "the moving objects re-trace slots that histories keep";
+  // The furnace-like still scene: the camera alone moves, no slot is traced again.
+  test::GltfBuilder b;
+  const int white = b.addMaterial({glm::vec4(0.8f, 0.8f, 0.8f, 1), 0, 1});
+  const int lamp = b.addMaterial({glm::vec4(0, 0, 0, 1), 0, 1, glm::vec3(1.0f), 10.0f});
+  b.addNode(b.addQuad({-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, white));
+  b.addNode(b.addQuad({-2, 0, -1}, {2, 0, -1}, {2, 2, -1}, {-2, 2, -1}, white));  // back wall
+  b.addNode(b.addQuad({-0.3f, 1.8f, -0.3f}, {0.3f, 1.8f, -0.3f}, {0.3f, 1.8f, 0.3f},
+                      {-0.3f, 1.8f, 0.3f}, lamp));
+  const int cam = b.addCamera(glm::vec3(0, 1.5f, 1.8f), glm::vec3(0, 0.5f, 0), 1.0f, 1.0f);
+  b.animateTranslation(cam, {0.0f, 1.0f}, {{-0.5f, 1.5f, 1.8f}, {0.5f, 1.4f, 1.7f}});
+  const std::string still = test::renderFrames(b.write(test::tempDir("hist-still"), "still"), "0-4",
+                                               args + " --fps 4", "hist-still");
+  EXPECT_EQ(counterSum(still, "counters", "history_dropped", 0), 0.0);
+  EXPECT_GT(counterSum(still, "counters", "history_kept", 1),
+            0.25 * counterSum(still, "rays", "camera", 1));
+  EXPECT_LE(counterSum(still, "rays", "connection", 0), counterSum(still, "rays", "camera", 0));
+}
+
 TEST(Reuse, ResampledConnectionsTraceOneRayPerEyeVertex) {
   const std::string scene = test::sourcePath("scenes/cornell-dynamic.gltf");
   auto stats = [&](const std::string& mode) {

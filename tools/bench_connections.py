@@ -1,16 +1,18 @@
 #!/usr/bin/env python3
 """Connection strategies against the path tracer: relMSE and relMSE x kernel seconds of one
 frame against a path-traced reference, for `reuse` with every connection traced
-(`--connections all`) and with K resampled ones, on the demo scenes and the atrium.
+(`--connections all`) and with K resampled ones, with and without a connection history, on the
+demo scenes and the atrium.
 
   python3 tools/bench_connections.py                   # 160-wide frames, 16 spp, PoCL or the default device
   python3 tools/bench_connections.py --width 640 --device gpu   # a GPU wants larger frames
+  python3 tools/bench_connections.py --frames 12     # frame 11 of 0-11: histories warmed up
 
-Each scene's reference is pathtrace at --ref-spp (seed 999); each configuration renders frame 0
-with --seeds seeds, interleaved, and the table gives medians over the seeds: relMSE (eps 0.01,
-as exr_compare), kernel seconds (the sum of the frame's stages), their product (lower is
-better: the error reached per unit of time), and shadow rays per camera sample (connection and
-next-event). --baseline-kernels DIR adds the reuse rows rendered with another kernels/ folder
+Each scene's reference is pathtrace at --ref-spp (seed 999); each configuration renders frames 0 to
+--frames - 1 and is measured on the last, with --seeds seeds, interleaved; the table gives
+medians over the seeds: relMSE (eps 0.01, as exr_compare), kernel seconds (the sum of the
+frame's stages), their product (lower is better: the error reached per unit of time), and
+shadow rays per camera sample (connection and next-event). --baseline-kernels DIR adds the reuse rows rendered with another kernels/ folder
 (PATHREUSE_KERNEL_DIR; e.g. `git archive` of an older commit), side by side in the same run.
 Standard library only, so that a GPU machine's Python runs it too.
 """
@@ -31,6 +33,11 @@ CONFIGS = [("pathtrace", ["--mode", "pathtrace"]),
            ("reuse all", ["--mode", "reuse", "--connections", "all"]),
            ("reuse K=1", ["--mode", "reuse", "--connections", "1"]),
            ("reuse K=2", ["--mode", "reuse", "--connections", "2"])]
+# The connection history (reservoirs carried over frames; measure it with --frames 8 or more),
+# and the candidates it stands for drawn in one frame instead.
+CONFIGS += [("reuse K=1 H20", ["--mode", "reuse", "--connections", "1", "--connection-history", "20"]),
+            ("reuse all H20", ["--mode", "reuse", "--connections", "all", "--connection-history", "20"]),
+            ("reuse K=1 C16", ["--mode", "reuse", "--connections", "1", "--paths-per-pixel", "16"])]
 ASPECT = {"cornell-dynamic": 0.75, "cornell-skinned": 0.75, "atrium": 0.5625}
 
 
@@ -43,6 +50,8 @@ def main():
     ap.add_argument("--spp", type=int, default=16)
     ap.add_argument("--ref-spp", type=int, default=1024)
     ap.add_argument("--seeds", type=int, default=3)
+    ap.add_argument("--frames", type=int, default=1,
+                    help="render frames 0 to N-1 and measure the last (a connection history's warm-up)")
     ap.add_argument("--device", help="--device of every render (default: the renderer's)")
     ap.add_argument("--baseline-kernels", help="another kernels/ folder for the reuse rows")
     ap.add_argument("--configs", help="comma-separated labels of the rows to run (default: all)")
@@ -57,15 +66,17 @@ def main():
     device = ["--device", a.device] if a.device else []
     work = Path(tempfile.mkdtemp(prefix="pathreuse-connections-"))
 
-    def render(scene, w, h, spp, seed, opts, tag, kernels=None):
+    last = a.frames - 1
+
+    def render(scene, w, h, spp, seed, opts, tag, kernels=None, first=0):
         out = work / f"{tag}_%04d.exr"
         stats = work / f"{tag}.jsonl"
-        subprocess.run([str(exe), "render", str(scene), "--frames", "0", "--width", str(w), "--height",
+        subprocess.run([str(exe), "render", str(scene), "--frames", f"{first}-{last}", "--width", str(w), "--height",
                         str(h), "--spp", str(spp), "--seed", str(seed), "--quiet", "--exr-float", "--out",
                         str(out), "--stats", str(stats)] + device + opts, check=True,
                        env=dict(os.environ, PATHREUSE_KERNEL_DIR=kernels) if kernels else None)
         rec = json.loads(stats.read_text().splitlines()[-1])
-        return work / f"{tag}_0000.exr", rec
+        return work / f"{tag}_{last:04d}.exr", rec
 
     print("# Connection strategies against the path tracer\n")
     print("\n".join(benchlib.machine_lines(exe)))
@@ -74,7 +85,8 @@ def main():
         scene = benchlib.ensure_atrium(a.atrium) if name == "atrium" else benchlib.REPO / "scenes" / f"{name}.gltf"
         w = a.width
         h = max(1, round(w * ASPECT.get(name, 0.75)))
-        ref, _ = render(scene, w, h, a.ref_spp, 999, ["--mode", "pathtrace"], f"{name}_ref")
+        ref, _ = render(scene, w, h, a.ref_spp, 999, ["--mode", "pathtrace"], f"{name}_ref",
+                        first=last)
         rows = {}
         for seed in range(1, a.seeds + 1):
             for label, opts, kernels in configs:
@@ -85,7 +97,7 @@ def main():
                 rays, cam = rec["rays"], max(1, rec["rays"]["camera"])
                 rows.setdefault(label, []).append(
                     (rel, benchlib.kernel_s(rec), rays.get("connection", 0) / cam, rays.get("shadow", 0) / cam))
-        print(f"## {name}, {w}x{h}, {a.spp} spp, frame 0, medians of {a.seeds} seeds; "
+        print(f"## {name}, {w}x{h}, {a.spp} spp, frame {last} (of 0-{last}), medians of {a.seeds} seeds; "
               f"reference: pathtrace {a.ref_spp} spp\n")
         print("| config | relMSE | kernel s | relMSE x s | connection rays / sample | NEE rays / sample |")
         print("|---|---:|---:|---:|---:|---:|")

@@ -67,6 +67,9 @@ def parse_args():
     ap.add_argument("--build", default="build", help="folder holding pathreuse and exr_compare")
     ap.add_argument("--cache", default=None, help="reference cache (default out/evaluate-cache)")
     ap.add_argument("--quiet", action="store_true")
+    ap.add_argument("--reuse-args", default="",
+                    help="extra options of every reuse and retrace render, e.g. "
+                         "\"--connections 1 --connection-history 20\"")
     args = ap.parse_args()
     if args.quick:
         args.width, args.frames, args.atrium_frames = 32, 5, 5

@@ -51,6 +51,11 @@ run "cornell-dynamic-pathtrace-power" scenes/cornell-dynamic.gltf --frames 0-1 -
   --light-sampler power
 # Resampled connections (two shadow rays per eye vertex).
 run "cornell-dynamic-reuse-ris" scenes/cornell-dynamic.gltf --frames 0-1 --mode reuse --connections 2
+# The connection history, carried over frames, in both modes (retrace marks changed slots only).
+for mode in reuse retrace; do
+  run "cornell-dynamic-$mode-history" scenes/cornell-dynamic.gltf --frames 0-2 --mode "$mode" \
+    --connections 1 --connection-history 20
+done
 # The other BVH layouts (8 is what a CPU gets by default): 4, a GPU's, and 2.
 for width in 2 4; do
   run "cornell-dynamic-reuse-bvh$width" scenes/cornell-dynamic.gltf --frames 0-1 --mode reuse \

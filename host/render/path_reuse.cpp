@@ -50,6 +50,12 @@ PathReuse::PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseS
   eye_ = alloc("eye vertices", uint64_t(film.pixels()) * sizeof(dev::EyeVertex));
   radiance_ = alloc("sample radiance", uint64_t(film.pixels()) * 16);
   counters_ = alloc("reuse counters", dev::PR_C_COUNT * 4);
+  // Without a history, one element each: the kernels take them but never read them.
+  const bool history = settings_.historyCap > 0;
+  changed_ = alloc("changed slot stamps", uint64_t(history ? slots_ : 1) * 4);
+  history_ = alloc("connection history", uint64_t(history ? film.pixels() : 1) *
+                                             (history ? settings_.spp : 1) *
+                                             sizeof(dev::ConnectionHistory));
 }
 
 void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameStats* stats) {
@@ -72,17 +78,23 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
   rp.scene_radius = scene_.sceneRadius();
   rp.cx = scene_.sceneCentre().x, rp.cy = scene_.sceneCentre().y, rp.cz = scene_.sceneCentre().z;
 
-  // 1. Which slots must be traced again.
+  // 1. Which slots must be traced again. With a connection history, retrace learns the same
+  // changed slots as reuse (invalidate marks them and leaves the arena alone), so that the
+  // histories, and the frames, agree.
+  const bool history = settings_.historyCap > 0;
+  const cl_uint frameStamp = history ? ++frames_ : 0;
   cl_uint toTrace = slots_;
   const cl::Buffer* list = &allSlots_;
-  if (!settings_.retraceAll && !first_) {
+  if (!first_ && (!settings_.retraceAll || history)) {
     setKernelArgs(invalidate_, scene_.setKernelArgs(invalidate_, 0), rp,
-                  cl_uint(scene_.anyInstanceMoved() ? 1 : 0), headers_, vertices_, list_,
-                  counters_);
+                  cl_uint(scene_.anyInstanceMoved() ? 1 : 0), headers_, vertices_, list_, counters_,
+                  cl_uint(settings_.retraceAll ? 1 : 0), frameStamp, changed_);
     ctx_.launch1D(invalidate_, slots_, "invalidate", &timer);
-    CL_CHECK(ctx_.queue().enqueueReadBuffer(counters_, CL_TRUE, dev::PR_C_LIST * 4, 4, &toTrace));
-    PR_CHECK(toTrace <= slots_);  // invalidate lists each slot at most once
-    list = &list_;
+    if (!settings_.retraceAll) {
+      CL_CHECK(ctx_.queue().enqueueReadBuffer(counters_, CL_TRUE, dev::PR_C_LIST * 4, 4, &toTrace));
+      PR_CHECK(toTrace <= slots_);  // invalidate lists each slot at most once
+      list = &list_;
+    }
   }
   first_ = false;
 
@@ -98,7 +110,8 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
   const cl_uint eyeSample = setKernelArgs(eyeHit_, scene_.setKernelArgs(eyeHit_, 0), rp, camera);
   setKernelArgs(eyeHit_, eyeSample + 1, eye_, radiance_, counters_);
   const cl_uint connectSample = setKernelArgs(connect_, scene_.setKernelArgs(connect_, 0), rp);
-  setKernelArgs(connect_, connectSample + 1, eye_, headers_, vertices_, radiance_, counters_);
+  setKernelArgs(connect_, connectSample + 1, eye_, headers_, vertices_, radiance_, counters_,
+                settings_.historyCap, frameStamp, changed_, history_);
   const cl_uint first = film_.first(), n = film_.end();
   for (int s = 0; s < settings_.spp; ++s) {
     CL_CHECK(eyeHit_.setArg(eyeSample, cl_uint(s)));

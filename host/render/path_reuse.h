@@ -25,6 +25,7 @@ struct PathReuseSettings {
   float clamp = 0.0f;
   float misThreshold = 4.0f;  // connection MIS (kernels/reuse/connect.cl); 0 = off
   uint32_t resample = 0;      // resampled connections per eye vertex (connect.cl); 0: all
+  uint32_t historyCap = 0;    // connection history (connect.cl): carried candidates per C; 0: off
   bool retraceAll = false;    // --mode retrace
   bool fixedNoise = false;    // camera samples keyed by frame 0 on every frame
 };
@@ -50,8 +51,10 @@ class PathReuse : public Integrator {
   PathReuseSettings settings_;
   uint32_t slots_ = 0, stride_ = 0;
   bool first_ = true;
+  uint32_t frames_ = 0;  // frames rendered with a connection history: its clock
   cl::Kernel invalidate_, lightTrace_, eyeHit_, connect_;
   cl::Buffer headers_, vertices_, list_, allSlots_, eye_, radiance_, counters_;
+  cl::Buffer changed_, history_;  // the connection history's slot stamps and pixel reservoirs
   uint64_t bytes_ = 0;
 };
 

@@ -134,6 +134,10 @@ int runRender(const RenderOptions& o) {
       ++skipped;
       continue;
     }
+    if (skipped > 0 && rendered == 0 && o.connectionHistory > 0 &&
+        o.mode != RenderMode::PathTrace && !o.quiet)
+      std::cerr << "note: --resume: the connection history starts afresh at frame " << f
+                << " (frames from here differ from an uninterrupted run's, unbiased)\n";
     const auto t0 = std::chrono::steady_clock::now();
     FrameStats fs;
     std::vector<DeviceFrame> parts;

@@ -121,6 +121,7 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
     r.resample = static_cast<uint32_t>(
         o.connections >= 0 ? o.connections
                            : defaultConnections((ctx_.device().type & CL_DEVICE_TYPE_GPU) != 0));
+    r.historyCap = static_cast<uint32_t>(o.connectionHistory);
     r.retraceAll = o.mode == RenderMode::Retrace;
     r.fixedNoise = o.fixedNoise;
     integrator_ = std::make_unique<PathReuse>(ctx_, *gpu_, *film_, r);

@@ -39,7 +39,17 @@ typedef struct {
 // Counts of the connections an eye sample made.
 typedef struct {
   uint candidates, rays, mis_rays, unoccluded, clamped;
+  uint history_kept, history_dropped;  // carried vertices kept; dropped, their slot re-traced
 } ConnectCounts;
+
+// The connection history's candidates at the first eye vertex: one kept by weighted reservoir
+// sampling on the luminance of its unshadowed contribution (taken with weight 1, not 1 / C).
+typedef struct {
+  uint slot, k;  // slot PR_INVALID_INDEX: none kept
+  float3 c;
+  Ray ray;
+  float p_sum;  // the candidates' target values
+} HistoryReservoir;
 
 // What every connection of one eye sample shares.
 typedef struct {
@@ -52,6 +62,10 @@ typedef struct {
   Reservoir res;
   Rng rr;  // the reservoir's draws
   ConnectCounts n;
+  uint history_cap;     // 0: no connection history; else the most candidates it carries, per C
+  uint slot_offset;     // added to every slot: with a history, a random one per frame
+  HistoryReservoir hr;  // strategy L's connections at the first eye vertex, carried
+  HistoryReservoir he;  // strategy E's there, this frame's alone
 } Connector;
 
 // A shaded point on the eye side of a connection.
@@ -117,7 +131,7 @@ PR_INLINE int light_point_eval(const LightPoint* y, float3 dir, float3* f, float
 
 // The light paths of the eye sample: slot of its c-th path.
 PR_INLINE uint connector_slot(const Connector* c, uint path) {
-  return (uint)(((ulong)c->j * c->rp->paths_per_pixel + path) % c->rp->slots);
+  return (uint)(((ulong)c->j * c->rp->paths_per_pixel + path + c->slot_offset) % c->rp->slots);
 }
 
 // Solid-angle pdf with which the light tracer leaves vertex 0 along dir; 0 where strategy E does
@@ -158,20 +172,25 @@ PR_INLINE float3 connection_trace_or_keep(Connector* cn, float3 c, Ray ray, u32 
   return c;
 }
 
-// One connection's contribution from its two sides (each side's BSDF and |cos|, the light
-// side's throughput) and MIS weight w; traced or kept as above. The geometry term is clamped
-// where rp.clamp asks.
-PR_INLINE float3 connection(Connector* cn, float3 tp_eye, float3 f_eye, float cos_eye,
-                            float3 tp_light, float3 f_light, float cos_light, float dist2,
-                            float corr, float w, Ray ray, u32 strategy) {
+// One connection's unshadowed contribution from its two sides (each side's BSDF and |cos|, the
+// light side's throughput), MIS weight w and share `scale` (1 / C, or 1 for the history). The
+// geometry term is clamped where rp.clamp asks (*clamped set).
+PR_INLINE float3 connection_value(const Connector* cn, float3 tp_eye, float3 f_eye, float cos_eye,
+                                  float3 tp_light, float3 f_light, float cos_light, float dist2,
+                                  float corr, float w, float scale, uint* clamped) {
   float g = cos_eye * cos_light / dist2;
   if (cn->rp->clamp > 0.0f && g > cn->rp->clamp) {
     g = cn->rp->clamp;
-    ++cn->n.clamped;
+    *clamped = 1u;
   }
-  const float3 contrib = tp_eye * f_eye * f_light * tp_light * (g * corr * cn->inv_c * w);
-  if (!(max3(contrib) > 0.0f)) return make_float3(0.0f, 0.0f, 0.0f);
-  return connection_trace_or_keep(cn, contrib, ray, strategy);
+  return tp_eye * f_eye * f_light * tp_light * (g * corr * scale * w);
+}
+
+// A connection of contribution c along `ray`: traced now or kept (connection_trace_or_keep).
+PR_INLINE float3 connection(Connector* cn, float3 c, uint clamped, Ray ray, u32 strategy) {
+  cn->n.clamped += clamped;
+  if (!(max3(c) > 0.0f)) return make_float3(0.0f, 0.0f, 0.0f);
+  return connection_trace_or_keep(cn, c, ray, strategy);
 }
 
 // Traces the reservoir's connections; returns their resampled contribution and empties it.
@@ -193,9 +212,80 @@ PR_INLINE float3 reservoir_resolve(Connector* cn) {
   return out;
 }
 
+// Strategy L's connection from the eye point x to the light point y, rebuilt from stored vertex
+// vk, which the light tracer reached with solid-angle pdf pdf_arrive (0: strategy E cannot reach
+// it): its unshadowed contribution with its MIS weight and share `scale`, and its shadow ray; 0
+// where they do not connect.
+PR_INLINE float3 light_vertex_value(const Connector* cn, const EyePoint* x, const LightPoint* y,
+                                    __global const LightVertex* vk, float pdf_arrive, float scale,
+                                    Ray* ray, uint* clamped) {
+  const float3 zero = make_float3(0.0f, 0.0f, 0.0f);
+  const float3 dxy = y->h.p - x->h.p;
+  const float dist2 = dot(dxy, dxy);
+  if (!(dist2 > 0.0f)) return zero;
+  const float3 dir = dxy * (1.0f / sqrt(dist2));  // from x to y
+  if (dot(dir, x->f.ng) <= 0.0f) return zero;
+  float3 f_y;
+  float pdf_unused, cos_y, corr;
+  if (!light_point_eval(y, dir, &f_y, &pdf_unused, &cos_y, &corr)) return zero;
+  float pdf_x;
+  const float3 f_x = eye_point_eval(x, dir, &pdf_x);
+  const float p_l =
+      solid_angle_to_area_pdf(pdf_arrive, fabs(dot(y->f.ng, vertex_dir(vk))), vk->t * vk->t);
+  const float p_e =
+      pdf_arrive > 0.0f ? solid_angle_to_area_pdf(pdf_x, fabs(dot(y->f.ng, dir)), dist2) : 0.0f;
+  const float w = connection_mis_weight(PR_STRATEGY_L, p_l, p_e, cn->rp->mis_threshold);
+  const float3 tpy = make_float3(vk->tp_r, vk->tp_g, vk->tp_b);
+  *ray = spawn_ray_to(x->h.p, x->f.ng, y->h.p, y->f.ng);
+  return connection_value(cn, x->tp, f_x, fabs(dot(x->f.n, dir)), tpy, f_y, cos_y, dist2, corr, w,
+                          scale, clamped);
+}
+
+// The same for stored vertex k of `slot` alone, with the share 1 (the history's re-evaluations).
+PR_INLINE float3 light_vertex_value_at(const Connector* cn, const EyePoint* x, uint slot, uint k,
+                                       Ray* ray) {
+  const SceneData* s = cn->s;
+  const float3 zero = make_float3(0.0f, 0.0f, 0.0f);
+  __global const LightVertex* v = cn->vertices + (size_t)slot * cn->rp->stride;
+  if (k < 1u || k >= cn->headers[slot].vertex_count || x->depth + k + 1u > cn->rp->max_depth)
+    return zero;
+  const LightPoint y = light_point(s, v + k);
+  if (y.delta) return zero;
+  // The light tracer's pdf of the step to y_k, as strategy_light_vertices finds it.
+  float pdf_arrive = 0.0f;
+  if (cn->rp->mis_threshold > 0.0f) {
+    if (k == 1u) {
+      pdf_arrive = light_emit_pdf(s, cn->headers[slot].light, v, vertex_dir(v + 1));
+    } else {
+      const LightPoint yp = light_point(s, v + k - 1u);
+      if (!yp.delta)
+        bsdf_eval(&yp.f.bsdf, yp.wprevl, to_local(vertex_dir(v + k), yp.f.t, yp.f.b, yp.f.n),
+                  &pdf_arrive);
+    }
+  }
+  uint clamped = 0u;
+  return light_vertex_value(cn, x, &y, v + k, pdf_arrive, 1.0f, ray, &clamped);
+}
+
+// A candidate of the connection history: kept with probability p / (sum of p so far).
+PR_INLINE void history_offer(Connector* cn, HistoryReservoir* hr, float3 c, Ray ray, uint slot,
+                             uint k) {
+  if (!(max3(c) > 0.0f)) return;
+  ++cn->n.candidates;
+  const float p = luminance(c);
+  if (!(p > 0.0f)) return;
+  hr->p_sum += p;
+  if (rng_next(&cn->rr) * hr->p_sum < p) {
+    hr->slot = slot;
+    hr->k = k;
+    hr->c = c;
+    hr->ray = ray;
+  }
+}
+
 // Strategy L: connections from the eye point x to the vertices k >= 1 of the sample's light
-// paths.
-PR_INLINE float3 strategy_light_vertices(Connector* cn, const EyePoint* x) {
+// paths; offered to the connection history where `history` is set.
+PR_INLINE float3 strategy_light_vertices(Connector* cn, const EyePoint* x, int history) {
   const SceneData* s = cn->s;
   const ReuseParams* rp = cn->rp;
   float3 sum = make_float3(0.0f, 0.0f, 0.0f);
@@ -218,33 +308,122 @@ PR_INLINE float3 strategy_light_vertices(Connector* cn, const EyePoint* x) {
                   &pdf_step);
       }
       if (y.delta) continue;
-      const float3 dxy = y.h.p - x->h.p;
-      const float dist2 = dot(dxy, dxy);
-      if (!(dist2 > 0.0f)) continue;
-      const float3 dir = dxy * (1.0f / sqrt(dist2));  // from x to y
-      if (dot(dir, x->f.ng) <= 0.0f) continue;
-      float3 f_y;
-      float pdf_unused, cos_y, corr;
-      if (!light_point_eval(&y, dir, &f_y, &pdf_unused, &cos_y, &corr)) continue;
-      float pdf_x;
-      const float3 f_x = eye_point_eval(x, dir, &pdf_x);
-      const float p_l = solid_angle_to_area_pdf(pdf_arrive, fabs(dot(y.f.ng, vertex_dir(v + k))),
-                                                v[k].t * v[k].t);
-      const float p_e =
-          pdf_arrive > 0.0f ? solid_angle_to_area_pdf(pdf_x, fabs(dot(y.f.ng, dir)), dist2) : 0.0f;
-      const float w = connection_mis_weight(PR_STRATEGY_L, p_l, p_e, rp->mis_threshold);
-      const float3 tpy = make_float3(v[k].tp_r, v[k].tp_g, v[k].tp_b);
-      sum += connection(cn, x->tp, f_x, fabs(dot(x->f.n, dir)), tpy, f_y, cos_y, dist2, corr, w,
-                        spawn_ray_to(x->h.p, x->f.ng, y.h.p, y.f.ng), PR_STRATEGY_L);
+      Ray ray;
+      uint clamped = 0u;
+      const float3 value = light_vertex_value(cn, x, &y, v + k, pdf_arrive,
+                                              history ? 1.0f : cn->inv_c, &ray, &clamped);
+      if (history) {
+        cn->n.clamped += clamped;
+        history_offer(cn, &cn->hr, value, ray, slot, k);
+      } else {
+        sum += connection(cn, value, clamped, ray, PR_STRATEGY_L);
+      }
     }
   }
   return sum;
 }
 
+// The connection history at the first eye vertex x, that of EyeVertex e (--connection-history).
+// The reservoir of strategy L's connections at x that this sample's candidates filled is merged
+// with the one the same pixel sample left in the previous frame (generalized RIS, Lin et al.
+// 2022: the balance heuristic over the two reservoirs' targets, each weighted by its confidence
+// m) and left for the next frame. A carried vertex whose slot was traced again this frame no
+// longer exists (changed[slot] > the frame that kept it): it is dropped, and the previous target
+// is 0 at this frame's new vertices. The previous reservoir is dropped whole where its eye vertex
+// lies on an instance that moved, whose target cannot be evaluated as it was. Strategy E's
+// connections at x (from this frame's BSDF sample, which the next frame cannot evaluate) have a
+// reservoir of their own; one of the two is chosen in proportion to its weight, and one shadow
+// ray traced. Returns the estimate of the connections at x.
+PR_INLINE float3 history_resolve(Connector* cn, const EyeVertex* e,
+                                 __global ConnectionHistory* hist, __global const uint* changed,
+                                 uint frame) {
+  const float mc = (float)cn->rp->paths_per_pixel;
+  // x as connect built it (rebuilt, rather than kept through the path's later vertices).
+  const SurfaceHit hx = surface_at(&cn->s->sd, e->prim, e->inst, e->b1, e->b2);
+  const EyePoint x0 = eye_point(cn->s, &hx, make_float3(e->wx, e->wy, e->wz),
+                                make_float3(e->tp_r, e->tp_g, e->tp_b), e->depth);
+  const EyePoint* x = &x0;
+  HistoryReservoir* hr = &cn->hr;
+  const ConnectionHistory prev = *hist;
+  const int have_prev = prev.frame != 0u && prev.frame + 1u == frame &&
+                        (prev.inst == PR_INVALID_INDEX || !cn->s->sd.instances[prev.inst].moved);
+  const uint prev_k = prev.depth_k >> 16;
+  // The two resampling weights m_i(y_i) p(y_i) W_i, with target p at x.
+  float w_cur = hr->slot != PR_INVALID_INDEX ? hr->p_sum / mc : 0.0f, w_prev = 0.0f, m_prev = 0.0f;
+  const float w_e = cn->he.slot != PR_INVALID_INDEX ? cn->he.p_sum / mc : 0.0f;
+  float3 c_prev = make_float3(0.0f, 0.0f, 0.0f);
+  Ray ray_prev;
+  if (have_prev) {
+    m_prev = fmin(prev.m, (float)cn->history_cap * mc);
+    if (prev.slot != PR_INVALID_INDEX && changed[prev.slot] <= prev.frame) {
+      c_prev = light_vertex_value_at(cn, x, prev.slot, prev_k, &ray_prev);
+      const float p_cur = luminance(c_prev);
+      const float den = m_prev * prev.p + mc * p_cur;
+      if (den > 0.0f && p_cur > 0.0f) w_prev = m_prev * prev.p / den * p_cur * prev.w;
+    } else if (prev.slot != PR_INVALID_INDEX) {
+      ++cn->n.history_dropped;
+    }
+    if (hr->slot != PR_INVALID_INDEX && changed[hr->slot] <= prev.frame) {
+      const SurfaceHit hp = surface_at(&cn->s->sd, prev.prim, prev.inst, prev.b1, prev.b2);
+      const EyePoint xp =
+          eye_point(cn->s, &hp, make_float3(prev.wx, prev.wy, prev.wz),
+                    make_float3(prev.tp_r, prev.tp_g, prev.tp_b), prev.depth_k & 0xffffu);
+      Ray unused;
+      const float p_old = luminance(light_vertex_value_at(cn, &xp, hr->slot, hr->k, &unused));
+      const float p_cur = luminance(hr->c);
+      w_cur *= mc * p_cur / (m_prev * p_old + mc * p_cur);
+    }
+  }
+  const float total = w_cur + w_prev;
+  ConnectionHistory next;
+  next.prim = e->prim;
+  next.inst = e->inst;
+  next.b1 = e->b1;
+  next.b2 = e->b2;
+  next.wx = e->wx, next.wy = e->wy, next.wz = e->wz;
+  next.tp_r = e->tp_r, next.tp_g = e->tp_g, next.tp_b = e->tp_b;
+  next.depth_k = e->depth;
+  next.slot = PR_INVALID_INDEX;
+  next.p = next.w = 0.0f;
+  next.m = m_prev + mc;
+  next.frame = frame;
+  // The merged reservoir's vertex y, with contribution c_l and weight total / p(y).
+  float3 c_l = make_float3(0.0f, 0.0f, 0.0f);
+  Ray ray_l;
+  if (total > 0.0f) {
+    const int take_prev = rng_next(&cn->rr) * total < w_prev;
+    c_l = take_prev ? c_prev : hr->c;
+    ray_l = take_prev ? ray_prev : hr->ray;
+    next.slot = take_prev ? prev.slot : hr->slot;
+    next.depth_k |= (take_prev ? prev_k : hr->k) << 16;
+    next.p = luminance(c_l);
+    next.w = total / next.p;
+    cn->n.history_kept += take_prev;
+  }
+  *hist = next;
+  // One shadow ray, to L's vertex or E's connection: resampled between the two.
+  float3 out = make_float3(0.0f, 0.0f, 0.0f);
+  const float both = total + w_e;
+  if (both > 0.0f) {
+    const int take_e = rng_next(&cn->rr) * both < w_e;
+    const float3 c = take_e ? cn->he.c : c_l;
+    ++cn->n.rays;
+    cn->n.mis_rays += take_e;
+    if (!trace_occluded(cn->s, take_e ? cn->he.ray : ray_l)) {
+      ++cn->n.unoccluded;
+      out = c * (both / luminance(c));
+    }
+  }
+  hr->slot = cn->he.slot = PR_INVALID_INDEX;
+  hr->p_sum = cn->he.p_sum = 0.0f;
+  return out;
+}
+
 // Strategy E: connections from Y, the non-delta first hit of the BSDF sample taken at the eye
 // vertex at xp with solid-angle pdf pdf_x, to the vertices k >= 0 of the sample's light paths,
 // each weighted by its share of the MIS.
-PR_INLINE float3 strategy_sampled_vertex(Connector* cn, float3 xp, float pdf_x, const EyePoint* y) {
+PR_INLINE float3 strategy_sampled_vertex(Connector* cn, float3 xp, float pdf_x, const EyePoint* y,
+                                         int history) {
   const SceneData* s = cn->s;
   const ReuseParams* rp = cn->rp;
   float3 sum = make_float3(0.0f, 0.0f, 0.0f);
@@ -289,8 +468,15 @@ PR_INLINE float3 strategy_sampled_vertex(Connector* cn, float3 xp, float pdf_x, 
       const Ray r = (k == 0u && v[0].prim == PR_INVALID_INDEX)
                         ? spawn_ray(y->h.p, y->f.ng, dir, sqrt(dist2) * (1.0f - 1e-4f))
                         : spawn_ray_to(y->h.p, y->f.ng, zp, zng);
-      sum += connection(cn, y->tp, f_y, fabs(dot(y->f.n, dir)), tpz, f_z, cos_z, dist2, corr, w, r,
-                        PR_STRATEGY_E);
+      uint clamped = 0u;
+      const float3 value = connection_value(cn, y->tp, f_y, fabs(dot(y->f.n, dir)), tpz, f_z, cos_z,
+                                            dist2, corr, w, history ? 1.0f : cn->inv_c, &clamped);
+      if (history) {
+        cn->n.clamped += clamped;
+        history_offer(cn, &cn->he, value, r, slot, k);
+      } else {
+        sum += connection(cn, value, clamped, r, PR_STRATEGY_E);
+      }
     }
   }
   return sum;
@@ -315,7 +501,9 @@ PR_INLINE float3 strategy_next_event(const Connector* cn, const EyePoint* x, Rng
 
 __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global const EyeVertex* eye,
                       __global const PathHeader* headers, __global const LightVertex* vertices,
-                      __global float4* radiance, __global uint* counters) {
+                      __global float4* radiance, __global uint* counters, uint history_cap,
+                      uint frame_stamp, __global const uint* changed,
+                      __global ConnectionHistory* history) {
   const uint i = (uint)get_global_id(0);
   if (i >= rp.pixel_count) return;
   const EyeVertex e = eye[i];
@@ -334,16 +522,32 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
   cn.res.candidates = 0u;
   cn.rr = rng_make(rp.seed, PR_RNG_RESAMPLE, rp.frame, i, sample);
   cn.n.candidates = cn.n.rays = cn.n.mis_rays = cn.n.unoccluded = cn.n.clamped = 0u;
+  cn.n.history_kept = cn.n.history_dropped = 0u;
+  cn.history_cap = history_cap;
+  // With a history, the light paths shift by a random offset each frame, so that the reservoir
+  // meets new candidates.
+  cn.slot_offset =
+      history_cap > 0u ? pr_hash_u32(rp.seed ^ pr_hash_u32(rp.frame ^ 0x534c4f54u)) % rp.slots : 0u;
+  cn.hr.slot = cn.he.slot = PR_INVALID_INDEX;
+  cn.hr.k = cn.he.k = 0u;
+  cn.hr.p_sum = cn.he.p_sum = 0.0f;
   const SurfaceHit first = surface_at(&s.sd, e.prim, e.inst, e.b1, e.b2);
   EyePoint x = eye_point(&s, &first, make_float3(e.wx, e.wy, e.wz),
                          make_float3(e.tp_r, e.tp_g, e.tp_b), e.depth);
   float3 L = make_float3(0.0f, 0.0f, 0.0f);
   uint shadow_rays = 0u, bounce_rays = 0u;
-  for (;;) {
+  // The first eye vertex's connections go to the history, where there is one.
+  int history_open = history_cap > 0u;
+  __global ConnectionHistory* hist = history + ((size_t)i * rp.spp + sample);
+  for (uint vertex = 0u;; ++vertex) {
+    if (history_open && vertex > 0u) {
+      L += history_resolve(&cn, &e, hist, changed, frame_stamp);
+      history_open = 0;
+    }
     // The previous eye vertex's kept connections (each vertex of a delta chain has its own).
     L += reservoir_resolve(&cn);
     L += strategy_next_event(&cn, &x, &rng, &shadow_rays);
-    L += strategy_light_vertices(&cn, &x);
+    L += strategy_light_vertices(&cn, &x, history_open);
     // The completeness extension: one BSDF direction, kept only through delta surfaces.
     const float u0 = rng_next(&rng);
     const float2 u12 = rng_next2(&rng);
@@ -378,7 +582,8 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
             t2 * surface_emission(&s, &h) * power_heuristic(pdf, emitter_pdf(&s, &h, x.h.p, x.f.n));
       if (chain == 0u && !is_delta) {
         // Strategy L at x counts these paths, apart from E's share.
-        if (rp.mis_threshold > 0.0f && !delta) L += strategy_sampled_vertex(&cn, x.h.p, pdf, &y);
+        if (rp.mis_threshold > 0.0f && !delta)
+          L += strategy_sampled_vertex(&cn, x.h.p, pdf, &y, history_open);
         break;
       }
       ++depth;
@@ -402,6 +607,7 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
     }
     if (!found || !(max3(x.tp) < PR_INF_F)) break;
   }
+  if (history_open) L += history_resolve(&cn, &e, hist, changed, frame_stamp);
   L += reservoir_resolve(&cn);
   radiance[i] += (float4)(L.x, L.y, L.z, 0.0f);
   if (shadow_rays) atomic_add(counters + PR_C_SHADOW_RAYS, shadow_rays);
@@ -411,4 +617,6 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
   if (cn.n.clamped) atomic_add(counters + PR_C_CLAMPED, cn.n.clamped);
   if (cn.n.candidates) atomic_add(counters + PR_C_CANDIDATES, cn.n.candidates);
   if (cn.n.unoccluded) atomic_add(counters + PR_C_CONNECTED, cn.n.unoccluded);
+  if (cn.n.history_kept) atomic_add(counters + PR_C_HISTORY_KEPT, cn.n.history_kept);
+  if (cn.n.history_dropped) atomic_add(counters + PR_C_HISTORY_DROPPED, cn.n.history_dropped);
 }

@@ -4,12 +4,15 @@
 // now meets DSG geometry before its stored end. Only the DSG is tested. Reads the headers, the
 // vertices, the instances' moved flags and the light table; clears `valid` of invalid slots,
 // appends them to `list` (its order varies, the set does not), and counts the light vertices
-// of the paths that stay valid.
+// of the paths that stay valid. Where frame_stamp > 0 (the connection history), it stamps each
+// invalid slot in `changed` with it; with `mark_only` (--mode retrace, which traces every slot
+// anyway) it does that alone, so that both modes learn the same changed slots.
 #include "shared/reuse.h"
 
 __kernel void invalidate(PR_SCENE_PARAMS, ReuseParams rp, uint test_segments,
                          __global PathHeader* headers, __global const LightVertex* vertices,
-                         __global uint* list, __global uint* counters) {
+                         __global uint* list, __global uint* counters, uint mark_only,
+                         uint frame_stamp, __global uint* changed) {
   const uint slot = (uint)get_global_id(0);
   if (slot >= rp.slots) return;
   const SceneData s = PR_SCENE();
@@ -39,6 +42,8 @@ __kernel void invalidate(PR_SCENE_PARAMS, ReuseParams rp, uint test_segments,
     }
   }
   if (rays) atomic_add(counters + PR_C_INVALID_RAYS, rays);
+  if (!ok && frame_stamp > 0u) changed[slot] = frame_stamp;
+  if (mark_only) return;
   if (!ok) {
     headers[slot].valid = 0u;
     list[atomic_inc(counters + PR_C_LIST)] = slot;

@@ -49,6 +49,22 @@ typedef struct {
   float b1, b2;
 } EyeVertex;
 
+// A pixel sample's connection history (--connection-history; kernels/reuse/connect.cl), carried
+// from one frame to the next: the first eye vertex its reservoir was last resampled at (rebuilt
+// with surface_at), the light vertex it keeps and its weights. 64 bytes.
+typedef struct {
+  u32 prim, inst;
+  float b1, b2;
+  float wx, wy, wz;  // towards the previous eye vertex
+  float tp_r, tp_g, tp_b;
+  u32 depth_k;  // the eye vertex's depth | the kept light vertex's depth k << 16
+  u32 slot;     // the kept light vertex's slot; PR_INVALID_INDEX: none
+  float p;      // its target value at that eye vertex
+  float w;      // its unbiased contribution weight
+  float m;      // the candidates the reservoir stands for (its confidence)
+  u32 frame;    // the frame (counted from 1 by the renderer) that wrote it; 0: never written
+} ConnectionHistory;
+
 // Octahedral normal encoding, two 16-bit fixed-point coordinates (Cigolle et al., JCGT 2014).
 PR_INLINE float pr_sign_nz(float v) {
   return v >= 0.0f ? 1.0f : -1.0f;
@@ -90,3 +106,5 @@ PR_STATIC_ASSERT(offsetof(pr::dev::LightVertex, prim) == 48, "LightVertex layout
 PR_STATIC_ASSERT(offsetof(pr::dev::LightVertex, b2) == 60, "LightVertex layout");
 PR_STATIC_ASSERT(sizeof(pr::dev::EyeVertex) == 64, "EyeVertex layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::EyeVertex, depth) == 44, "EyeVertex layout");
+PR_STATIC_ASSERT(sizeof(pr::dev::ConnectionHistory) == 64, "ConnectionHistory layout");
+PR_STATIC_ASSERT(offsetof(pr::dev::ConnectionHistory, frame) == 60, "ConnectionHistory layout");

@@ -46,7 +46,9 @@ typedef struct {
   X(CLAMPED, counters, "connections_clamped")      /* geometry term clamped */         \
   X(MIS_RAYS, counters, "connections_mis")         /* connection rays of strategy E */ \
   X(CANDIDATES, counters, "connection_candidates") /* each a ray without resampling */ \
-  X(CONNECTED, counters, "connections_unoccluded")
+  X(CONNECTED, counters, "connections_unoccluded")                                     \
+  X(HISTORY_KEPT, counters, "history_kept")       /* carried vertices chosen again */  \
+  X(HISTORY_DROPPED, counters, "history_dropped") /* carried, their slot re-traced */
 
 #define PR_C_ENUM(name, group, key) PR_C_##name,
 enum { PR_REUSE_COUNTERS(PR_C_ENUM) PR_C_COUNT };

@@ -85,6 +85,8 @@ class Runner:
                "--max-depth", str(self.args.max_depth), "--seed", str(seed), "--mode", mode,
                "--out", str(out / "f_%04d.exr"), "--stats", str(stats), "--quiet", "--exr-float",
                *extra]  # float EXRs in every run, so that runs pay the same for writing
+        if mode != "pathtrace":
+            cmd += self.args.reuse_args.split()
         if fixed:
             cmd.append("--fixed-noise")
         self.loads.append(os.getloadavg()[0])
