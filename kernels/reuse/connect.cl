@@ -21,6 +21,10 @@
 // an unbiased estimate of the sum of all candidates' shadowed contributions, for K shadow rays
 // instead of one per candidate. The reservoir's draws come from a stream of their own, so the
 // path's draws stay in place.
+//
+// The connection history (history_cap > 0, docs/design.md section 5): the first eye vertex's
+// connections are resampled into a reservoir that each pixel sample carries to the next frame
+// (history_resolve); one shadow ray there.
 #include "shared/reuse.h"
 // After reuse.h: its FP_CONTRACT OFF (shared/bvh.h) holds for these weights too.
 #include "shared/connection_mis.h"
