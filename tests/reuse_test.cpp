@@ -289,6 +289,13 @@ TEST(Reuse, AConnectionHistoryConvergesToThePathTracer) {
                   32, 2, 3);
 }
 
+// A moving camera: each frame's target is evaluated at the new eye vertex.
+TEST(Reuse, AConnectionHistoryConvergesWithAMovingCamera) {
+  expectSameImage(test::sourcePath("scenes/cornell-orbit.gltf"),
+                  "--force-diffuse --max-depth 6 --connections 1 --connection-history 20", 48, 36,
+                  32, 2, 3);
+}
+
 TEST(Reuse, AConnectionHistoryConvergesWhereMovingObjectsDisturbThePaths) {
   expectSameImage(sweepScene(), "--fps 4 --max-depth 6 --connections 1 --connection-history 20", 48,
                   36, 32, 2, 3);
