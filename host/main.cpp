@@ -138,9 +138,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   render
       ->add_option("--connection-history", ro.connectionHistory,
-                   "Carry each pixel's reservoir of connections at its first eye vertex from "
-                   "one sample pass to the next and across frames (reuse/retrace; generalized "
-                   "RIS), standing for at most this many times C candidates; 0 = off")
+                   "Carry each pixel sample's reservoir of connections at its first eye vertex "
+                   "from frame to frame (reuse/retrace; generalized RIS), standing for at most "
+                   "this many times C candidates; 0 = off")
       ->check(CLI::Range(0, 1000))
       ->capture_default_str();
   render->add_option(

@@ -64,7 +64,7 @@ struct RenderOptions {
   float connectionMis = 4.0f;  // MIS threshold on p_E / p_L (kernels/reuse/connect.cl); 0 = off
   int connections = -1;        // RIS-chosen connections per eye vertex (1-4); 0: every candidate;
                                // -1: defaultConnections of the device
-  int connectionHistory = 0;   // cap on the pixel's carried connection reservoir, per C; 0 = off
+  int connectionHistory = 0;   // cap on a pixel sample's carried reservoir, per C; 0 = off
   // The environment light (scene/environment.h): a map file, "none", or "" (a uniform one of
   // envColor where --env-color is given, else white where the scene has no lights, else none).
   std::string env;
