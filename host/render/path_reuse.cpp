@@ -53,9 +53,8 @@ PathReuse::PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseS
   // Without a history, one element each: the kernels take them but never read them.
   const bool history = settings_.historyCap > 0;
   changed_ = alloc("changed slot stamps", uint64_t(history ? slots_ : 1) * 4);
-  history_ = alloc("connection history", uint64_t(history ? film.pixels() : 1) *
-                                             (history ? settings_.spp : 1) *
-                                             sizeof(dev::ConnectionHistory));
+  const uint64_t records = history ? uint64_t(film.pixels()) * settings_.spp : 1;
+  history_ = alloc("connection history", records * sizeof(dev::ConnectionHistory));
 }
 
 void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameStats* stats) {

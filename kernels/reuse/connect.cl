@@ -103,6 +103,13 @@ PR_INLINE EyePoint eye_point(const SceneData* s, const SurfaceHit* h, float3 wo,
   return x;
 }
 
+// An eye point rebuilt from a stored surface point (an EyeVertex, or a history's record).
+PR_INLINE EyePoint eye_point_at(const SceneData* s, u32 prim, u32 inst, float b1, float b2,
+                                float3 wo, float3 tp, uint depth) {
+  const SurfaceHit h = surface_at(&s->sd, prim, inst, b1, b2);
+  return eye_point(s, &h, wo, tp, depth);
+}
+
 PR_INLINE LightPoint light_point(const SceneData* s, __global const LightVertex* v) {
   LightPoint y;
   y.h = surface_interp(&s->sd, v->prim, v->inst, v->b1, v->b2, 0);  // ns as stored
@@ -343,9 +350,9 @@ PR_INLINE float3 history_resolve(Connector* cn, const EyeVertex* e,
                                  uint frame) {
   const float mc = (float)cn->rp->paths_per_pixel;
   // x as connect built it (rebuilt, rather than kept through the path's later vertices).
-  const SurfaceHit hx = surface_at(&cn->s->sd, e->prim, e->inst, e->b1, e->b2);
-  const EyePoint x0 = eye_point(cn->s, &hx, make_float3(e->wx, e->wy, e->wz),
-                                make_float3(e->tp_r, e->tp_g, e->tp_b), e->depth);
+  const EyePoint x0 =
+      eye_point_at(cn->s, e->prim, e->inst, e->b1, e->b2, make_float3(e->wx, e->wy, e->wz),
+                   make_float3(e->tp_r, e->tp_g, e->tp_b), e->depth);
   const EyePoint* x = &x0;
   HistoryReservoir* hr = &cn->hr;
   const ConnectionHistory prev = *hist;
@@ -368,10 +375,9 @@ PR_INLINE float3 history_resolve(Connector* cn, const EyeVertex* e,
       ++cn->n.history_dropped;
     }
     if (hr->slot != PR_INVALID_INDEX && changed[hr->slot] <= prev.frame) {
-      const SurfaceHit hp = surface_at(&cn->s->sd, prev.prim, prev.inst, prev.b1, prev.b2);
-      const EyePoint xp =
-          eye_point(cn->s, &hp, make_float3(prev.wx, prev.wy, prev.wz),
-                    make_float3(prev.tp_r, prev.tp_g, prev.tp_b), prev.depth_k & 0xffffu);
+      const EyePoint xp = eye_point_at(
+          cn->s, prev.prim, prev.inst, prev.b1, prev.b2, make_float3(prev.wx, prev.wy, prev.wz),
+          make_float3(prev.tp_r, prev.tp_g, prev.tp_b), prev.depth_k & 0xffffu);
       Ray unused;
       const float p_old = luminance(light_vertex_value_at(cn, &xp, hr->slot, hr->k, &unused));
       const float p_cur = luminance(hr->c);
@@ -535,9 +541,8 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
   cn.hr.slot = cn.he.slot = PR_INVALID_INDEX;
   cn.hr.k = cn.he.k = 0u;
   cn.hr.p_sum = cn.he.p_sum = 0.0f;
-  const SurfaceHit first = surface_at(&s.sd, e.prim, e.inst, e.b1, e.b2);
-  EyePoint x = eye_point(&s, &first, make_float3(e.wx, e.wy, e.wz),
-                         make_float3(e.tp_r, e.tp_g, e.tp_b), e.depth);
+  EyePoint x = eye_point_at(&s, e.prim, e.inst, e.b1, e.b2, make_float3(e.wx, e.wy, e.wz),
+                            make_float3(e.tp_r, e.tp_g, e.tp_b), e.depth);
   float3 L = make_float3(0.0f, 0.0f, 0.0f);
   uint shadow_rays = 0u, bounce_rays = 0u;
   // The first eye vertex's connections go to the history, where there is one.
