@@ -5,8 +5,7 @@
 // with mirrors and glass, one BSDF direction from x: if it meets a delta surface, the delta
 // chain is followed and its end is treated like x (emission, next-event estimation,
 // connections), up to the maximum depth. If it meets a non-delta surface Y, that surface is
-// connected to the same light paths where connection MIS gives it a share (strategy E), and so
-// is the surface Z that a BSDF sample from Y finds (strategy E2, for corners).
+// connected to the same light paths where connection MIS gives it a share.
 // Reads the EyeVertex, the arena and the scene; adds to the sample's radiance and the counters.
 //
 // Each strategy is one function over a Connector (what every connection of the eye sample
@@ -158,7 +157,7 @@ PR_INLINE float light_emit_pdf(const SceneData* s, u32 light, __global const Lig
 // resampling; returns what it adds) or offered to the reservoir (returns 0).
 PR_INLINE float3 connection_trace_or_keep(Connector* cn, float3 c, Ray ray, u32 strategy) {
   ++cn->n.candidates;
-  const u32 mis = strategy != PR_STRATEGY_L;
+  const u32 mis = strategy == PR_STRATEGY_E;
   if (cn->rp->resample > 0u) {
     Reservoir* res = &cn->res;
     const float w = luminance(c);
@@ -212,7 +211,7 @@ PR_INLINE float3 reservoir_resolve(Connector* cn) {
   if (res->candidates > 0u) {
     for (u32 k = 0u; k < cn->rp->resample; ++k) {
       ++cn->n.rays;
-      cn->n.mis_rays += res->strategy[k] != PR_STRATEGY_L;
+      cn->n.mis_rays += res->strategy[k] == PR_STRATEGY_E;
       if (trace_occluded(cn->s, res->ray[k])) continue;
       ++cn->n.unoccluded;
       out += make_float3(res->c[3 * k], res->c[3 * k + 1], res->c[3 * k + 2]) *
@@ -227,12 +226,10 @@ PR_INLINE float3 reservoir_resolve(Connector* cn) {
 // Strategy L's connection from the eye point x to the light point y, rebuilt from stored vertex
 // vk, which the light tracer reached with solid-angle pdf pdf_arrive (0: strategy E cannot reach
 // it): its unshadowed contribution with its MIS weight and share `scale`, and its shadow ray; 0
-// where they do not connect. q_l is the area pdf of the vertex before, Z, under the light tracer
-// (0: strategy E2 cannot make the path), and z_geo converts y's solid angle towards Z to area
-// at Z (|cos| there over the squared length).
+// where they do not connect.
 PR_INLINE float3 light_vertex_value(const Connector* cn, const EyePoint* x, const LightPoint* y,
-                                    __global const LightVertex* vk, float pdf_arrive, float q_l,
-                                    float z_geo, float scale, Ray* ray, uint* clamped) {
+                                    __global const LightVertex* vk, float pdf_arrive, float scale,
+                                    Ray* ray, uint* clamped) {
   const float3 zero = make_float3(0.0f, 0.0f, 0.0f);
   const float3 dxy = y->h.p - x->h.p;
   const float dist2 = dot(dxy, dxy);
@@ -248,37 +245,11 @@ PR_INLINE float3 light_vertex_value(const Connector* cn, const EyePoint* x, cons
       solid_angle_to_area_pdf(pdf_arrive, fabs(dot(y->f.ng, vertex_dir(vk))), vk->t * vk->t);
   const float p_e =
       pdf_arrive > 0.0f ? solid_angle_to_area_pdf(pdf_x, fabs(dot(y->f.ng, dir)), dist2) : 0.0f;
-  // E2 samples Z from y, arriving from x: y's BSDF the other way round.
-  float q_e = 0.0f;
-  if (q_l > 0.0f && p_e > 0.0f) {
-    bsdf_eval(&y->f.bsdf, to_local(-dir, y->f.t, y->f.b, y->f.n), y->wprevl, &q_e);
-    q_e *= z_geo;
-  }
-  const float w = connection_mis_weight(PR_STRATEGY_L, p_l, p_e, q_l, q_e, cn->rp->mis_threshold);
+  const float w = connection_mis_weight(PR_STRATEGY_L, p_l, p_e, cn->rp->mis_threshold);
   const float3 tpy = make_float3(vk->tp_r, vk->tp_g, vk->tp_b);
   *ray = spawn_ray_to(x->h.p, x->f.ng, y->h.p, y->f.ng);
   return connection_value(cn, x->tp, f_x, fabs(dot(x->f.n, dir)), tpy, f_y, cos_y, dist2, corr, w,
                           scale, clamped);
-}
-
-// The light tracer's solid-angle pdf of its step from y_{k-1} to y_k (k >= 1) of path v (light
-// `light`), as strategy_light_vertices finds it in its loop; 0 where strategy E cannot reach
-// y_{k-1} (a delta surface, or a light it does not connect to).
-PR_INLINE float light_step_pdf(const Connector* cn, u32 light, __global const LightVertex* v,
-                               uint k) {
-  if (k == 1u) return light_emit_pdf(cn->s, light, v, vertex_dir(v + 1));
-  const LightPoint yp = light_point(cn->s, v + k - 1u);
-  float pdf = 0.0f;
-  if (!yp.delta)
-    bsdf_eval(&yp.f.bsdf, yp.wprevl, to_local(vertex_dir(v + k), yp.f.t, yp.f.b, yp.f.n), &pdf);
-  return pdf;
-}
-
-// The same per unit area at y_k, whose geometric normal is ng.
-PR_INLINE float light_step_area_pdf(const Connector* cn, u32 light, __global const LightVertex* v,
-                                    uint k, float3 ng) {
-  return solid_angle_to_area_pdf(light_step_pdf(cn, light, v, k), fabs(dot(ng, vertex_dir(v + k))),
-                                 v[k].t * v[k].t);
 }
 
 // The same for stored vertex k of `slot` alone, with the share 1 (the history's re-evaluations).
@@ -287,24 +258,24 @@ PR_INLINE float3 light_vertex_value_at(const Connector* cn, const EyePoint* x, u
   const SceneData* s = cn->s;
   const float3 zero = make_float3(0.0f, 0.0f, 0.0f);
   __global const LightVertex* v = cn->vertices + (size_t)slot * cn->rp->stride;
-  const u32 light = cn->headers[slot].light;
   if (k < 1u || k >= cn->headers[slot].vertex_count || x->depth + k + 1u > cn->rp->max_depth)
     return zero;
   const LightPoint y = light_point(s, v + k);
   if (y.delta) return zero;
-  float pdf_arrive = 0.0f, q_l = 0.0f, z_geo = 0.0f;
+  // The light tracer's pdf of the step to y_k, as strategy_light_vertices finds it.
+  float pdf_arrive = 0.0f;
   if (cn->rp->mis_threshold > 0.0f) {
-    pdf_arrive = light_step_pdf(cn, light, v, k);
-    if (k >= 2u &&
-        strategy_e2_takes_part(v[k].t * v[k].t, v[k - 1u].t * v[k - 1u].t, cn->rp->mis_threshold)) {
-      // Z = y_{k-1}, for strategy E2.
-      const float3 z_ng = oct_decode(v[k - 1u].ng_oct);
-      q_l = light_step_area_pdf(cn, light, v, k - 1u, z_ng);
-      z_geo = fabs(dot(z_ng, vertex_dir(v + k))) / (v[k].t * v[k].t);
+    if (k == 1u) {
+      pdf_arrive = light_emit_pdf(s, cn->headers[slot].light, v, vertex_dir(v + 1));
+    } else {
+      const LightPoint yp = light_point(s, v + k - 1u);
+      if (!yp.delta)
+        bsdf_eval(&yp.f.bsdf, yp.wprevl, to_local(vertex_dir(v + k), yp.f.t, yp.f.b, yp.f.n),
+                  &pdf_arrive);
     }
   }
   uint clamped = 0u;
-  return light_vertex_value(cn, x, &y, v + k, pdf_arrive, q_l, z_geo, 1.0f, ray, &clamped);
+  return light_vertex_value(cn, x, &y, v + k, pdf_arrive, 1.0f, ray, &clamped);
 }
 
 // A candidate of the connection history: kept with probability p / (sum of p so far).
@@ -338,10 +309,6 @@ PR_INLINE float3 strategy_light_vertices(Connector* cn, const EyePoint* x, int h
     float pdf_step = (mis && count > 1u)
                          ? light_emit_pdf(s, cn->headers[slot].light, v, vertex_dir(v + 1))
                          : 0.0f;
-    // y_{k-1} seen by strategy E2: its area pdf under the light tracer (0: E2 cannot make the
-    // path) and its geometric normal.
-    float q_l = 0.0f;
-    float3 z_ng = make_float3(0.0f, 0.0f, 0.0f);
     for (uint k = 1u; k < count && x->depth + k + 1u <= rp->max_depth; ++k) {
       const LightPoint y = light_point(s, v + k);
       const float pdf_arrive = pdf_step;
@@ -351,22 +318,11 @@ PR_INLINE float3 strategy_light_vertices(Connector* cn, const EyePoint* x, int h
         bsdf_eval(&y.f.bsdf, y.wprevl, to_local(vertex_dir(v + k + 1u), y.f.t, y.f.b, y.f.n),
                   &pdf_step);
       }
-      const float q_l_here = q_l;
-      const float3 z_ng_here = z_ng;
-      q_l = (mis && !y.delta)
-                ? solid_angle_to_area_pdf(pdf_arrive, fabs(dot(y.h.ng, vertex_dir(v + k))),
-                                          v[k].t * v[k].t)
-                : 0.0f;
-      z_ng = y.h.ng;
       if (y.delta) continue;
       Ray ray;
       uint clamped = 0u;
-      const float z_geo = fabs(dot(z_ng_here, vertex_dir(v + k))) / (v[k].t * v[k].t);
-      const int e2 =
-          q_l_here > 0.0f &&
-          strategy_e2_takes_part(v[k].t * v[k].t, v[k - 1u].t * v[k - 1u].t, rp->mis_threshold);
-      const float3 value = light_vertex_value(cn, x, &y, v + k, pdf_arrive, e2 ? q_l_here : 0.0f,
-                                              z_geo, history ? 1.0f : cn->inv_c, &ray, &clamped);
+      const float3 value = light_vertex_value(cn, x, &y, v + k, pdf_arrive,
+                                              history ? 1.0f : cn->inv_c, &ray, &clamped);
       if (history) {
         cn->n.clamped += clamped;
         history_offer(cn, &cn->hr, value, ray, slot, k);
@@ -473,104 +429,63 @@ PR_INLINE float3 history_resolve(Connector* cn, const EyeVertex* e,
   return out;
 }
 
-// The area pdf at v of the BSDF sample from xp that found it, with solid-angle pdf pdf_w; 0
-// where there is none.
-PR_INLINE float sampled_area_pdf(float3 xp, float pdf_w, const EyePoint* v) {
-  const float3 d = v->h.p - xp;
-  const float d2 = dot(d, d);
-  if (!(d2 > 0.0f) || !(pdf_w > 0.0f)) return 0.0f;
-  return solid_angle_to_area_pdf(pdf_w, fabs(dot(v->f.ng, d)) / sqrt(d2), d2);
-}
-
-// Strategies E and E2: connections from the eye point v, the non-delta first hit of a BSDF
-// sample with area pdf a_e at v, to the vertices k >= 0 of the sample's light paths, each
-// weighted by its share of the MIS. E (second = 0): v is Y, found by x's sample. E2: v is Z,
-// found by the sample from y = Y, which x's sample found with area pdf p_e.
-PR_INLINE float3 strategy_sampled_vertex(Connector* cn, const EyePoint* v, float a_e,
-                                         const EyePoint* y, float p_e, int second, int history) {
+// Strategy E: connections from Y, the non-delta first hit of the BSDF sample taken at the eye
+// vertex at xp with solid-angle pdf pdf_x, to the vertices k >= 0 of the sample's light paths,
+// each weighted by its share of the MIS.
+PR_INLINE float3 strategy_sampled_vertex(Connector* cn, float3 xp, float pdf_x, const EyePoint* y,
+                                         int history) {
   const SceneData* s = cn->s;
   const ReuseParams* rp = cn->rp;
-  const float t = rp->mis_threshold;
   float3 sum = make_float3(0.0f, 0.0f, 0.0f);
-  if (!(a_e > 0.0f)) return sum;
-  // E2: Y as the light tracer would reach it from Z (solid angle to area at Y).
-  float yz2 = 0.0f, y_geo = 0.0f;
-  if (second) {
-    const float3 dzy = y->h.p - v->h.p;
-    yz2 = dot(dzy, dzy);
-    if (!(yz2 > 0.0f)) return sum;
-    y_geo = fabs(dot(y->f.ng, dzy)) / (yz2 * sqrt(yz2));
-  }
+  const float3 dxy = y->h.p - xp;
+  const float dxy2 = dot(dxy, dxy);
+  if (!(dxy2 > 0.0f) || !(pdf_x > 0.0f)) return sum;
+  const float p_e = solid_angle_to_area_pdf(pdf_x, fabs(dot(y->f.ng, dxy)) / sqrt(dxy2), dxy2);
   for (uint c = 0u; c < rp->paths_per_pixel; ++c) {
     const uint slot = connector_slot(cn, c);
     const uint count = cn->headers[slot].vertex_count;
-    const u32 light = cn->headers[slot].light;
-    __global const LightVertex* lv = cn->vertices + (size_t)slot * rp->stride;
-    for (uint k = 0u; k < count && v->depth + k + 1u <= rp->max_depth; ++k) {
-      const float3 zp = vertex_pos(lv + k);
-      const float3 d = zp - v->h.p;
+    __global const LightVertex* v = cn->vertices + (size_t)slot * rp->stride;
+    for (uint k = 0u; k < count && y->depth + k + 1u <= rp->max_depth; ++k) {
+      const float3 zp = vertex_pos(v + k);
+      const float3 d = zp - y->h.p;
       const float dist2 = dot(d, d);
       if (!(dist2 > 0.0f)) continue;
-      if (second && !strategy_e2_takes_part(yz2, dist2, t)) continue;
-      const float3 dir = d * (1.0f / sqrt(dist2));  // from v to z
-      if (dot(dir, v->f.ng) <= 0.0f) continue;
+      const float3 dir = d * (1.0f / sqrt(dist2));  // from Y to z
+      if (dot(dir, y->f.ng) <= 0.0f) continue;
       float3 zng, f_z;
       float pdf_l, cos_z, corr = 1.0f;
       if (k == 0u) {
         // Vertex 0: the point on the light; f_z * tpz is its emission over the position pdf.
-        const u32 type = s->lights.lights[light].type;
+        const u32 type = s->lights.lights[cn->headers[slot].light].type;
         if (type != PR_LIGHT_TRIANGLE && type != PR_LIGHT_POINT) continue;
-        zng = oct_decode(lv[0].ng_oct);
-        pdf_l = light_emit_pdf(s, light, lv, dir);
+        zng = oct_decode(v[0].ng_oct);
+        pdf_l = light_emit_pdf(s, cn->headers[slot].light, v, dir);
         // The stored throughput is emission over (position pdf times pdf_l / cos).
         const int tri = type == PR_LIGHT_TRIANGLE;
         cos_z = tri ? fabs(dot(zng, dir)) : 1.0f;
         f_z = make_float3(1.0f, 1.0f, 1.0f) * (tri ? 0.5f * PR_INV_PI : 0.25f * PR_INV_PI);
       } else {
-        const LightPoint z = light_point(s, lv + k);
+        const LightPoint z = light_point(s, v + k);
         if (z.delta || !light_point_eval(&z, dir, &f_z, &pdf_l, &cos_z, &corr)) continue;
         zng = z.f.ng;
       }
-      // v's area pdf under the light tracer, from z.
-      const float a_l = solid_angle_to_area_pdf(pdf_l, fabs(dot(v->f.ng, dir)), dist2);
-      float pdf_v, w;
-      if (!second) {
-        // E's weight only falls where E2 takes part too: most candidates stop here.
-        w = connection_mis_weight(PR_STRATEGY_E, a_l, a_e, 0.0f, 0.0f, t);
-        if (!(w > 0.0f)) continue;
-        if (k >= 1u && strategy_e2_takes_part(dist2, lv[k].t * lv[k].t, t)) {
-          // E2 samples z from v, arriving from x; the light tracer reached z from z_{k-1}
-          // (q_l 0: E2 cannot connect z to z_{k-1}).
-          const float q_l = light_step_area_pdf(cn, light, lv, k, zng);
-          float q_e = 0.0f;
-          if (q_l > 0.0f) {
-            bsdf_eval(&v->f.bsdf, v->wol, to_local(dir, v->f.t, v->f.b, v->f.n), &pdf_v);
-            q_e = solid_angle_to_area_pdf(pdf_v, fabs(dot(zng, dir)), dist2);
-          }
-          w = connection_mis_weight(PR_STRATEGY_E, a_l, a_e, q_l, q_e, t);
-          if (!(w > 0.0f)) continue;
-        }
-      } else {
-        // The light tracer, arriving at v from z, would reach Y with v's BSDF the other way.
-        float pdf_zy;
-        bsdf_eval(&v->f.bsdf, to_local(dir, v->f.t, v->f.b, v->f.n), v->wol, &pdf_zy);
-        w = connection_mis_weight(PR_STRATEGY_E2, pdf_zy * y_geo, p_e, a_l, a_e, t);
-        if (!(w > 0.0f)) continue;
-      }
-      const float3 f_v = eye_point_eval(v, dir, &pdf_v);
-      const float3 tpz = make_float3(lv[k].tp_r, lv[k].tp_g, lv[k].tp_b);
-      const Ray r = (k == 0u && lv[0].prim == PR_INVALID_INDEX)
-                        ? spawn_ray(v->h.p, v->f.ng, dir, sqrt(dist2) * (1.0f - 1e-4f))
-                        : spawn_ray_to(v->h.p, v->f.ng, zp, zng);
+      const float p_l = solid_angle_to_area_pdf(pdf_l, fabs(dot(y->f.ng, dir)), dist2);
+      const float w = connection_mis_weight(PR_STRATEGY_E, p_l, p_e, rp->mis_threshold);
+      if (!(w > 0.0f)) continue;
+      float pdf_unused;
+      const float3 f_y = eye_point_eval(y, dir, &pdf_unused);
+      const float3 tpz = make_float3(v[k].tp_r, v[k].tp_g, v[k].tp_b);
+      const Ray r = (k == 0u && v[0].prim == PR_INVALID_INDEX)
+                        ? spawn_ray(y->h.p, y->f.ng, dir, sqrt(dist2) * (1.0f - 1e-4f))
+                        : spawn_ray_to(y->h.p, y->f.ng, zp, zng);
       uint clamped = 0u;
-      const float3 value = connection_value(cn, v->tp, f_v, fabs(dot(v->f.n, dir)), tpz, f_z, cos_z,
+      const float3 value = connection_value(cn, y->tp, f_y, fabs(dot(y->f.n, dir)), tpz, f_z, cos_z,
                                             dist2, corr, w, history ? 1.0f : cn->inv_c, &clamped);
-      const u32 strategy = second ? PR_STRATEGY_E2 : PR_STRATEGY_E;
       if (history) {
         cn->n.clamped += clamped;
         history_offer(cn, &cn->he, value, r, slot, k);
       } else {
-        sum += connection(cn, value, clamped, r, strategy);
+        sum += connection(cn, value, clamped, r, PR_STRATEGY_E);
       }
     }
   }
@@ -626,8 +541,6 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
   cn.hr.slot = cn.he.slot = PR_INVALID_INDEX;
   cn.hr.k = cn.he.k = 0u;
   cn.hr.p_sum = cn.he.p_sum = 0.0f;
-  // Strategy E2's BSDF samples, apart from the path's draws.
-  Rng r2 = rng_make(rp.seed, PR_RNG_SECOND, rp.frame, i, sample);
   EyePoint x = eye_point_at(&s, e.prim, e.inst, e.b1, e.b2, make_float3(e.wx, e.wy, e.wz),
                             make_float3(e.tp_r, e.tp_g, e.tp_b), e.depth);
   float3 L = make_float3(0.0f, 0.0f, 0.0f);
@@ -657,18 +570,13 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
     uint depth = x.depth;
     Ray ray = spawn_ray(x.h.p, x.f.ng, d, PR_INF_F);
     int found = 0;
-    // After strategy E at Y, this loop traces Y's own BSDF sample for strategy E2 (second): one
-    // call site each for tracing and for the strategy keeps the kernel's compile time down.
-    int second = 0;
-    EyePoint ys;  // Y
-    float p_e = 0.0f, pdf_y = 0.0f;
     for (uint chain = 0u; depth < rp.max_depth; ++chain) {
       Hit hit;
       ++bounce_rays;
       if (!trace_closest(&s, ray, &hit)) {
         // The environment: the sample from x shares it with next-event estimation at x.
         const float3 le = environment_radiance(&s, d);
-        if (!second && max3(le) > 0.0f)
+        if (max3(le) > 0.0f)
           L += t2 * le *
                (chain == 0u ? power_heuristic(pdf, environment_pdf(&s, x.h.p, x.f.n, d)) : 1.0f);
         break;
@@ -678,39 +586,13 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
       const EyePoint y = eye_point(&s, &h, -d, t2, depth + 1u);
       const int is_delta = bsdf_is_delta(&y.f.bsdf);
       // An emitter met by the sample from x: its MIS share against next-event estimation at x.
-      if (!second && chain == 0u && (s.sd.materials[h.material].flags & PR_MAT_EMISSIVE))
+      if (chain == 0u && (s.sd.materials[h.material].flags & PR_MAT_EMISSIVE))
         L +=
             t2 * surface_emission(&s, &h) * power_heuristic(pdf, emitter_pdf(&s, &h, x.h.p, x.f.n));
-      // Strategy L at x counts the paths through Y, apart from E's and E2's shares: E from Y
-      // (the first non-delta hit), E2 from Z (the hit of Y's sample).
-      int sampled = 0;
-      float a_e = 0.0f;
-      if (second) {
-        sampled = !is_delta;
-        if (sampled) a_e = sampled_area_pdf(ys.h.p, pdf_y, &y);
-      } else if (chain == 0u && !is_delta && rp.mis_threshold > 0.0f && !delta) {
-        sampled = 1;
-        a_e = p_e = sampled_area_pdf(x.h.p, pdf, &y);
-        ys = y;
-      }
-      if (sampled) L += strategy_sampled_vertex(&cn, &y, a_e, &ys, p_e, second, history_open);
-      if (second) break;
       if (chain == 0u && !is_delta) {
-        // Y's sample for E2, from its own stream; Z's connection to the light's vertex 0 makes
-        // the shortest path.
-        const float v0 = rng_next(&r2);
-        const float2 v12 = rng_next2(&r2);
-        PathStep ystep;
-        if (sampled && y.depth + 2u <= rp.max_depth &&
-            path_step(&y.f, y.wo, v0, v12.x, v12.y, PR_RADIANCE, &ystep) && !ystep.delta) {
-          second = 1;
-          pdf_y = ystep.pdf;
-          d = ystep.wi;
-          t2 = t2 * ystep.weight;
-          ray = spawn_ray(h.p, y.f.ng, d, PR_INF_F);
-          ++depth;
-          continue;
-        }
+        // Strategy L at x counts these paths, apart from E's share.
+        if (rp.mis_threshold > 0.0f && !delta)
+          L += strategy_sampled_vertex(&cn, x.h.p, pdf, &y, history_open);
         break;
       }
       ++depth;
