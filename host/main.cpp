@@ -143,6 +143,13 @@ int main(int argc, char** argv) {
                    "this many times C candidates; 0 = off")
       ->check(CLI::Range(0, 1000))
       ->capture_default_str();
+  render
+      ->add_option("--connection-history-period", ro.connectionHistoryPeriod,
+                   "With a connection history, the light paths each pixel sample connects to "
+                   "shift every this many frames: 1 gives the least error per frame, more keeps "
+                   "the noise steady for longer (less flicker)")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
   render->add_option(
       "--env", ro.env,
       "Environment light: an equirectangular map (.exr or .hdr; +Y up, its centre looking along "

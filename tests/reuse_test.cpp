@@ -342,6 +342,31 @@ TEST(Reuse, AConnectionHistoryDropsTheVerticesOfRetracedSlots) {
   EXPECT_LE(counterSum(still, "rays", "connection", 0), counterSum(still, "rays", "camera", 0));
 }
 
+// The history's light paths shift every --connection-history-period frames, and only then: in
+// renders whose periods group frames 0-3 alike the frames are bit-identical, and the first frame
+// where the groups part is the first that differs. (What a longer period buys, less flicker for
+// more error per frame, is measured by tools/evaluate.py and tools/bench_connections.py.)
+TEST(Reuse, AConnectionHistoryShiftsItsLightPathsOncePerPeriod) {
+  const std::string scene = test::sourcePath("scenes/cornell-dynamic.gltf");
+  const std::string args =
+      "--mode reuse --width 32 --height 24 --spp 1 --connections 1 --connection-history 20 ";
+  auto render = [&](int period) {
+    return test::renderFrames(scene, "0-3",
+                              args + "--connection-history-period " + std::to_string(period),
+                              "hist-period-" + std::to_string(period));
+  };
+  const std::string p1 = render(1), p2 = render(2), p4 = render(4), p8 = render(8);
+  auto same = [](const std::string& a, const std::string& b, int f) {
+    return test::frameImage(a, f).rgba == test::frameImage(b, f).rgba;
+  };
+  for (int f = 0; f <= 3; ++f) EXPECT_TRUE(same(p4, p8, f)) << "frame " << f;
+  EXPECT_TRUE(same(p2, p4, 0));
+  EXPECT_TRUE(same(p2, p4, 1));
+  EXPECT_FALSE(same(p2, p4, 2)) << "period 2 shifts at frame 2";
+  EXPECT_TRUE(same(p1, p2, 0));
+  EXPECT_FALSE(same(p1, p2, 1)) << "period 1 shifts at frame 1";
+}
+
 TEST(Reuse, ResampledConnectionsTraceOneRayPerEyeVertex) {
   const std::string scene = test::sourcePath("scenes/cornell-dynamic.gltf");
   auto stats = [&](const std::string& mode) {

@@ -65,6 +65,7 @@ struct RenderOptions {
   int connections = -1;        // RIS-chosen connections per eye vertex (1-4); 0: every candidate;
                                // -1: defaultConnections of the device
   int connectionHistory = 0;   // cap on a pixel sample's carried reservoir, per C; 0 = off
+  int connectionHistoryPeriod = 1;  // frames between moves of the history's light-path offset
   // The environment light (scene/environment.h): a map file, "none", or "" (a uniform one of
   // envColor where --env-color is given, else white where the scene has no lights, else none).
   std::string env;

@@ -110,7 +110,7 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
   setKernelArgs(eyeHit_, eyeSample + 1, eye_, radiance_, counters_);
   const cl_uint connectSample = setKernelArgs(connect_, scene_.setKernelArgs(connect_, 0), rp);
   setKernelArgs(connect_, connectSample + 1, eye_, headers_, vertices_, radiance_, counters_,
-                settings_.historyCap, frameStamp, changed_, history_);
+                settings_.historyCap, settings_.historyPeriod, frameStamp, changed_, history_);
   const cl_uint first = film_.first(), n = film_.end();
   for (int s = 0; s < settings_.spp; ++s) {
     CL_CHECK(eyeHit_.setArg(eyeSample, cl_uint(s)));

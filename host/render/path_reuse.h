@@ -23,11 +23,12 @@ struct PathReuseSettings {
   uint32_t lightPaths = 0;  // N_L; 0: one per pixel
   uint32_t pathsPerPixel = 4;
   float clamp = 0.0f;
-  float misThreshold = 4.0f;  // connection MIS (kernels/reuse/connect.cl); 0 = off
-  uint32_t resample = 0;      // resampled connections per eye vertex (connect.cl); 0: all
-  uint32_t historyCap = 0;    // connection history (connect.cl): carried candidates per C; 0: off
-  bool retraceAll = false;    // --mode retrace
-  bool fixedNoise = false;    // camera samples keyed by frame 0 on every frame
+  float misThreshold = 4.0f;   // connection MIS (kernels/reuse/connect.cl); 0 = off
+  uint32_t resample = 0;       // resampled connections per eye vertex (connect.cl); 0: all
+  uint32_t historyCap = 0;     // connection history (connect.cl): carried candidates per C; 0: off
+  uint32_t historyPeriod = 1;  // frames between moves of the history's light-path offset (>= 1)
+  bool retraceAll = false;     // --mode retrace
+  bool fixedNoise = false;     // camera samples keyed by frame 0 on every frame
 };
 
 class PathReuse : public Integrator {

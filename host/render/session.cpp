@@ -79,6 +79,9 @@ void validateRenderOptions(const RenderOptions& o) {
     throw InputError("--clamp: must be 0 (off) or positive");
   if (!(o.connectionMis >= 0.0f) || !std::isfinite(o.connectionMis))
     throw InputError("--connection-mis: must be 0 (off) or positive");
+  if (o.connectionHistoryPeriod < 1 || o.connectionHistoryPeriod > 1000)
+    throw InputError("--connection-history-period " + std::to_string(o.connectionHistoryPeriod) +
+                     ": must be 1 to 1000");
   if (!std::isfinite(o.exposure)) throw InputError("--exposure: must be finite");
   if (!(o.envStrength >= 0.0f) || !std::isfinite(o.envStrength))
     throw InputError("--env-strength: must be 0 or positive");
@@ -122,6 +125,7 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
         o.connections >= 0 ? o.connections
                            : defaultConnections((ctx_.device().type & CL_DEVICE_TYPE_GPU) != 0));
     r.historyCap = static_cast<uint32_t>(o.connectionHistory);
+    r.historyPeriod = static_cast<uint32_t>(o.connectionHistoryPeriod);
     r.retraceAll = o.mode == RenderMode::Retrace;
     r.fixedNoise = o.fixedNoise;
     integrator_ = std::make_unique<PathReuse>(ctx_, *gpu_, *film_, r);

@@ -67,7 +67,7 @@ typedef struct {
   Rng rr;  // the reservoir's draws
   ConnectCounts n;
   uint history_cap;     // 0: no connection history; else the most candidates it carries, per C
-  uint slot_offset;     // added to every slot: with a history, a random one per frame
+  uint slot_offset;     // added to every slot: with a history, a random one per period
   HistoryReservoir hr;  // strategy L's connections at the first eye vertex, carried
   HistoryReservoir he;  // strategy E's there, this frame's alone
 } Connector;
@@ -512,7 +512,7 @@ PR_INLINE float3 strategy_next_event(const Connector* cn, const EyePoint* x, Rng
 __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global const EyeVertex* eye,
                       __global const PathHeader* headers, __global const LightVertex* vertices,
                       __global float4* radiance, __global uint* counters, uint history_cap,
-                      uint frame_stamp, __global const uint* changed,
+                      uint history_period, uint frame_stamp, __global const uint* changed,
                       __global ConnectionHistory* history) {
   const uint i = (uint)get_global_id(0);
   if (i >= rp.pixel_count) return;
@@ -534,10 +534,12 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
   cn.n.candidates = cn.n.rays = cn.n.mis_rays = cn.n.unoccluded = cn.n.clamped = 0u;
   cn.n.history_kept = cn.n.history_dropped = 0u;
   cn.history_cap = history_cap;
-  // With a history, the light paths shift by a random offset each frame, so that the reservoir
-  // meets new candidates.
+  // With a history, the light paths shift by a random offset every history_period frames, so
+  // that the reservoir meets new candidates; between shifts the noise stays put (less flicker).
   cn.slot_offset =
-      history_cap > 0u ? pr_hash_u32(rp.seed ^ pr_hash_u32(rp.frame ^ 0x534c4f54u)) % rp.slots : 0u;
+      history_cap > 0u
+          ? pr_hash_u32(rp.seed ^ pr_hash_u32((rp.frame / history_period) ^ 0x534c4f54u)) % rp.slots
+          : 0u;
   cn.hr.slot = cn.he.slot = PR_INVALID_INDEX;
   cn.hr.k = cn.he.k = 0u;
   cn.hr.p_sum = cn.he.p_sum = 0.0f;
