@@ -36,8 +36,8 @@ CONFIGS = [("pathtrace", ["--mode", "pathtrace"]),
 # The connection history (reservoirs carried over frames; measure it with --frames 8 or more),
 # and the candidates it stands for drawn in one frame instead.
 CONFIGS += [("reuse K=1 H20", ["--mode", "reuse", "--connections", "1", "--connection-history", "20"]),
-            ("reuse K=1 H20 P1", ["--mode", "reuse", "--connections", "1", "--connection-history", "20",
-                                  "--connection-history-period", "1"]),
+            ("reuse K=1 H20 P4", ["--mode", "reuse", "--connections", "1", "--connection-history", "20",
+                                  "--connection-history-period", "4"]),
             ("reuse all H20", ["--mode", "reuse", "--connections", "all", "--connection-history", "20"]),
             ("reuse K=1 C16", ["--mode", "reuse", "--connections", "1", "--paths-per-pixel", "16"])]
 ASPECT = {"cornell-dynamic": 0.75, "cornell-skinned": 0.75, "atrium": 0.5625}
