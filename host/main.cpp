@@ -148,7 +148,6 @@ int main(int argc, char** argv) {
                    "With a connection history, the light paths each pixel sample connects to "
                    "shift every this many frames: 1 gives the least error per frame, more keeps "
                    "the noise steady for longer (less flicker)")
-      ->check(CLI::Range(1, 1000))
       ->capture_default_str();
   render->add_option(
       "--env", ro.env,

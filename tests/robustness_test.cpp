@@ -353,6 +353,19 @@ TEST(DeviceMemory, AbsurdSizesAreBadInput) {
   }
 }
 
+TEST(BadOptions, HistoryPeriodOutOfRangeIsOneLineAndExitTwo) {
+  for (const char* period : {"0", "1001", "-3"}) {
+    const std::string dir = test::tempDir("bad-period");
+    const auto r =
+        test::runPathreuse("render '" + kScene + "' --frames 0 --connection-history-period " +
+                           period + " --out '" + dir + "/f_%04d.exr'");
+    EXPECT_EQ(r.exitCode, 2) << period << ": " << r.err;
+    EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find("--connection-history-period"), std::string::npos) << r.err;
+    EXPECT_TRUE(fs::is_empty(dir));
+  }
+}
+
 TEST(LoaderFromMemory, SameSceneAsFromTheFile) {
   std::string bytes;
   bytes = slurp(kScene);
