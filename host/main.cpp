@@ -149,6 +149,11 @@ int main(int argc, char** argv) {
                    "shift every this many frames: 1 gives the least error per frame, more keeps "
                    "the noise steady for longer (less flicker)")
       ->capture_default_str();
+  render->add_flag(
+      "--eye-paths", ro.eyePaths,
+      "Reuse/retrace: trace whole eye paths as the path tracer does and weigh them against the "
+      "connections to stored light paths over whole paths (MIS), so that connections count "
+      "where they sample a path better, and eye paths elsewhere (dark corners, occluded rooms)");
   render->add_option(
       "--env", ro.env,
       "Environment light: an equirectangular map (.exr or .hdr; +Y up, its centre looking along "

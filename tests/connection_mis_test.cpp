@@ -111,5 +111,36 @@ TEST(ConnectionMis, AreaPdfIntegratesToTheSolidAngle) {
   EXPECT_NEAR(total, want, 1e-4 * want);
 }
 
+// --eye-paths: the three strategies' weights, each from its own view of the same three
+// densities (the others over its own), add to 1; a strategy that cannot make the path (density
+// 0) gets 0.
+TEST(EyePathShare, WeightsAddToOneForEveryPath) {
+  const float inf = std::numeric_limits<float>::infinity();
+  std::vector<float> dens = {0.0f, 1e-30f, 1e-6f, 0.5f, 1.0f, 7.0f, 1e6f, 1e30f};
+  std::mt19937 gen(11);
+  std::uniform_real_distribution<float> logu(-15.0f, 15.0f);
+  for (int i = 0; i < 40; ++i) dens.push_back(std::exp(logu(gen)));
+  for (float l : dens)
+    for (float n : dens)
+      for (float h : dens) {
+        if (l + n + h == 0.0f) continue;  // no strategy makes the path
+        const float wl = eye_path_share(n / l, h / l), wn = eye_path_share(l / n, h / n),
+                    wh = eye_path_share(l / h, n / h);
+        ASSERT_GE(wl, 0.0f);
+        ASSERT_GE(wn, 0.0f);
+        ASSERT_GE(wh, 0.0f);
+        if (l == 0.0f) {
+          ASSERT_EQ(wl, 0.0f) << n << " " << h;
+        }
+        if (n == 0.0f) {
+          ASSERT_EQ(wn, 0.0f) << l << " " << h;
+        }
+        ASSERT_NEAR(wl + wn + wh, 1.0f, 1e-5f) << l << " " << n << " " << h;
+      }
+  // The power heuristic: a strategy twice as likely as the other, the third unable.
+  EXPECT_NEAR(eye_path_share(0.5f, 0.0f), 0.8f, 1e-6f);
+  EXPECT_EQ(eye_path_share(inf, 0.0f), 0.0f);
+}
+
 }  // namespace
 }  // namespace pr

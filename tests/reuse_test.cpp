@@ -427,6 +427,35 @@ TEST(Reuse, ConnectionMisStrategyEConvergesOnADiffuseScene) {
                   "--force-diffuse --connection-mis 0.001 --max-depth 6", 48, 36, 32, 2);
 }
 
+// --eye-paths (kernels/shared/eye_paths.h): the path tracer's eye paths and the connections make
+// the same paths, weighted against each other over whole paths. The weights must add to 1 on
+// every path, or the image moves (a connection weight 1.5 times too large fails these): on
+// glossy and delta materials, with area and point lights and an emitter among the light
+// vertices, with one resampled connection and a history where moving objects disturb the light
+// paths, and with an environment whose light paths are left to the eye paths.
+TEST(Reuse, EyePathsConvergeToThePathTracer) {
+  expectSameImage(test::sourcePath("scenes/cornell-dynamic.gltf"), "--max-depth 6 --eye-paths", 48,
+                  36, 64, 2);
+  expectSameImage(sweepScene(), "--max-depth 6 --eye-paths --env-color 0.2,0.2,0.3", 48, 36, 32, 2);
+}
+
+TEST(Reuse, EyePathsConvergeWithAHistoryWhereMovingObjectsDisturbThePaths) {
+  expectSameImage(sweepScene(),
+                  "--fps 4 --max-depth 6 --eye-paths --connections 1 --connection-history 20", 48,
+                  36, 32, 2, 3);
+}
+
+// Every wall a light: paths end on emitters at every depth, by all three strategies.
+TEST(Reuse, WhiteFurnaceConvergesWithEyePaths) {
+  expectFurnace(16, 20, 16384, "--eye-paths", "furnace-eye");
+}
+
+TEST(Reuse, EqualsRetraceWithEyePaths) {
+  expectReuseEqualsRetrace(test::sourcePath("scenes/cornell-dynamic.gltf"), "20-31", 20, 31,
+                           "--eye-paths --connections 1 --connection-history 20");
+  expectReuseEqualsRetrace(sweepScene(), "0-7", 0, 7, "--fps 8 --eye-paths");
+}
+
 // Twice the variance of a mode, from two renders with different seeds: mean over pixels and
 // channels of (a - b)^2, relative as in the evaluation's relMSE.
 double twiceRelativeVariance(const std::string& scene, const std::string& args,

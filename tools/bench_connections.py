@@ -40,6 +40,13 @@ CONFIGS += [("reuse K=1 H20", ["--mode", "reuse", "--connections", "1", "--conne
                                   "--connection-history-period", "4"]),
             ("reuse all H20", ["--mode", "reuse", "--connections", "all", "--connection-history", "20"]),
             ("reuse K=1 C16", ["--mode", "reuse", "--connections", "1", "--paths-per-pixel", "16"])]
+# Eye paths (--eye-paths): the path tracer's eye paths with the connections, MIS over whole paths.
+CONFIGS += [("eye all", ["--mode", "reuse", "--eye-paths", "--connections", "all"]),
+            ("eye K=1", ["--mode", "reuse", "--eye-paths", "--connections", "1"]),
+            ("eye K=1 C1", ["--mode", "reuse", "--eye-paths", "--connections", "1",
+                            "--paths-per-pixel", "1"]),
+            ("eye K=1 H20", ["--mode", "reuse", "--eye-paths", "--connections", "1",
+                             "--connection-history", "20"])]
 ASPECT = {"cornell-dynamic": 0.75, "cornell-skinned": 0.75, "atrium": 0.5625}
 
 

@@ -65,6 +65,12 @@ python3 tools/gen_atrium.py --size 0.02 --light lanterns --out "$work/lanterns/a
 for mode in pathtrace reuse; do
   run "lanterns-$mode" "$work/lanterns/atrium.gltf" --frames 0-1 --mode "$mode" --light-sampler bvh
 done
+# Eye paths weighted against the connections (--eye-paths): with a history on the demo, and
+# among many triangle, point and spot lights.
+run "cornell-dynamic-reuse-eye-history" scenes/cornell-dynamic.gltf --frames 0-2 --mode reuse \
+  --eye-paths --connections 1 --connection-history 20
+run "lanterns-reuse-eye" "$work/lanterns/atrium.gltf" --frames 0-1 --mode reuse --eye-paths \
+  --light-sampler bvh
 # Normal maps (generated tangents) in every kernel that shades, under an environment map too.
 python3 tools/gen_atrium.py --size 0.02 --normal-maps --out "$work/bumps/atrium.gltf" >/dev/null
 python3 - "$work/bumps/sky.hdr" <<'PY'
@@ -80,4 +86,6 @@ for mode in pathtrace reuse; do
   run "atrium-normal-maps-env-$mode" "$work/bumps/atrium.gltf" --frames 0-1 --mode "$mode" \
     --camera 1 --env "$work/bumps/sky.hdr" --env-rotate 40
 done
+run "atrium-normal-maps-env-eye" "$work/bumps/atrium.gltf" --frames 0-1 --mode reuse --eye-paths \
+  --camera 1 --env "$work/bumps/sky.hdr" --env-rotate 40
 exit $fail

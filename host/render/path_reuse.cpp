@@ -55,6 +55,12 @@ PathReuse::PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseS
   changed_ = alloc("changed slot stamps", uint64_t(history ? slots_ : 1) * 4);
   const uint64_t records = history ? uint64_t(film.pixels()) * settings_.spp : 1;
   history_ = alloc("connection history", records * sizeof(dev::ConnectionHistory));
+  if (settings_.eyePaths) {
+    PathTracerSettings pt{settings_.spp, settings_.maxDepth, settings_.seed, settings_.fixedNoise};
+    pt.lightPaths = settings_.pathsPerPixel;
+    eyePaths_ = std::make_unique<PathTracer>(ctx, scene, film, pt);
+    bytes_ += eyePaths_->deviceBytes();
+  }
 }
 
 void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameStats* stats) {
@@ -70,7 +76,9 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
   rp.pixel_count = film_.end();  // the bound of the film's pixels [first, end)
   rp.frame = settings_.fixedNoise ? 0u : static_cast<uint32_t>(frame);  // RNG key only
   rp.clamp = settings_.clamp;
-  rp.mis_threshold = settings_.misThreshold;
+  // With eye paths, strategy E's paths are the path tracer's.
+  rp.mis_threshold = settings_.eyePaths ? 0.0f : settings_.misThreshold;
+  rp.eye_paths = settings_.eyePaths ? 1u : 0u;
   PR_CHECK(settings_.resample <= PR_MAX_CONNECTIONS);  // the CLI allows 1-4
   rp.resample = settings_.resample;
   rp.trace_total = scene_.traceTotalPower();
@@ -110,18 +118,27 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
   setKernelArgs(eyeHit_, eyeSample + 1, eye_, radiance_, counters_);
   const cl_uint connectSample = setKernelArgs(connect_, scene_.setKernelArgs(connect_, 0), rp);
   setKernelArgs(connect_, connectSample + 1, eye_, headers_, vertices_, radiance_, counters_,
-                settings_.historyCap, settings_.historyPeriod, frameStamp, changed_, history_);
+                settings_.historyCap, settings_.historyPeriod, frameStamp, changed_, history_,
+                scene_.traceCdf());
+  if (eyePaths_) eyePaths_->beginFrame(frame, camera, radiance_, eye_);
   const cl_uint first = film_.first(), n = film_.end();
   for (int s = 0; s < settings_.spp; ++s) {
-    CL_CHECK(eyeHit_.setArg(eyeSample, cl_uint(s)));
+    // With eye paths, the path tracer's pass writes the sample's radiance and its first eye
+    // vertex, where eye_hit would.
+    if (eyePaths_) {
+      eyePaths_->tracePass(s, &timer);
+    } else {
+      CL_CHECK(eyeHit_.setArg(eyeSample, cl_uint(s)));
+      ctx_.launch1D(eyeHit_, first, n, "eye_hit", &timer);
+    }
     CL_CHECK(connect_.setArg(connectSample, cl_uint(s)));
-    ctx_.launch1D(eyeHit_, first, n, "eye_hit", &timer);
     ctx_.launch1D(connect_, first, n, "connect", &timer);
     film_.accumulate(radiance_, &timer);
     // Wait for each pass, so that an interrupt stops a frame of many samples within one pass.
     ctx_.finish();
     if (interrupted()) return;
   }
+  if (eyePaths_) eyePaths_->reportRays(stats);
   cl_uint c[dev::PR_C_COUNT] = {};
   CL_CHECK(ctx_.queue().enqueueReadBuffer(counters_, CL_TRUE, 0, sizeof c, c));
   auto times = timer.collect();

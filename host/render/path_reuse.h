@@ -6,12 +6,14 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "cl/context.h"
 #include "render/film.h"
 #include "render/gpu_scene.h"
 #include "render/integrator.h"
+#include "render/path_tracer.h"
 #include "shared/arena.h"
 
 namespace pr {
@@ -27,6 +29,7 @@ struct PathReuseSettings {
   uint32_t resample = 0;       // resampled connections per eye vertex (connect.cl); 0: all
   uint32_t historyCap = 0;     // connection history (connect.cl): carried candidates per C; 0: off
   uint32_t historyPeriod = 1;  // frames between moves of the history's light-path offset (>= 1)
+  bool eyePaths = false;       // connections weighted against the path tracer's eye paths
   bool retraceAll = false;     // --mode retrace
   bool fixedNoise = false;     // camera samples keyed by frame 0 on every frame
 };
@@ -56,6 +59,7 @@ class PathReuse : public Integrator {
   cl::Kernel invalidate_, lightTrace_, eyeHit_, connect_;
   cl::Buffer headers_, vertices_, list_, allSlots_, eye_, radiance_, counters_;
   cl::Buffer changed_, history_;  // the connection history's slot stamps and pixel reservoirs
+  std::unique_ptr<PathTracer> eyePaths_;  // --eye-paths: the eye paths of every sample
   uint64_t bytes_ = 0;
 };
 

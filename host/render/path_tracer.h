@@ -15,6 +15,10 @@ struct PathTracerSettings {
   int maxDepth = 8;
   uint32_t seed = 1;
   bool fixedNoise = false;  // RNG keyed by frame 0 on every frame
+  // --eye-paths: C light paths per camera sample that path reuse joins to each first eye
+  // vertex; the ends of eye paths on lights are weighted against those connections
+  // (kernels/shared/eye_paths.h). 0: the path tracer alone.
+  uint32_t lightPaths = 0;
 };
 
 class PathTracer : public Integrator {
@@ -23,13 +27,24 @@ class PathTracer : public Integrator {
   void renderFrame(int frame, const dev::CameraParams& camera, FrameStats* stats) override;
   uint64_t deviceBytes() const override { return bytes_; }
 
+  // One frame's kernel arguments, with the samples' radiance written to `radiance` (one float4
+  // per pixel) and, with lightPaths > 0, each sample's first non-delta vertex to `eye` (one
+  // EyeVertex per pixel); then one pass per sample index, which leaves both for the caller.
+  void beginFrame(int frame, const dev::CameraParams& camera, const cl::Buffer& radiance,
+                  const cl::Buffer& eye);
+  void tracePass(int sample, StageTimer* timer);
+  // The rays the passes since beginFrame traced, into stats.
+  void reportRays(FrameStats* stats);
+
  private:
   Context& ctx_;
   GpuScene& scene_;
   Film& film_;
   PathTracerSettings settings_;
   cl::Kernel generate_, extend_, shade_, shadow_;
+  cl_uint generateSample_ = 0, shadeSample_ = 0;  // the `sample` arguments' indices
   cl::Buffer states_, hits_, radiance_, shadows_, rays_;
+  cl::Buffer noEye_;  // the eye-vertex argument when nothing is written there
   uint64_t bytes_ = 0;
 };
 

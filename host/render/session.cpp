@@ -126,6 +126,7 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
                            : defaultConnections((ctx_.device().type & CL_DEVICE_TYPE_GPU) != 0));
     r.historyCap = static_cast<uint32_t>(o.connectionHistory);
     r.historyPeriod = static_cast<uint32_t>(o.connectionHistoryPeriod);
+    r.eyePaths = o.eyePaths;
     r.retraceAll = o.mode == RenderMode::Retrace;
     r.fixedNoise = o.fixedNoise;
     integrator_ = std::make_unique<PathReuse>(ctx_, *gpu_, *film_, r);

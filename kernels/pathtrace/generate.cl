@@ -1,12 +1,15 @@
 // pt_generate: one work-item per pixel. Reads the camera; writes a fresh PathState with the
-// camera ray through a jittered point of the pixel (random dimensions 0 and 1), and zero radiance.
+// camera ray through a jittered point of the pixel (random dimensions 0 and 1), and zero radiance;
+// with write_eye (--eye-paths), marks the sample's EyeVertex empty.
+#include "shared/arena.h"
 #include "shared/bvh.h"
 #include "shared/camera.h"
 #include "shared/path_state.h"
 #include "shared/rng.h"
 
 __kernel void pt_generate(CameraParams cam, uint seed, uint frame, uint sample,
-                          __global PathState* states, __global float4* radiance, uint count) {
+                          __global PathState* states, __global float4* radiance, uint count,
+                          __global EyeVertex* eye, uint write_eye) {
   const uint i = (uint)get_global_id(0);
   if (i >= count) return;
   Rng rng = rng_make(seed, PR_RNG_CAMERA, frame, i, sample);
@@ -23,7 +26,12 @@ __kernel void pt_generate(CameraParams cam, uint seed, uint frame, uint sample,
   s.prev_y = cam.py;
   s.prev_z = cam.pz;
   s.prev_nx = s.prev_ny = s.prev_nz = 0.0f;
+  s.x1_depth = 0u;
+  s.eye_ratio = 1.0f;
+  s.seg_cos = 0.0f;
+  s.eye_flags = 0u;
   s.pad = 0u;
   states[i] = s;
   radiance[i] = (float4)(0.0f, 0.0f, 0.0f, 0.0f);
+  if (write_eye) eye[i].prim = PR_INVALID_INDEX;  // until pt_shade meets x_1
 }

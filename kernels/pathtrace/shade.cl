@@ -1,13 +1,36 @@
 // pt_shade: one work-item per live path. Reads the path and its hit; adds emission (MIS-weighted
 // against next-event estimation) to the sample's radiance, writes a shadow ray for next-event
 // estimation, samples the BSDF for the next ray and applies Russian roulette.
-// Writes the PathState, the radiance and the ShadowRay of the same index.
-#include "shared/integrator.h"
+// With light_paths = C > 0 (--eye-paths), the eye path's ends on a light are weighted against
+// the reuse connections that make the same paths too (shared/eye_paths.h): the path keeps the
+// ratio of the two ways' densities of its vertices beyond x_1 as it goes.
+// With light_paths > 0, x_1 (the first non-delta vertex) is written to the sample's EyeVertex for
+// connect. Writes the PathState, the radiance and the ShadowRay of the same index.
+#include "shared/arena.h"
+#include "shared/eye_paths.h"
 #include "shared/path_state.h"
+
+// L's density of the path over that of the eye path's vertices beyond x_1 (p->eye_ratio
+// holds the rest), for a path ending at x_t on light li at z0, with cos_x = |cos| at x_t
+// and d2 the squared distance; rev = the light-tracing density of x_{t-1} from x_t (1 at t = 2).
+PR_INLINE float eye_paths_light_side(const SceneData* s, const PathState* p, u32 light_paths,
+                                     __global const float* trace_cdf, float trace_total, u32 li,
+                                     float3 z0, float3 xt, float cos_x, float rev) {
+  const Light l = s->lights.lights[li];
+  if (!eye_paths_light(&l) || !(trace_total > 0.0f)) return 0.0f;
+  const float3 d = xt - z0;
+  const float d2 = dot(d, d);
+  const float3 n_tri =
+      l.type == PR_LIGHT_TRIANGLE ? eye_paths_light_normal(s, &l) : make_float3(0.0f, 0.0f, 1.0f);
+  return (float)light_paths * eye_paths_start_density(&l, li, trace_cdf, trace_total) *
+         eye_paths_emit_density(&l, n_tri, d * (1.0f / sqrt(d2)), cos_x, d2) * rev * p->eye_ratio;
+}
 
 __kernel void pt_shade(PR_SCENE_PARAMS, __global PathState* states, __global const Hit* hits,
                        __global float4* radiance, __global ShadowRay* shadows, uint count,
-                       uint seed, uint frame, uint sample, uint max_depth) {
+                       uint seed, uint frame, uint sample, uint max_depth, uint light_paths,
+                       __global const float* trace_cdf, float trace_total,
+                       __global EyeVertex* eye) {
   const uint i = (uint)get_global_id(0);
   if (i >= count) return;
   const SceneData s = PR_SCENE();
@@ -39,26 +62,111 @@ __kernel void pt_shade(PR_SCENE_PARAMS, __global PathState* states, __global con
   const float3 wo = -d;
   const SurfaceHit h = surface_at(&s.sd, hit.prim, hit.inst, hit.u, hit.v);
   float3 tp = make_float3(p.tp_r, p.tp_g, p.tp_b) * volume_transmittance(&s, &h, d, hit.t);
+  const float3 prev = make_float3(p.prev_x, p.prev_y, p.prev_z);
+  const float3 prev_n = make_float3(p.prev_nx, p.prev_ny, p.prev_nz);
+  const float dist2 = hit.t * hit.t;
+  // Connections can make the paths that end after x_t, t >= 2 (x_t: the vertex `ray` left).
+  const int joinable =
+      light_paths > 0u && (p.eye_flags & PR_EYE_JOINABLE) && p.depth >= p.x1_depth + 1u;
 
   PR_GLOBAL const Material* mat = s.sd.materials + h.material;
   if (mat->flags & PR_MAT_EMISSIVE) {
     const float3 le = surface_emission(&s, &h);
     float w = 1.0f;
-    if (!(p.flags & PR_PATH_SPECULAR))
-      w = power_heuristic(p.last_pdf, emitter_pdf(&s, &h, make_float3(p.prev_x, p.prev_y, p.prev_z),
-                                                  make_float3(p.prev_nx, p.prev_ny, p.prev_nz)));
+    const u32 li = emitter_light(&s, &h);
+    if (joinable && li != PR_INVALID_INDEX) {
+      // H's density of z0 against N's and L's (see eye_paths.h).
+      const Light l = s.lights.lights[li];
+      const float3 n_tri = eye_paths_light_normal(&s, &l);
+      const float cos_z = fabs(dot(n_tri, d));
+      const float dens_h =
+          (p.flags & PR_PATH_SPECULAR) ? 1.0f : solid_angle_to_area_pdf(p.last_pdf, cos_z, dist2);
+      const float dens_n = (p.flags & PR_PATH_SPECULAR)
+                               ? 0.0f
+                               : eye_paths_nee_density(&s, &l, li, prev, prev_n, h.p, n_tri);
+      const float dens_l = eye_paths_light_side(&s, &p, light_paths, trace_cdf, trace_total, li,
+                                                h.p, prev, p.seg_cos, 1.0f);
+      w = eye_path_share(dens_n / dens_h, dens_l / dens_h);
+    } else if (!(p.flags & PR_PATH_SPECULAR)) {
+      w = power_heuristic(p.last_pdf, emitter_pdf(&s, &h, prev, prev_n));
+    }
     const float3 add = tp * le * w;
     radiance[i] += (float4)(add.x, add.y, add.z, 0.0f);
   }
   p.depth += 1u;
+  const ShadingFrame f = shading_frame(&s, &h, wo);
+  const int delta_here = bsdf_is_delta(&f.bsdf);
+  if (light_paths > 0u) {
+    if (p.x1_depth == 0u) {
+      if (!delta_here && p.depth < max_depth) {
+        // x_1: the eye vertex that connect joins to the stored light paths.
+        p.x1_depth = p.depth;
+        EyeVertex e;
+        e.px = h.p.x;
+        e.py = h.p.y;
+        e.pz = h.p.z;
+        e.ng_oct = oct_encode(h.ng);
+        e.wx = wo.x;
+        e.wy = wo.y;
+        e.wz = wo.z;
+        e.ns_oct = oct_encode(h.ns);
+        e.tp_r = tp.x;
+        e.tp_g = tp.y;
+        e.tp_b = tp.z;
+        e.depth = p.depth;
+        e.prim = hit.prim;
+        e.inst = hit.inst;
+        e.b1 = hit.u;
+        e.b2 = hit.v;
+        eye[p.pixel] = e;
+      }
+    } else {
+      if (p.depth == p.x1_depth + 1u) p.eye_flags = delta_here ? 0u : PR_EYE_JOINABLE;
+      // This vertex's eye density (x_t, t >= 2): 1 when sampled from a delta vertex.
+      if (!(p.flags & PR_PATH_SPECULAR))
+        p.eye_ratio /= solid_angle_to_area_pdf(p.last_pdf, fabs(dot(h.ng, d)), dist2);
+    }
+  }
+  // x_t with t >= 3: the light tracer's density of x_{t-1}, reached from this vertex.
+  const int has_rev =
+      light_paths > 0u && (p.eye_flags & PR_EYE_JOINABLE) && p.depth >= p.x1_depth + 2u;
   if (p.depth >= max_depth) {
     p.alive = 0u;
   } else {
-    const ShadingFrame f = shading_frame(&s, &h, wo);
-    if (!bsdf_is_delta(&f.bsdf)) {
+    if (!delta_here) {
       Ray shadow;
       float3 c;
-      if (next_event(&s, &h, &f, wo, 1, &rng, &shadow, &c)) {
+      NextEventChoice ch;
+      const int here_joinable =
+          light_paths > 0u && (p.eye_flags & PR_EYE_JOINABLE) && p.depth >= p.x1_depth + 1u;
+      if (next_event(&s, &h, &f, wo, !here_joinable, &rng, &shadow, &c, &ch)) {
+        if (here_joinable) {
+          // N's density of z0 against H's and L's.
+          const Light l = s.lights.lights[ch.light];
+          float w = 0.0f;
+          if (eye_paths_light(&l)) {
+            const float3 n_tri = l.type == PR_LIGHT_TRIANGLE ? eye_paths_light_normal(&s, &l)
+                                                             : make_float3(0.0f, 0.0f, 1.0f);
+            const float3 dz = ch.pos - h.p;
+            const float dz2 = dot(dz, dz);
+            const float3 wi = dz * (1.0f / sqrt(dz2));
+            const float dens_n = eye_paths_nee_density(&s, &l, ch.light, h.p, f.n, ch.pos, n_tri);
+            const float dens_h =
+                l.type == PR_LIGHT_TRIANGLE
+                    ? solid_angle_to_area_pdf(ch.pdf_bsdf, fabs(dot(n_tri, wi)), dz2)
+                    : 0.0f;
+            const float rev =
+                has_rev ? solid_angle_to_area_pdf(eye_paths_bsdf_pdf(&f, wi, wo), p.seg_cos, dist2)
+                        : 1.0f;
+            const float dens_l =
+                eye_paths_light_side(&s, &p, light_paths, trace_cdf, trace_total, ch.light, ch.pos,
+                                     h.p, fabs(dot(f.ng, wi)), rev);
+            w = eye_path_share(dens_h / dens_n, dens_l / dens_n);
+          } else {
+            w = ch.delta ? 1.0f : power_heuristic(ch.pdf_light, ch.pdf_bsdf);
+          }
+          c = c * w;
+        }
         c = tp * c;
         shadows[i].ray = shadow;
         shadows[i].c_r = c.x;
@@ -79,6 +187,10 @@ __kernel void pt_shade(PR_SCENE_PARAMS, __global PathState* states, __global con
       // From the third vertex on (the camera's throughput starts at 1).
       const float rr = rng_next(&rng);
       if (p.depth >= 3u && !russian_roulette(max3(tp), rr, &tp)) p.alive = 0u;
+      if (has_rev && !delta_here)
+        p.eye_ratio *=
+            solid_angle_to_area_pdf(eye_paths_bsdf_pdf(&f, step.wi, wo), p.seg_cos, dist2);
+      p.seg_cos = fabs(dot(f.ng, step.wi));
       p.ray = spawn_ray(h.p, f.ng, step.wi, PR_INF_F);
       p.prev_x = h.p.x;
       p.prev_y = h.p.y;

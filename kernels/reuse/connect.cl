@@ -28,6 +28,7 @@
 #include "shared/reuse.h"
 // After reuse.h: its FP_CONTRACT OFF (shared/bvh.h) holds for these weights too.
 #include "shared/connection_mis.h"
+#include "shared/eye_paths.h"
 
 // The connections kept so far among an eye vertex's candidates: rp.resample of them, each
 // chosen independently among all (with replacement), sharing the sum of the weights.
@@ -70,6 +71,7 @@ typedef struct {
   uint slot_offset;     // added to every slot: with a history, a random one per period
   HistoryReservoir hr;  // strategy L's connections at the first eye vertex, carried
   HistoryReservoir he;  // strategy E's there, this frame's alone
+  __global const float* trace_cdf;  // the light tracer's power table (--eye-paths weights)
 } Connector;
 
 // A shaded point on the eye side of a connection.
@@ -223,13 +225,117 @@ PR_INLINE float3 reservoir_resolve(Connector* cn) {
   return out;
 }
 
+// --eye-paths: what L's weight against the eye path's strategies needs of a stored light path,
+// gathered vertex by vertex as a connection walks it (shared/eye_paths.h; z_k the vertex
+// reached, z_0 on the light).
+typedef struct {
+  int on;            // the path's light takes part
+  u32 li;            // its light
+  float light_dens;  // C x the light tracer's densities of z_0 .. z_k
+  float eye_dens;    // the eye's densities of z_1 .. z_{k-2}, each sampled from the next vertex
+  float nee;         // next-event estimation's density of z_0 from z_1 (0: z_1 delta)
+  float hit;         // the eye's density of z_0 from z_1, arriving from z_2 (1: z_1 delta)
+  float pdf_next;    // solid-angle pdf of the light tracer's step from z_k
+  int delta_k;       // z_k is delta: densities sampled from it count as 1
+  float3 n_tri;      // the light triangle's normal
+  float3 ng_prev;    // geometric normal of z_{k-1}
+  float3 ng_k;       // and of z_k
+  Light light;
+} EyeWalk;
+
+PR_INLINE EyeWalk eye_walk_start(const Connector* cn, uint slot) {
+  EyeWalk w;
+  w.li = cn->headers[slot].light;
+  w.light = cn->s->lights.lights[w.li];
+  w.on = cn->rp->eye_paths && eye_paths_light(&w.light) && cn->rp->trace_total > 0.0f;
+  w.light_dens =
+      w.on ? (float)cn->rp->paths_per_pixel *
+                 eye_paths_start_density(&w.light, w.li, cn->trace_cdf, cn->rp->trace_total)
+           : 0.0f;
+  w.eye_dens = 1.0f;
+  w.nee = 0.0f;
+  w.hit = 1.0f;
+  w.pdf_next = 0.0f;
+  w.delta_k = 0;
+  w.n_tri = (w.on && w.light.type == PR_LIGHT_TRIANGLE) ? eye_paths_light_normal(cn->s, &w.light)
+                                                        : make_float3(0.0f, 0.0f, 1.0f);
+  w.ng_prev = w.ng_k = w.n_tri;
+  return w;
+}
+
+// Arriving at z_k (rebuilt as y), k >= 1: its light-tracing density; at z_1, next-event
+// estimation's density of z_0.
+PR_INLINE void eye_walk_arrive(const Connector* cn, EyeWalk* w, __global const LightVertex* v,
+                               uint k, const LightPoint* y) {
+  w->ng_prev = w->ng_k;
+  w->ng_k = y->h.ng;
+  const float3 dir = vertex_dir(v + k);
+  const float cos_k = fabs(dot(y->h.ng, dir)), t2 = v[k].t * v[k].t;
+  if (k == 1u) {
+    w->light_dens *= eye_paths_emit_density(&w->light, w->n_tri, dir, cos_k, t2);
+    if (!y->delta)
+      w->nee =
+          eye_paths_nee_density(cn->s, &w->light, w->li, y->h.p, y->f.n, vertex_pos(v), w->n_tri);
+  } else if (!w->delta_k) {
+    w->light_dens *= solid_angle_to_area_pdf(w->pdf_next, cos_k, t2);
+  }
+  w->delta_k = y->delta;
+}
+
+// Leaving z_k (rebuilt as y) for z_{k+1}, after z_k's connection: the eye's density of z_{k-1}
+// sampled from z_k arriving from z_{k+1}, and the light tracer's pdf of the step.
+PR_INLINE void eye_walk_leave(EyeWalk* w, __global const LightVertex* v, uint k,
+                              const LightPoint* y) {
+  const float3 next = vertex_dir(v + k + 1u);
+  float rev = 1.0f;
+  w->pdf_next = 0.0f;
+  if (!y->delta) {
+    const float3 nl = to_local(next, y->f.t, y->f.b, y->f.n);
+    bsdf_eval(&y->f.bsdf, y->wprevl, nl, &w->pdf_next);
+    bsdf_eval(&y->f.bsdf, nl, y->wprevl, &rev);
+  }
+  const float3 dir = vertex_dir(v + k);
+  const float t2 = v[k].t * v[k].t;
+  if (k == 1u) {
+    w->hit = y->delta ? 1.0f
+             : w->light.type == PR_LIGHT_TRIANGLE
+                 ? solid_angle_to_area_pdf(rev, fabs(dot(w->n_tri, dir)), t2)
+                 : 0.0f;
+  } else if (!y->delta) {
+    w->eye_dens *= solid_angle_to_area_pdf(rev, fabs(dot(w->ng_prev, dir)), t2);
+  }
+}
+
+// L's weight for the connection of the eye point x (BSDF pdf pdf_x towards y) to z_k = y at
+// distance^2 dist2 along dir: eye_path_share over N's and H's densities of the path against L's.
+PR_INLINE float eye_walk_weight(const EyeWalk* w, __global const LightVertex* v, uint k,
+                                const LightPoint* y, float pdf_x, float3 dir, float dist2) {
+  if (!w->on) return 0.0f;
+  float eye = solid_angle_to_area_pdf(pdf_x, fabs(dot(y->h.ng, dir)), dist2);
+  // The eye's density of z_{k-1} from y, arriving from x (z_0 for k = 1: H's).
+  float rev = 0.0f;
+  bsdf_eval(&y->f.bsdf, to_local(-dir, y->f.t, y->f.b, y->f.n), y->wprevl, &rev);
+  const float3 din = vertex_dir(v + k);
+  const float t2 = v[k].t * v[k].t;
+  float hit = w->hit;
+  if (k == 1u) {
+    hit = w->light.type == PR_LIGHT_TRIANGLE
+              ? solid_angle_to_area_pdf(rev, fabs(dot(w->n_tri, din)), t2)
+              : 0.0f;
+  } else {
+    eye *= solid_angle_to_area_pdf(rev, fabs(dot(w->ng_prev, din)), t2) * w->eye_dens;
+  }
+  return eye_path_share(eye * w->nee / w->light_dens, eye * hit / w->light_dens);
+}
+
 // Strategy L's connection from the eye point x to the light point y, rebuilt from stored vertex
 // vk, which the light tracer reached with solid-angle pdf pdf_arrive (0: strategy E cannot reach
 // it): its unshadowed contribution with its MIS weight and share `scale`, and its shadow ray; 0
-// where they do not connect.
+// where they do not connect. With --eye-paths, the weight is against the eye path's strategies
+// instead, from what walk w gathered up to z_k = y.
 PR_INLINE float3 light_vertex_value(const Connector* cn, const EyePoint* x, const LightPoint* y,
                                     __global const LightVertex* vk, float pdf_arrive, float scale,
-                                    Ray* ray, uint* clamped) {
+                                    const EyeWalk* w, uint k, Ray* ray, uint* clamped) {
   const float3 zero = make_float3(0.0f, 0.0f, 0.0f);
   const float3 dxy = y->h.p - x->h.p;
   const float dist2 = dot(dxy, dxy);
@@ -245,10 +351,12 @@ PR_INLINE float3 light_vertex_value(const Connector* cn, const EyePoint* x, cons
       solid_angle_to_area_pdf(pdf_arrive, fabs(dot(y->f.ng, vertex_dir(vk))), vk->t * vk->t);
   const float p_e =
       pdf_arrive > 0.0f ? solid_angle_to_area_pdf(pdf_x, fabs(dot(y->f.ng, dir)), dist2) : 0.0f;
-  const float w = connection_mis_weight(PR_STRATEGY_L, p_l, p_e, cn->rp->mis_threshold);
+  const float mis = cn->rp->eye_paths
+                        ? eye_walk_weight(w, vk - k, k, y, pdf_x, dir, dist2)
+                        : connection_mis_weight(PR_STRATEGY_L, p_l, p_e, cn->rp->mis_threshold);
   const float3 tpy = make_float3(vk->tp_r, vk->tp_g, vk->tp_b);
   *ray = spawn_ray_to(x->h.p, x->f.ng, y->h.p, y->f.ng);
-  return connection_value(cn, x->tp, f_x, fabs(dot(x->f.n, dir)), tpy, f_y, cos_y, dist2, corr, w,
+  return connection_value(cn, x->tp, f_x, fabs(dot(x->f.n, dir)), tpy, f_y, cos_y, dist2, corr, mis,
                           scale, clamped);
 }
 
@@ -260,8 +368,19 @@ PR_INLINE float3 light_vertex_value_at(const Connector* cn, const EyePoint* x, u
   __global const LightVertex* v = cn->vertices + (size_t)slot * cn->rp->stride;
   if (k < 1u || k >= cn->headers[slot].vertex_count || x->depth + k + 1u > cn->rp->max_depth)
     return zero;
+  EyeWalk w = eye_walk_start(cn, slot);
+  if (cn->rp->eye_paths) {
+    // The walk to z_k, as strategy_light_vertices makes it.
+    if (!w.on) return zero;
+    for (uint m = 1u; m < k; ++m) {
+      const LightPoint ym = light_point(s, v + m);
+      eye_walk_arrive(cn, &w, v, m, &ym);
+      eye_walk_leave(&w, v, m, &ym);
+    }
+  }
   const LightPoint y = light_point(s, v + k);
   if (y.delta) return zero;
+  if (cn->rp->eye_paths) eye_walk_arrive(cn, &w, v, k, &y);
   // The light tracer's pdf of the step to y_k, as strategy_light_vertices finds it.
   float pdf_arrive = 0.0f;
   if (cn->rp->mis_threshold > 0.0f) {
@@ -275,7 +394,7 @@ PR_INLINE float3 light_vertex_value_at(const Connector* cn, const EyePoint* x, u
     }
   }
   uint clamped = 0u;
-  return light_vertex_value(cn, x, &y, v + k, pdf_arrive, 1.0f, ray, &clamped);
+  return light_vertex_value(cn, x, &y, v + k, pdf_arrive, 1.0f, &w, k, ray, &clamped);
 }
 
 // A candidate of the connection history: kept with probability p / (sum of p so far).
@@ -309,8 +428,11 @@ PR_INLINE float3 strategy_light_vertices(Connector* cn, const EyePoint* x, int h
     float pdf_step = (mis && count > 1u)
                          ? light_emit_pdf(s, cn->headers[slot].light, v, vertex_dir(v + 1))
                          : 0.0f;
+    EyeWalk w = eye_walk_start(cn, slot);
+    if (rp->eye_paths && !w.on) continue;  // the path tracer's alone
     for (uint k = 1u; k < count && x->depth + k + 1u <= rp->max_depth; ++k) {
       const LightPoint y = light_point(s, v + k);
+      if (rp->eye_paths) eye_walk_arrive(cn, &w, v, k, &y);
       const float pdf_arrive = pdf_step;
       pdf_step = 0.0f;
       if (mis && !y.delta && k + 1u < count) {
@@ -318,11 +440,15 @@ PR_INLINE float3 strategy_light_vertices(Connector* cn, const EyePoint* x, int h
         bsdf_eval(&y.f.bsdf, y.wprevl, to_local(vertex_dir(v + k + 1u), y.f.t, y.f.b, y.f.n),
                   &pdf_step);
       }
-      if (y.delta) continue;
+      if (y.delta) {
+        if (rp->eye_paths && k + 1u < count) eye_walk_leave(&w, v, k, &y);
+        continue;
+      }
       Ray ray;
       uint clamped = 0u;
       const float3 value = light_vertex_value(cn, x, &y, v + k, pdf_arrive,
-                                              history ? 1.0f : cn->inv_c, &ray, &clamped);
+                                              history ? 1.0f : cn->inv_c, &w, k, &ray, &clamped);
+      if (rp->eye_paths && k + 1u < count) eye_walk_leave(&w, v, k, &y);
       if (history) {
         cn->n.clamped += clamped;
         history_offer(cn, &cn->hr, value, ray, slot, k);
@@ -502,7 +628,8 @@ PR_INLINE float3 strategy_next_event(const Connector* cn, const EyePoint* x, Rng
   }
   Ray shadow;
   float3 c;
-  if (!next_event(cn->s, &x->h, &x->f, x->wo, x->depth + 1u < cn->rp->max_depth, rng, &shadow, &c))
+  if (!next_event(cn->s, &x->h, &x->f, x->wo, x->depth + 1u < cn->rp->max_depth, rng, &shadow, &c,
+                  0))
     return make_float3(0.0f, 0.0f, 0.0f);
   ++*shadow_rays;
   if (trace_occluded(cn->s, shadow)) return make_float3(0.0f, 0.0f, 0.0f);
@@ -513,7 +640,7 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
                       __global const PathHeader* headers, __global const LightVertex* vertices,
                       __global float4* radiance, __global uint* counters, uint history_cap,
                       uint history_period, uint frame_stamp, __global const uint* changed,
-                      __global ConnectionHistory* history) {
+                      __global ConnectionHistory* history, __global const float* trace_cdf) {
   const uint i = (uint)get_global_id(0);
   if (i >= rp.pixel_count) return;
   const EyeVertex e = eye[i];
@@ -534,6 +661,7 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
   cn.n.candidates = cn.n.rays = cn.n.mis_rays = cn.n.unoccluded = cn.n.clamped = 0u;
   cn.n.history_kept = cn.n.history_dropped = 0u;
   cn.history_cap = history_cap;
+  cn.trace_cdf = trace_cdf;
   // With a history, the light paths shift by a random offset every history_period frames, so
   // that the reservoir meets new candidates; between shifts the noise stays put (less flicker).
   cn.slot_offset =
@@ -557,6 +685,11 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
     }
     // The previous eye vertex's kept connections (each vertex of a delta chain has its own).
     L += reservoir_resolve(&cn);
+    // With --eye-paths, the path tracer's eye paths make everything but L's connections at x.
+    if (rp.eye_paths) {
+      L += strategy_light_vertices(&cn, &x, history_open);
+      break;
+    }
     L += strategy_next_event(&cn, &x, &rng, &shadow_rays);
     L += strategy_light_vertices(&cn, &x, history_open);
     // The completeness extension: one BSDF direction, kept only through delta surfaces.

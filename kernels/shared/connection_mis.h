@@ -28,4 +28,16 @@ PR_INLINE float connection_mis_weight(u32 strategy, float p_l, float p_e, float 
   return strategy == PR_STRATEGY_L ? w_l : 1.0f - w_l;
 }
 
+// --eye-paths (docs/design.md section 5, "Eye paths"): the weight of one of the three strategies
+// that can make a path ending on a light, L (the first eye vertex joined to a stored light
+// vertex), N (the eye path's next-event estimation) and H (its BSDF sample meets the emitter),
+// given r1 and r2, the other two strategies' densities of the path over this one's: the power
+// heuristic 1 / (1 + r1^2 + r2^2). A NaN ratio (0 / 0: neither makes the path) counts as 0, an
+// infinite one gives 0. Computed from the same three densities, the weights add to 1.
+PR_INLINE float eye_path_share(float r1, float r2) {
+  const float a = r1 == r1 ? r1 * r1 : 0.0f;
+  const float b = r2 == r2 ? r2 * r2 : 0.0f;
+  return 1.0f / (1.0f + a + b);
+}
+
 PR_NAMESPACE_END

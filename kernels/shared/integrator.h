@@ -177,8 +177,19 @@ PR_INLINE float environment_pdf(const SceneData* s, float3 ref, float3 n_ref, fl
 // reuse, where BSDF-sampled hits on emitters are not counted).
 #define PR_NEXT_EVENT_DRAWS 2u  // rng_skip this many where next_event is not called
 
+// What next_event chose, for weights of its own (--eye-paths): the light, the point on it, and
+// the solid-angle pdfs of the direction under light sampling (as BSDF-sampled hits see it) and
+// under BSDF sampling.
+typedef struct {
+  u32 light;
+  int delta;
+  float3 pos;
+  float pdf_light, pdf_bsdf;
+} NextEventChoice;
+
 PR_INLINE int next_event(const SceneData* s, const SurfaceHit* h, const ShadingFrame* f, float3 wo,
-                         int use_mis, Rng* rng, Ray* shadow, float3* contribution) {
+                         int use_mis, Rng* rng, Ray* shadow, float3* contribution,
+                         NextEventChoice* choice) {
   const float2 us = rng_next2(rng);  // the light; the tree's resampling
   const float2 ul = rng_next2(rng);
   const float u1 = ul.x, u2 = ul.y;
@@ -212,6 +223,13 @@ PR_INLINE int next_event(const SceneData* s, const SurfaceHit* h, const ShadingF
       (ls.delta || !use_mis) ? 1.0f : power_heuristic(ls.pdf * (mis_pmf / pmf), bsdf_pdf);
   *contribution = fr * le * (cos_i * w / ls.pdf);
   if (max3(*contribution) <= 0.0f) return 0;
+  if (choice) {
+    choice->light = idx;
+    choice->delta = ls.delta;
+    choice->pos = ls.pos;
+    choice->pdf_light = ls.pdf * (mis_pmf / pmf);
+    choice->pdf_bsdf = bsdf_pdf;
+  }
   if (l.type == PR_LIGHT_TRIANGLE) {
     *shadow = spawn_ray_to(h->p, f->ng, ls.pos, ls.normal);
   } else {

@@ -6,7 +6,7 @@
 
 PR_NAMESPACE_BEGIN
 
-// 96 bytes.
+// 112 bytes.
 typedef struct {
   Ray ray;
   float tp_r, tp_g, tp_b;
@@ -18,10 +18,16 @@ typedef struct {
   u32 flags;                        // PR_PATH_*
   float prev_x, prev_y, prev_z;     // the vertex `ray` leaves and its shading normal (for the
   float prev_nx, prev_ny, prev_nz;  // emitter pdf of its hit)
+  // --eye-paths (shared/eye_paths.h), on the vertices x_2.. after the first non-delta one:
+  u32 x1_depth;     // depth of the first non-delta vertex x_1; 0: not met yet
+  float eye_ratio;  // prod of light-tracing densities of x_2..x_{t-1} / eye densities of x_2..x_t
+  float seg_cos;    // |cos| of `ray` with the geometric normal of the vertex it leaves
+  u32 eye_flags;    // PR_EYE_*
   u32 pad;
 } PathState;
 
 #define PR_PATH_SPECULAR 1u  // the last bounce was delta (or the ray is the camera ray)
+#define PR_EYE_JOINABLE 1u   // x_2 is non-delta: stored light paths can make this path's ends
 
 // A shadow ray with the contribution it carries if unoccluded. 48 bytes.
 typedef struct {
@@ -32,7 +38,7 @@ typedef struct {
 
 PR_NAMESPACE_END
 
-PR_STATIC_ASSERT(sizeof(pr::dev::PathState) == 96, "PathState layout");
+PR_STATIC_ASSERT(sizeof(pr::dev::PathState) == 112, "PathState layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::PathState, depth) == 48, "PathState layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::PathState, flags) == 64, "PathState layout");
 PR_STATIC_ASSERT(sizeof(pr::dev::ShadowRay) == 48, "ShadowRay layout");

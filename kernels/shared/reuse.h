@@ -8,7 +8,7 @@
 
 PR_NAMESPACE_BEGIN
 
-// 64 bytes, passed by value to every reuse kernel.
+// 80 bytes, passed by value to every reuse kernel.
 typedef struct {
   u32 seed;
   u32 slots;            // N_L
@@ -25,6 +25,8 @@ typedef struct {
   float cx, cy, cz;     // scene centre
   u32 resample;         // RIS-chosen connections per eye vertex, at most PR_MAX_CONNECTIONS;
                         // 0 = every candidate
+  u32 eye_paths;        // 1: connections weighted against the path tracer's (--eye-paths)
+  u32 pad0, pad1, pad2;
 } ReuseParams;
 
 // Most resampled connections per eye vertex (ReuseParams.resample; reservoir slots in connect).
@@ -78,5 +80,5 @@ PR_INLINE float shading_normal_correction(float3 wo, float3 wi, float3 ns, float
 
 PR_NAMESPACE_END
 
-PR_STATIC_ASSERT(sizeof(pr::dev::ReuseParams) == 64, "ReuseParams layout");
+PR_STATIC_ASSERT(sizeof(pr::dev::ReuseParams) == 80, "ReuseParams layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::ReuseParams, clamp) == 32, "ReuseParams layout");

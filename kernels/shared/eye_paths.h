@@ -1,0 +1,67 @@
+// --eye-paths (docs/design.md section 5, "Eye paths"): the path tracer's eye paths and the
+// reuse connections make the same paths, weighted against each other by eye_path_share over
+// three strategies: L (the first non-delta eye vertex x1 joined to the stored light vertex z_k),
+// N (the eye path's next-event estimation) and H (its BSDF sample meets the emitter). Each
+// strategy's density of a path is the product of the densities (per unit area) of the vertices
+// it samples beyond x1, with C light paths per camera sample counted in L's; a density sampled
+// from a delta vertex counts as 1 on both sides. Russian roulette is left out: any weights that
+// both sides compute alike add to 1, and the estimate stays unbiased. These helpers are what
+// connect (kernels/reuse) and pt_shade (kernels/pathtrace) share, so that they agree.
+#pragma once
+
+#include "shared/connection_mis.h"
+#include "shared/integrator.h"
+
+PR_NAMESPACE_BEGIN
+
+// The lights whose stored paths take part: emissive triangles and point lights. The others'
+// paths are the path tracer's alone.
+PR_INLINE int eye_paths_light(const Light* l) {
+  return l->type == PR_LIGHT_TRIANGLE || l->type == PR_LIGHT_POINT;
+}
+
+// The unit normal of an emissive triangle light, from the light table.
+PR_INLINE float3 eye_paths_light_normal(const SceneData* s, const Light* l) {
+  float3 v0, e1, e2;
+  triangle_world(&s->sd, l->prim, l->inst, &v0, &e1, &e2);
+  return normalize(cross(e1, e2));
+}
+
+// The density with which the light tracer starts on light li at a point: its power table's
+// pmf, over the area for triangles.
+PR_INLINE float eye_paths_start_density(const Light* l, u32 li, PR_GLOBAL const float* trace_cdf,
+                                        float trace_total) {
+  const float pmf = (trace_cdf[li] - (li > 0u ? trace_cdf[li - 1u] : 0.0f)) / trace_total;
+  return l->type == PR_LIGHT_TRIANGLE ? pmf / l->area : pmf;
+}
+
+// The density at a point (|cos| cos_x of its geometric normal with the segment, squared
+// distance d2) of the light tracer's first step from z0 along dir.
+PR_INLINE float eye_paths_emit_density(const Light* l, float3 n_tri, float3 dir, float cos_x,
+                                       float d2) {
+  return solid_angle_to_area_pdf(light_pdf_emit_dir(l, n_tri, dir), cos_x, d2);
+}
+
+// The density with which next-event estimation at x (shading normal n) picks the point z0 of
+// light li: per unit area on triangles, the pmf for point lights.
+PR_INLINE float eye_paths_nee_density(const SceneData* s, const Light* l, u32 li, float3 x,
+                                      float3 n, float3 z0, float3 n_tri) {
+  const float pmf = light_choice_pmf(&s->lights, li, x, n);
+  if (l->type != PR_LIGHT_TRIANGLE) return pmf;
+  float3 v0, e1, e2;
+  triangle_world(&s->sd, l->prim, l->inst, &v0, &e1, &e2);
+  const float3 d = z0 - x;
+  const float d2 = dot(d, d);
+  if (!(d2 > 0.0f)) return 0.0f;
+  return solid_angle_to_area_pdf(light_pdf_triangle(pmf, x, n, z0, v0, e1, e2),
+                                 fabs(dot(n_tri, d)) / sqrt(d2), d2);
+}
+
+// The solid-angle pdf with which the BSDF in frame f, sampled from wo, gives wi (0 if delta).
+PR_INLINE float eye_paths_bsdf_pdf(const ShadingFrame* f, float3 wo, float3 wi) {
+  float pdf = 0.0f;
+  bsdf_eval(&f->bsdf, to_local(wo, f->t, f->b, f->n), to_local(wi, f->t, f->b, f->n), &pdf);
+  return pdf;
+}
+
+PR_NAMESPACE_END
