@@ -74,21 +74,19 @@ __kernel void pt_shade(PR_SCENE_PARAMS, __global PathState* states, __global con
     const float3 le = surface_emission(&s, &h);
     float w = 1.0f;
     const u32 li = emitter_light(&s, &h);
+    if (!(p.flags & PR_PATH_SPECULAR))
+      w = power_heuristic(p.last_pdf, emitter_pdf(&s, &h, prev, prev_n));
     if (joinable && li != PR_INVALID_INDEX) {
-      // H's density of z0 against N's and L's (see eye_paths.h).
+      // The connections' share of the path (eye_paths.h); the eye path's N and H split the rest.
       const Light l = s.lights.lights[li];
       const float3 n_tri = eye_paths_light_normal(&s, &l);
-      const float cos_z = fabs(dot(n_tri, d));
+      const int spec = (p.flags & PR_PATH_SPECULAR) != 0u;
       const float dens_h =
-          (p.flags & PR_PATH_SPECULAR) ? 1.0f : solid_angle_to_area_pdf(p.last_pdf, cos_z, dist2);
-      const float dens_n = (p.flags & PR_PATH_SPECULAR)
-                               ? 0.0f
-                               : eye_paths_nee_density(&s, &l, li, prev, prev_n, h.p, n_tri);
+          spec ? 1.0f : solid_angle_to_area_pdf(p.last_pdf, fabs(dot(n_tri, d)), dist2);
       const float dens_l = eye_paths_light_side(&s, &p, light_paths, trace_cdf, trace_total, li,
                                                 h.p, prev, p.seg_cos, 1.0f);
-      w = eye_path_share(dens_n / dens_h, dens_l / dens_h);
-    } else if (!(p.flags & PR_PATH_SPECULAR)) {
-      w = power_heuristic(p.last_pdf, emitter_pdf(&s, &h, prev, prev_n));
+      const float dens_n = spec ? 0.0f : eye_paths_start_density(&l, li, trace_cdf, trace_total);
+      if (dens_l > 0.0f) w *= 1.0f - eye_path_share(dens_n / dens_l, dens_h / dens_l);
     }
     const float3 add = tp * le * w;
     radiance[i] += (float4)(add.x, add.y, add.z, 0.0f);
@@ -141,16 +139,16 @@ __kernel void pt_shade(PR_SCENE_PARAMS, __global PathState* states, __global con
           light_paths > 0u && (p.eye_flags & PR_EYE_JOINABLE) && p.depth >= p.x1_depth + 1u;
       if (next_event(&s, &h, &f, wo, !here_joinable, &rng, &shadow, &c, &ch)) {
         if (here_joinable) {
-          // N's density of z0 against H's and L's.
+          // The path tracer's weight, times what the connections leave of the path.
           const Light l = s.lights.lights[ch.light];
-          float w = 0.0f;
+          float w = ch.delta ? 1.0f : power_heuristic(ch.pdf_light, ch.pdf_bsdf);
           if (eye_paths_light(&l)) {
             const float3 n_tri = l.type == PR_LIGHT_TRIANGLE ? eye_paths_light_normal(&s, &l)
                                                              : make_float3(0.0f, 0.0f, 1.0f);
             const float3 dz = ch.pos - h.p;
             const float dz2 = dot(dz, dz);
             const float3 wi = dz * (1.0f / sqrt(dz2));
-            const float dens_n = eye_paths_nee_density(&s, &l, ch.light, h.p, f.n, ch.pos, n_tri);
+            const float dens_n = eye_paths_start_density(&l, ch.light, trace_cdf, trace_total);
             const float dens_h =
                 l.type == PR_LIGHT_TRIANGLE
                     ? solid_angle_to_area_pdf(ch.pdf_bsdf, fabs(dot(n_tri, wi)), dz2)
@@ -161,9 +159,7 @@ __kernel void pt_shade(PR_SCENE_PARAMS, __global PathState* states, __global con
             const float dens_l =
                 eye_paths_light_side(&s, &p, light_paths, trace_cdf, trace_total, ch.light, ch.pos,
                                      h.p, fabs(dot(f.ng, wi)), rev);
-            w = eye_path_share(dens_h / dens_n, dens_l / dens_n);
-          } else {
-            w = ch.delta ? 1.0f : power_heuristic(ch.pdf_light, ch.pdf_bsdf);
+            if (dens_l > 0.0f) w *= 1.0f - eye_path_share(dens_n / dens_l, dens_h / dens_l);
           }
           c = c * w;
         }

@@ -233,7 +233,7 @@ typedef struct {
   u32 li;            // its light
   float light_dens;  // C x the light tracer's densities of z_0 .. z_k
   float eye_dens;    // the eye's densities of z_1 .. z_{k-2}, each sampled from the next vertex
-  float nee;         // next-event estimation's density of z_0 from z_1 (0: z_1 delta)
+  float nee;         // next-event estimation's density of z_0 (0: z_1 delta)
   float hit;         // the eye's density of z_0 from z_1, arriving from z_2 (1: z_1 delta)
   float pdf_next;    // solid-angle pdf of the light tracer's step from z_k
   int delta_k;       // z_k is delta: densities sampled from it count as 1
@@ -273,9 +273,9 @@ PR_INLINE void eye_walk_arrive(const Connector* cn, EyeWalk* w, __global const L
   const float cos_k = fabs(dot(y->h.ng, dir)), t2 = v[k].t * v[k].t;
   if (k == 1u) {
     w->light_dens *= eye_paths_emit_density(&w->light, w->n_tri, dir, cos_k, t2);
+    // N's density of z_0, counted as the light tracer's (eye_paths.h); 0 where z_1 is delta.
     if (!y->delta)
-      w->nee =
-          eye_paths_nee_density(cn->s, &w->light, w->li, y->h.p, y->f.n, vertex_pos(v), w->n_tri);
+      w->nee = eye_paths_start_density(&w->light, w->li, cn->trace_cdf, cn->rp->trace_total);
   } else if (!w->delta_k) {
     w->light_dens *= solid_angle_to_area_pdf(w->pdf_next, cos_k, t2);
   }
@@ -369,18 +369,17 @@ PR_INLINE float3 light_vertex_value_at(const Connector* cn, const EyePoint* x, u
   if (k < 1u || k >= cn->headers[slot].vertex_count || x->depth + k + 1u > cn->rp->max_depth)
     return zero;
   EyeWalk w = eye_walk_start(cn, slot);
-  if (cn->rp->eye_paths) {
-    // The walk to z_k, as strategy_light_vertices makes it.
-    if (!w.on) return zero;
-    for (uint m = 1u; m < k; ++m) {
-      const LightPoint ym = light_point(s, v + m);
-      eye_walk_arrive(cn, &w, v, m, &ym);
-      eye_walk_leave(&w, v, m, &ym);
+  if (cn->rp->eye_paths && !w.on) return zero;
+  // With eye paths, the walk to z_k, as strategy_light_vertices makes it.
+  LightPoint y;
+  for (uint m = cn->rp->eye_paths ? 1u : k; m <= k; ++m) {
+    y = light_point(s, v + m);
+    if (cn->rp->eye_paths) {
+      eye_walk_arrive(cn, &w, v, m, &y);
+      if (m < k) eye_walk_leave(&w, v, m, &y);
     }
   }
-  const LightPoint y = light_point(s, v + k);
   if (y.delta) return zero;
-  if (cn->rp->eye_paths) eye_walk_arrive(cn, &w, v, k, &y);
   // The light tracer's pdf of the step to y_k, as strategy_light_vertices finds it.
   float pdf_arrive = 0.0f;
   if (cn->rp->mis_threshold > 0.0f) {
@@ -492,22 +491,31 @@ PR_INLINE float3 history_resolve(Connector* cn, const EyeVertex* e,
   Ray ray_prev;
   if (have_prev) {
     m_prev = fmin(prev.m, (float)cn->history_cap * mc);
-    if (prev.slot != PR_INVALID_INDEX && changed[prev.slot] <= prev.frame) {
-      c_prev = light_vertex_value_at(cn, x, prev.slot, prev_k, &ray_prev);
-      const float p_cur = luminance(c_prev);
-      const float den = m_prev * prev.p + mc * p_cur;
-      if (den > 0.0f && p_cur > 0.0f) w_prev = m_prev * prev.p / den * p_cur * prev.w;
-    } else if (prev.slot != PR_INVALID_INDEX) {
-      ++cn->n.history_dropped;
-    }
-    if (hr->slot != PR_INVALID_INDEX && changed[hr->slot] <= prev.frame) {
-      const EyePoint xp = eye_point_at(
-          cn->s, prev.prim, prev.inst, prev.b1, prev.b2, make_float3(prev.wx, prev.wy, prev.wz),
-          make_float3(prev.tp_r, prev.tp_g, prev.tp_b), prev.depth_k & 0xffffu);
-      Ray unused;
-      const float p_old = luminance(light_vertex_value_at(cn, &xp, hr->slot, hr->k, &unused));
-      const float p_cur = luminance(hr->c);
-      w_cur *= mc * p_cur / (m_prev * p_old + mc * p_cur);
+    const int prev_kept = prev.slot != PR_INVALID_INDEX && changed[prev.slot] <= prev.frame;
+    if (!prev_kept && prev.slot != PR_INVALID_INDEX) ++cn->n.history_dropped;
+    const EyePoint xp = eye_point_at(
+        cn->s, prev.prim, prev.inst, prev.b1, prev.b2, make_float3(prev.wx, prev.wy, prev.wz),
+        make_float3(prev.tp_r, prev.tp_g, prev.tp_b), prev.depth_k & 0xffffu);
+    // Two targets, in one loop (one copy of the evaluation in the program): the carried
+    // vertex's at x, and this frame's chosen vertex's at the carried eye vertex.
+    for (int q = 0; q < 2; ++q) {
+      const int carried = q == 0;
+      const uint slot = carried ? prev.slot : hr->slot;
+      if (slot == PR_INVALID_INDEX || changed[slot] > prev.frame) continue;
+      Ray ray;
+      const float3 c =
+          light_vertex_value_at(cn, carried ? x : &xp, slot, carried ? prev_k : hr->k, &ray);
+      if (carried) {
+        c_prev = c;
+        ray_prev = ray;
+        const float p_cur = luminance(c_prev);
+        const float den = m_prev * prev.p + mc * p_cur;
+        if (den > 0.0f && p_cur > 0.0f) w_prev = m_prev * prev.p / den * p_cur * prev.w;
+      } else {
+        const float p_old = luminance(c);
+        const float p_cur = luminance(hr->c);
+        w_cur *= mc * p_cur / (m_prev * p_old + mc * p_cur);
+      }
     }
   }
   const float total = w_cur + w_prev;
@@ -679,19 +687,14 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
   int history_open = history_cap > 0u;
   __global ConnectionHistory* hist = history + ((size_t)i * rp.spp + sample);
   for (uint vertex = 0u;; ++vertex) {
-    if (history_open && vertex > 0u) {
-      L += history_resolve(&cn, &e, hist, changed, frame_stamp);
-      history_open = 0;
-    }
+    // The history holds the first eye vertex's connections alone (resolved after the loop).
+    if (vertex > 0u) history_open = 0;
     // The previous eye vertex's kept connections (each vertex of a delta chain has its own).
     L += reservoir_resolve(&cn);
     // With --eye-paths, the path tracer's eye paths make everything but L's connections at x.
-    if (rp.eye_paths) {
-      L += strategy_light_vertices(&cn, &x, history_open);
-      break;
-    }
-    L += strategy_next_event(&cn, &x, &rng, &shadow_rays);
+    if (!rp.eye_paths) L += strategy_next_event(&cn, &x, &rng, &shadow_rays);
     L += strategy_light_vertices(&cn, &x, history_open);
+    if (rp.eye_paths) break;
     // The completeness extension: one BSDF direction, kept only through delta surfaces.
     const float u0 = rng_next(&rng);
     const float2 u12 = rng_next2(&rng);
@@ -751,7 +754,7 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
     }
     if (!found || !(max3(x.tp) < PR_INF_F)) break;
   }
-  if (history_open) L += history_resolve(&cn, &e, hist, changed, frame_stamp);
+  if (history_cap > 0u) L += history_resolve(&cn, &e, hist, changed, frame_stamp);
   L += reservoir_resolve(&cn);
   radiance[i] += (float4)(L.x, L.y, L.z, 0.0f);
   if (shadow_rays) atomic_add(counters + PR_C_SHADOW_RAYS, shadow_rays);

@@ -1,12 +1,14 @@
 // --eye-paths (docs/design.md section 5, "Eye paths"): the path tracer's eye paths and the
-// reuse connections make the same paths, weighted against each other by eye_path_share over
-// three strategies: L (the first non-delta eye vertex x1 joined to the stored light vertex z_k),
-// N (the eye path's next-event estimation) and H (its BSDF sample meets the emitter). Each
-// strategy's density of a path is the product of the densities (per unit area) of the vertices
-// it samples beyond x1, with C light paths per camera sample counted in L's; a density sampled
-// from a delta vertex counts as 1 on both sides. Russian roulette is left out: any weights that
-// both sides compute alike add to 1, and the estimate stays unbiased. These helpers are what
-// connect (kernels/reuse) and pt_shade (kernels/pathtrace) share, so that they agree.
+// reuse connections make the same paths. L (the first non-delta eye vertex x_1 joined to the
+// stored light vertex z_k) takes the share eye_path_share gives it against N (the eye path's
+// next-event estimation) and H (its BSDF sample meets the emitter), and the eye path the rest,
+// split between N and H by the path tracer's own power heuristic. Each strategy's density of a
+// path is the product of the densities (per unit area) of the vertices it samples beyond x_1,
+// with C light paths per camera sample counted in L's; a density sampled from a delta vertex
+// counts as 1 on both sides. N's choice of z_0 is counted as the light tracer's (its power
+// table, uniform on the triangle), and Russian roulette is left out: any share that both sides
+// compute alike keeps the estimate unbiased, and this one needs no light-tree walk in connect.
+// These helpers are what connect (kernels/reuse) and pt_shade (kernels/pathtrace) share.
 #pragma once
 
 #include "shared/connection_mis.h"
@@ -40,21 +42,6 @@ PR_INLINE float eye_paths_start_density(const Light* l, u32 li, PR_GLOBAL const 
 PR_INLINE float eye_paths_emit_density(const Light* l, float3 n_tri, float3 dir, float cos_x,
                                        float d2) {
   return solid_angle_to_area_pdf(light_pdf_emit_dir(l, n_tri, dir), cos_x, d2);
-}
-
-// The density with which next-event estimation at x (shading normal n) picks the point z0 of
-// light li: per unit area on triangles, the pmf for point lights.
-PR_INLINE float eye_paths_nee_density(const SceneData* s, const Light* l, u32 li, float3 x,
-                                      float3 n, float3 z0, float3 n_tri) {
-  const float pmf = light_choice_pmf(&s->lights, li, x, n);
-  if (l->type != PR_LIGHT_TRIANGLE) return pmf;
-  float3 v0, e1, e2;
-  triangle_world(&s->sd, l->prim, l->inst, &v0, &e1, &e2);
-  const float3 d = z0 - x;
-  const float d2 = dot(d, d);
-  if (!(d2 > 0.0f)) return 0.0f;
-  return solid_angle_to_area_pdf(light_pdf_triangle(pmf, x, n, z0, v0, e1, e2),
-                                 fabs(dot(n_tri, d)) / sqrt(d2), d2);
 }
 
 // The solid-angle pdf with which the BSDF in frame f, sampled from wo, gives wi (0 if delta).
