@@ -43,6 +43,10 @@ CONFIGS += [("reuse K=1 H20", ["--mode", "reuse", "--connections", "1", "--conne
 # Eye paths (--eye-paths): the path tracer's eye paths with the connections, MIS over whole paths.
 CONFIGS += [("eye all", ["--mode", "reuse", "--eye-paths", "--connections", "all"]),
             ("eye K=1", ["--mode", "reuse", "--eye-paths", "--connections", "1"]),
+            ("eye all C1", ["--mode", "reuse", "--eye-paths", "--connections", "all",
+                            "--paths-per-pixel", "1"]),
+            ("eye all C2", ["--mode", "reuse", "--eye-paths", "--connections", "all",
+                            "--paths-per-pixel", "2"]),
             ("eye K=1 C1", ["--mode", "reuse", "--eye-paths", "--connections", "1",
                             "--paths-per-pixel", "1"]),
             ("eye K=1 H20", ["--mode", "reuse", "--eye-paths", "--connections", "1",

@@ -25,6 +25,10 @@
 // The connection history (history_cap > 0, docs/design.md section 5): the first eye vertex's
 // connections are resampled into a reservoir that each pixel sample carries to the next frame
 // (history_resolve); one shadow ray there.
+//
+// With --eye-paths (rp.eye_paths), the path tracer's pass has written the sample's radiance and
+// x (its first non-delta vertex): connect adds strategy L there alone, each connection with its
+// share against the eye path's ways of making the same path (EyeWalk, shared/eye_paths.h).
 #include "shared/reuse.h"
 // After reuse.h: its FP_CONTRACT OFF (shared/bvh.h) holds for these weights too.
 #include "shared/connection_mis.h"
@@ -243,11 +247,15 @@ typedef struct {
   Light light;
 } EyeWalk;
 
-PR_INLINE EyeWalk eye_walk_start(const Connector* cn, uint slot) {
-  EyeWalk w;
+PR_INLINE void eye_walk_start(const Connector* cn, uint slot, EyeWalk* out) {
+  EyeWalk w = {0};
   w.li = cn->headers[slot].light;
-  w.light = cn->s->lights.lights[w.li];
-  w.on = cn->rp->eye_paths && eye_paths_light(&w.light) && cn->rp->trace_total > 0.0f;
+  // Without eye paths, or a slot with no light (none in the scene), the walk is off.
+  w.on = cn->rp->eye_paths && w.li != PR_INVALID_INDEX && cn->rp->trace_total > 0.0f;
+  if (w.on) {
+    w.light = cn->s->lights.lights[w.li];
+    w.on = eye_paths_light(&w.light);
+  }
   w.light_dens =
       w.on ? (float)cn->rp->paths_per_pixel *
                  eye_paths_start_density(&w.light, w.li, cn->trace_cdf, cn->rp->trace_total)
@@ -260,7 +268,7 @@ PR_INLINE EyeWalk eye_walk_start(const Connector* cn, uint slot) {
   w.n_tri = (w.on && w.light.type == PR_LIGHT_TRIANGLE) ? eye_paths_light_normal(cn->s, &w.light)
                                                         : make_float3(0.0f, 0.0f, 1.0f);
   w.ng_prev = w.ng_k = w.n_tri;
-  return w;
+  *out = w;
 }
 
 // Arriving at z_k (rebuilt as y), k >= 1: its light-tracing density; at z_1, next-event
@@ -368,7 +376,8 @@ PR_INLINE float3 light_vertex_value_at(const Connector* cn, const EyePoint* x, u
   __global const LightVertex* v = cn->vertices + (size_t)slot * cn->rp->stride;
   if (k < 1u || k >= cn->headers[slot].vertex_count || x->depth + k + 1u > cn->rp->max_depth)
     return zero;
-  EyeWalk w = eye_walk_start(cn, slot);
+  EyeWalk w;
+  eye_walk_start(cn, slot, &w);
   if (cn->rp->eye_paths && !w.on) return zero;
   // With eye paths, the walk to z_k, as strategy_light_vertices makes it.
   LightPoint y;
@@ -427,7 +436,8 @@ PR_INLINE float3 strategy_light_vertices(Connector* cn, const EyePoint* x, int h
     float pdf_step = (mis && count > 1u)
                          ? light_emit_pdf(s, cn->headers[slot].light, v, vertex_dir(v + 1))
                          : 0.0f;
-    EyeWalk w = eye_walk_start(cn, slot);
+    EyeWalk w;
+    eye_walk_start(cn, slot, &w);
     if (rp->eye_paths && !w.on) continue;  // the path tracer's alone
     for (uint k = 1u; k < count && x->depth + k + 1u <= rp->max_depth; ++k) {
       const LightPoint y = light_point(s, v + k);
@@ -496,26 +506,17 @@ PR_INLINE float3 history_resolve(Connector* cn, const EyeVertex* e,
     const EyePoint xp = eye_point_at(
         cn->s, prev.prim, prev.inst, prev.b1, prev.b2, make_float3(prev.wx, prev.wy, prev.wz),
         make_float3(prev.tp_r, prev.tp_g, prev.tp_b), prev.depth_k & 0xffffu);
-    // Two targets, in one loop (one copy of the evaluation in the program): the carried
-    // vertex's at x, and this frame's chosen vertex's at the carried eye vertex.
-    for (int q = 0; q < 2; ++q) {
-      const int carried = q == 0;
-      const uint slot = carried ? prev.slot : hr->slot;
-      if (slot == PR_INVALID_INDEX || changed[slot] > prev.frame) continue;
-      Ray ray;
-      const float3 c =
-          light_vertex_value_at(cn, carried ? x : &xp, slot, carried ? prev_k : hr->k, &ray);
-      if (carried) {
-        c_prev = c;
-        ray_prev = ray;
-        const float p_cur = luminance(c_prev);
-        const float den = m_prev * prev.p + mc * p_cur;
-        if (den > 0.0f && p_cur > 0.0f) w_prev = m_prev * prev.p / den * p_cur * prev.w;
-      } else {
-        const float p_old = luminance(c);
-        const float p_cur = luminance(hr->c);
-        w_cur *= mc * p_cur / (m_prev * p_old + mc * p_cur);
-      }
+    if (prev_kept) {
+      c_prev = light_vertex_value_at(cn, x, prev.slot, prev_k, &ray_prev);
+      const float p_cur = luminance(c_prev);
+      const float den = m_prev * prev.p + mc * p_cur;
+      if (den > 0.0f && p_cur > 0.0f) w_prev = m_prev * prev.p / den * p_cur * prev.w;
+    }
+    if (hr->slot != PR_INVALID_INDEX && changed[hr->slot] <= prev.frame) {
+      Ray unused;
+      const float p_old = luminance(light_vertex_value_at(cn, &xp, hr->slot, hr->k, &unused));
+      const float p_cur = luminance(hr->c);
+      w_cur *= mc * p_cur / (m_prev * p_old + mc * p_cur);
     }
   }
   const float total = w_cur + w_prev;
