@@ -6,8 +6,8 @@
 // ratio of the two ways' densities of its vertices beyond x_1 as it goes.
 // With light_paths > 0, x_1 (the first non-delta vertex) is written to the sample's EyeVertex for
 // connect. Writes the PathState, the radiance and the ShadowRay of the same index.
-#include "shared/arena.h"
 #include "shared/eye_paths.h"
+#include "shared/reuse.h"
 #include "shared/path_state.h"
 
 // L's density of the path over that of the eye path's vertices beyond x_1 (p->eye_ratio
@@ -100,22 +100,7 @@ __kernel void pt_shade(PR_SCENE_PARAMS, __global PathState* states, __global con
         // x_1: the eye vertex that connect joins to the stored light paths.
         p.x1_depth = p.depth;
         EyeVertex e;
-        e.px = h.p.x;
-        e.py = h.p.y;
-        e.pz = h.p.z;
-        e.ng_oct = oct_encode(h.ng);
-        e.wx = wo.x;
-        e.wy = wo.y;
-        e.wz = wo.z;
-        e.ns_oct = oct_encode(h.ns);
-        e.tp_r = tp.x;
-        e.tp_g = tp.y;
-        e.tp_b = tp.z;
-        e.depth = p.depth;
-        e.prim = hit.prim;
-        e.inst = hit.inst;
-        e.b1 = hit.u;
-        e.b2 = hit.v;
+        eye_vertex_set(&e, &h, &hit, wo, tp, p.depth);
         eye[p.pixel] = e;
       }
     } else {

@@ -32,22 +32,7 @@ __kernel void eye_hit(PR_SCENE_PARAMS, ReuseParams rp, CameraParams cam, uint sa
     if (depth >= rp.max_depth) break;
     const ShadingFrame f = shading_frame(&s, &h, wo);
     if (!bsdf_is_delta(&f.bsdf)) {
-      e.px = h.p.x;
-      e.py = h.p.y;
-      e.pz = h.p.z;
-      e.ng_oct = oct_encode(h.ng);
-      e.ns_oct = oct_encode(h.ns);
-      e.wx = wo.x;
-      e.wy = wo.y;
-      e.wz = wo.z;
-      e.tp_r = tp.x;
-      e.tp_g = tp.y;
-      e.tp_b = tp.z;
-      e.depth = depth;
-      e.prim = hit.prim;
-      e.inst = hit.inst;
-      e.b1 = hit.u;
-      e.b2 = hit.v;
+      eye_vertex_set(&e, &h, &hit, wo, tp, depth);
       break;
     }
     const float u0 = rng_next(&rng);

@@ -64,6 +64,28 @@ PR_INLINE Ray light_segment_ray(float3 p, u32 ng_oct, u32 prim, float3 dir) {
   return spawn_ray(p, oct_decode(ng_oct), dir, PR_INF_F);
 }
 
+// The first non-delta eye vertex of a pixel sample, as eye_hit (or, with --eye-paths, the path
+// tracer's pt_shade) finds it: hit h of ray `hit`, towards wo, with throughput tp, at `depth`.
+PR_INLINE void eye_vertex_set(EyeVertex* e, const SurfaceHit* h, const Hit* hit, float3 wo,
+                              float3 tp, u32 depth) {
+  e->px = h->p.x;
+  e->py = h->p.y;
+  e->pz = h->p.z;
+  e->ng_oct = oct_encode(h->ng);
+  e->ns_oct = oct_encode(h->ns);
+  e->wx = wo.x;
+  e->wy = wo.y;
+  e->wz = wo.z;
+  e->tp_r = tp.x;
+  e->tp_g = tp.y;
+  e->tp_b = tp.z;
+  e->depth = depth;
+  e->prim = hit->prim;
+  e->inst = hit->inst;
+  e->b1 = hit->u;
+  e->b2 = hit->v;
+}
+
 PR_INLINE float3 vertex_pos(PR_GLOBAL const LightVertex* v) {
   return make_float3(v->px, v->py, v->pz);
 }
