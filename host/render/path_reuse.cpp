@@ -21,6 +21,15 @@ void setLightPathCounter(FrameStats* stats, const char* key, uint64_t value) {
 
 }  // namespace
 
+cl_uint PathReuse::historySlotOffset(const dev::ReuseParams& rp) const {
+  // With a history, the light paths shift by a random offset every historyPeriod frames of the
+  // RNG's frame key, so that the reservoir meets new candidates; between shifts the noise stays
+  // put (less flicker). Without one, the fixed mapping.
+  if (settings_.historyCap == 0) return 0;
+  const uint32_t key = rp.frame / settings_.historyPeriod;
+  return dev::pr_hash_u32(rp.seed ^ dev::pr_hash_u32(key ^ 0x534c4f54u)) % rp.slots;
+}
+
 PathReuse::PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseSettings& settings)
     : ctx_(ctx), scene_(scene), film_(film), settings_(settings) {
   if (settings_.maxDepth < 2) throw InputError("--max-depth: path reuse needs at least 2");
@@ -118,7 +127,7 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
   setKernelArgs(eyeHit_, eyeSample + 1, eye_, radiance_, counters_);
   const cl_uint connectSample = setKernelArgs(connect_, scene_.setKernelArgs(connect_, 0), rp);
   setKernelArgs(connect_, connectSample + 1, eye_, headers_, vertices_, radiance_, counters_,
-                settings_.historyCap, settings_.historyPeriod, frameStamp, changed_, history_,
+                settings_.historyCap, historySlotOffset(rp), frameStamp, changed_, history_,
                 scene_.traceCdf());
   if (eyePaths_) eyePaths_->beginFrame(frame, camera, radiance_, eye_);
   const cl_uint first = film_.first(), n = film_.end();

@@ -15,6 +15,7 @@
 #include "render/integrator.h"
 #include "render/path_tracer.h"
 #include "shared/arena.h"
+#include "shared/reuse.h"
 
 namespace pr {
 
@@ -49,6 +50,9 @@ class PathReuse : public Integrator {
   void readArena(std::vector<dev::PathHeader>* headers, std::vector<dev::LightVertex>* vertices);
 
  private:
+  // The slot offset of the light paths each pixel sample connects to, this frame.
+  cl_uint historySlotOffset(const dev::ReuseParams& rp) const;
+
   Context& ctx_;
   GpuScene& scene_;
   Film& film_;

@@ -10,20 +10,16 @@
 #include "shared/reuse.h"
 #include "shared/path_state.h"
 
-// L's density of the path over that of the eye path's vertices beyond x_1 (p->eye_ratio
-// holds the rest), for a path ending at x_t on light li at z0, with cos_x = |cos| at x_t
-// and d2 the squared distance; rev = the light-tracing density of x_{t-1} from x_t (1 at t = 2).
-PR_INLINE float eye_paths_light_side(const SceneData* s, const PathState* p, u32 light_paths,
-                                     __global const float* trace_cdf, float trace_total, u32 li,
-                                     float3 z0, float3 xt, float cos_x, float rev) {
-  const Light l = s->lights.lights[li];
-  if (!eye_paths_light(&l) || !(trace_total > 0.0f)) return 0.0f;
+// L's density of the path over that of the eye path's vertices beyond x_1 (eye_ratio holds
+// the rest), for a path ending at x_t on light l (normal n_tri, start density `start`) at z0,
+// with cos_x = |cos| at x_t and rev = the light-tracing density of x_{t-1} from x_t (1 at t = 2).
+PR_INLINE float eye_paths_light_side(const Light* l, float3 n_tri, float start, u32 light_paths,
+                                     float eye_ratio, float3 z0, float3 xt, float cos_x,
+                                     float rev) {
   const float3 d = xt - z0;
   const float d2 = dot(d, d);
-  const float3 n_tri =
-      l.type == PR_LIGHT_TRIANGLE ? eye_paths_light_normal(s, &l) : make_float3(0.0f, 0.0f, 1.0f);
-  return (float)light_paths * eye_paths_start_density(&l, li, trace_cdf, trace_total) *
-         eye_paths_emit_density(&l, n_tri, d * (1.0f / sqrt(d2)), cos_x, d2) * rev * p->eye_ratio;
+  return (float)light_paths * start *
+         eye_paths_emit_density(l, n_tri, d * (1.0f / sqrt(d2)), cos_x, d2) * rev * eye_ratio;
 }
 
 __kernel void pt_shade(PR_SCENE_PARAMS, __global PathState* states, __global const Hit* hits,
@@ -73,19 +69,20 @@ __kernel void pt_shade(PR_SCENE_PARAMS, __global PathState* states, __global con
   if (mat->flags & PR_MAT_EMISSIVE) {
     const float3 le = surface_emission(&s, &h);
     float w = 1.0f;
-    const u32 li = emitter_light(&s, &h);
     if (!(p.flags & PR_PATH_SPECULAR))
       w = power_heuristic(p.last_pdf, emitter_pdf(&s, &h, prev, prev_n));
-    if (joinable && li != PR_INVALID_INDEX) {
+    const u32 li = joinable ? emitter_light(&s, &h) : PR_INVALID_INDEX;
+    if (li != PR_INVALID_INDEX) {
       // The connections' share of the path (eye_paths.h); the eye path's N and H split the rest.
       const Light l = s.lights.lights[li];
       const float3 n_tri = eye_paths_light_normal(&s, &l);
+      const float start = eye_paths_start_density(&l, li, trace_cdf, trace_total);
       const int spec = (p.flags & PR_PATH_SPECULAR) != 0u;
       const float dens_h =
           spec ? 1.0f : solid_angle_to_area_pdf(p.last_pdf, fabs(dot(n_tri, d)), dist2);
-      const float dens_l = eye_paths_light_side(&s, &p, light_paths, trace_cdf, trace_total, li,
-                                                h.p, prev, p.seg_cos, 1.0f);
-      const float dens_n = spec ? 0.0f : eye_paths_start_density(&l, li, trace_cdf, trace_total);
+      const float dens_l = eye_paths_light_side(&l, n_tri, start, light_paths, p.eye_ratio, h.p,
+                                                prev, p.seg_cos, 1.0f);
+      const float dens_n = spec ? 0.0f : start;
       if (dens_l > 0.0f) w *= 1.0f - eye_path_share(dens_n / dens_l, dens_h / dens_l);
     }
     const float3 add = tp * le * w;
@@ -141,9 +138,8 @@ __kernel void pt_shade(PR_SCENE_PARAMS, __global PathState* states, __global con
             const float rev =
                 has_rev ? solid_angle_to_area_pdf(eye_paths_bsdf_pdf(&f, wi, wo), p.seg_cos, dist2)
                         : 1.0f;
-            const float dens_l =
-                eye_paths_light_side(&s, &p, light_paths, trace_cdf, trace_total, ch.light, ch.pos,
-                                     h.p, fabs(dot(f.ng, wi)), rev);
+            const float dens_l = eye_paths_light_side(&l, n_tri, dens_n, light_paths, p.eye_ratio,
+                                                      ch.pos, h.p, fabs(dot(f.ng, wi)), rev);
             if (dens_l > 0.0f) w *= 1.0f - eye_path_share(dens_n / dens_l, dens_h / dens_l);
           }
           c = c * w;

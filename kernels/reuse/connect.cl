@@ -256,12 +256,10 @@ PR_INLINE void eye_walk_start(const Connector* cn, uint slot, EyeWalk* out) {
     w.light = cn->s->lights.lights[w.li];
     w.on = eye_paths_light(&w.light);
   }
-  w.light_dens =
-      w.on ? (float)cn->rp->paths_per_pixel *
-                 eye_paths_start_density(&w.light, w.li, cn->trace_cdf, cn->rp->trace_total)
-           : 0.0f;
+  // N's density of z_0 is counted as the light tracer's (eye_paths.h); 0 later if z_1 is delta.
+  w.nee = w.on ? eye_paths_start_density(&w.light, w.li, cn->trace_cdf, cn->rp->trace_total) : 0.0f;
+  w.light_dens = (float)cn->rp->paths_per_pixel * w.nee;
   w.eye_dens = 1.0f;
-  w.nee = 0.0f;
   w.hit = 1.0f;
   w.pdf_next = 0.0f;
   w.delta_k = 0;
@@ -271,19 +269,17 @@ PR_INLINE void eye_walk_start(const Connector* cn, uint slot, EyeWalk* out) {
   *out = w;
 }
 
-// Arriving at z_k (rebuilt as y), k >= 1: its light-tracing density; at z_1, next-event
-// estimation's density of z_0.
-PR_INLINE void eye_walk_arrive(const Connector* cn, EyeWalk* w, __global const LightVertex* v,
-                               uint k, const LightPoint* y) {
+// Arriving at z_k (rebuilt as y), k >= 1: its light-tracing density; at z_1, whether next-event
+// estimation can reach z_0 from it.
+PR_INLINE void eye_walk_arrive(EyeWalk* w, __global const LightVertex* v, uint k,
+                               const LightPoint* y) {
   w->ng_prev = w->ng_k;
   w->ng_k = y->h.ng;
   const float3 dir = vertex_dir(v + k);
   const float cos_k = fabs(dot(y->h.ng, dir)), t2 = v[k].t * v[k].t;
   if (k == 1u) {
     w->light_dens *= eye_paths_emit_density(&w->light, w->n_tri, dir, cos_k, t2);
-    // N's density of z_0, counted as the light tracer's (eye_paths.h); 0 where z_1 is delta.
-    if (!y->delta)
-      w->nee = eye_paths_start_density(&w->light, w->li, cn->trace_cdf, cn->rp->trace_total);
+    if (y->delta) w->nee = 0.0f;  // no next-event estimation from a delta z_1
   } else if (!w->delta_k) {
     w->light_dens *= solid_angle_to_area_pdf(w->pdf_next, cos_k, t2);
   }
@@ -384,7 +380,7 @@ PR_INLINE float3 light_vertex_value_at(const Connector* cn, const EyePoint* x, u
   for (uint m = cn->rp->eye_paths ? 1u : k; m <= k; ++m) {
     y = light_point(s, v + m);
     if (cn->rp->eye_paths) {
-      eye_walk_arrive(cn, &w, v, m, &y);
+      eye_walk_arrive(&w, v, m, &y);
       if (m < k) eye_walk_leave(&w, v, m, &y);
     }
   }
@@ -441,7 +437,7 @@ PR_INLINE float3 strategy_light_vertices(Connector* cn, const EyePoint* x, int h
     if (rp->eye_paths && !w.on) continue;  // the path tracer's alone
     for (uint k = 1u; k < count && x->depth + k + 1u <= rp->max_depth; ++k) {
       const LightPoint y = light_point(s, v + k);
-      if (rp->eye_paths) eye_walk_arrive(cn, &w, v, k, &y);
+      if (rp->eye_paths) eye_walk_arrive(&w, v, k, &y);
       const float pdf_arrive = pdf_step;
       pdf_step = 0.0f;
       if (mis && !y.delta && k + 1u < count) {
@@ -503,9 +499,6 @@ PR_INLINE float3 history_resolve(Connector* cn, const EyeVertex* e,
     m_prev = fmin(prev.m, (float)cn->history_cap * mc);
     const int prev_kept = prev.slot != PR_INVALID_INDEX && changed[prev.slot] <= prev.frame;
     if (!prev_kept && prev.slot != PR_INVALID_INDEX) ++cn->n.history_dropped;
-    const EyePoint xp = eye_point_at(
-        cn->s, prev.prim, prev.inst, prev.b1, prev.b2, make_float3(prev.wx, prev.wy, prev.wz),
-        make_float3(prev.tp_r, prev.tp_g, prev.tp_b), prev.depth_k & 0xffffu);
     if (prev_kept) {
       c_prev = light_vertex_value_at(cn, x, prev.slot, prev_k, &ray_prev);
       const float p_cur = luminance(c_prev);
@@ -513,6 +506,9 @@ PR_INLINE float3 history_resolve(Connector* cn, const EyeVertex* e,
       if (den > 0.0f && p_cur > 0.0f) w_prev = m_prev * prev.p / den * p_cur * prev.w;
     }
     if (hr->slot != PR_INVALID_INDEX && changed[hr->slot] <= prev.frame) {
+      const EyePoint xp = eye_point_at(
+          cn->s, prev.prim, prev.inst, prev.b1, prev.b2, make_float3(prev.wx, prev.wy, prev.wz),
+          make_float3(prev.tp_r, prev.tp_g, prev.tp_b), prev.depth_k & 0xffffu);
       Ray unused;
       const float p_old = luminance(light_vertex_value_at(cn, &xp, hr->slot, hr->k, &unused));
       const float p_cur = luminance(hr->c);
@@ -648,7 +644,7 @@ PR_INLINE float3 strategy_next_event(const Connector* cn, const EyePoint* x, Rng
 __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global const EyeVertex* eye,
                       __global const PathHeader* headers, __global const LightVertex* vertices,
                       __global float4* radiance, __global uint* counters, uint history_cap,
-                      uint history_period, uint frame_stamp, __global const uint* changed,
+                      uint slot_offset, uint frame_stamp, __global const uint* changed,
                       __global ConnectionHistory* history, __global const float* trace_cdf) {
   const uint i = (uint)get_global_id(0);
   if (i >= rp.pixel_count) return;
@@ -671,12 +667,7 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
   cn.n.history_kept = cn.n.history_dropped = 0u;
   cn.history_cap = history_cap;
   cn.trace_cdf = trace_cdf;
-  // With a history, the light paths shift by a random offset every history_period frames, so
-  // that the reservoir meets new candidates; between shifts the noise stays put (less flicker).
-  cn.slot_offset =
-      history_cap > 0u
-          ? pr_hash_u32(rp.seed ^ pr_hash_u32((rp.frame / history_period) ^ 0x534c4f54u)) % rp.slots
-          : 0u;
+  cn.slot_offset = slot_offset;  // 0 without a history (PathReuse::renderFrame)
   cn.hr.slot = cn.he.slot = PR_INVALID_INDEX;
   cn.hr.k = cn.he.k = 0u;
   cn.hr.p_sum = cn.he.p_sum = 0.0f;

@@ -30,9 +30,10 @@ PR_INLINE float3 eye_paths_light_normal(const SceneData* s, const Light* l) {
 }
 
 // The density with which the light tracer starts on light li at a point: its power table's
-// pmf, over the area for triangles.
+// pmf, over the area for triangles (0 without a table).
 PR_INLINE float eye_paths_start_density(const Light* l, u32 li, PR_GLOBAL const float* trace_cdf,
                                         float trace_total) {
+  if (!(trace_total > 0.0f)) return 0.0f;
   const float pmf = (trace_cdf[li] - (li > 0u ? trace_cdf[li - 1u] : 0.0f)) / trace_total;
   return l->type == PR_LIGHT_TRIANGLE ? pmf / l->area : pmf;
 }
