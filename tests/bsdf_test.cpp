@@ -242,11 +242,17 @@ void expectReciprocal(const BsdfParams& m, Rng r, int n) {
   for (int i = 0; i < n; ++i) {
     const float3 a = sample_cosine_hemisphere(rng_next(&r), rng_next(&r));
     const float3 b = sample_cosine_hemisphere(rng_next(&r), rng_next(&r));
-    float p;
-    const float3 fab = bsdf_eval(&m, a, b, &p), fba = bsdf_eval(&m, b, a, &p);
+    float p_ab, p_ba, p_both, p_rev;
+    const float3 fab = bsdf_eval(&m, a, b, &p_ab), fba = bsdf_eval(&m, b, a, &p_ba);
     EXPECT_NEAR(fab.x, fba.x, 1e-4f * std::fmax(1.0f, fab.x));
     EXPECT_NEAR(fab.y, fba.y, 1e-4f * std::fmax(1.0f, fab.y));
     EXPECT_NEAR(fab.z, fba.z, 1e-4f * std::fmax(1.0f, fab.z));
+    // One evaluation gives both directions' pdfs: the forward one bit for bit, the reverse
+    // one as evaluating the other way round does.
+    const float3 f_both = bsdf_eval_both(&m, a, b, &p_both, &p_rev);
+    EXPECT_EQ(f_both.x, fab.x);
+    EXPECT_EQ(p_both, p_ab);
+    EXPECT_NEAR(p_rev, p_ba, 1e-5f * std::fmax(1.0f, p_ba));
   }
 }
 
@@ -304,6 +310,9 @@ TEST(Bsdf, SpecularFactorZeroLeavesTheDiffuseBaseAndCoatAddsAReflection) {
 TEST(Bsdf, Reciprocity) {
   expectReciprocal(microfacet(make_float3(0.6f, 0.4f, 0.2f), 0.4f, 0.5f),
                    rng_make(6, PR_RNG_TEST, 0, 0, 0), 1000);
+  BsdfParams lambert = microfacet(make_float3(0.6f, 0.4f, 0.2f), 0.0f, 1.0f);
+  lambert.kind = PR_BSDF_LAMBERT;
+  expectReciprocal(lambert, rng_make(6, PR_RNG_TEST, 0, 0, 1), 200);
 }
 
 TEST(Bsdf, GlassConservesEnergyAndRefractsBySnell) {

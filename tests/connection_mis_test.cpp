@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "shared/connection_mis.h"
+#include "shared/eye_paths.h"
 #include "shared/sampling.h"
 
 namespace pr {
@@ -140,6 +141,76 @@ TEST(EyePathShare, WeightsAddToOneForEveryPath) {
   // The power heuristic: a strategy twice as likely as the other, the third unable.
   EXPECT_NEAR(eye_path_share(0.5f, 0.0f), 0.8f, 1e-6f);
   EXPECT_EQ(eye_path_share(inf, 0.0f), 0.0f);
+}
+
+// The light side that light_trace keeps per vertex (eye_path_walk_*) and connect finishes
+// (eye_path_weight) gives the same weight as the strategies' densities multiplied out along the
+// whole path, vertex by vertex, on random paths with delta vertices, triangle and point lights.
+TEST(EyePathShare, KeptRatiosGiveTheWeightOfTheWholePathsDensities) {
+  std::mt19937 gen(5);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  auto unit = [&] {
+    const float z = 2.0f * u(gen) - 1.0f, phi = 6.2831853f * u(gen), r = std::sqrt(1 - z * z);
+    return make_float3(r * std::cos(phi), r * std::sin(phi), z);
+  };
+  const float trace_cdf[2] = {0.25f, 1.0f};
+  int checked = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    Light l{};
+    l.type = trial % 3 == 2 ? PR_LIGHT_POINT : PR_LIGHT_TRIANGLE;
+    l.area = 0.1f + u(gen);
+    const u32 li = trial % 2;
+    const int tri = l.type == PR_LIGHT_TRIANGLE;
+    const float3 n_tri = tri ? unit() : make_float3(0.0f, 0.0f, 1.0f);
+    const float C = float(1 + trial % 4);
+    const float start = eye_paths_start_density(&l, li, trace_cdf, 1.0f);
+    const int K = 1 + trial % 5;  // vertices z_1 .. z_K
+    std::vector<float3> dir(K + 1), ng(K + 1);
+    std::vector<float> t(K + 1), fwd(K + 1), rev(K + 1);
+    std::vector<int> delta(K + 1);
+    ng[0] = n_tri;
+    for (int k = 1; k <= K; ++k) {
+      dir[k] = unit();
+      ng[k] = unit();
+      t[k] = 0.2f + 3.0f * u(gen);
+      fwd[k] = 0.05f + u(gen);
+      rev[k] = 0.05f + u(gen);
+      delta[k] = u(gen) < 0.25f;
+    }
+    EyePathWalk w = eye_path_walk_start(&l, li, n_tri, trace_cdf, 1.0f);
+    for (int k = 1; k <= K; ++k) {
+      const EyePathRatio r = eye_path_walk_arrive(&w, k, dir[k], t[k], ng[k]);
+      if (!delta[k]) {
+        // Join x_1 to z_k: x_1's pdf towards z_k, the cos and distance there, and z_k's pdf of
+        // sampling z_{k-1} arriving from x_1.
+        const float pdf_x = 0.05f + u(gen), cos_z = 0.05f + u(gen), d2 = 0.1f + 4.0f * u(gen);
+        const float rev_join = 0.05f + u(gen);
+        auto area = [](float pdf, float3 n, float3 d, float dist) {
+          return pdf * std::fabs(dot(n, d)) / (dist * dist);
+        };
+        // L: C paths, z_0 by the power table, then each step from the vertex before.
+        double dl = C * start * light_pdf_emit_dir(&l, n_tri, dir[1]) *
+                    std::fabs(dot(ng[1], dir[1])) / (t[1] * t[1]);
+        for (int m = 2; m <= k; ++m)
+          if (!delta[m - 1]) dl *= area(fwd[m - 1], ng[m], dir[m], t[m]);
+        // The eye path: z_k from x_1, then z_{m-1} from z_m for m = k .. 2; N ends by next-event
+        // estimation from z_1 (none from a delta z_1), H by z_1's BSDF sample.
+        double de = pdf_x * cos_z / d2;
+        for (int m = k; m >= 2; --m)
+          if (!delta[m]) de *= area(m == k ? rev_join : rev[m], ng[m - 1], dir[m], t[m]);
+        const double dn = delta[1] ? 0.0 : de * start;
+        const double dh = delta[1] ? de
+                          : tri    ? de * area(k == 1 ? rev_join : rev[1], n_tri, dir[1], t[1])
+                                   : 0.0;
+        const double expect = 1.0 / (1.0 + (dn / dl) * (dn / dl) + (dh / dl) * (dh / dl));
+        const float got = eye_path_weight(r, k, pdf_x, cos_z, d2, rev_join, 1.0f / C);
+        EXPECT_NEAR(got, expect, 1e-4 * std::max(1.0, expect)) << "trial " << trial << " k " << k;
+        ++checked;
+      }
+      eye_path_walk_leave(&w, k, delta[k], delta[k] ? 0.0f : fwd[k], delta[k] ? 0.0f : rev[k]);
+    }
+  }
+  EXPECT_GT(checked, 500);
 }
 
 }  // namespace

@@ -50,6 +50,9 @@ PathReuse::PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseS
   };
   // The arena first: the largest buffer, so a too large request fails naming it.
   vertices_ = alloc("light vertex arena", uint64_t(slots_) * stride_ * sizeof(dev::LightVertex));
+  // With eye paths, L's weights' light side beside each vertex; else one unread element.
+  ratios_ = alloc("eye-path ratios", (settings_.eyePaths ? uint64_t(slots_) * stride_ : 1) *
+                                         sizeof(dev::EyePathRatio));
   headers_ = alloc("path headers", uint64_t(slots_) * sizeof(dev::PathHeader));
   list_ = alloc("invalid slot list", uint64_t(slots_) * 4);
   allSlots_ = alloc("slot list", uint64_t(slots_) * 4);
@@ -117,7 +120,7 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
   // 2. Trace them.
   if (toTrace > 0) {
     setKernelArgs(lightTrace_, scene_.setKernelArgs(lightTrace_, 0), rp, scene_.traceCdf(),
-                  headers_, vertices_, *list, toTrace, counters_);
+                  headers_, vertices_, ratios_, *list, toTrace, counters_);
     ctx_.launch1D(lightTrace_, toTrace, "light_trace", &timer);
   }
 
@@ -128,7 +131,7 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
   const cl_uint connectSample = setKernelArgs(connect_, scene_.setKernelArgs(connect_, 0), rp);
   setKernelArgs(connect_, connectSample + 1, eye_, headers_, vertices_, radiance_, counters_,
                 settings_.historyCap, historySlotOffset(rp), frameStamp, changed_, history_,
-                scene_.traceCdf());
+                ratios_);
   if (eyePaths_) eyePaths_->beginFrame(frame, camera, radiance_, eye_);
   const cl_uint first = film_.first(), n = film_.end();
   for (int s = 0; s < settings_.spp; ++s) {

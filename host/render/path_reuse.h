@@ -44,7 +44,9 @@ class PathReuse : public Integrator {
   uint32_t slots() const { return slots_; }
   uint32_t stride() const { return stride_; }
   uint64_t arenaBytes() const {
-    return uint64_t(slots_) * (sizeof(dev::PathHeader) + stride_ * sizeof(dev::LightVertex));
+    const uint64_t vertex =
+        sizeof(dev::LightVertex) + (settings_.eyePaths ? sizeof(dev::EyePathRatio) : 0);
+    return uint64_t(slots_) * (sizeof(dev::PathHeader) + stride_ * vertex);
   }
   // The arena as it stands (for tests and diagnostics).
   void readArena(std::vector<dev::PathHeader>* headers, std::vector<dev::LightVertex>* vertices);
@@ -61,7 +63,7 @@ class PathReuse : public Integrator {
   bool first_ = true;
   uint32_t frames_ = 0;  // frames rendered with a connection history: its clock
   cl::Kernel invalidate_, lightTrace_, eyeHit_, connect_;
-  cl::Buffer headers_, vertices_, list_, allSlots_, eye_, radiance_, counters_;
+  cl::Buffer headers_, vertices_, ratios_, list_, allSlots_, eye_, radiance_, counters_;
   cl::Buffer changed_, history_;  // the connection history's slot stamps and pixel reservoirs
   std::unique_ptr<PathTracer> eyePaths_;  // --eye-paths: the eye paths of every sample
   uint64_t bytes_ = 0;

@@ -28,7 +28,8 @@
 //
 // With --eye-paths (rp.eye_paths), the path tracer's pass has written the sample's radiance and
 // x (its first non-delta vertex): connect adds strategy L there alone, each connection with its
-// share against the eye path's ways of making the same path (EyeWalk, shared/eye_paths.h).
+// share against the eye path's ways of making the same path (eye_path_weight, from the ratios
+// light_trace kept beside each vertex; shared/eye_paths.h).
 #include "shared/reuse.h"
 // After reuse.h: its FP_CONTRACT OFF (shared/bvh.h) holds for these weights too.
 #include "shared/connection_mis.h"
@@ -75,7 +76,7 @@ typedef struct {
   uint slot_offset;     // added to every slot: with a history, a random one per period
   HistoryReservoir hr;  // strategy L's connections at the first eye vertex, carried
   HistoryReservoir he;  // strategy E's there, this frame's alone
-  __global const float* trace_cdf;  // the light tracer's power table (--eye-paths weights)
+  __global const EyePathRatio* ratios;  // --eye-paths: beside the vertices (light_trace)
 } Connector;
 
 // A shaded point on the eye side of a connection.
@@ -135,12 +136,13 @@ PR_INLINE float3 eye_point_eval(const EyePoint* x, float3 dir, float* pdf) {
 }
 
 // The light side of a connection reached along dir (unit, from the eye side): its BSDF towards
-// -dir with the pdf of leaving along it, |cos| at its shading normal and the shading-normal
-// correction of light paths. 0 where it faces away from the eye side.
-PR_INLINE int light_point_eval(const LightPoint* y, float3 dir, float3* f, float* pdf, float* cos_t,
-                               float* corr) {
+// -dir with the pdf of leaving along it (and that of arriving from it, pdf_rev), |cos| at its
+// shading normal and the shading-normal correction of light paths. 0 where it faces away from
+// the eye side.
+PR_INLINE int light_point_eval(const LightPoint* y, float3 dir, float3* f, float* pdf,
+                               float* pdf_rev, float* cos_t, float* corr) {
   if (dot(-dir, y->f.ng) <= 0.0f) return 0;
-  *f = bsdf_eval(&y->f.bsdf, y->wprevl, to_local(-dir, y->f.t, y->f.b, y->f.n), pdf);
+  *f = bsdf_eval_both(&y->f.bsdf, y->wprevl, to_local(-dir, y->f.t, y->f.b, y->f.n), pdf, pdf_rev);
   *cos_t = fabs(dot(y->f.n, dir));
   *corr = shading_normal_correction(y->wprev, -dir, y->f.n, y->f.ng);
   return 1;
@@ -229,117 +231,22 @@ PR_INLINE float3 reservoir_resolve(Connector* cn) {
   return out;
 }
 
-// --eye-paths: what L's weight against the eye path's strategies needs of a stored light path,
-// gathered vertex by vertex as a connection walks it (shared/eye_paths.h; z_k the vertex
-// reached, z_0 on the light).
-typedef struct {
-  int on;            // the path's light takes part
-  u32 li;            // its light
-  float light_dens;  // C x the light tracer's densities of z_0 .. z_k
-  float eye_dens;    // the eye's densities of z_1 .. z_{k-2}, each sampled from the next vertex
-  float nee;         // next-event estimation's density of z_0 (0: z_1 delta)
-  float hit;         // the eye's density of z_0 from z_1, arriving from z_2 (1: z_1 delta)
-  float pdf_next;    // solid-angle pdf of the light tracer's step from z_k
-  int delta_k;       // z_k is delta: densities sampled from it count as 1
-  float3 n_tri;      // the light triangle's normal
-  float3 ng_prev;    // geometric normal of z_{k-1}
-  float3 ng_k;       // and of z_k
-  Light light;
-} EyeWalk;
-
-PR_INLINE void eye_walk_start(const Connector* cn, uint slot, EyeWalk* out) {
-  EyeWalk w = {0};
-  w.li = cn->headers[slot].light;
-  // Without eye paths, or a slot with no light (none in the scene), the walk is off.
-  w.on = cn->rp->eye_paths && w.li != PR_INVALID_INDEX && cn->rp->trace_total > 0.0f;
-  if (w.on) {
-    w.light = cn->s->lights.lights[w.li];
-    w.on = eye_paths_light(&w.light);
-  }
-  // N's density of z_0 is counted as the light tracer's (eye_paths.h); 0 later if z_1 is delta.
-  w.nee = w.on ? eye_paths_start_density(&w.light, w.li, cn->trace_cdf, cn->rp->trace_total) : 0.0f;
-  w.light_dens = (float)cn->rp->paths_per_pixel * w.nee;
-  w.eye_dens = 1.0f;
-  w.hit = 1.0f;
-  w.pdf_next = 0.0f;
-  w.delta_k = 0;
-  w.n_tri = (w.on && w.light.type == PR_LIGHT_TRIANGLE) ? eye_paths_light_normal(cn->s, &w.light)
-                                                        : make_float3(0.0f, 0.0f, 1.0f);
-  w.ng_prev = w.ng_k = w.n_tri;
-  *out = w;
-}
-
-// Arriving at z_k (rebuilt as y), k >= 1: its light-tracing density; at z_1, whether next-event
-// estimation can reach z_0 from it.
-PR_INLINE void eye_walk_arrive(EyeWalk* w, __global const LightVertex* v, uint k,
-                               const LightPoint* y) {
-  w->ng_prev = w->ng_k;
-  w->ng_k = y->h.ng;
-  const float3 dir = vertex_dir(v + k);
-  const float cos_k = fabs(dot(y->h.ng, dir)), t2 = v[k].t * v[k].t;
-  if (k == 1u) {
-    w->light_dens *= eye_paths_emit_density(&w->light, w->n_tri, dir, cos_k, t2);
-    if (y->delta) w->nee = 0.0f;  // no next-event estimation from a delta z_1
-  } else if (!w->delta_k) {
-    w->light_dens *= solid_angle_to_area_pdf(w->pdf_next, cos_k, t2);
-  }
-  w->delta_k = y->delta;
-}
-
-// Leaving z_k (rebuilt as y) for z_{k+1}, after z_k's connection: the eye's density of z_{k-1}
-// sampled from z_k arriving from z_{k+1}, and the light tracer's pdf of the step.
-PR_INLINE void eye_walk_leave(EyeWalk* w, __global const LightVertex* v, uint k,
-                              const LightPoint* y) {
-  const float3 next = vertex_dir(v + k + 1u);
-  float rev = 1.0f;
-  w->pdf_next = 0.0f;
-  if (!y->delta) {
-    const float3 nl = to_local(next, y->f.t, y->f.b, y->f.n);
-    bsdf_eval(&y->f.bsdf, y->wprevl, nl, &w->pdf_next);
-    bsdf_eval(&y->f.bsdf, nl, y->wprevl, &rev);
-  }
-  const float3 dir = vertex_dir(v + k);
-  const float t2 = v[k].t * v[k].t;
-  if (k == 1u) {
-    w->hit = y->delta ? 1.0f
-             : w->light.type == PR_LIGHT_TRIANGLE
-                 ? solid_angle_to_area_pdf(rev, fabs(dot(w->n_tri, dir)), t2)
-                 : 0.0f;
-  } else if (!y->delta) {
-    w->eye_dens *= solid_angle_to_area_pdf(rev, fabs(dot(w->ng_prev, dir)), t2);
-  }
-}
-
-// L's weight for the connection of the eye point x (BSDF pdf pdf_x towards y) to z_k = y at
-// distance^2 dist2 along dir: eye_path_share over N's and H's densities of the path against L's.
-PR_INLINE float eye_walk_weight(const EyeWalk* w, __global const LightVertex* v, uint k,
-                                const LightPoint* y, float pdf_x, float3 dir, float dist2) {
-  if (!w->on) return 0.0f;
-  float eye = solid_angle_to_area_pdf(pdf_x, fabs(dot(y->h.ng, dir)), dist2);
-  // The eye's density of z_{k-1} from y, arriving from x (z_0 for k = 1: H's).
-  float rev = 0.0f;
-  bsdf_eval(&y->f.bsdf, to_local(-dir, y->f.t, y->f.b, y->f.n), y->wprevl, &rev);
-  const float3 din = vertex_dir(v + k);
-  const float t2 = v[k].t * v[k].t;
-  float hit = w->hit;
-  if (k == 1u) {
-    hit = w->light.type == PR_LIGHT_TRIANGLE
-              ? solid_angle_to_area_pdf(rev, fabs(dot(w->n_tri, din)), t2)
-              : 0.0f;
-  } else {
-    eye *= solid_angle_to_area_pdf(rev, fabs(dot(w->ng_prev, din)), t2) * w->eye_dens;
-  }
-  return eye_path_share(eye * w->nee / w->light_dens, eye * hit / w->light_dens);
+// Whether the light of the path in `slot` takes part in --eye-paths' weights (shared/eye_paths.h).
+PR_INLINE int eye_paths_slot(const Connector* cn, uint slot) {
+  const u32 li = cn->headers[slot].light;
+  if (li == PR_INVALID_INDEX || !(cn->rp->trace_total > 0.0f)) return 0;
+  const Light l = cn->s->lights.lights[li];
+  return eye_paths_light(&l);
 }
 
 // Strategy L's connection from the eye point x to the light point y, rebuilt from stored vertex
-// vk, which the light tracer reached with solid-angle pdf pdf_arrive (0: strategy E cannot reach
-// it): its unshadowed contribution with its MIS weight and share `scale`, and its shadow ray; 0
-// where they do not connect. With --eye-paths, the weight is against the eye path's strategies
-// instead, from what walk w gathered up to z_k = y.
+// vk (the path's k-th), which the light tracer reached with solid-angle pdf pdf_arrive (0:
+// strategy E cannot reach it): its unshadowed contribution with its MIS weight and share
+// `scale`, and its shadow ray; 0 where they do not connect. With --eye-paths, the weight is
+// against the eye path's strategies instead, from the ratios light_trace kept for vk.
 PR_INLINE float3 light_vertex_value(const Connector* cn, const EyePoint* x, const LightPoint* y,
                                     __global const LightVertex* vk, float pdf_arrive, float scale,
-                                    const EyeWalk* w, uint k, Ray* ray, uint* clamped) {
+                                    uint k, Ray* ray, uint* clamped) {
   const float3 zero = make_float3(0.0f, 0.0f, 0.0f);
   const float3 dxy = y->h.p - x->h.p;
   const float dist2 = dot(dxy, dxy);
@@ -347,8 +254,8 @@ PR_INLINE float3 light_vertex_value(const Connector* cn, const EyePoint* x, cons
   const float3 dir = dxy * (1.0f / sqrt(dist2));  // from x to y
   if (dot(dir, x->f.ng) <= 0.0f) return zero;
   float3 f_y;
-  float pdf_unused, cos_y, corr;
-  if (!light_point_eval(y, dir, &f_y, &pdf_unused, &cos_y, &corr)) return zero;
+  float pdf_unused, pdf_rev, cos_y, corr;
+  if (!light_point_eval(y, dir, &f_y, &pdf_unused, &pdf_rev, &cos_y, &corr)) return zero;
   float pdf_x;
   const float3 f_x = eye_point_eval(x, dir, &pdf_x);
   const float p_l =
@@ -356,7 +263,8 @@ PR_INLINE float3 light_vertex_value(const Connector* cn, const EyePoint* x, cons
   const float p_e =
       pdf_arrive > 0.0f ? solid_angle_to_area_pdf(pdf_x, fabs(dot(y->f.ng, dir)), dist2) : 0.0f;
   const float mis = cn->rp->eye_paths
-                        ? eye_walk_weight(w, vk - k, k, y, pdf_x, dir, dist2)
+                        ? eye_path_weight(cn->ratios[vk - cn->vertices], k, pdf_x,
+                                          fabs(dot(y->h.ng, dir)), dist2, pdf_rev, cn->inv_c)
                         : connection_mis_weight(PR_STRATEGY_L, p_l, p_e, cn->rp->mis_threshold);
   const float3 tpy = make_float3(vk->tp_r, vk->tp_g, vk->tp_b);
   *ray = spawn_ray_to(x->h.p, x->f.ng, y->h.p, y->f.ng);
@@ -372,18 +280,8 @@ PR_INLINE float3 light_vertex_value_at(const Connector* cn, const EyePoint* x, u
   __global const LightVertex* v = cn->vertices + (size_t)slot * cn->rp->stride;
   if (k < 1u || k >= cn->headers[slot].vertex_count || x->depth + k + 1u > cn->rp->max_depth)
     return zero;
-  EyeWalk w;
-  eye_walk_start(cn, slot, &w);
-  if (cn->rp->eye_paths && !w.on) return zero;
-  // With eye paths, the walk to z_k, as strategy_light_vertices makes it.
-  LightPoint y;
-  for (uint m = cn->rp->eye_paths ? 1u : k; m <= k; ++m) {
-    y = light_point(s, v + m);
-    if (cn->rp->eye_paths) {
-      eye_walk_arrive(&w, v, m, &y);
-      if (m < k) eye_walk_leave(&w, v, m, &y);
-    }
-  }
+  if (cn->rp->eye_paths && !eye_paths_slot(cn, slot)) return zero;
+  const LightPoint y = light_point(s, v + k);
   if (y.delta) return zero;
   // The light tracer's pdf of the step to y_k, as strategy_light_vertices finds it.
   float pdf_arrive = 0.0f;
@@ -398,7 +296,7 @@ PR_INLINE float3 light_vertex_value_at(const Connector* cn, const EyePoint* x, u
     }
   }
   uint clamped = 0u;
-  return light_vertex_value(cn, x, &y, v + k, pdf_arrive, 1.0f, &w, k, ray, &clamped);
+  return light_vertex_value(cn, x, &y, v + k, pdf_arrive, 1.0f, k, ray, &clamped);
 }
 
 // A candidate of the connection history: kept with probability p / (sum of p so far).
@@ -432,12 +330,9 @@ PR_INLINE float3 strategy_light_vertices(Connector* cn, const EyePoint* x, int h
     float pdf_step = (mis && count > 1u)
                          ? light_emit_pdf(s, cn->headers[slot].light, v, vertex_dir(v + 1))
                          : 0.0f;
-    EyeWalk w;
-    eye_walk_start(cn, slot, &w);
-    if (rp->eye_paths && !w.on) continue;  // the path tracer's alone
+    if (rp->eye_paths && !eye_paths_slot(cn, slot)) continue;  // the path tracer's alone
     for (uint k = 1u; k < count && x->depth + k + 1u <= rp->max_depth; ++k) {
       const LightPoint y = light_point(s, v + k);
-      if (rp->eye_paths) eye_walk_arrive(&w, v, k, &y);
       const float pdf_arrive = pdf_step;
       pdf_step = 0.0f;
       if (mis && !y.delta && k + 1u < count) {
@@ -445,15 +340,11 @@ PR_INLINE float3 strategy_light_vertices(Connector* cn, const EyePoint* x, int h
         bsdf_eval(&y.f.bsdf, y.wprevl, to_local(vertex_dir(v + k + 1u), y.f.t, y.f.b, y.f.n),
                   &pdf_step);
       }
-      if (y.delta) {
-        if (rp->eye_paths && k + 1u < count) eye_walk_leave(&w, v, k, &y);
-        continue;
-      }
+      if (y.delta) continue;
       Ray ray;
       uint clamped = 0u;
       const float3 value = light_vertex_value(cn, x, &y, v + k, pdf_arrive,
-                                              history ? 1.0f : cn->inv_c, &w, k, &ray, &clamped);
-      if (rp->eye_paths && k + 1u < count) eye_walk_leave(&w, v, k, &y);
+                                              history ? 1.0f : cn->inv_c, k, &ray, &clamped);
       if (history) {
         cn->n.clamped += clamped;
         history_offer(cn, &cn->hr, value, ray, slot, k);
@@ -597,7 +488,9 @@ PR_INLINE float3 strategy_sampled_vertex(Connector* cn, float3 xp, float pdf_x, 
         f_z = make_float3(1.0f, 1.0f, 1.0f) * (tri ? 0.5f * PR_INV_PI : 0.25f * PR_INV_PI);
       } else {
         const LightPoint z = light_point(s, v + k);
-        if (z.delta || !light_point_eval(&z, dir, &f_z, &pdf_l, &cos_z, &corr)) continue;
+        float pdf_rev_unused;
+        if (z.delta || !light_point_eval(&z, dir, &f_z, &pdf_l, &pdf_rev_unused, &cos_z, &corr))
+          continue;
         zng = z.f.ng;
       }
       const float p_l = solid_angle_to_area_pdf(pdf_l, fabs(dot(y->f.ng, dir)), dist2);
@@ -645,7 +538,7 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
                       __global const PathHeader* headers, __global const LightVertex* vertices,
                       __global float4* radiance, __global uint* counters, uint history_cap,
                       uint slot_offset, uint frame_stamp, __global const uint* changed,
-                      __global ConnectionHistory* history, __global const float* trace_cdf) {
+                      __global ConnectionHistory* history, __global const EyePathRatio* ratios) {
   const uint i = (uint)get_global_id(0);
   if (i >= rp.pixel_count) return;
   const EyeVertex e = eye[i];
@@ -666,7 +559,7 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
   cn.n.candidates = cn.n.rays = cn.n.mis_rays = cn.n.unoccluded = cn.n.clamped = 0u;
   cn.n.history_kept = cn.n.history_dropped = 0u;
   cn.history_cap = history_cap;
-  cn.trace_cdf = trace_cdf;
+  cn.ratios = ratios;
   cn.slot_offset = slot_offset;  // 0 without a history (PathReuse::renderFrame)
   cn.hr.slot = cn.he.slot = PR_INVALID_INDEX;
   cn.hr.k = cn.he.k = 0u;

@@ -1,12 +1,16 @@
 // light_trace: one work-item per slot in the compacted list of invalid slots. Traces the slot's
 // light sub-path from scratch with the random numbers keyed by (seed, slot, generation), and
 // stores its vertices. Reads the scene, the light-tracing power table and the slot's
-// generation; writes the slot's PathHeader and LightVertex records and adds to the counters.
+// generation; writes the slot's PathHeader and LightVertex records (with --eye-paths, their
+// EyePathRatio records too) and adds to the counters.
 #include "shared/reuse.h"
+// After reuse.h: its FP_CONTRACT OFF (shared/bvh.h) holds for the ratios too.
+#include "shared/eye_paths.h"
 
 __kernel void light_trace(PR_SCENE_PARAMS, ReuseParams rp, __global const float* trace_cdf,
                           __global PathHeader* headers, __global LightVertex* vertices,
-                          __global const uint* list, uint list_count, __global uint* counters) {
+                          __global EyePathRatio* ratios, __global const uint* list, uint list_count,
+                          __global uint* counters) {
   const uint i = (uint)get_global_id(0);
   if (i >= list_count) return;
   const uint slot = list[i];
@@ -105,6 +109,15 @@ __kernel void light_trace(PR_SCENE_PARAMS, ReuseParams rp, __global const float*
   out[0] = v;
   uint count = 1u;
   Ray ray = light_segment_ray(p0, v.ng_oct, prim0, dir);
+  // With eye paths, the light side of L's weight at each vertex (shared/eye_paths.h).
+  const int walk_on = rp.eye_paths && eye_paths_light(&L);
+  EyePathWalk walk;
+  if (walk_on)
+    walk = eye_path_walk_start(&L, li,
+                               L.type == PR_LIGHT_TRIANGLE ? eye_paths_light_normal(&s, &L)
+                                                           : make_float3(0.0f, 0.0f, 1.0f),
+                               trace_cdf, rp.trace_total);
+  __global EyePathRatio* ratio_out = ratios + (size_t)slot * rp.stride;
   const float tp0 = max3(tp);  // Russian roulette weighs the throughput against this
 
   for (uint k = 1u; k < rp.stride; ++k) {
@@ -136,6 +149,7 @@ __kernel void light_trace(PR_SCENE_PARAMS, ReuseParams rp, __global const float*
     v.b1 = hit.u;
     v.b2 = hit.v;
     out[k] = v;
+    if (walk_on) ratio_out[k] = eye_path_walk_arrive(&walk, k, dir, hit.t, oct_decode(v.ng_oct));
     count = k + 1u;
     if (hit.inst == PR_INVALID_INDEX)
       ++ssg;
@@ -156,6 +170,14 @@ __kernel void light_trace(PR_SCENE_PARAMS, ReuseParams rp, __global const float*
     const ShadingFrame f = shading_frame(&s, &q, wo);
     PathStep step;
     if (!path_step(&f, wo, u0, v1, v2, PR_IMPORTANCE, &step)) break;
+    if (walk_on) {
+      const int delta = bsdf_is_delta(&f.bsdf);
+      float pdf_fwd = 0.0f, pdf_rev = 0.0f;
+      if (!delta)
+        bsdf_eval_both(&f.bsdf, to_local(wo, f.t, f.b, f.n), to_local(step.wi, f.t, f.b, f.n),
+                       &pdf_fwd, &pdf_rev);
+      eye_path_walk_leave(&walk, k, delta, pdf_fwd, pdf_rev);
+    }
     float3 w = step.weight * shading_normal_correction(wo, step.wi, f.n, f.ng);
     // On the throughput relative to what left the light, from the third vertex on.
     if (k >= 2u && !russian_roulette(max3(tp * w) / tp0, rr, &w)) break;

@@ -49,6 +49,14 @@ typedef struct {
   float b1, b2;
 } EyeVertex;
 
+// --eye-paths: what L's weight against the eye path needs of stored light vertex z_k, k >= 1,
+// kept beside it (the same index) by light_trace, so that connect needs no walk along the path
+// (shared/eye_paths.h, eye_path_walk_arrive). 8 bytes.
+typedef struct {
+  float n;  // N's density of the path over L's, but for the factors connect adds
+  float h;  // the same for H
+} EyePathRatio;
+
 // A pixel sample's connection history (--connection-history; kernels/reuse/connect.cl), carried
 // from one frame to the next: the first eye vertex its reservoir was last resampled at (rebuilt
 // with surface_at), the light vertex it keeps and its weights. 64 bytes.
@@ -106,5 +114,6 @@ PR_STATIC_ASSERT(offsetof(pr::dev::LightVertex, prim) == 48, "LightVertex layout
 PR_STATIC_ASSERT(offsetof(pr::dev::LightVertex, b2) == 60, "LightVertex layout");
 PR_STATIC_ASSERT(sizeof(pr::dev::EyeVertex) == 64, "EyeVertex layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::EyeVertex, depth) == 44, "EyeVertex layout");
+PR_STATIC_ASSERT(sizeof(pr::dev::EyePathRatio) == 8, "EyePathRatio layout");
 PR_STATIC_ASSERT(sizeof(pr::dev::ConnectionHistory) == 64, "ConnectionHistory layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::ConnectionHistory, frame) == 60, "ConnectionHistory layout");

@@ -96,12 +96,16 @@ PR_INLINE float ggx_reflection(float3 wo, float3 wi, float3 h, float a2, float* 
   return d / (1.0f + lo + li) / (4.0f * wo.z * wi.z);
 }
 
-// f(wo, wi) and the pdf of sampling wi given wo, for the microfacet model.
-PR_INLINE float3 bsdf_eval(const BsdfParams* m, float3 wo, float3 wi, float* pdf) {
+// f(wo, wi), the pdf of sampling wi given wo and (pdf_rev) that of sampling wo given wi, for
+// the microfacet model: one evaluation where a path needs its density both ways.
+PR_INLINE float3 bsdf_eval_both(const BsdfParams* m, float3 wo, float3 wi, float* pdf,
+                                float* pdf_rev) {
   *pdf = 0.0f;
+  *pdf_rev = 0.0f;
   if (bsdf_is_delta(m) || wo.z <= 0.0f || wi.z <= 0.0f) return make_float3(0.0f, 0.0f, 0.0f);
   if (m->kind == PR_BSDF_LAMBERT) {
     *pdf = wi.z * PR_INV_PI;
+    *pdf_rev = wo.z * PR_INV_PI;
     return m->base * PR_INV_PI;
   }
   const float a2 = m->alpha * m->alpha;
@@ -121,22 +125,34 @@ PR_INLINE float3 bsdf_eval(const BsdfParams* m, float3 wo, float3 wi, float* pdf
   const float3 dielectric =
       fd * spec + m->base * ((make_float3(1.0f, 1.0f, 1.0f) - fd) * PR_INV_PI);
   float3 f = dielectric * (1.0f - m->metallic) + fm * (spec * m->metallic);
-  // VNDF pdf: G1(wo) D(h) / (4 cos_o).
+  // VNDF pdf: G1(wo) D(h) / (4 cos_o). The reverse: the same with wo and wi swapped (h and
+  // v.h are symmetric).
   const float ps = bsdf_spec_probability(m, wo.z);
   const float pdf_spec = d / ((1.0f + lo) * 4.0f * wo.z);
   const float pdf_diff = wi.z * PR_INV_PI;
   *pdf = ps * pdf_spec + (1.0f - ps) * pdf_diff;
+  const float ps_rev = bsdf_spec_probability(m, wi.z);
+  *pdf_rev = ps_rev * (d / ((1.0f + li) * 4.0f * wi.z)) + (1.0f - ps_rev) * (wo.z * PR_INV_PI);
   if (m->coat > 0.0f) {
     // The coat over the rest: mix(base, coat specular, coat x its Fresnel).
     const float fc = m->coat * coat_fresnel(w5);
+    const float ca2 = m->coat_alpha * m->coat_alpha;
     float pdf_coat;
-    const float coat_spec =
-        ggx_reflection(wo, wi, h, m->coat_alpha * m->coat_alpha, &pdf_coat) * fc;
+    const float coat_spec = ggx_reflection(wo, wi, h, ca2, &pdf_coat) * fc;
     f = f * (1.0f - fc) + make_float3(coat_spec, coat_spec, coat_spec);
     const float pc = bsdf_coat_probability(m, wo.z);
     *pdf = pc * pdf_coat + (1.0f - pc) * *pdf;
+    const float pc_rev = bsdf_coat_probability(m, wi.z);
+    const float pdf_coat_rev = ggx_d(h.z, ca2) / ((1.0f + ggx_lambda(wi.z, ca2)) * 4.0f * wi.z);
+    *pdf_rev = pc_rev * pdf_coat_rev + (1.0f - pc_rev) * *pdf_rev;
   }
   return f;
+}
+
+// f(wo, wi) and the pdf of sampling wi given wo.
+PR_INLINE float3 bsdf_eval(const BsdfParams* m, float3 wo, float3 wi, float* pdf) {
+  float pdf_rev;  // unused: the compiler drops its arithmetic
+  return bsdf_eval_both(m, wo, wi, pdf, &pdf_rev);
 }
 
 // Visible-normal sampling of GGX (Heitz 2018, isotropic).

@@ -11,6 +11,7 @@
 // These helpers are what connect (kernels/reuse) and pt_shade (kernels/pathtrace) share.
 #pragma once
 
+#include "shared/arena.h"
 #include "shared/connection_mis.h"
 #include "shared/integrator.h"
 
@@ -50,6 +51,83 @@ PR_INLINE float eye_paths_bsdf_pdf(const ShadingFrame* f, float3 wo, float3 wi) 
   float pdf = 0.0f;
   bsdf_eval(&f->bsdf, to_local(wo, f->t, f->b, f->n), to_local(wi, f->t, f->b, f->n), &pdf);
   return pdf;
+}
+
+// The light side of L's weight, gathered by light_trace as it traces a path (z_0 on the light,
+// z_k the vertex reached) and kept per vertex in an EyePathRatio: with E = the eye's density of
+// z_k sampled from x_1, over C, and rev = z_k's pdf of sampling z_{k-1} arriving from x_1, N's
+// density of the path over L's is E x n (k = 1) or E x rev x n (k >= 2), and H's E x rev x h
+// (eye_path_weight).
+typedef struct {
+  Light light;
+  int tri;          // a triangle light (H can reach z_0)
+  float inv_start;  // 1 / the light tracer's density of z_0
+  float rest;       // its densities of z_1 .. z_k
+  float eye;        // the eye's densities of z_1 .. z_{k-2}, each sampled from the next vertex
+  float hit;        // the eye's density of z_0 sampled from z_1 arriving from z_2 (1: z_1 delta)
+  float pdf_next;   // solid-angle pdf of the light tracer's step from z_k
+  float g;          // |cos| at z_{k-1} over the squared distance to z_k (z_0: the triangle's)
+  int z1_delta, delta_k;
+  float3 n_tri;    // the light triangle's normal
+  float3 ng_prev;  // geometric normal of z_{k-1}, then (after arriving) of z_k
+} EyePathWalk;
+
+// The walk of a path that starts on light l (index li, triangle normal n_tri).
+PR_INLINE EyePathWalk eye_path_walk_start(const Light* l, u32 li, float3 n_tri,
+                                          PR_GLOBAL const float* trace_cdf, float trace_total) {
+  EyePathWalk w;
+  w.light = *l;
+  w.tri = l->type == PR_LIGHT_TRIANGLE;
+  w.inv_start = 1.0f / eye_paths_start_density(l, li, trace_cdf, trace_total);
+  w.rest = w.eye = w.hit = 1.0f;
+  w.pdf_next = w.g = 0.0f;
+  w.z1_delta = w.delta_k = 0;
+  w.n_tri = w.ng_prev = n_tri;
+  return w;
+}
+
+// Arriving at z_k (k >= 1) along unit dir at distance t, its geometric normal ng: the ratios
+// kept for it.
+PR_INLINE EyePathRatio eye_path_walk_arrive(EyePathWalk* w, u32 k, float3 dir, float t, float3 ng) {
+  const float t2 = t * t, cos_k = fabs(dot(ng, dir));
+  if (k == 1u)
+    w->rest = eye_paths_emit_density(&w->light, w->n_tri, dir, cos_k, t2);
+  else if (!w->delta_k)  // a density sampled from a delta vertex counts as 1
+    w->rest *= solid_angle_to_area_pdf(w->pdf_next, cos_k, t2);
+  w->g = (k > 1u || w->tri) ? fabs(dot(w->ng_prev, dir)) / t2 : 0.0f;
+  w->ng_prev = ng;
+  EyePathRatio r;
+  if (k == 1u) {
+    r.n = 1.0f / w->rest;
+    r.h = w->g * w->inv_start / w->rest;
+  } else {
+    const float a = w->g * w->eye / w->rest;
+    r.n = w->z1_delta ? 0.0f : a;  // no next-event estimation from a delta z_1
+    r.h = a * w->hit * w->inv_start;
+  }
+  return r;
+}
+
+// Leaving z_k (delta or not) by the light tracer's step, whose pdf was pdf_fwd and that of the
+// reverse step (towards z_{k-1}) pdf_rev.
+PR_INLINE void eye_path_walk_leave(EyePathWalk* w, u32 k, int delta, float pdf_fwd, float pdf_rev) {
+  if (k == 1u) {
+    w->z1_delta = delta;
+    w->hit = delta ? 1.0f : pdf_rev * w->g;  // g is 0 where z_0 is not a triangle
+  } else if (!delta) {
+    w->eye *= pdf_rev * w->g;
+  }
+  w->pdf_next = delta ? 0.0f : pdf_fwd;
+  w->delta_k = delta;
+}
+
+// L's weight for joining x_1 to z_k (stored ratios r): pdf_x is x_1's BSDF pdf towards z_k,
+// cos_z the |cos| there with dist2 the squared distance, pdf_rev z_k's pdf of sampling z_{k-1}
+// arriving from x_1, and inv_c 1 / C.
+PR_INLINE float eye_path_weight(EyePathRatio r, u32 k, float pdf_x, float cos_z, float dist2,
+                                float pdf_rev, float inv_c) {
+  const float e = solid_angle_to_area_pdf(pdf_x, cos_z, dist2) * inv_c;
+  return eye_path_share(e * (k == 1u ? 1.0f : pdf_rev) * r.n, e * pdf_rev * r.h);
 }
 
 PR_NAMESPACE_END

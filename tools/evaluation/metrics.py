@@ -170,9 +170,19 @@ def speedup(t_reuse, t_pathtrace):
 
 
 def equal_error(settings, sweep, spp):
-    """The time reuse and pathtrace need to reach pathtrace's relMSE at spp."""
-    target = setting(settings, "pathtrace", spp).summary()
-    reuse = time_to_target(settings, "reuse", sweep, target.relmse)
+    """The time reuse and pathtrace need to reach pathtrace's relMSE at spp. Where reuse's lowest
+    spp already beats that, pathtrace's relMSE at the next larger spp of the sweep that reuse's
+    sweep brackets is the target instead (so that both times are measured, not bounded); only
+    where none is bracketed is the speed-up a lower bound."""
+    for s in [x for x in sweep if x >= spp]:
+        target = setting(settings, "pathtrace", s).summary()
+        reuse = time_to_target(settings, "reuse", sweep, target.relmse)
+        if reuse.how != LOWEST:
+            spp = s
+            break
+    else:
+        target = setting(settings, "pathtrace", spp).summary()
+        reuse = time_to_target(settings, "reuse", sweep, target.relmse)
     pathtrace = time_to_target(settings, "pathtrace", sweep, target.relmse)
     # The same on relMSE without the worst 1% of pixels (a diagnosis of how much rare, large
     # errors decide the plain one).

@@ -88,7 +88,7 @@ def plot_equal_error(results, spp, path):
         ax.loglog([fx.time_s_per_frame.median], [fx.relmse], marker="x",
                   color=MODE_STYLE["pathtrace fixed"][0], ls="", label=f"pathtrace fixed, spp {spp}")
         ax.axhline(r.equal_error.target_relmse, color="gray", lw=0.8, ls="--",
-                   label=f"pathtrace spp {spp} relMSE")
+                   label=f"{r.equal_error.target_from} relMSE")
         ax.set_title(f"{r.scene.key}", fontsize=9)
         ax.set_xlabel("time per frame [s]")
         ax.set_ylabel("relMSE")

@@ -159,7 +159,10 @@ def equal_time_section(et):
 
 def equal_error_section(ee, spp):
     L = ["", "### Equal error", "",
-         f"Target: the relMSE of pathtrace at spp {spp} (fresh seeds), {fmt_e(ee.target_relmse)}. "
+         f"Target: the relMSE of {ee.target_from} (fresh seeds), {fmt_e(ee.target_relmse)}"
+         + (f" (reuse's lowest spp already beats pathtrace's at spp {spp}, so the target is "
+            "the first larger spp of the sweep that reuse's sweep brackets)"
+            if ee.target_from != f"pathtrace spp {spp}" else "") + ". "
          "Time to reach it: log-log interpolation between the two sweep points around it; "
          "no extrapolation. Tail slope: d log relMSE / d log spp between the last two sweep "
          "points (-1 when error is variance only; near 0 at a floor).", "",
@@ -210,8 +213,8 @@ def findings(results, args):
                  f"without lowering the error.")
         ee = r.equal_error
         if ee.speedup:
-            F.append(f"- **{key}, equal error**: reuse reaches pathtrace's spp-{args.spp} "
-                     f"relMSE in {ee.reuse.time_s:.4f} s per frame against "
+            F.append(f"- **{key}, equal error**: reuse reaches the relMSE of {ee.target_from} "
+                     f"in {ee.reuse.time_s:.4f} s per frame against "
                      f"{ee.pathtrace.time_s:.4f} s: speed-up "
                      + (f"at least {ee.speedup:.2f}x (reuse's lowest spp already beats the "
                         "target, so its time there bounds what it needs from above)."
