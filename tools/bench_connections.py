@@ -50,7 +50,11 @@ CONFIGS += [("eye all", ["--mode", "reuse", "--eye-paths", "--connections", "all
             ("eye K=1 C1", ["--mode", "reuse", "--eye-paths", "--connections", "1",
                             "--paths-per-pixel", "1"]),
             ("eye K=1 H20", ["--mode", "reuse", "--eye-paths", "--connections", "1",
-                             "--connection-history", "20"])]
+                             "--connection-history", "20"]),
+            ("eye K=1 C8", ["--mode", "reuse", "--eye-paths", "--connections", "1",
+                            "--paths-per-pixel", "8"]),
+            ("eye K=1 C16", ["--mode", "reuse", "--eye-paths", "--connections", "1",
+                             "--paths-per-pixel", "16"])]
 ASPECT = {"cornell-dynamic": 0.75, "cornell-skinned": 0.75, "atrium": 0.5625}
 
 
