@@ -150,10 +150,12 @@ int main(int argc, char** argv) {
                    "the noise steady for longer (less flicker)")
       ->capture_default_str();
   render->add_flag(
-      "--eye-paths", ro.eyePaths,
+      "--eye-paths,!--no-eye-paths", ro.eyePaths,
       "Reuse/retrace: trace whole eye paths as the path tracer does and weigh them against the "
       "connections to stored light paths over whole paths (MIS), so that connections count "
-      "where they sample a path better, and eye paths elsewhere (dark corners, occluded rooms)");
+      "where they sample a path better, and eye paths elsewhere (dark corners, occluded rooms). "
+      "On by default; --no-eye-paths: the connections alone at the first eye vertex, with "
+      "next-event estimation, strategy E and the delta-chain extension there");
   render->add_option(
       "--env", ro.env,
       "Environment light: an equirectangular map (.exr or .hdr; +Y up, its centre looking along "

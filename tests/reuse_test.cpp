@@ -19,6 +19,15 @@
 namespace pr {
 namespace {
 
+// These tests check the connections as the paper makes them, at the first eye vertex with
+// next-event estimation, strategy E and the delta-chain extension: --no-eye-paths unless a test
+// asks for eye paths (the default).
+std::string renderReuse(const std::string& scene, const std::string& frames,
+                        const std::string& args, const std::string& tag) {
+  const bool eye = args.find("--eye-paths") != std::string::npos;
+  return test::renderFrames(scene, frames, eye ? args : args + " --no-eye-paths", tag);
+}
+
 using test::Moments;
 using test::regionMean;
 
@@ -54,9 +63,8 @@ std::string sweepScene() {
 void expectReuseEqualsRetrace(const std::string& scene, const std::string& frames, int first,
                               int last, const std::string& extra) {
   const std::string args = "--width 48 --height 36 --spp 2 --seed 3 " + extra;
-  const std::string reuse = test::renderFrames(scene, frames, args + " --mode reuse", "reuse");
-  const std::string retrace =
-      test::renderFrames(scene, frames, args + " --mode retrace", "retrace");
+  const std::string reuse = renderReuse(scene, frames, args + " --mode reuse", "reuse");
+  const std::string retrace = renderReuse(scene, frames, args + " --mode retrace", "retrace");
   uint64_t invalidated = 0, reused = 0;
   for (const auto& line : test::statsLines(reuse)) {
     const auto j = nlohmann::json::parse(line);
@@ -163,7 +171,7 @@ TEST(Reuse, CameraMotionAloneInvalidatesNothing) {
   b.animateTranslation(cam, {0.0f, 1.0f}, {{-1.5f, 1.5f, 1.8f}, {1.5f, 1.2f, 1.6f}});
   const std::string scene = b.write(test::tempDir("camonly"), "camonly");
   const std::string dir =
-      test::renderFrames(scene, "0-5", "--fps 5 --width 24 --height 24 --spp 1", "camonly-out");
+      renderReuse(scene, "0-5", "--fps 5 --width 24 --height 24 --spp 1", "camonly-out");
   const auto lines = test::statsLines(dir);
   ASSERT_EQ(lines.size(), 6u);
   for (size_t i = 1; i < lines.size(); ++i) {
@@ -186,11 +194,11 @@ void expectFurnace(int spp, int depth, int lightPaths, const std::string& extra,
   b.addCamera(glm::vec3(0.1f, 0.2f, 0.3f), glm::vec3(1, 0.5f, -1), 1.2f, 1.0f);
   const std::string scene = b.write(test::tempDir("furnace"), "furnace");
   const std::string dir =
-      test::renderFrames(scene, "0-" + std::to_string(frame),
-                         "--width 32 --height 32 --spp " + std::to_string(spp) + " --max-depth " +
-                             std::to_string(depth) + " --light-paths " +
-                             std::to_string(lightPaths) + " --force-diffuse " + extra,
-                         name);
+      renderReuse(scene, "0-" + std::to_string(frame),
+                  "--width 32 --height 32 --spp " + std::to_string(spp) + " --max-depth " +
+                      std::to_string(depth) + " --light-paths " + std::to_string(lightPaths) +
+                      " --force-diffuse " + extra,
+                  name);
   const Image img = test::frameImage(dir, frame);
   const double expected = le / (1.0 - albedo);
   for (int c = 0; c < 3; ++c) {
@@ -233,13 +241,11 @@ void expectSameImage(const std::string& scene, const std::string& args, int w, i
   const std::string size = "--width " + std::to_string(w) + " --height " + std::to_string(h) +
                            " --spp " + std::to_string(spp) + " " + args;
   const std::string f = std::to_string(frame);
-  const std::string a =
-      test::renderFrames(scene, "0-" + f,
-                         size + " --mode reuse --paths-per-pixel " + std::to_string(c) +
-                             " --light-paths " + std::to_string(w * h * spp * c),
-                         "conv-reuse");
-  const std::string b =
-      test::renderFrames(scene, f, size + " --mode pathtrace --seed 77", "conv-pt");
+  const std::string a = renderReuse(scene, "0-" + f,
+                                    size + " --mode reuse --paths-per-pixel " + std::to_string(c) +
+                                        " --light-paths " + std::to_string(w * h * spp * c),
+                                    "conv-reuse");
+  const std::string b = renderReuse(scene, f, size + " --mode pathtrace --seed 77", "conv-pt");
   const Image ia = test::frameImage(a, frame), ib = test::frameImage(b, frame);
   int worstRegion = -1;
   double worst = 0;
@@ -317,7 +323,7 @@ double counterSum(const std::string& dir, const char* group, const char* key, in
 TEST(Reuse, AConnectionHistoryDropsTheVerticesOfRetracedSlots) {
   const std::string args =
       "--mode reuse --width 48 --height 36 --spp 2 --connections 1 --connection-history 20";
-  const std::string moving = test::renderFrames(sweepScene(), "0-5", args + " --fps 4", "hist-mv");
+  const std::string moving = renderReuse(sweepScene(), "0-5", args + " --fps 4", "hist-mv");
   EXPECT_EQ(counterSum(moving, "counters", "history_kept", 0),
             counterSum(moving, "counters", "history_kept", 1))
       << "frame 0 has no history";
@@ -334,8 +340,8 @@ TEST(Reuse, AConnectionHistoryDropsTheVerticesOfRetracedSlots) {
                       {-0.3f, 1.8f, 0.3f}, lamp));
   const int cam = b.addCamera(glm::vec3(0, 1.5f, 1.8f), glm::vec3(0, 0.5f, 0), 1.0f, 1.0f);
   b.animateTranslation(cam, {0.0f, 1.0f}, {{-0.5f, 1.5f, 1.8f}, {0.5f, 1.4f, 1.7f}});
-  const std::string still = test::renderFrames(b.write(test::tempDir("hist-still"), "still"), "0-4",
-                                               args + " --fps 4", "hist-still");
+  const std::string still = renderReuse(b.write(test::tempDir("hist-still"), "still"), "0-4",
+                                        args + " --fps 4", "hist-still");
   EXPECT_EQ(counterSum(still, "counters", "history_dropped", 0), 0.0);
   EXPECT_GT(counterSum(still, "counters", "history_kept", 1),
             0.25 * counterSum(still, "rays", "camera", 1));
@@ -351,9 +357,8 @@ TEST(Reuse, AConnectionHistoryShiftsItsLightPathsOncePerPeriod) {
   const std::string args =
       "--mode reuse --width 32 --height 24 --spp 1 --connections 1 --connection-history 20 ";
   auto render = [&](int period) {
-    return test::renderFrames(scene, "0-3",
-                              args + "--connection-history-period " + std::to_string(period),
-                              "hist-period-" + std::to_string(period));
+    return renderReuse(scene, "0-3", args + "--connection-history-period " + std::to_string(period),
+                       "hist-period-" + std::to_string(period));
   };
   const std::string p1 = render(1), p2 = render(2), p4 = render(4), p8 = render(8);
   auto same = [](const std::string& a, const std::string& b, int f) {
@@ -370,11 +375,11 @@ TEST(Reuse, AConnectionHistoryShiftsItsLightPathsOncePerPeriod) {
 TEST(Reuse, ResampledConnectionsTraceOneRayPerEyeVertex) {
   const std::string scene = test::sourcePath("scenes/cornell-dynamic.gltf");
   auto stats = [&](const std::string& mode) {
-    const std::string dir = test::renderFrames(scene, "0",
-                                               "--mode reuse --width 64 --height 48 "
-                                               "--spp 4 --connections " +
-                                                   mode,
-                                               "conn-" + mode);
+    const std::string dir = renderReuse(scene, "0",
+                                        "--mode reuse --width 64 --height 48 "
+                                        "--spp 4 --connections " +
+                                            mode,
+                                        "conn-" + mode);
     const auto lines = test::statsLines(dir);
     EXPECT_EQ(lines.size(), 1u);
     return nlohmann::json::parse(lines.at(0));
@@ -396,17 +401,37 @@ TEST(Reuse, AutoConnectionsFollowTheDeviceKind) {
   const std::string scene = test::sourcePath("scenes/cornell-dynamic.gltf");
   const bool gpu = (test::testContext().device().type & CL_DEVICE_TYPE_GPU) != 0;
   const std::string args = "--mode reuse --width 32 --height 24 --spp 2";
-  const std::string autoDir = test::renderFrames(scene, "0", args, "conn-auto");
+  const std::string autoDir = renderReuse(scene, "0", args, "conn-auto");
   const std::string fixedDir =
-      test::renderFrames(scene, "0", args + " --connections " + (gpu ? "2" : "all"), "conn-fixed");
+      renderReuse(scene, "0", args + " --connections " + (gpu ? "2" : "all"), "conn-fixed");
   const std::string otherDir =
-      test::renderFrames(scene, "0", args + " --connections " + (gpu ? "all" : "2"), "conn-other");
+      renderReuse(scene, "0", args + " --connections " + (gpu ? "all" : "2"), "conn-other");
   const auto rays = [](const std::string& dir) {
     return double(nlohmann::json::parse(test::statsLines(dir).at(0))["rays"]["connection"]);
   };
   EXPECT_EQ(rays(autoDir), rays(fixedDir));
   EXPECT_NE(rays(autoDir), rays(otherDir));
   EXPECT_EQ(test::frameImage(autoDir, 0).rgba, test::frameImage(fixedDir, 0).rgba);
+}
+
+// Eye paths are the default: the path tracer's kernels find the eye vertices, not eye_hit, and
+// the same frame with --eye-paths spelled out is the same; --no-eye-paths runs eye_hit instead.
+TEST(Reuse, EyePathsAreTheDefault) {
+  const std::string scene = test::sourcePath("scenes/cornell-dynamic.gltf");
+  const std::string args = "--mode reuse --width 32 --height 24 --spp 1";
+  const std::string byDefault = test::renderFrames(scene, "0", args, "eye-default");
+  const std::string spelled = test::renderFrames(scene, "0", args + " --eye-paths", "eye-spelled");
+  const std::string without =
+      test::renderFrames(scene, "0", args + " --no-eye-paths", "eye-without");
+  const auto stages = [](const std::string& dir) {
+    return nlohmann::json::parse(test::statsLines(dir).at(0))["stages_s"];
+  };
+  EXPECT_TRUE(stages(byDefault).contains("shade"));
+  EXPECT_FALSE(stages(byDefault).contains("eye_hit"));
+  EXPECT_TRUE(stages(without).contains("eye_hit"));
+  EXPECT_FALSE(stages(without).contains("shade"));
+  EXPECT_EQ(test::frameImage(byDefault, 0).rgba, test::frameImage(spelled, 0).rgba);
+  EXPECT_NE(test::frameImage(byDefault, 0).rgba, test::frameImage(without, 0).rgba);
 }
 
 TEST(Reuse, ConvergesToThePathTracerOnCornellNvpro) {
@@ -461,10 +486,8 @@ TEST(Reuse, EqualsRetraceWithEyePaths) {
 double twiceRelativeVariance(const std::string& scene, const std::string& args,
                              const std::string& name) {
   const std::string base = "--width 128 --height 96 --spp 4 --max-depth 6 " + args;
-  const Image a =
-      test::frameImage(test::renderFrames(scene, "0", base + " --seed 5", name + "-a"), 0);
-  const Image b =
-      test::frameImage(test::renderFrames(scene, "0", base + " --seed 6", name + "-b"), 0);
+  const Image a = test::frameImage(renderReuse(scene, "0", base + " --seed 5", name + "-a"), 0);
+  const Image b = test::frameImage(renderReuse(scene, "0", base + " --seed 6", name + "-b"), 0);
   double sum = 0;
   size_t n = 0;
   for (size_t i = 0; i < a.rgba.size(); ++i) {

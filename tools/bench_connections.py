@@ -29,18 +29,20 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import benchlib  # noqa: E402
 
+# The connections alone (--no-eye-paths), as the paper makes them.
+CONN = ["--mode", "reuse", "--no-eye-paths"]
 CONFIGS = [("pathtrace", ["--mode", "pathtrace"]),
-           ("reuse all", ["--mode", "reuse", "--connections", "all"]),
-           ("reuse K=1", ["--mode", "reuse", "--connections", "1"]),
-           ("reuse K=2", ["--mode", "reuse", "--connections", "2"])]
+           ("reuse all", CONN + ["--connections", "all"]),
+           ("reuse K=1", CONN + ["--connections", "1"]),
+           ("reuse K=2", CONN + ["--connections", "2"])]
 # The connection history (reservoirs carried over frames; measure it with --frames 8 or more),
 # and the candidates it stands for drawn in one frame instead.
-CONFIGS += [("reuse K=1 H20", ["--mode", "reuse", "--connections", "1", "--connection-history", "20"]),
-            ("reuse K=1 H20 P4", ["--mode", "reuse", "--connections", "1", "--connection-history", "20",
-                                  "--connection-history-period", "4"]),
-            ("reuse all H20", ["--mode", "reuse", "--connections", "all", "--connection-history", "20"]),
-            ("reuse K=1 C16", ["--mode", "reuse", "--connections", "1", "--paths-per-pixel", "16"])]
-# Eye paths (--eye-paths): the path tracer's eye paths with the connections, MIS over whole paths.
+CONFIGS += [("reuse K=1 H20", CONN + ["--connections", "1", "--connection-history", "20"]),
+            ("reuse K=1 H20 P4", CONN + ["--connections", "1", "--connection-history", "20",
+                                         "--connection-history-period", "4"]),
+            ("reuse all H20", CONN + ["--connections", "all", "--connection-history", "20"]),
+            ("reuse K=1 C16", CONN + ["--connections", "1", "--paths-per-pixel", "16"])]
+# Eye paths (the default): the path tracer's eye paths with the connections, MIS over whole paths.
 CONFIGS += [("eye all", ["--mode", "reuse", "--eye-paths", "--connections", "all"]),
             ("eye K=1", ["--mode", "reuse", "--eye-paths", "--connections", "1"]),
             ("eye all C1", ["--mode", "reuse", "--eye-paths", "--connections", "all",

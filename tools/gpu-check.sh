@@ -126,7 +126,8 @@ fi
 if [ -f "$atrium" ]; then
   say "== connection strategies on --device $device (tools/bench_connections.py, 640 wide, 16 spp)"
   timeout 150 python3 tools/bench_connections.py --build "$src/build" --device "$device" --width 640 \
-    --atrium "$atrium" >"$out/connections.md" 2>>"$summary"
+    --atrium "$atrium" --configs "pathtrace,reuse all,reuse K=2,eye all,eye K=1,eye all C1" \
+    >"$out/connections.md" 2>>"$summary"
   say "bench_connections: exit $?"
   grep '^|\|^##' "$out/connections.md" >>"$summary"
 fi

@@ -36,10 +36,13 @@ run() {
 }
 
 # Frames 0-2: the second and third frames invalidate and re-trace what the sphere disturbs.
+# Reuse and retrace with eye paths (the default); the connections alone (--no-eye-paths: eye_hit,
+# next-event estimation, strategy E and the delta-chain extension in connect) further down.
 for mode in pathtrace reuse retrace; do
   run "cornell-dynamic-$mode" scenes/cornell-dynamic.gltf --frames 0-2 --mode "$mode"
 done
-run "cornell-orbit-reuse" scenes/cornell-orbit.gltf --frames 0-1 --mode reuse
+run "cornell-orbit-reuse-connections" scenes/cornell-orbit.gltf --frames 0-1 --mode reuse \
+  --no-eye-paths
 # A skinned and a morphing mesh: deformed, BVH rebuilt and shading vertices uploaded per frame.
 run "cornell-skinned-reuse" scenes/cornell-skinned.gltf --frames 0-2 --mode reuse
 # The light BVH's kernels and the choice by power (on the demo scenes --light-sampler auto
@@ -50,11 +53,12 @@ run "cornell-dynamic-pathtrace-lightbvh" scenes/cornell-dynamic.gltf --frames 0-
 run "cornell-dynamic-pathtrace-power" scenes/cornell-dynamic.gltf --frames 0-1 --mode pathtrace \
   --light-sampler power
 # Resampled connections (two shadow rays per eye vertex).
-run "cornell-dynamic-reuse-ris" scenes/cornell-dynamic.gltf --frames 0-1 --mode reuse --connections 2
+run "cornell-dynamic-reuse-ris" scenes/cornell-dynamic.gltf --frames 0-1 --mode reuse --connections 2 \
+  --no-eye-paths
 # The connection history, carried over frames, in both modes (retrace marks changed slots only).
 for mode in reuse retrace; do
   run "cornell-dynamic-$mode-history" scenes/cornell-dynamic.gltf --frames 0-2 --mode "$mode" \
-    --connections 1 --connection-history 20
+    --connections 1 --connection-history 20 --no-eye-paths
 done
 # The other BVH layouts (8 is what a CPU gets by default): 4, a GPU's, and 2.
 for width in 2 4; do
@@ -62,15 +66,14 @@ for width in 2 4; do
     --bvh-width "$width"
 done
 python3 tools/gen_atrium.py --size 0.02 --light lanterns --out "$work/lanterns/atrium.gltf" >/dev/null
-for mode in pathtrace reuse; do
-  run "lanterns-$mode" "$work/lanterns/atrium.gltf" --frames 0-1 --mode "$mode" --light-sampler bvh
-done
-# Eye paths weighted against the connections (--eye-paths): with a history on the demo, and
-# among many triangle, point and spot lights.
+run "lanterns-pathtrace" "$work/lanterns/atrium.gltf" --frames 0-1 --mode pathtrace --light-sampler bvh
+run "lanterns-reuse-connections" "$work/lanterns/atrium.gltf" --frames 0-1 --mode reuse \
+  --light-sampler bvh --no-eye-paths
+# Eye paths weighted against the connections: with a history on the demo, and among many
+# triangle, point and spot lights.
 run "cornell-dynamic-reuse-eye-history" scenes/cornell-dynamic.gltf --frames 0-2 --mode reuse \
-  --eye-paths --connections 1 --connection-history 20
-run "lanterns-reuse-eye" "$work/lanterns/atrium.gltf" --frames 0-1 --mode reuse --eye-paths \
-  --light-sampler bvh
+  --connections 1 --connection-history 20
+run "lanterns-reuse-eye" "$work/lanterns/atrium.gltf" --frames 0-1 --mode reuse --light-sampler bvh
 # Normal maps (generated tangents) in every kernel that shades, under an environment map too.
 python3 tools/gen_atrium.py --size 0.02 --normal-maps --out "$work/bumps/atrium.gltf" >/dev/null
 python3 - "$work/bumps/sky.hdr" <<'PY'
@@ -82,10 +85,10 @@ with open(sys.argv[1], "wb") as f:
         for x in range(w):
             f.write(bytes([200, 160, 120, 134] if (x, y) == (5, 1) else [100, 120, 160, 128]))
 PY
-for mode in pathtrace reuse; do
-  run "atrium-normal-maps-env-$mode" "$work/bumps/atrium.gltf" --frames 0-1 --mode "$mode" \
-    --camera 1 --env "$work/bumps/sky.hdr" --env-rotate 40
-done
-run "atrium-normal-maps-env-eye" "$work/bumps/atrium.gltf" --frames 0-1 --mode reuse --eye-paths \
+run "atrium-normal-maps-env-pathtrace" "$work/bumps/atrium.gltf" --frames 0-1 --mode pathtrace \
+  --camera 1 --env "$work/bumps/sky.hdr" --env-rotate 40
+run "atrium-normal-maps-env-reuse-connections" "$work/bumps/atrium.gltf" --frames 0-1 --mode reuse \
+  --camera 1 --env "$work/bumps/sky.hdr" --env-rotate 40 --no-eye-paths
+run "atrium-normal-maps-env-eye" "$work/bumps/atrium.gltf" --frames 0-1 --mode reuse \
   --camera 1 --env "$work/bumps/sky.hdr" --env-rotate 40
 exit $fail

@@ -66,7 +66,7 @@ struct RenderOptions {
                                // -1: defaultConnections of the device
   int connectionHistory = 0;   // cap on a pixel sample's carried reservoir, per C; 0 = off
   int connectionHistoryPeriod = 1;  // frames between moves of the history's light-path offset
-  bool eyePaths = false;  // full eye paths, weighted against the connections over whole paths
+  bool eyePaths = true;  // full eye paths, weighted against the connections over whole paths
   // The environment light (scene/environment.h): a map file, "none", or "" (a uniform one of
   // envColor where --env-color is given, else white where the scene has no lights, else none).
   std::string env;

@@ -30,7 +30,7 @@ struct PathReuseSettings {
   uint32_t resample = 0;       // resampled connections per eye vertex (connect.cl); 0: all
   uint32_t historyCap = 0;     // connection history (connect.cl): carried candidates per C; 0: off
   uint32_t historyPeriod = 1;  // frames between moves of the history's light-path offset (>= 1)
-  bool eyePaths = false;       // connections weighted against the path tracer's eye paths
+  bool eyePaths = true;        // connections weighted against the path tracer's eye paths
   bool retraceAll = false;     // --mode retrace
   bool fixedNoise = false;     // camera samples keyed by frame 0 on every frame
 };
