@@ -43,20 +43,15 @@ CONFIGS += [("reuse K=1 H20", CONN + ["--connections", "1", "--connection-histor
             ("reuse all H20", CONN + ["--connections", "all", "--connection-history", "20"]),
             ("reuse K=1 C16", CONN + ["--connections", "1", "--paths-per-pixel", "16"])]
 # Eye paths (the default): the path tracer's eye paths with the connections, MIS over whole paths.
-CONFIGS += [("eye all", ["--mode", "reuse", "--eye-paths", "--connections", "all"]),
-            ("eye K=1", ["--mode", "reuse", "--eye-paths", "--connections", "1"]),
-            ("eye all C1", ["--mode", "reuse", "--eye-paths", "--connections", "all",
-                            "--paths-per-pixel", "1"]),
-            ("eye all C2", ["--mode", "reuse", "--eye-paths", "--connections", "all",
-                            "--paths-per-pixel", "2"]),
-            ("eye K=1 C1", ["--mode", "reuse", "--eye-paths", "--connections", "1",
-                            "--paths-per-pixel", "1"]),
-            ("eye K=1 H20", ["--mode", "reuse", "--eye-paths", "--connections", "1",
-                             "--connection-history", "20"]),
-            ("eye K=1 C8", ["--mode", "reuse", "--eye-paths", "--connections", "1",
-                            "--paths-per-pixel", "8"]),
-            ("eye K=1 C16", ["--mode", "reuse", "--eye-paths", "--connections", "1",
-                             "--paths-per-pixel", "16"])]
+EYE = ["--mode", "reuse", "--eye-paths"]
+CONFIGS += [("eye all", EYE + ["--connections", "all"]),
+            ("eye K=1", EYE + ["--connections", "1"]),
+            ("eye all C1", EYE + ["--connections", "all", "--paths-per-pixel", "1"]),
+            ("eye all C2", EYE + ["--connections", "all", "--paths-per-pixel", "2"]),
+            ("eye K=1 C1", EYE + ["--connections", "1", "--paths-per-pixel", "1"]),
+            ("eye K=1 H20", EYE + ["--connections", "1", "--connection-history", "20"]),
+            ("eye K=1 C8", EYE + ["--connections", "1", "--paths-per-pixel", "8"]),
+            ("eye K=1 C16", EYE + ["--connections", "1", "--paths-per-pixel", "16"])]
 ASPECT = {"cornell-dynamic": 0.75, "cornell-skinned": 0.75, "atrium": 0.5625}
 
 

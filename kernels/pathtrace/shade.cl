@@ -136,8 +136,7 @@ __kernel void pt_shade(PR_SCENE_PARAMS, __global PathState* states, __global con
                     ? solid_angle_to_area_pdf(ch.pdf_bsdf, fabs(dot(n_tri, wi)), dz2)
                     : 0.0f;
             const float rev =
-                has_rev ? solid_angle_to_area_pdf(eye_paths_bsdf_pdf(&f, wi, wo), p.seg_cos, dist2)
-                        : 1.0f;
+                has_rev ? solid_angle_to_area_pdf(ch.pdf_bsdf_rev, p.seg_cos, dist2) : 1.0f;
             const float dens_l = eye_paths_light_side(&l, n_tri, dens_n, light_paths, p.eye_ratio,
                                                       ch.pos, h.p, fabs(dot(f.ng, wi)), rev);
             if (dens_l > 0.0f) w *= 1.0f - eye_path_share(dens_n / dens_l, dens_h / dens_l);

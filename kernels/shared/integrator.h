@@ -177,14 +177,14 @@ PR_INLINE float environment_pdf(const SceneData* s, float3 ref, float3 n_ref, fl
 // reuse, where BSDF-sampled hits on emitters are not counted).
 #define PR_NEXT_EVENT_DRAWS 2u  // rng_skip this many where next_event is not called
 
-// What next_event chose, for weights of its own (--eye-paths): the light, the point on it, and
-// the solid-angle pdfs of the direction under light sampling (as BSDF-sampled hits see it) and
-// under BSDF sampling.
+// What next_event chose, for weights of its own (--eye-paths): the light, the point on it, the
+// solid-angle pdfs of the direction under light sampling (as BSDF-sampled hits see it) and under
+// BSDF sampling, and the BSDF's pdf of sampling wo from that direction (the same evaluation).
 typedef struct {
   u32 light;
   int delta;
   float3 pos;
-  float pdf_light, pdf_bsdf;
+  float pdf_light, pdf_bsdf, pdf_bsdf_rev;
 } NextEventChoice;
 
 PR_INLINE int next_event(const SceneData* s, const SurfaceHit* h, const ShadingFrame* f, float3 wo,
@@ -214,9 +214,9 @@ PR_INLINE int next_event(const SceneData* s, const SurfaceHit* h, const ShadingF
     const SurfaceHit e = surface_interp(&s->sd, l.prim, l.inst, b1, b2, 0);
     le = material_emission(&s->sd, &e);
   }
-  float bsdf_pdf = 0.0f;
+  float bsdf_pdf = 0.0f, bsdf_pdf_rev = 0.0f;
   const float3 wol = to_local(wo, f->t, f->b, f->n), wil = to_local(ls.wi, f->t, f->b, f->n);
-  const float3 fr = bsdf_eval(&f->bsdf, wol, wil, &bsdf_pdf);
+  const float3 fr = bsdf_eval_both(&f->bsdf, wol, wil, &bsdf_pdf, &bsdf_pdf_rev);
   const float cos_i = fabs(wil.z);
   // MIS from the pmf that BSDF-sampled emitter hits see (light_choice_pmf).
   const float w =
@@ -229,6 +229,7 @@ PR_INLINE int next_event(const SceneData* s, const SurfaceHit* h, const ShadingF
     choice->pos = ls.pos;
     choice->pdf_light = ls.pdf * (mis_pmf / pmf);
     choice->pdf_bsdf = bsdf_pdf;
+    choice->pdf_bsdf_rev = bsdf_pdf_rev;
   }
   if (l.type == PR_LIGHT_TRIANGLE) {
     *shadow = spawn_ray_to(h->p, f->ng, ls.pos, ls.normal);

@@ -174,15 +174,13 @@ def equal_error(settings, sweep, spp):
     spp already beats that, pathtrace's relMSE at the next larger spp of the sweep that reuse's
     sweep brackets is the target instead (so that both times are measured, not bounded); only
     where none is bracketed is the speed-up a lower bound."""
-    for s in [x for x in sweep if x >= spp]:
-        target = setting(settings, "pathtrace", s).summary()
-        reuse = time_to_target(settings, "reuse", sweep, target.relmse)
-        if reuse.how != LOWEST:
-            spp = s
-            break
-    else:
-        target = setting(settings, "pathtrace", spp).summary()
-        reuse = time_to_target(settings, "reuse", sweep, target.relmse)
+    def bracketed(s):
+        relmse = setting(settings, "pathtrace", s).summary().relmse
+        return time_to_target(settings, "reuse", sweep, relmse).how != LOWEST
+
+    spp = next((s for s in sweep if s >= spp and bracketed(s)), spp)
+    target = setting(settings, "pathtrace", spp).summary()
+    reuse = time_to_target(settings, "reuse", sweep, target.relmse)
     pathtrace = time_to_target(settings, "pathtrace", sweep, target.relmse)
     # The same on relMSE without the worst 1% of pixels (a diagnosis of how much rare, large
     # errors decide the plain one).
