@@ -1,6 +1,7 @@
 // The command line as a user meets it: exit codes, one-line errors, the devices listing.
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "support/test_env.h"
@@ -68,6 +69,48 @@ TEST(Cli, HelpIsExitZero) {
   auto r = test::runPathreuse("--help");
   EXPECT_EQ(r.exitCode, 0);
   EXPECT_NE(r.out.find("devices"), std::string::npos);
+}
+
+// A first render says once that it compiles kernels (a GPU's compiler may take minutes) and its
+// first stats line gives each program's seconds; the next run loads them from the cache.
+TEST(Cli, KernelBuildsAreAnnouncedOnceAndTimedInTheFirstStatsLine) {
+  const std::string dir = test::tempDir("builds");
+  const std::string cache = "PATHREUSE_CACHE_DIR='" + dir + "/cache' ";
+  const std::string common = "render '" + test::sourcePath("scenes/cornell-dynamic.gltf") +
+                             "' --frames 0-1 --width 16 --height 12 --spp 1 --out '" + dir +
+                             "/f_%04d.exr' --stats '" + dir + "/stats.jsonl'";
+  const std::string args = common + " --mode reuse";
+  auto firstLine = [&](size_t i) {
+    std::ifstream in(dir + "/stats.jsonl");
+    std::string line;
+    for (size_t k = 0; k <= i; ++k) std::getline(in, line);
+    return nlohmann::json::parse(line);
+  };
+  const std::string notice = "compiling OpenCL kernels for ";
+  auto r = test::runPathreuse(args, cache);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const size_t at = r.err.find(notice);
+  ASSERT_NE(at, std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find(notice, at + 1), std::string::npos) << "announced twice: " << r.err;
+  EXPECT_NE(r.err.find(dir + "/cache/kernels"), std::string::npos) << r.err;
+  nlohmann::json builds = firstLine(0)["build_s"];
+  ASSERT_TRUE(builds.contains("reuse/connect.cl")) << builds.dump();
+  EXPECT_GT(builds["reuse/connect.cl"].get<double>(), 0.0);
+  EXPECT_TRUE(builds.contains("pathtrace/shade.cl")) << builds.dump();  // the eye paths
+  EXPECT_FALSE(firstLine(1).contains("build_s")) << "frame 1 built nothing";
+
+  r = test::runPathreuse(args, cache);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(r.err.find(notice), std::string::npos) << r.err;
+  builds = firstLine(0)["build_s"];
+  EXPECT_TRUE(builds.contains("reuse/connect.cl (cached)")) << builds.dump();
+  EXPECT_FALSE(builds.contains("reuse/connect.cl")) << builds.dump();
+
+  // The path tracer's kernels compile sooner than reuse's.
+  r = test::runPathreuse(common + " --mode pathtrace --quiet",
+                         "PATHREUSE_CACHE_DIR='" + dir + "/cold' ");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(r.err, "");
 }
 
 }  // namespace

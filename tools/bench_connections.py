@@ -46,6 +46,7 @@ CONFIGS += [("reuse K=1 H20", CONN + ["--connections", "1", "--connection-histor
 EYE = ["--mode", "reuse", "--eye-paths"]
 CONFIGS += [("eye all", EYE + ["--connections", "all"]),
             ("eye K=1", EYE + ["--connections", "1"]),
+            ("eye K=2", EYE + ["--connections", "2"]),
             ("eye all C1", EYE + ["--connections", "all", "--paths-per-pixel", "1"]),
             ("eye all C2", EYE + ["--connections", "all", "--paths-per-pixel", "2"]),
             ("eye K=1 C1", EYE + ["--connections", "1", "--paths-per-pixel", "1"]),

@@ -4,11 +4,13 @@
 # suite with the reference frames rendered on the CPU, times the demo on the GPU, and (where
 # the bundle has ray_bench) measures ray throughput and frame times of each BVH width there, on
 # the demo and on the atrium; then the connection strategies (tools/bench_connections.py), the
-# GPU with the CPU in one render, and a short form of the evaluation. On an H200 it took 4 min
-# 16 s before those last three were added; they have time limits of their own.
+# GPU with the machine's CPU in one render, and a short form of the evaluation. On an H200 it
+# took 4 min 16 s before those last three were added; they have time limits of their own.
 # Everything goes to OUT. The programs come from a bundle made by tools/gpu-bundle.sh on the
 # build machine and carried along (default: .gpu in the repository root).
 # Usage: tools/gpu-check.sh OUT [BUNDLE] [DEVICE]   (DEVICE: a --device spec, default gpu)
+# GPU_CHECK_STEPS picks the steps and their order (default: all, in the order of STEPS below), so
+# that a short device lease spends its minutes on what matters most and what ran comes back.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 out="${1:?usage: tools/gpu-check.sh OUT [BUNDLE] [DEVICE]}"
@@ -58,36 +60,73 @@ for py in /usr/bin/python3 python3; do
 done
 say "python for the evaluation: ${PATHREUSE_PYTHON:-none with numpy and matplotlib}"
 
-rm -f /tmp/gpu-check-rc
-say "== tests on --device $device"
-tests=("$src"/build/*_test)
-export PATHREUSE_TEST_DEVICE="$device"
-printf '%s\n' "${tests[@]}" | xargs -P 8 -I{} sh -c \
-  'timeout 240 "{}" --gtest_brief=1 >"/tmp/$(basename "{}").log" 2>&1; echo "$? $(basename "{}")" >>/tmp/gpu-check-rc'
-for t in "${tests[@]}"; do
-  n=$(basename "$t")
-  { echo "### $n"; cat "/tmp/$n.log"; } >>"$out/tests.log"
-done
-failed=$(awk '$1 != 0 {print $2 " (exit " $1 ")"}' /tmp/gpu-check-rc)
-say "test programs: ${#tests[@]}, failed: ${failed:-none}"
-grep -h "FAILED  \]\|SKIPPED \]" "$out/tests.log" | sort -u | head -n 40 >>"$summary"
+exe="$src/build/pathreuse"
+median_wall() {  # median wall seconds per frame of a --stats file, after skipping its first N lines
+  python3 -c 'import json,sys,statistics; L=[json.loads(l) for l in open(sys.argv[1])][int(sys.argv[2]):]; print(round(statistics.median(l["wall_s"] for l in L), 4))' "$1" "${2:-0}" 2>/dev/null
+}
+atrium=/tmp/pathreuse-atrium-gpu/atrium.gltf
+ensure_atrium() {  # generated here (7 MB) rather than carried
+  [ -f "$atrium" ] || ${PATHREUSE_PYTHON:-python3} tools/gen_atrium.py --size 1 --out "$atrium" >/dev/null 2>>"$summary"
+  [ -f "$atrium" ]
+}
 
-say "== portability: --device $device against the CPU's reference frames"
-"$src/build/pathreuse" portability --quiet --device "$device" --reference "$bundle/reference" \
-  --out /tmp/pathreuse-portability >"$out/portability.txt" 2>&1
-say "portability exit code: $?"
-tail -n 2 "$out/portability.txt" >>"$summary"
+# What a first render costs on this device: each mode's kernels compiled from source (the
+# driver's own cache off), seconds per program from --stats. It also fills the kernel cache
+# that the tests then load from.
+step_compile() {
+  say "== kernel compilation on --device $device (cold, 48x36, seconds per program)"
+  local mode cold
+  cold=$(mktemp -d)
+  for mode in pathtrace reuse; do  # reuse's programs serve with and without eye paths
+    PATHREUSE_CACHE_DIR="$cold" CUDA_CACHE_DISABLE=1 timeout "${GPU_CHECK_COMPILE_S:-300}" "$exe" render \
+      scenes/cornell-dynamic.gltf --device "$device" --mode "$mode" --width 48 --height 36 --spp 2 --frames 0 \
+      --quiet --out "/tmp/pathreuse-compile/$mode-%04d.exr" --stats "$out/stats-compile-$mode.jsonl" 2>>"$summary"
+    say "$mode: exit $?, $(python3 -c 'import json,sys; b=json.loads(open(sys.argv[1]).readline()).get("build_s", {}); print("%.1f s in all:" % sum(b.values()), " ".join("%s %.1f" % (k, v) for k, v in sorted(b.items(), key=lambda kv: -kv[1])))' "$out/stats-compile-$mode.jsonl" 2>/dev/null)"
+  done
+  mkdir -p "$PATHREUSE_CACHE_DIR/kernels" && cp -n "$cold"/kernels/* "$PATHREUSE_CACHE_DIR/kernels/" 2>/dev/null
+  rm -rf "$cold"
+}
 
-say "== demo timing on --device $device (320x240, 4 spp, frames 0-23)"
-for mode in pathtrace reuse; do
-  "$src/build/pathreuse" render scenes/cornell-dynamic.gltf --device "$device" --mode "$mode" \
-    --width 320 --height 240 --spp 4 --frames 0-23 --quiet --out "/tmp/pathreuse-demo/$mode-%04d.exr" \
-    --stats "$out/stats-$mode.jsonl" 2>>"$summary"
-  say "$mode: exit $?, median frame wall seconds $(python3 -c 'import json,sys,statistics; print(statistics.median(json.loads(l)["wall_s"] for l in open(sys.argv[1])))' "$out/stats-$mode.jsonl" 2>/dev/null)"
-done
+step_tests() {
+  say "== tests on --device $device"
+  rm -f /tmp/gpu-check-rc
+  local tests=("$src"/build/*_test)
+  export PATHREUSE_TEST_DEVICE="$device"
+  printf '%s\n' "${tests[@]}" | xargs -P 8 -I{} sh -c \
+    'timeout 240 "{}" --gtest_brief=1 >"/tmp/$(basename "{}").log" 2>&1; echo "$? $(basename "{}")" >>/tmp/gpu-check-rc'
+  for t in "${tests[@]}"; do
+    n=$(basename "$t")
+    { echo "### $n"; cat "/tmp/$n.log"; } >>"$out/tests.log"
+  done
+  local failed
+  failed=$(awk '$1 != 0 {print $2 " (exit " $1 ")"}' /tmp/gpu-check-rc)
+  say "test programs: ${#tests[@]}, failed: ${failed:-none}"
+  grep -h "FAILED  \]\|SKIPPED \]" "$out/tests.log" | sort -u | head -n 40 >>"$summary"
+  grep -h "^\[  PASSED  \]" "$out/tests.log" | awk '{n += $4} END {print "tests passed: " n}' | tee -a "$summary"
+}
+
+step_portability() {
+  say "== portability: --device $device against the CPU's reference frames"
+  "$exe" portability --quiet --device "$device" --reference "$bundle/reference" \
+    --out /tmp/pathreuse-portability >"$out/portability.txt" 2>&1
+  say "portability exit code: $?"
+  tail -n 2 "$out/portability.txt" >>"$summary"
+}
+
+step_demo() {
+  say "== demo timing on --device $device (320x240, 4 spp, frames 0-23)"
+  for mode in pathtrace reuse; do
+    "$exe" render scenes/cornell-dynamic.gltf --device "$device" --mode "$mode" \
+      --width 320 --height 240 --spp 4 --frames 0-23 --quiet --out "/tmp/pathreuse-demo/$mode-%04d.exr" \
+      --stats "$out/stats-$mode.jsonl" 2>>"$summary"
+    say "$mode: exit $?, median frame wall seconds $(median_wall "$out/stats-$mode.jsonl")"
+  done
+}
 
 # Which BVH layout suits the GPU: ray throughput at each width (auto gives a GPU width 4).
-if [ -x "$bundle/bin/ray_bench" ]; then
+step_rays() {
+  [ -x "$bundle/bin/ray_bench" ] || { say "== rays: the bundle has no ray_bench"; return; }
+  local scene w
   scene="$(dirname "$src")/shared/scenes/cornell-nvpro/cornellBox.gltf"
   [ -f "$scene" ] || scene=scenes/cornell-dynamic.gltf
   say "== ray throughput on --device $device by BVH width ($(basename "$scene"), Mrays/s camera shadow bounce)"
@@ -95,67 +134,86 @@ if [ -x "$bundle/bin/ray_bench" ]; then
     "$bundle/bin/ray_bench" "$scene" --device "$device" --repeats 3 --bvh-width "$w" >"$out/rays-w$w.txt" 2>&1
     say "width $w: exit $?, $(awk '/^(camera|shadow|bounce) /{printf "%s ", $6}' "$out/rays-w$w.txt")"
   done
-fi
+  ensure_atrium || return
+  say "== ray throughput on --device $device by BVH width (atrium, 1280x720, Mrays/s camera shadow bounce)"
+  for w in 2 4 8; do
+    "$bundle/bin/ray_bench" "$atrium" --device "$device" --repeats 5 --width 1280 --height 720 \
+      --bvh-width "$w" >"$out/rays-atrium-w$w.txt" 2>&1
+    say "width $w: exit $?, $(awk '/^(camera|shadow|bounce) /{printf "%s ", $6}' "$out/rays-atrium-w$w.txt")"
+  done
+}
 
-# The atrium (generated here: 7 MB) at each BVH width: ray throughput and frame times.
-atrium=/tmp/pathreuse-atrium-gpu/atrium.gltf
-${PATHREUSE_PYTHON:-python3} tools/gen_atrium.py --size 1 --out "$atrium" >/dev/null 2>>"$summary"
-if [ -f "$atrium" ]; then
-  if [ -x "$bundle/bin/ray_bench" ]; then
-    say "== ray throughput on --device $device by BVH width (atrium, 1280x720, Mrays/s camera shadow bounce)"
-    for w in 2 4 8; do
-      "$bundle/bin/ray_bench" "$atrium" --device "$device" --repeats 5 --width 1280 --height 720 \
-        --bvh-width "$w" >"$out/rays-atrium-w$w.txt" 2>&1
-      say "width $w: exit $?, $(awk '/^(camera|shadow|bounce) /{printf "%s ", $6}' "$out/rays-atrium-w$w.txt")"
-    done
-  fi
+# The atrium's frame times at each BVH width.
+step_atrium() {
+  ensure_atrium || { say "== atrium: could not be generated"; return; }
   say "== atrium frame times on --device $device by BVH width (640x360, 16 spp, frames 0-11, median wall s)"
+  local w mode line
   for w in 2 4 8; do
     line="width $w:"
     for mode in pathtrace reuse; do
-      "$src/build/pathreuse" render "$atrium" --device "$device" --mode "$mode" --bvh-width "$w" \
+      "$exe" render "$atrium" --device "$device" --mode "$mode" --bvh-width "$w" \
         --width 640 --height 360 --spp 16 --frames 0-11 --quiet --out "/tmp/pathreuse-atrium-gpu/$mode-%04d.exr" \
         --stats "$out/stats-atrium-$mode-w$w.jsonl" 2>>"$summary"
-      line="$line $mode $(python3 -c 'import json,sys,statistics; print(round(statistics.median(json.loads(l)["wall_s"] for l in open(sys.argv[1])), 4))' "$out/stats-atrium-$mode-w$w.jsonl" 2>/dev/null)"
+      line="$line $mode $(median_wall "$out/stats-atrium-$mode-w$w.jsonl")"
     done
     say "$line"
   done
-fi
+}
 
 # Connection strategies against the path tracer on the GPU (frames large enough to fill it).
-if [ -f "$atrium" ]; then
+step_connections() {
+  ensure_atrium || { say "== connections: the atrium could not be generated"; return; }
   say "== connection strategies on --device $device (tools/bench_connections.py, 640 wide, 16 spp)"
-  timeout 150 python3 tools/bench_connections.py --build "$src/build" --device "$device" --width 640 \
-    --atrium "$atrium" --configs "pathtrace,reuse all,reuse K=2,eye all,eye K=1,eye all C1" \
-    >"$out/connections.md" 2>>"$summary"
+  timeout "${GPU_CHECK_CONNECTIONS_S:-150}" python3 tools/bench_connections.py --build "$src/build" --device "$device" \
+    --width 640 --atrium "$atrium" --scenes cornell-dynamic,atrium \
+    --configs "pathtrace,reuse K=2,eye all,eye K=1,eye K=2,eye all C1" >"$out/connections.md" 2>>"$summary"
   say "bench_connections: exit $?"
   grep '^|\|^##' "$out/connections.md" >>"$summary"
-fi
+}
 
-# Several devices in one render: the GPU, the machine's CPU (PoCL) and both, rows balanced by
-# throughput (README: several devices).
-say "== several devices: demo 640x480, 8 spp, frames 0-8, median wall s per frame (frames 1-8)"
-for mode in pathtrace reuse; do
-  line="$mode:"
-  for devs in "$device" cpu "$device cpu"; do
-    args=()
-    for d in $devs; do args+=(--device "$d"); done
-    tag=$(echo "$devs" | tr ' ' '+')
-    timeout 120 "$src/build/pathreuse" render scenes/cornell-dynamic.gltf "${args[@]}" --mode "$mode" \
-      --width 640 --height 480 --spp 8 --frames 0-8 --quiet --out "/tmp/pathreuse-multi/$mode-$tag-%04d.exr" \
-      --stats "$out/stats-multi-$mode-$tag.jsonl" 2>>"$summary"
-    line="$line $tag $(python3 -c 'import json,sys,statistics; L=[json.loads(l) for l in open(sys.argv[1])][1:]; print(round(statistics.median(l["wall_s"] for l in L), 4), "rows", "/".join(str(d["rows"]) for d in L[-1].get("devices", [])))' "$out/stats-multi-$mode-$tag.jsonl" 2>/dev/null);"
+# Several devices in one render: the GPU, the machine's CPU and both, rows balanced by
+# throughput (README: several devices). Needs a CPU OpenCL implementation on the GPU machine.
+step_multi() {
+  if ! "$exe" devices 2>/dev/null | grep -q " CPU,"; then
+    say "== several devices: skipped, this machine has no CPU OpenCL device ($(ls /etc/OpenCL/vendors 2>/dev/null | tr '\n' ' '))"
+    return
+  fi
+  say "== several devices: demo 640x480, 8 spp, frames 0-8, median wall s per frame (frames 1-8)"
+  local mode devs d tag line args
+  for mode in pathtrace reuse; do
+    line="$mode:"
+    for devs in "$device" cpu "$device cpu"; do
+      args=()
+      for d in $devs; do args+=(--device "$d"); done
+      tag=$(echo "$devs" | tr ' ' '_')
+      timeout 120 "$exe" render scenes/cornell-dynamic.gltf "${args[@]}" --mode "$mode" \
+        --width 640 --height 480 --spp 8 --frames 0-8 --quiet --out "/tmp/pathreuse-multi/$mode-$tag-%04d.exr" \
+        --stats "$out/stats-multi-$mode-$tag.jsonl" 2>>"$summary"
+      line="$line $tag $(median_wall "$out/stats-multi-$mode-$tag.jsonl" 1) rows $(python3 -c 'import json,sys; L=[json.loads(l) for l in open(sys.argv[1])]; print("/".join(str(d["rows"]) for d in L[-1].get("devices", [])))' "$out/stats-multi-$mode-$tag.jsonl" 2>/dev/null);"
+    done
+    say "$line"
   done
-  say "$line"
-done
+}
 
 # A short form of the evaluation (relMSE against a reference, equal-time comparisons) on the GPU.
-if [ -n "${PATHREUSE_PYTHON:-}" ]; then
-  say "== short evaluation on the default device (the first GPU), results in evaluation/"
-  PATHREUSE_DEVICE="$device" timeout 200 "$PATHREUSE_PYTHON" tools/evaluate.py --quiet --out-dir "$out/evaluation" \
-    --build "$src/build" --cache /tmp/pathreuse-eval-cache --atrium "$atrium" --frames 9 --atrium-frames 9 \
-    --timing-frames 25 --atrium-timing-frames 13 --seeds 1,2 --repeats 2 --ref-spp 256 --atrium-ref-spp 128 \
-    --equal-time-rounds 1 >"$out/evaluation.log" 2>&1
+step_evaluation() {
+  [ -n "${PATHREUSE_PYTHON:-}" ] || { say "== evaluation: no Python with numpy and matplotlib"; return; }
+  ensure_atrium || return
+  say "== short evaluation on --device $device, results in evaluation/"
+  PATHREUSE_DEVICE="$device" timeout "${GPU_CHECK_EVALUATION_S:-200}" "$PATHREUSE_PYTHON" tools/evaluate.py --quiet \
+    --out-dir "$out/evaluation" --build "$src/build" --cache /tmp/pathreuse-eval-cache --atrium "$atrium" \
+    --frames 9 --atrium-frames 9 --timing-frames 25 --atrium-timing-frames 13 --seeds 1,2 --repeats 2 \
+    --ref-spp 256 --atrium-ref-spp 128 --equal-time-rounds 1 >"$out/evaluation.log" 2>&1
   say "evaluation: exit $?"
   sed -n '/^## Goals/,/^## /p' "$out/evaluation/results.md" 2>/dev/null | head -n 30 >>"$summary"
-fi
+}
+
+STEPS="compile tests portability demo rays atrium connections multi evaluation"
+start=$SECONDS
+for s in ${GPU_CHECK_STEPS:-$STEPS}; do
+  case " $STEPS " in *" $s "*) ;; *) say "gpu-check: no step '$s' (steps: $STEPS)"; exit 2 ;; esac
+  t0=$SECONDS
+  "step_$s"
+  say "-- step $s: $((SECONDS - t0)) s"
+done
+say "gpu-check: $((SECONDS - start)) s in all"

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -146,6 +147,7 @@ ProgramBuild Context::buildProgramFromSource(const std::string& source, const st
         out.program = program;
         out.fromCache = true;
         out.seconds = secondsSince(t0);
+        buildSeconds_[label + " (cached)"] += out.seconds;
         return out;
       }
       // A binary the driver refuses (driver updated in place, truncated file): rebuild.
@@ -154,6 +156,13 @@ ProgramBuild Context::buildProgramFromSource(const std::string& source, const st
     }
   }
 
+  if (buildNotice_ && !noticeGiven_) {
+    noticeGiven_ = true;
+    std::fprintf(stderr, "compiling OpenCL kernels for %s (once for these options; %s)\n",
+                 device_.name.c_str(),
+                 file.empty() ? "the kernel cache is off"
+                              : ("later runs load them from " + dir + "/kernels").c_str());
+  }
   cl_int err = CL_SUCCESS;
   cl::Program program(context_, source, false, &err);
   CL_CHECK(err);
@@ -171,6 +180,7 @@ ProgramBuild Context::buildProgramFromSource(const std::string& source, const st
   }
   out.program = program;
   out.seconds = secondsSince(t0);
+  buildSeconds_[label] += out.seconds;
   return out;
 }
 

@@ -3,7 +3,9 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <string>
+#include <utility>
 
 #include "cl/cl.h"
 #include "cl/device.h"
@@ -50,6 +52,13 @@ class Context {
   void release(uint64_t bytes) { bytesInUse_ -= bytes <= bytesInUse_ ? bytes : bytesInUse_; }
   uint64_t bytesInUse() const { return bytesInUse_; }
 
+  // With a notice, the first build from source (not from the cache) prints one line on stderr:
+  // a GPU's compiler may take minutes over the reuse kernels.
+  void setBuildNotice(bool on) { buildNotice_ = on; }
+  // The programs built or loaded from the cache since the last call: "file" or "file (cached)"
+  // with its seconds, for --stats.
+  std::map<std::string, double> takeBuildSeconds() { return std::exchange(buildSeconds_, {}); }
+
   // Fills a buffer with zero bytes (PoCL does not zero new buffers).
   void zero(const cl::Buffer& buffer, uint64_t bytes);
 
@@ -74,6 +83,9 @@ class Context {
   cl::Context context_;
   cl::CommandQueue queue_;
   uint64_t bytesInUse_ = 0;
+  bool buildNotice_ = false;
+  bool noticeGiven_ = false;
+  std::map<std::string, double> buildSeconds_;
 };
 
 }  // namespace pr

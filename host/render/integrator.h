@@ -19,6 +19,9 @@ struct FrameStats {
   std::map<std::string, double> hostSeconds;
   std::map<std::string, uint64_t> rays;      // rays by kind
   std::map<std::string, uint64_t> counters;  // mode-specific counts (slots reused, ...)
+  // Kernel programs built (or loaded from the cache, "(cached)") since the last frame, with
+  // their seconds: the first frame's line shows what a cold start costs.
+  std::map<std::string, double> buildSeconds;
   // Those of `counters` that describe the light paths, which every device of a several-device
   // render holds alike (render/multi_device.h counts them once).
   std::set<std::string> lightPathCounters;

@@ -115,6 +115,7 @@ Image MultiDeviceSession::renderFrame(int frame, FrameStats* total,
       const FrameStats& s = p[i].stats;
       for (const auto& [k, v] : s.stageSeconds) t.stageSeconds[k] += v;
       for (const auto& [k, v] : s.hostSeconds) t.hostSeconds[k] += v;
+      for (const auto& [k, v] : s.buildSeconds) t.buildSeconds[k] += v;
       for (const auto& [k, v] : s.rays) t.rays[k] += v;
       for (const auto& [k, v] : s.counters)
         if (i == 0 || !s.lightPathCounters.count(k)) t.counters[k] += v;

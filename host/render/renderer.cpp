@@ -157,6 +157,7 @@ int runRender(const RenderOptions& o) {
       j["wall_s"] = fs.wallSeconds;
       j["stages_s"] = fs.stageSeconds;
       j["host_s"] = fs.hostSeconds;
+      if (!fs.buildSeconds.empty()) j["build_s"] = fs.buildSeconds;
       j["rays"] = fs.rays;
       if (!fs.counters.empty()) j["counters"] = fs.counters;
       j["device_bytes"] = fs.deviceBytes;

@@ -96,6 +96,7 @@ void validateRenderOptions(const RenderOptions& o) {
 RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
                              const RenderOptions& options)
     : scene_(scene), options_(options), ctx_(device) {
+  ctx_.setBuildNotice(!options.quiet);
   if (scene.staticTriangleCount() + scene.dynamicTriangleCount() == 0)
     throw InputError(options.scene + ": nothing to render (no triangles)");
   camera_ = checkedCamera(scene, options);
@@ -157,6 +158,7 @@ void RenderSession::renderRows(int frame, Image* image, FrameStats* stats) {
   fs->hostSeconds["deform"] = gpu_->lastDeformSeconds();
   film_->clear();
   fs->frame = frame;
+  for (const auto& [k, v] : ctx_.takeBuildSeconds()) fs->buildSeconds[k] += v;
   integrator_->renderFrame(frame, gpu_->camera(camera_, time, width_, height_), fs);
   film_->readRows(image, &fs->badSamples);
   fs->deviceBytes = ctx_.bytesInUse();
