@@ -17,6 +17,9 @@ relMSE. A render that fails (e.g. an option this build lacks) gives a row saying
 PATHREUSE_KERNEL_DIR at another kernels/ folder (e.g. `git archive` of an older commit), so
 both run in the same binary on the same machine in the same run. Standard library only.
 
+--reuse adds a row rendered with --mode reuse and its defaults (eye paths and connections), a
+single frame, so its light paths are all traced in that frame's time.
+
 --cycles adds, for the cases whose light transport Blender can match (--force-diffuse scenes
 without punctual lights: cases 1-3), a row rendered by Blender Cycles (Debian's `blender`,
 tools/cycles_peer.py: Lambert + emission, box filter, bounces = --max-depth - 2, 2 threads)
@@ -75,7 +78,8 @@ def render(exe, scene, w, h, spp, seed, opts, out_exr, stats, kernels=None):
     env = dict(os.environ)
     if kernels:
         env["PATHREUSE_KERNEL_DIR"] = str(kernels)
-    cmd = [str(exe), "render", str(scene), "--mode", "pathtrace", "--frames", "0", "--width", str(w),
+    mode = [] if "--mode" in opts else ["--mode", "pathtrace"]
+    cmd = [str(exe), "render", str(scene)] + mode + ["--frames", "0", "--width", str(w),
            "--height", str(h), "--spp", str(spp), "--seed", str(seed), "--quiet", "--exr-float",
            "--out", str(out_exr).replace("0000", "%04d"), "--stats", str(stats)] + opts
     run = subprocess.run(cmd, env=env, stderr=subprocess.PIPE, text=True)
@@ -148,6 +152,8 @@ def main():
     ap.add_argument("--cache", default="/tmp/pathreuse-bench-sampling")
     ap.add_argument("--python", default="/usr/bin/python3", help="python for gen_atrium.py")
     ap.add_argument("--cycles", action="store_true", help="add Blender Cycles rows (cases 1-3)")
+    ap.add_argument("--reuse", action="store_true",
+                    help="add a row of --mode reuse with its defaults (one frame: every light path traced)")
     args = ap.parse_args()
     exe = Path(args.build) / "pathreuse"
     compare = Path(args.build) / "exr_compare"
@@ -186,6 +192,8 @@ def main():
                 continue
             shutil.move(str(tmp / "ref_0000.exr"), str(ref))   # only a finished one is cached
         rows = [(label, vlabel, kd, vopts) for vlabel, vopts in variants for label, kd in configs]
+        if args.reuse:
+            rows.append(("reuse (its defaults)", None, None, ["--mode", "reuse"]))
         if args.cycles and ci in CYCLES_CASES:
             rows.append(("Blender Cycles 3.4 (CPU, 2 threads; time: render call)", None, "cycles", []))
         results = {(label, vlabel): ([], [], [], []) for label, vlabel, _, _ in rows}
