@@ -10,7 +10,8 @@
 # build machine and carried along (default: .gpu in the repository root).
 # Usage: tools/gpu-check.sh OUT [BUNDLE] [DEVICE]   (DEVICE: a --device spec, default gpu)
 # GPU_CHECK_STEPS picks the steps and their order (default: all, in the order of STEPS below), so
-# that a short device lease spends its minutes on what matters most and what ran comes back.
+# that a short device lease spends its minutes on what matters most; GPU_CHECK_TAR=FILE packs
+# OUT into FILE after each step, so that what ran comes back where few files may.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 out="${1:?usage: tools/gpu-check.sh OUT [BUNDLE] [DEVICE]}"
@@ -215,5 +216,8 @@ for s in ${GPU_CHECK_STEPS:-$STEPS}; do
   t0=$SECONDS
   "step_$s"
   say "-- step $s: $((SECONDS - t0)) s"
+  # Where only a few files may come back from the machine: all of OUT in one archive, after
+  # every step, so that a run cut short still returns what it measured.
+  [ -n "${GPU_CHECK_TAR:-}" ] && tar czf "$GPU_CHECK_TAR" -C "$out" .
 done
 say "gpu-check: $((SECONDS - start)) s in all"
