@@ -1,9 +1,9 @@
 // The command line as a user meets it: exit codes, one-line errors, the devices listing.
 #include <gtest/gtest.h>
 
-#include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "support/render_helpers.h"
 #include "support/test_env.h"
 
 namespace pr {
@@ -80,12 +80,7 @@ TEST(Cli, KernelBuildsAreAnnouncedOnceAndTimedInTheFirstStatsLine) {
                              "' --frames 0-1 --width 16 --height 12 --spp 1 --out '" + dir +
                              "/f_%04d.exr' --stats '" + dir + "/stats.jsonl'";
   const std::string args = common + " --mode reuse";
-  auto firstLine = [&](size_t i) {
-    std::ifstream in(dir + "/stats.jsonl");
-    std::string line;
-    for (size_t k = 0; k <= i; ++k) std::getline(in, line);
-    return nlohmann::json::parse(line);
-  };
+  auto statsLine = [&](size_t i) { return nlohmann::json::parse(test::statsLines(dir).at(i)); };
   const std::string notice = "compiling OpenCL kernels for ";
   auto r = test::runPathreuse(args, cache);
   ASSERT_EQ(r.exitCode, 0) << r.err;
@@ -93,16 +88,16 @@ TEST(Cli, KernelBuildsAreAnnouncedOnceAndTimedInTheFirstStatsLine) {
   ASSERT_NE(at, std::string::npos) << r.err;
   EXPECT_EQ(r.err.find(notice, at + 1), std::string::npos) << "announced twice: " << r.err;
   EXPECT_NE(r.err.find(dir + "/cache/kernels"), std::string::npos) << r.err;
-  nlohmann::json builds = firstLine(0)["build_s"];
+  nlohmann::json builds = statsLine(0)["build_s"];
   ASSERT_TRUE(builds.contains("reuse/connect.cl")) << builds.dump();
   EXPECT_GT(builds["reuse/connect.cl"].get<double>(), 0.0);
   EXPECT_TRUE(builds.contains("pathtrace/shade.cl")) << builds.dump();  // the eye paths
-  EXPECT_FALSE(firstLine(1).contains("build_s")) << "frame 1 built nothing";
+  EXPECT_FALSE(statsLine(1).contains("build_s")) << "frame 1 built nothing";
 
   r = test::runPathreuse(args, cache);
   ASSERT_EQ(r.exitCode, 0) << r.err;
   EXPECT_EQ(r.err.find(notice), std::string::npos) << r.err;
-  builds = firstLine(0)["build_s"];
+  builds = statsLine(0)["build_s"];
   EXPECT_TRUE(builds.contains("reuse/connect.cl (cached)")) << builds.dump();
   EXPECT_FALSE(builds.contains("reuse/connect.cl")) << builds.dump();
 
