@@ -102,6 +102,22 @@ int main(int argc, char** argv) {
                    "at most 4, power between)")
       ->check(CLI::IsMember({"auto", "bvh", "exhaustive", "power"}))
       ->capture_default_str();
+  std::string materialModelText = "energy";
+  render
+      ->add_option("--material-model", materialModelText,
+                   "The BSDF: energy (multiple-scattering GGX, layers by albedo scaling; as "
+                   "Blender's Cycles and OpenPBR) or gltf-reference (the glTF specification's "
+                   "single-scattering model, for conformance comparisons)")
+      ->check(CLI::IsMember({"energy", "gltf-reference"}))
+      ->capture_default_str();
+  std::string terminatorText = "on";
+  render
+      ->add_option("--shadow-terminator", terminatorText,
+                   "Coarse smooth-shaded facets: on (rays leave from the smooth surface the "
+                   "vertex normals describe, facets seen edge-on keep their light) or off (the "
+                   "flat facets' shadows, as renders before the correction)")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
   std::string bvhWidthText = "auto";
   render
       ->add_option("--bvh-width", bvhWidthText,
@@ -267,6 +283,9 @@ int main(int argc, char** argv) {
       ro.mode = modeText == "pathtrace" ? pr::RenderMode::PathTrace
                 : modeText == "retrace" ? pr::RenderMode::Retrace
                                         : pr::RenderMode::Reuse;
+      ro.materialModel = materialModelText == "gltf-reference" ? pr::MaterialModel::Gltf
+                                                               : pr::MaterialModel::Energy;
+      ro.shadowTerminator = terminatorText == "on";
       ro.lightSampler = lightSamplerText == "bvh"          ? pr::LightSampler::Bvh
                         : lightSamplerText == "exhaustive" ? pr::LightSampler::Exhaustive
                         : lightSamplerText == "power"      ? pr::LightSampler::Power

@@ -68,6 +68,30 @@ TEST(Tangents, ChooseTheNormalMapsUvSetPerTriangle) {
   }
 }
 
+// A flat primitive's vertices have zero normals: the face's normal sets the frame, and the
+// handedness still follows the uvs.
+TEST(Tangents, OfFlatVerticesFollowTheirFaces) {
+  TriangleMesh m = plane({{0, 0}, {1, 0}, {1, 1}, {0, 1}});
+  m.normals.assign(4, glm::vec3(0.0f));
+  generateTangents(m, {});
+  expectTangents(m, {1, 0, 0}, 1.0f);
+  m = plane({{1, 0}, {0, 0}, {0, 1}, {1, 1}});  // u mirrored
+  m.normals.assign(4, glm::vec3(0.0f));
+  generateTangents(m, {});
+  expectTangents(m, {-1, 0, 0}, -1.0f);
+  // A fold: the shared edge's tangent lies between the faces' planes; zero normals stay zero.
+  m = plane({{0, 0}, {1, 0}, {1, 1}, {0, 1}});
+  m.positions[3] = {0, 1, 1};
+  m.normals.assign(4, glm::vec3(0.0f));
+  generateTangents(m, {});
+  for (size_t v = 0; v < 4; ++v) {
+    EXPECT_NEAR(glm::length(glm::vec3(m.tangents[v])), 1.0f, 1e-5f);
+    EXPECT_GT(m.tangents[v].x, 0.7f);
+    EXPECT_EQ(m.tangents[v].w, 1.0f);
+    EXPECT_EQ(m.normals[v], glm::vec3(0.0f));
+  }
+}
+
 TEST(Tangents, AreOrthogonalToCurvedNormals) {
   TriangleMesh m = plane({{0, 0}, {1, 0}, {1, 1}, {0, 1}});
   for (glm::vec3& n : m.normals) n = glm::normalize(glm::vec3(0.3f, -0.2f, 1.0f));
@@ -91,9 +115,11 @@ struct PlaneScene {
   float lightAngle = 0.0f;   // light from (sin a, 0, cos a), or (0, -sin a, cos a):
   bool lightAboutX = false;  // the light turned about x instead of y
   json planeNode = {{"mesh", 0}};
+  bool withNormals = true;
   bool withTangents = false;
   glm::vec4 tangent{1, 0, 0, 1};
   int normalTexCoord = 0;
+  json material;  // replaces the grey normal-mapped material where set
 
   std::string write(const std::string& tag) {
     const std::string dir = test::tempDir(tag);
@@ -121,6 +147,7 @@ struct PlaneScene {
                   {"NORMAL", add(nrm, sizeof nrm, 5126, 4, "VEC3")},
                   {"TEXCOORD_0", add(uv0, sizeof uv0, 5126, 4, "VEC2")},
                   {"TEXCOORD_1", add(uv1, sizeof uv1, 5126, 4, "VEC2")}};
+    if (!withNormals) attrs.erase("NORMAL");
     if (withTangents) attrs["TANGENT"] = add(tan, sizeof tan, 5126, 4, "VEC4");
     const int indices = add(idx, sizeof idx, 5123, 6, "SCALAR");
     accessors[0]["min"] = {-1, -1, 0};
@@ -155,6 +182,17 @@ struct PlaneScene {
         {"accessors", accessors},
         {"bufferViews", views},
         {"buffers", {{{"byteLength", bin.size()}, {"uri", "plane.bin"}}}}};
+    if (!material.is_null()) {
+      // Unused sheen and anisotropic materials: the kernels are then built with the material
+      // tests' features (one build of them, not two).
+      doc["materials"] = {
+          material,
+          {{"extensions", {{"KHR_materials_sheen", {{"sheenColorFactor", {1, 1, 1}}}}}}},
+          {{"extensions", {{"KHR_materials_anisotropy", {{"anisotropyStrength", 0.5}}}}}}};
+      for (const char* e : {"KHR_materials_clearcoat", "KHR_materials_specular",
+                            "KHR_materials_sheen", "KHR_materials_anisotropy"})
+        doc["extensionsUsed"].push_back(e);
+    }
     const std::string path = dir + "/plane.gltf";
     std::ofstream(path) << doc.dump();
     return path;
@@ -251,6 +289,38 @@ TEST(NormalMap, ShadesByTheMappedNormalInBothModes) {
   }
 }
 
+// KHR_materials_clearcoat: the coat has its own normal, the vertex normal or its
+// clearcoatNormalTexture, never the base layer's normal map. A black base under a rough coat,
+// lit where the coat's highlight lies for a normal tilted 30 degrees by the map and far off it
+// for the untilted one: the base's map leaves the coat's reflection as it is, the coat's own
+// map moves the highlight to the camera.
+TEST(NormalMap, TheClearcoatHasItsOwnNormal) {
+  auto render = [](bool baseMap, bool coatMap, const std::string& tag) {
+    PlaneScene p;
+    p.lightAngle =
+        1.0472f;  // 60 degrees: the mirror direction of the view about a 30-degree normal
+    json m = {{"pbrMetallicRoughness",
+               {{"baseColorFactor", {0, 0, 0, 1}}, {"metallicFactor", 0}, {"roughnessFactor", 1}}},
+              {"extensions",
+               {{"KHR_materials_specular", {{"specularFactor", 0.0}}},
+                {"KHR_materials_clearcoat",
+                 {{"clearcoatFactor", 1.0}, {"clearcoatRoughnessFactor", 0.3}}}}}};
+    if (baseMap) m["normalTexture"] = {{"index", 0}};
+    if (coatMap)
+      m["extensions"]["KHR_materials_clearcoat"]["clearcoatNormalTexture"] = {{"index", 0}};
+    p.material = m;
+    const std::string dir = test::renderFrames(
+        p.write("coat-n-" + tag), "0",
+        "--mode pathtrace --width 24 --height 24 --spp 16 --max-depth 2", "coat-n-out-" + tag);
+    return test::regionMean(test::frameImage(dir, 0), 6, 6, 18, 18, 1).mean;
+  };
+  const double plain = render(false, false, "plain"), base = render(true, false, "base"),
+               coat = render(false, true, "coat");
+  ASSERT_GT(plain, 0.0);
+  EXPECT_NEAR(base / plain, 1.0, 0.02) << plain << " " << base;
+  EXPECT_GT(coat / plain, 20.0) << plain << " " << coat;
+}
+
 // Given tangents are used as they are (here along +y, left-handed), and TEXCOORD_1's
 // generated tangent where the map reads it.
 TEST(NormalMap, GivenTangentsAndTheSecondUvSetSetTheFrame) {
@@ -274,6 +344,33 @@ TEST(NormalMap, GivenTangentsAndTheSecondUvSetSetTheFrame) {
     const double got1 = centreMean(q.write("nm-uv1"), "--mode pathtrace", "nm-uv1-r");
     EXPECT_NEAR(got1 / ref, q.expectedRatio({0, 1, 0}, 1), 0.01) << angle;
   }
+}
+
+// Without NORMAL the plane is flat and its TANGENT (here along +y, left-handed) is ignored:
+// the map reads the frame of the tangent generated from TEXCOORD_0 (t = +x, b = +y), static
+// or on a moving instance, in both modes.
+TEST(NormalMap, WithoutNormalsTheGivenTangentsAreIgnored) {
+  for (const char* mode : {"pathtrace", "reuse"})
+    for (bool dynamic : {false, true})
+      for (float angle : {0.6f, -0.6f}) {
+        SCOPED_TRACE(std::string(mode) + (dynamic ? " dynamic " : " static ") +
+                     std::to_string(angle));
+        PlaneScene flat, p;
+        flat.normalTexel = {128, 128, 255, 255};
+        flat.normalScale = 0.0f;
+        p.normalTexel = {191, 128, 238, 255};  // leans 30 degrees towards the tangent
+        p.withTangents = true;
+        p.tangent = {0, 1, 0, -1};
+        flat.withNormals = p.withNormals = false;
+        if (dynamic) flat.planeNode = p.planeNode = {{"mesh", 0}, {"extras", {{"dynamic", true}}}};
+        flat.lightAngle = p.lightAngle = angle;
+        const std::string m = std::string("--mode ") + mode;
+        const double ref = centreMean(flat.write("nm-nf"), m, "nm-nf-r");
+        // The unmapped flat plane: rho / pi * E * cos(angle), rho = 0.5, E = 2.
+        EXPECT_NEAR(ref, 1.0 / M_PI * std::cos(angle), 0.01 * ref);
+        const double got = centreMean(p.write("nm-np"), m, "nm-np-r");
+        EXPECT_NEAR(got / ref, p.expectedRatio({1, 0, 0}, 1), 0.01);
+      }
 }
 
 // On moving geometry the tangent turns with the instance, and a mirroring instance turns the

@@ -1,5 +1,6 @@
 // The baseline path tracer against known answers: a white furnace, a diffuse plane under a point
-// light, determinism by seed, and frames free of NaN and Inf.
+// light, determinism by seed, and frames free of NaN and Inf; flat facets where a primitive has
+// no normals (in both modes).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -114,6 +115,86 @@ TEST(PathTrace, SameSeedSameFrameDifferentSeedSameMean) {
     const Moments ma = regionMean(a, 0, 0, 40, 30, ch), mc = regionMean(c, 0, 0, 40, 30, ch);
     EXPECT_NEAR(ma.mean, mc.mean, 5 * std::hypot(ma.stderr_, mc.stderr_)) << "channel " << ch;
   }
+}
+
+// An octagonal prism without NORMAL (radius 1, y in [-1, 1]; neighbouring facets share their
+// edge vertices, so averaged normals would round it) with one facet facing the camera on +Z,
+// lit by a directional light 45 degrees off that facet. Animated three ways through t = 1:
+// moved, morphed (radius 1 to 1.5, with target NORMAL deltas that must be ignored) or skinned.
+enum class PrismMotion { None, Moves, Morphs, Skinned };
+
+std::string flatPrism(PrismMotion motion, const std::string& tag) {
+  test::GltfBuilder b;
+  const int mat = b.addMaterial({glm::vec4(0.8f, 0.8f, 0.8f, 1), 0, 1});
+  std::vector<glm::vec3> p;
+  std::vector<uint32_t> idx;
+  test::MeshAttributes a;
+  for (int i = 0; i < 8; ++i) {
+    const float beta = (float(i) - 0.5f) * float(M_PI) / 4;  // facet k: vertices k and k + 1
+    for (float y : {-1.0f, 1.0f}) p.emplace_back(std::sin(beta), y, std::cos(beta));
+  }
+  for (uint32_t k = 0; k < 8; ++k) {
+    const uint32_t b0 = 2 * k, t0 = b0 + 1, b1 = 2 * ((k + 1) % 8), t1 = b1 + 1;
+    idx.insert(idx.end(), {b0, b1, t1, b0, t1, t0});  // counter-clockwise seen from outside
+  }
+  if (motion == PrismMotion::Morphs) {
+    a.targetPositions.emplace_back();
+    for (const glm::vec3& v : p) a.targetPositions[0].push_back(0.5f * glm::vec3(v.x, 0, v.z));
+    a.targetNormals.emplace_back(p.size(), glm::vec3(0, 1, 0));
+  }
+  if (motion == PrismMotion::Skinned) {
+    a.joints.assign(p.size(), {0, 0, 0, 0});
+    a.weights.assign(p.size(), glm::vec4(1, 0, 0, 0));
+  }
+  const int node = b.addNode(b.addMesh(p, idx, mat, a));
+  const std::vector<glm::vec3> sway = {{0, -0.2f, 0}, {0, 0.2f, 0}};
+  if (motion == PrismMotion::Moves) b.animateTranslation(node, {0, 1}, sway);
+  if (motion == PrismMotion::Morphs) b.animateWeights(node, {0, 1}, {{0}, {1}});
+  if (motion == PrismMotion::Skinned) {
+    const int joint = b.addNode(-1);
+    b.addSkin(node, {joint});
+    b.animateTranslation(joint, {0, 1}, sway);
+  }
+  b.addDirectionalLight(glm::angleAxis(float(M_PI) / 4, glm::vec3(0, 1, 0)), glm::vec3(1), 2.0f);
+  b.addCamera(glm::vec3(0, 0, 5), glm::vec3(0), 0.4f, 1.0f);
+  return b.write(test::tempDir(tag), "prism");
+}
+
+// glTF: a primitive without NORMAL is shaded flat. Direct light only, so a facet under a
+// directional light has one radiance, rho / pi * E * cos 45, in every pixel well inside it
+// (averaged normals would take it from cos 67.5 to cos 22.5 across the facet); the same in
+// both modes and while the prism moves, morphs or is skinned (frame 12 is t = 0.5).
+TEST(FlatShading, PrimitivesWithoutNormals) {
+  const double expected = 0.8 / M_PI * 2.0 * std::cos(M_PI / 4);
+  const struct {
+    PrismMotion motion;
+    const char* name;
+  } cases[] = {{PrismMotion::None, "static"},
+               {PrismMotion::Moves, "moving"},
+               {PrismMotion::Morphs, "morphing"},
+               {PrismMotion::Skinned, "skinned"}};
+  for (const auto& c : cases)
+    for (const char* mode : {"pathtrace", "reuse"}) {
+      SCOPED_TRACE(std::string(c.name) + " " + mode);
+      const std::string scene = flatPrism(c.motion, std::string("prism-") + c.name);
+      const int frame = c.motion == PrismMotion::None ? 0 : 12;
+      const std::string dir = test::renderFrames(
+          scene, std::to_string(frame),
+          std::string("--width 32 --height 32 --spp 4 --max-depth 2 --env none --force-diffuse "
+                      "--mode ") +
+              mode,
+          std::string("prism-") + c.name + "-" + mode);
+      const Image img = test::frameImage(dir, frame);
+      // The facet spans columns 8.6 to 23.4 (more where morphed) and every row.
+      double lo = 1e30, hi = 0;
+      for (int y = 8; y < 24; ++y)
+        for (int x = 10; x < 22; ++x) {
+          lo = std::fmin(lo, img.pixel(x, y)[1]);
+          hi = std::fmax(hi, img.pixel(x, y)[1]);
+        }
+      EXPECT_NEAR(lo, expected, 0.01 * expected);
+      EXPECT_NEAR(hi, expected, 0.01 * expected);
+    }
 }
 
 uint64_t badSamplesIn(const std::string& statsFile, int* lines) {

@@ -12,6 +12,7 @@
 
 #include "render/gpu_scene.h"
 #include "scene/gltf_loader.h"
+#include "support/gltf_builder.h"
 #include "support/test_env.h"
 #include "util/error.h"
 
@@ -268,6 +269,21 @@ struct Quad {
             {{{"buffer", 0}, {"byteOffset", 0}, {"byteLength", 48}},
              {{"buffer", 0}, {"byteOffset", 48}, {"byteLength", 12}}}}};
   }
+  // Appends float data as an accessor of `count` elements of `type`; returns its index.
+  int addFloats(const std::vector<float>& v, size_t count, const char* type) {
+    doc["bufferViews"].push_back(
+        {{"buffer", 0}, {"byteOffset", bin.size()}, {"byteLength", v.size() * 4}});
+    bin.append(reinterpret_cast<const char*>(v.data()), v.size() * 4);
+    doc["accessors"].push_back({{"bufferView", doc["bufferViews"].size() - 1},
+                                {"componentType", 5126},
+                                {"count", count},
+                                {"type", type}});
+    return int(doc["accessors"].size() - 1);
+  }
+  void addNormals() {
+    doc["meshes"][0]["primitives"][0]["attributes"]["NORMAL"] =
+        addFloats({0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1}, 4, "VEC3");
+  }
   std::string write(const std::string& name = "quad.gltf") {
     doc["buffers"] = {{{"byteLength", bin.size()},
                        {"uri", "data:application/octet-stream;base64," + base64(bin)}}};
@@ -277,7 +293,7 @@ struct Quad {
   }
 };
 
-TEST(SceneLoader, QuadDefaultsAndComputedNormals) {
+TEST(SceneLoader, QuadDefaultsAndFlatNormals) {
   Quad q;
   Scene s;
   ASSERT_EQ(tryLoad(q.write(), &s), "");
@@ -287,7 +303,7 @@ TEST(SceneLoader, QuadDefaultsAndComputedNormals) {
   EXPECT_FLOAT_EQ(s.materials[0].roughnessFactor, 1.0f);
   EXPECT_FLOAT_EQ(s.materials[0].ior, 1.5f);
   EXPECT_FALSE(s.materials[0].isEmissive());
-  for (const auto& n : s.staticMesh.normals) EXPECT_NEAR(n.z, 1.0f, 1e-6f);  // computed, CCW front
+  for (const auto& n : s.staticMesh.normals) EXPECT_EQ(n, glm::vec3(0.0f));  // no NORMAL: flat
   EXPECT_EQ(s.fileCameraCount(), 0u);
   EXPECT_EQ(s.cameras.size(), 1u);  // default
 }
@@ -295,12 +311,13 @@ TEST(SceneLoader, QuadDefaultsAndComputedNormals) {
 // An optional extension we do not support is named once in a warning; the file still loads.
 TEST(SceneLoader, UnsupportedOptionalExtensionsAreNamedOnce) {
   Quad q;
-  q.doc["extensionsUsed"] = {"KHR_materials_sheen", "KHR_materials_ior", "EXT_foo"};
+  q.doc["extensionsUsed"] = {"KHR_materials_iridescence", "KHR_materials_ior", "EXT_foo"};
   Scene s;
   ASSERT_EQ(tryLoad(q.write(), &s), "");
   EXPECT_EQ(s.staticTriangleCount(), 2u);
   ASSERT_EQ(s.warnings.size(), 2u);
-  EXPECT_NE(s.warnings[0].find("extension KHR_materials_sheen is not supported"), std::string::npos)
+  EXPECT_NE(s.warnings[0].find("extension KHR_materials_iridescence is not supported"),
+            std::string::npos)
       << s.warnings[0];
   EXPECT_NE(s.warnings[1].find("extension EXT_foo is not supported"), std::string::npos)
       << s.warnings[1];
@@ -308,6 +325,7 @@ TEST(SceneLoader, UnsupportedOptionalExtensionsAreNamedOnce) {
 
 TEST(SceneLoader, InstancingAndMirroring) {
   Quad q;
+  q.addNormals();
   q.doc["nodes"] = {{{"mesh", 0}, {"translation", {0, 0, 1}}},
                     {{"mesh", 0}, {"scale", {-1, 1, 1}}},  // mirrored: winding must flip
                     {{"mesh", 0}, {"extras", {{"dynamic", true}}}},
@@ -329,6 +347,94 @@ TEST(SceneLoader, InstancingAndMirroring) {
     EXPECT_GT(glm::dot(ng, m.normals[m.indices[3 * t]]), 0.0f);
   }
   EXPECT_NEAR(glm::vec3(s.instanceTransform(1, 0.0)[3]).x, 5.0f, 1e-6f);
+}
+
+// glTF: a primitive without NORMAL is shaded flat and its TANGENT ignored. Its normals are zero
+// (the device then shades by the geometric normal) wherever the mesh is placed; a primitive with
+// NORMAL in the same mesh keeps its own, normalised, and its TANGENT.
+TEST(SceneLoader, PrimitivesWithoutNormalAreFlat) {
+  Quad q;
+  const int nrm = q.addFloats({0, 0, 2, 0, 0, 2, 0, 0, 2, 0, 0, 2}, 4, "VEC3");
+  const int tan = q.addFloats({0, 1, 0, -1, 0, 1, 0, -1, 0, 1, 0, -1, 0, 1, 0, -1}, 4, "VEC4");
+  json& prims = q.doc["meshes"][0]["primitives"];
+  prims[0]["attributes"]["TANGENT"] = tan;
+  prims.push_back(
+      {{"attributes", {{"POSITION", 0}, {"NORMAL", nrm}, {"TANGENT", tan}}}, {"indices", 1}});
+  q.doc["nodes"] = {{{"mesh", 0}},
+                    {{"mesh", 0}, {"scale", {-1, 1, 1}}},
+                    {{"mesh", 0}, {"extras", {{"dynamic", true}}}}};
+  q.doc["scenes"] = {{{"nodes", {0, 1, 2}}}};
+  Scene s;
+  ASSERT_EQ(tryLoad(q.write("flat.gltf"), &s), "");
+  // Vertices 0-3 come from the primitive without NORMAL, 4-7 from the other; the static mesh
+  // holds the plain copy, then the mirrored one.
+  const TriangleMesh& m = s.staticMesh;
+  ASSERT_EQ(m.vertexCount(), 16u);
+  ASSERT_EQ(m.tangents.size(), 16u);
+  for (size_t i = 0; i < 16; ++i)
+    EXPECT_EQ(m.normals[i], i % 8 < 4 ? glm::vec3(0.0f) : glm::vec3(0, 0, 1)) << "vertex " << i;
+  for (size_t i = 0; i < 4; ++i) {
+    EXPECT_NE(glm::vec3(m.tangents[i]), glm::vec3(0, 1, 0)) << "ignored";
+    EXPECT_EQ(m.tangents[4 + i], glm::vec4(0, 1, 0, -1)) << "given";
+  }
+  ASSERT_EQ(s.dynamicMeshes.size(), 1u);
+  for (size_t i = 0; i < 8; ++i)
+    EXPECT_EQ(s.dynamicMeshes[0].normals[i], i < 4 ? glm::vec3(0.0f) : glm::vec3(0, 0, 1));
+  // What the device reads.
+  const dev::ShadingVertex v = shadingVertex(m, 0);
+  EXPECT_EQ(glm::vec3(v.nx, v.ny, v.nz), glm::vec3(0.0f));
+}
+
+// A deforming primitive without NORMAL stays flat: its targets' NORMAL deltas are ignored, and
+// morphing (animated or applied once at load) and skinning keep its normals zero.
+TEST(SceneLoader, DeformedPrimitivesWithoutNormalStayFlat) {
+  const std::vector<glm::vec3> quad = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  const std::vector<uint32_t> idx = {0, 1, 2, 0, 2, 3};
+  auto build = [&](bool skinned, bool animated) {
+    test::GltfBuilder b;
+    test::MeshAttributes a;
+    a.targetPositions = {{{0, 0, 0}, {0, 0, 0}, {0, 0, 1}, {0, 0, 0}}};
+    a.targetNormals = {std::vector<glm::vec3>(4, glm::vec3(1, 0, 0))};
+    if (skinned) {
+      a.joints.assign(4, {0, 0, 0, 0});
+      a.weights.assign(4, glm::vec4(1, 0, 0, 0));
+    }
+    const int node = b.addNode(b.addMesh(quad, idx, b.addMaterial({}), a));
+    if (animated) b.animateWeights(node, {0, 1}, {{0}, {1}});
+    if (skinned) {
+      const glm::quat turn = glm::angleAxis(1.0f, glm::normalize(glm::vec3(1, 2, 3)));
+      const int joint = b.addNode(-1, glm::vec3(0), turn);
+      b.addSkin(node, {joint});
+      b.animateTranslation(joint, {0, 1}, {{0, 0, 0}, {1, 2, 3}});
+    }
+    return b.write(test::tempDir("flat-deform"), "m");
+  };
+  auto expectZero = [](const TriangleMesh& m) {
+    ASSERT_EQ(m.normals.size(), 4u);
+    for (const glm::vec3& n : m.normals) EXPECT_EQ(n, glm::vec3(0.0f));
+  };
+  for (bool skinned : {false, true}) {
+    SCOPED_TRACE(skinned ? "skinned and morphed" : "morphed");
+    const Scene s = loadScene(build(skinned, true), quiet());
+    ASSERT_EQ(s.dynamicMeshes.size(), 1u);
+    ASSERT_TRUE(s.meshDeforms(0));
+    expectZero(s.dynamicMeshes[0]);
+    TriangleMesh m = s.dynamicMeshes[0];
+    s.deformMesh(0, 0.5, &m);
+    // The target applies (vertex 2 rises by 0.5), then the joint's rigid turn and move.
+    EXPECT_NEAR(glm::length(m.positions[2] - m.positions[1]), std::sqrt(1.25f), 1e-5f);
+    expectZero(m);
+  }
+  // Weights nothing animates: applied once at load, into the static mesh.
+  const std::string path = build(false, false);
+  json doc;
+  std::ifstream(path) >> doc;
+  doc["meshes"][0]["weights"] = {0.5};
+  std::ofstream(path) << doc.dump();
+  const Scene s = loadScene(path, quiet());
+  EXPECT_TRUE(s.dynamicMeshes.empty());
+  EXPECT_NEAR(s.staticMesh.positions[2].z, 0.5f, 1e-6f);
+  expectZero(s.staticMesh);
 }
 
 TEST(SceneLoader, MaterialsAndExtensions) {

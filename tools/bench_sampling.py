@@ -4,6 +4,7 @@ high-spp reference, on the scenes where emitter sampling and stratification matt
 
   python3 tools/bench_sampling.py                       # the table, this build's kernels
   python3 tools/bench_sampling.py --baseline-kernels DIR  # and side by side with other kernels
+  python3 tools/bench_sampling.py --baseline-build DIR    # ... or with another build's binary
 
 For each case the reference is rendered once (cached in --cache, keyed by the scene's name
 and file contents, its settings and the kernels it was rendered with) at --ref-factor x the
@@ -15,7 +16,9 @@ the reference with the default sampler); a line below the table gives the ratio 
 relMSE. A render that fails (e.g. an option this build lacks) gives a row saying so.
 --baseline-kernels points
 PATHREUSE_KERNEL_DIR at another kernels/ folder (e.g. `git archive` of an older commit), so
-both run in the same binary on the same machine in the same run. Standard library only.
+both run in the same binary on the same machine in the same run; --baseline-build runs another
+build's pathreuse instead (e.g. of an older commit whose device structs differ). Standard
+library only.
 
 --reuse adds a row rendered with --mode reuse and its defaults (eye paths and connections), a
 single frame, so its light paths are all traced in that frame's time.
@@ -148,6 +151,7 @@ def main():
     ap.add_argument("--ref-factor", type=int, default=16)
     ap.add_argument("--seeds", type=int, default=3)
     ap.add_argument("--baseline-kernels", help="another kernels/ folder to compare with")
+    ap.add_argument("--baseline-build", help="another build folder whose pathreuse to compare with")
     ap.add_argument("--cases", help="comma-separated case numbers (1-based) to run")
     ap.add_argument("--cache", default="/tmp/pathreuse-bench-sampling")
     ap.add_argument("--python", default="/usr/bin/python3", help="python for gen_atrium.py")
@@ -162,6 +166,8 @@ def main():
     configs = [("this build", None)]
     if args.baseline_kernels:
         configs.insert(0, ("baseline", Path(args.baseline_kernels).resolve()))
+    if args.baseline_build:
+        configs.insert(0, ("baseline build", Path(args.baseline_build).resolve() / "pathreuse"))
     chosen = [int(c) - 1 for c in args.cases.split(",")] if args.cases else range(len(CASES))
     # generated scenes first, so that the generator's lines do not land inside the table
     scenes = {CASES[ci][1]: scene_path(CASES[ci][1], args.python) for ci in chosen}
@@ -207,8 +213,11 @@ def main():
                     if kd == "cycles":
                         ks, wall = render_cycles(sp, w, h, args.spp, seed, opts, img), None
                     else:
-                        ks, wall = render(exe, sp, w, h, args.spp, seed, opts + vopts, img,
-                                          tmp / "s.jsonl", kd)
+                        # kd: another kernels/ folder, or another build's binary
+                        other = kd is not None and kd.name == "pathreuse"
+                        ks, wall = render(kd if other else exe, sp, w, h, args.spp, seed,
+                                          opts + vopts, img, tmp / "s.jsonl",
+                                          None if other else kd)
                 except RenderFailed as err:
                     failed.append(str(err))
                     continue

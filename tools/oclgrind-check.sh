@@ -91,4 +91,11 @@ run "atrium-normal-maps-env-reuse-connections" "$work/bumps/atrium.gltf" --frame
   --camera 1 --env "$work/bumps/sky.hdr" --env-rotate 40 --no-eye-paths
 run "atrium-normal-maps-env-eye" "$work/bumps/atrium.gltf" --frames 0-1 --mode reuse \
   --camera 1 --env "$work/bumps/sky.hdr" --env-rotate 40
+# Every BSDF lobe and texture (sheen, a coat with its own normal map, anisotropy with a direction
+# texture) in both integrators, and the glTF specification's model.
+for mode in pathtrace reuse; do
+  run "materials-extensions-$mode" tests/data/materials/extensions.gltf --frames 0 --mode "$mode"
+  run "materials-gltf-model-$mode" tests/data/materials/zoo.gltf --frames 0 --mode "$mode" \
+    --material-model gltf-reference
+done
 exit $fail

@@ -5,7 +5,7 @@
 
 namespace pr {
 
-dev::Material toDeviceMaterial(const Material& m, bool forceDiffuse) {
+dev::Material toDeviceMaterial(const Material& m, const MaterialOptions& options) {
   dev::Material d{};
   d.base_r = m.baseColorFactor.r;
   d.base_g = m.baseColorFactor.g;
@@ -53,7 +53,8 @@ dev::Material toDeviceMaterial(const Material& m, bool forceDiffuse) {
              !m.metallicRoughnessTexture.valid()) {
     flags |= PR_MAT_MIRROR;
   }
-  if (forceDiffuse && !(flags & (PR_MAT_GLASS | PR_MAT_MIRROR))) flags |= PR_MAT_LAMBERT;
+  if (options.forceDiffuse && !(flags & (PR_MAT_GLASS | PR_MAT_MIRROR))) flags |= PR_MAT_LAMBERT;
+  if (options.model == MaterialModel::Gltf) flags |= PR_MAT_GLTF_MODEL;
   d.flags = flags;
   // KHR_texture_transform: uv' = T * R * S * uv with R = [[c, s], [-s, c]].
   auto transform = [](const TextureRef& t, float* out) {
@@ -78,6 +79,24 @@ dev::Material toDeviceMaterial(const Material& m, bool forceDiffuse) {
                (m.specularColorTexture.texCoord == 1 ? PR_UV_SPEC_COLOR : 0u) |
                (m.clearcoatTexture.texCoord == 1 ? PR_UV_COAT : 0u) |
                (m.clearcoatRoughnessTexture.texCoord == 1 ? PR_UV_COAT_ROUGHNESS : 0u);
+  d.coat_normal_texture = texture(m.clearcoatNormalTexture);
+  d.coat_normal_scale = m.clearcoatNormalScale;
+  transform(m.clearcoatNormalTexture, d.coat_normal_uv);
+  for (int c = 0; c < 3; ++c) d.sheen[c] = m.sheenColor[c];
+  d.sheen_roughness = m.sheenRoughness;
+  d.sheen_texture = texture(m.sheenColorTexture);
+  d.sheen_roughness_texture = texture(m.sheenRoughnessTexture);
+  transform(m.sheenColorTexture, d.sheen_uv);
+  transform(m.sheenRoughnessTexture, d.sheen_roughness_uv);
+  d.aniso_strength = m.anisotropyStrength;
+  d.aniso_cos = std::cos(m.anisotropyRotation);
+  d.aniso_sin = std::sin(m.anisotropyRotation);
+  d.aniso_texture = texture(m.anisotropyTexture);
+  transform(m.anisotropyTexture, d.aniso_uv);
+  d.uv_sets |= (m.clearcoatNormalTexture.texCoord == 1 ? PR_UV_COAT_NORMAL : 0u) |
+               (m.sheenColorTexture.texCoord == 1 ? PR_UV_SHEEN : 0u) |
+               (m.sheenRoughnessTexture.texCoord == 1 ? PR_UV_SHEEN_ROUGHNESS : 0u) |
+               (m.anisotropyTexture.texCoord == 1 ? PR_UV_ANISO : 0u);
   return d;
 }
 

@@ -5,15 +5,23 @@
 #include <cstdint>
 #include <vector>
 
+#include "render/options.h"
 #include "scene/scene.h"
 #include "shared/geometry.h"
 #include "shared/material.h"
 
 namespace pr {
 
+// How the device materials shade: forceDiffuse makes every non-delta material pure Lambert;
+// model picks the BSDF (kernels/shared/bsdf.h).
+struct MaterialOptions {
+  bool forceDiffuse = false;
+  MaterialModel model = MaterialModel::Energy;
+};
+
 // The device material: factors, texture slots with their transforms and uv sets, the
-// extensions' parameters. forceDiffuse makes every non-delta material pure Lambert.
-dev::Material toDeviceMaterial(const Material& m, bool forceDiffuse = false);
+// extensions' parameters.
+dev::Material toDeviceMaterial(const Material& m, const MaterialOptions& options = {});
 
 // All textures in one texel buffer (RGBA8 packed in u32) with a table of where each starts.
 struct DeviceTextures {

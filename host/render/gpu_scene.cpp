@@ -64,8 +64,14 @@ GpuScene::GpuScene(Context& ctx, const Scene& scene, const GpuSceneOptions& opti
   }
   deviceAccel_.uploadStatic(ctx_, ssg_);
   deviceAccel_.uploadMeshes(ctx_, dsg_);
-  for (const Material& m : scene.materials)
+  for (const Material& m : scene.materials) {
     if (m.alphaMode != AlphaMode::Opaque) hasAlpha_ = true;
+    // The BSDF's lobes the kernels compile (a --force-diffuse scene shades Lambert only).
+    if (options.forceDiffuse) continue;
+    if (m.sheenColor != glm::vec3(0.0f)) hasSheen_ = true;
+    if (m.clearcoat > 0.0f) hasCoat_ = true;
+    if (m.isAnisotropic()) hasAnisotropy_ = true;
+  }
 
   // Static emitters, once; the light of each emissive triangle, for the pdf of a BSDF ray
   // that hits it.
@@ -172,7 +178,7 @@ void GpuScene::uploadShading() {
 
   std::vector<dev::Material> mats;
   for (const Material& m : scene_.materials)
-    mats.push_back(toDeviceMaterial(m, options_.forceDiffuse));
+    mats.push_back(toDeviceMaterial(m, {options_.forceDiffuse, options_.materialModel}));
   if (mats.empty()) mats.push_back(toDeviceMaterial(Material{}));
 
   const DeviceTextures packed = packTextures(scene_.textures);
@@ -380,6 +386,12 @@ cl_uint GpuScene::setKernelArgs(cl::Kernel& kernel, cl_uint first) {
 std::string GpuScene::buildOptions() const {
   std::string o = "-DPR_BVH_WIDTH=" + std::to_string(bvhWidth_) + " ";
   if (hasAlpha_) o += "-DPR_HAS_ALPHA=1 ";
+  if (hasSheen_) o += "-DPR_HAS_SHEEN=1 ";
+  if (hasCoat_) o += "-DPR_HAS_COAT=1 ";
+  if (hasAnisotropy_) o += "-DPR_HAS_ANISOTROPY=1 ";
+  if (!options_.shadowTerminator) o += "-DPR_TERMINATOR_OFFSET=0 ";
+  if (options_.materialModel == MaterialModel::Gltf)
+    o += "-DPR_HAS_GLTF_MODEL=1 -DPR_HAS_ENERGY_MODEL=0 ";
   if (lightChoice_ == LightSampler::Power) o += "-DPR_LIGHT_SAMPLER_POWER=1 ";
   if (lightChoice_ == LightSampler::Exhaustive) o += "-DPR_LIGHT_SAMPLER_EXHAUSTIVE=1 ";
   if (!o.empty()) o.pop_back();

@@ -26,6 +26,8 @@ struct GpuSceneOptions {
   // Every non-delta material becomes pure Lambert with its base colour (pbrt's --force-diffuse):
   // a diagnostic with exactly known albedo, used by the furnace tests.
   bool forceDiffuse = false;
+  MaterialModel materialModel = MaterialModel::Energy;  // the BSDF model
+  bool shadowTerminator = true;  // smooth-shaded facets' terminator offset (shared/integrator.h)
   LightSampler lightSampler = LightSampler::Auto;
   int bvhWidth = 0;         // children per BVH node; 0: defaultBvhWidth of the device
   Environment environment;  // the environment light; none where !present()
@@ -103,6 +105,7 @@ class GpuScene {
   bool firstFrame_ = true;
   bool anyMoved_ = true;
   bool hasAlpha_ = false;
+  bool hasSheen_ = false, hasCoat_ = false, hasAnisotropy_ = false;  // of any material
 
   // The light table keeps one order for the whole animation: static emitters, then the
   // emissive triangles of each instance, then punctual lights.

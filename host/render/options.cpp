@@ -35,6 +35,10 @@ const char* renderModeName(RenderMode m) {
   return "?";
 }
 
+const char* materialModelName(MaterialModel m) {
+  return m == MaterialModel::Gltf ? "gltf-reference" : "energy";
+}
+
 namespace {
 
 bool parseInt(const std::string& s, int* out) {

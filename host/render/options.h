@@ -25,6 +25,11 @@ int defaultConnections(bool gpu);
 
 const char* renderModeName(RenderMode m);
 
+// The BSDF model (kernels/shared/bsdf.h): energy-conserving (multiple-scattering GGX, layers by
+// albedo scaling; the default) or the glTF specification's single-scattering one.
+enum class MaterialModel { Energy, Gltf };
+const char* materialModelName(MaterialModel m);
+
 struct FrameRange {
   int first = 0;
   int last = -1;  // -1: up to the end of the animation
@@ -50,6 +55,8 @@ struct RenderOptions {
   float exposure = 0.0f;
   bool quiet = false;
   bool forceDiffuse = false;
+  MaterialModel materialModel = MaterialModel::Energy;
+  bool shadowTerminator = true;  // the terminator offset (kernels/shared/integrator.h)
   LightSampler lightSampler = LightSampler::Auto;
   int bvhWidth = 0;  // 0: defaultBvhWidth of the device
   std::string statsFile;

@@ -104,6 +104,8 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
   chooseSize(options, scene.cameraAt(camera_, 0.0), &width_, &height_);
   GpuSceneOptions sceneOptions;
   sceneOptions.forceDiffuse = options.forceDiffuse;
+  sceneOptions.materialModel = options.materialModel;
+  sceneOptions.shadowTerminator = options.shadowTerminator;
   sceneOptions.lightSampler = options.lightSampler;
   sceneOptions.bvhWidth = options.bvhWidth;
   sceneOptions.environment = resolveEnvironment(options, scene);

@@ -129,12 +129,16 @@ class Converter : Stage {
     out.name = mesh.name;
     bool anyTangents = false, anyUv1 = false, anyNormalMap = false;
     for (const auto& p : mesh.primitives) {
-      anyTangents = anyTangents || p.attributes.count("TANGENT");
+      // glTF: a primitive without NORMAL is shaded flat and its TANGENT ignored.
+      anyTangents = anyTangents || (p.attributes.count("TANGENT") && p.attributes.count("NORMAL"));
       anyUv1 = anyUv1 || p.attributes.count("TEXCOORD_1");
-      anyNormalMap =
-          anyNormalMap || scene_.materials[size_t(materialIndex(p.material))].normalTexture.valid();
+      // A tangent frame is needed by normal maps, the coat's normal map and anisotropy.
+      const Material& m = scene_.materials[size_t(materialIndex(p.material))];
+      anyNormalMap = anyNormalMap || m.normalTexture.valid() || m.clearcoatNormalTexture.valid() ||
+                     m.isAnisotropic();
     }
-    std::vector<uint8_t> normalUvSet;  // per triangle: the uv set its normal map reads
+    std::vector<uint8_t> normalUvSet;   // per triangle: the uv set its tangents follow
+    std::vector<uint8_t> givenTangent;  // per vertex: TANGENT from the file is used
     // Skin and morph data: as many JOINTS_n sets as the primitive with most, the targets'
     // POSITION (and NORMAL where any primitive has it) deltas.
     size_t jointSets = 0, targets = 0;
@@ -199,28 +203,33 @@ class Converter : Stage {
       for (size_t v = 0; v < vcount; ++v)
         out.positions.emplace_back(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]);
 
-      // Normals: given ones normalised; absent or degenerate ones area-weighted from faces.
-      std::vector<glm::vec3> faceNormals(vcount, glm::vec3(0.0f));
-      for (size_t t = 0; t + 2 < idx.size(); t += 3) {
-        const glm::vec3 a = out.positions[base + idx[t]], b = out.positions[base + idx[t + 1]],
-                        c = out.positions[base + idx[t + 2]];
-        const glm::vec3 n = glm::cross(b - a, c - a);  // length = twice the area
-        if (!std::isfinite(n.x + n.y + n.z)) continue;
-        for (int k = 0; k < 3; ++k) faceNormals[idx[t + size_t(k)]] += n;
-      }
-      std::vector<double> normals;
-      if (const auto it = p.attributes.find("NORMAL"); it != p.attributes.end())
-        normals = readAccessor(model_, it->second);
-      for (size_t v = 0; v < vcount; ++v) {
-        glm::vec3 n(0.0f);
-        if (!normals.empty()) n = glm::vec3(normals[3 * v], normals[3 * v + 1], normals[3 * v + 2]);
-        float len = glm::length(n);
-        if (!(len > 1e-12f) || !std::isfinite(len)) {
-          n = faceNormals[v];
-          len = glm::length(n);
+      // Normals: given ones normalised, degenerate ones area-weighted from faces. Without
+      // NORMAL the primitive is flat: zero normals, which every transform keeps zero, make the
+      // device shade by the geometric normal of the triangle as it is then (deformed or not).
+      const auto normalAttr = p.attributes.find("NORMAL");
+      const bool hasNormals = normalAttr != p.attributes.end();
+      if (!hasNormals) {
+        out.normals.resize(out.positions.size(), glm::vec3(0.0f));
+      } else {
+        std::vector<glm::vec3> faceNormals(vcount, glm::vec3(0.0f));
+        for (size_t t = 0; t + 2 < idx.size(); t += 3) {
+          const glm::vec3 a = out.positions[base + idx[t]], b = out.positions[base + idx[t + 1]],
+                          c = out.positions[base + idx[t + 2]];
+          const glm::vec3 n = glm::cross(b - a, c - a);  // length = twice the area
+          if (!std::isfinite(n.x + n.y + n.z)) continue;
+          for (int k = 0; k < 3; ++k) faceNormals[idx[t + size_t(k)]] += n;
         }
-        out.normals.push_back(len > 0.0f && std::isfinite(len) ? n / len
-                                                               : glm::vec3(0.0f, 0.0f, 1.0f));
+        const std::vector<double> normals = readAccessor(model_, normalAttr->second);
+        for (size_t v = 0; v < vcount; ++v) {
+          glm::vec3 n(normals[3 * v], normals[3 * v + 1], normals[3 * v + 2]);
+          float len = glm::length(n);
+          if (!(len > 1e-12f) || !std::isfinite(len)) {
+            n = faceNormals[v];
+            len = glm::length(n);
+          }
+          out.normals.push_back(len > 0.0f && std::isfinite(len) ? n / len
+                                                                 : glm::vec3(0.0f, 0.0f, 1.0f));
+        }
       }
       if (const auto it = p.attributes.find("TEXCOORD_0"); it != p.attributes.end()) {
         const std::vector<double> uv = readAccessor(model_, it->second);
@@ -280,7 +289,8 @@ class Converter : Stage {
         const auto* t = ti < p.targets.size() ? &p.targets[ti] : nullptr;
         std::vector<double> dp, dn;
         if (t && t->count("POSITION")) dp = readAccessor(model_, t->at("POSITION"));
-        if (t && t->count("NORMAL")) dn = readAccessor(model_, t->at("NORMAL"));
+        // NORMAL deltas of a flat primitive are ignored: its normals stay zero.
+        if (t && t->count("NORMAL") && hasNormals) dn = readAccessor(model_, t->at("NORMAL"));
         for (size_t v = 0; v < vcount; ++v) {
           glm::vec3 d(0.0f), n(0.0f);
           if (!dp.empty()) d = glm::vec3(dp[3 * v], dp[3 * v + 1], dp[3 * v + 2]);
@@ -292,10 +302,11 @@ class Converter : Stage {
           if (targetNormals) out.morphNormals[ti].push_back(n);
         }
       }
+      std::vector<double> tan;
+      if (const auto it = p.attributes.find("TANGENT"); it != p.attributes.end() && hasNormals)
+        tan = readAccessor(model_, it->second);
+      givenTangent.insert(givenTangent.end(), vcount, uint8_t(!tan.empty()));
       if (anyTangents) {
-        std::vector<double> tan;
-        if (const auto it = p.attributes.find("TANGENT"); it != p.attributes.end())
-          tan = readAccessor(model_, it->second);
         for (size_t v = 0; v < vcount; ++v) {
           glm::vec4 t(1.0f, 0.0f, 0.0f, 1.0f);
           if (!tan.empty()) {
@@ -311,11 +322,26 @@ class Converter : Stage {
       for (uint32_t i : idx) out.indices.push_back(base + i);
       out.materials.insert(out.materials.end(), idx.size() / 3, mat);
       normalUvSet.insert(normalUvSet.end(), idx.size() / 3,
-                         uint8_t(scene_.materials[mat].normalTexture.texCoord == 1));
+                         uint8_t(tangentUvSet(scene_.materials[mat])));
     }
-    // glTF asks for MikkTSpace tangents where a normal-mapped mesh has none.
-    if (!anyTangents && anyNormalMap) generateTangents(out, normalUvSet);
+    // glTF asks for MikkTSpace tangents where a normal-mapped mesh has none: generated for
+    // every vertex whose primitive gives none (or gives them without NORMAL).
+    if (anyNormalMap &&
+        std::find(givenTangent.begin(), givenTangent.end(), uint8_t(0)) != givenTangent.end()) {
+      const std::vector<glm::vec4> given = std::move(out.tangents);
+      generateTangents(out, normalUvSet);
+      for (size_t v = 0; v < given.size(); ++v)
+        if (givenTangent[v]) out.tangents[v] = given[v];
+    }
     return out;
+  }
+
+  // The uv set a material's generated tangents follow: its normal map's, else its coat normal
+  // map's, else its anisotropy texture's, else TEXCOORD_0.
+  static int tangentUvSet(const Material& m) {
+    if (m.normalTexture.valid()) return m.normalTexture.texCoord;
+    if (m.clearcoatNormalTexture.valid()) return m.clearcoatNormalTexture.texCoord;
+    return m.anisotropyTexture.valid() ? m.anisotropyTexture.texCoord : 0;
   }
 
   const TriangleMesh& objectMesh(int meshIndex) {
@@ -341,7 +367,7 @@ class Converter : Stage {
       ssg.tangents.resize(ssg.positions.size(), glm::vec4(1.0f, 0.0f, 0.0f, 1.0f));
     for (size_t v = 0; v < mesh.positions.size(); ++v) {
       ssg.positions.push_back(glm::vec3(world * glm::vec4(mesh.positions[v], 1.0f)));
-      glm::vec3 n = sign * (cof * mesh.normals[v]);
+      glm::vec3 n = sign * (cof * mesh.normals[v]);  // a flat primitive's zero stays zero
       const float len = glm::length(n);
       ssg.normals.push_back(len > 0.0f && std::isfinite(len) ? n / len : mesh.normals[v]);
       ssg.uvs.push_back(mesh.uvs[v]);
@@ -436,8 +462,26 @@ class Converter : Stage {
         m.clearcoatTexture = extensionTexture(*e, "clearcoatTexture", false, where);
         m.clearcoatRoughnessTexture =
             extensionTexture(*e, "clearcoatRoughnessTexture", false, where);
-        // The coat shades with the surface's normal (and its normal map).
-        warnTextures(*e, {"clearcoatNormalTexture"}, where);
+        m.clearcoatNormalTexture = extensionTexture(*e, "clearcoatNormalTexture", false, where);
+        if (const Value* t = member(*e, "clearcoatNormalTexture"))
+          if (const Value* scale = member(*t, "scale"))
+            m.clearcoatNormalScale = float(scale->GetNumberAsDouble());
+      }
+      if (const Value* e = extension(src.extensions, "KHR_materials_sheen")) {
+        if (const Value* c = member(*e, "sheenColorFactor"))
+          m.sheenColor = glm::vec3(c->Get(0).GetNumberAsDouble(), c->Get(1).GetNumberAsDouble(),
+                                   c->Get(2).GetNumberAsDouble());
+        if (const Value* r = member(*e, "sheenRoughnessFactor"))
+          m.sheenRoughness = float(r->GetNumberAsDouble());
+        m.sheenColorTexture = extensionTexture(*e, "sheenColorTexture", true, where);
+        m.sheenRoughnessTexture = extensionTexture(*e, "sheenRoughnessTexture", false, where);
+      }
+      if (const Value* e = extension(src.extensions, "KHR_materials_anisotropy")) {
+        if (const Value* s = member(*e, "anisotropyStrength"))
+          m.anisotropyStrength = float(s->GetNumberAsDouble());
+        if (const Value* r = member(*e, "anisotropyRotation"))
+          m.anisotropyRotation = float(r->GetNumberAsDouble());
+        m.anisotropyTexture = extensionTexture(*e, "anisotropyTexture", false, where);
       }
       scene_.materials.push_back(m);
     }
@@ -752,10 +796,16 @@ Scene load(Document& doc) {
 }  // namespace gltf
 
 bool isSupportedExtension(const std::string& name) {
-  static const std::set<std::string> supported = {
-      "KHR_materials_emissive_strength", "KHR_materials_transmission", "KHR_materials_ior",
-      "KHR_materials_specular",          "KHR_materials_clearcoat",    "KHR_materials_volume",
-      "KHR_texture_transform",           "KHR_lights_punctual"};
+  static const std::set<std::string> supported = {"KHR_materials_emissive_strength",
+                                                  "KHR_materials_transmission",
+                                                  "KHR_materials_ior",
+                                                  "KHR_materials_specular",
+                                                  "KHR_materials_clearcoat",
+                                                  "KHR_materials_volume",
+                                                  "KHR_materials_sheen",
+                                                  "KHR_materials_anisotropy",
+                                                  "KHR_texture_transform",
+                                                  "KHR_lights_punctual"};
   return supported.count(name) > 0;
 }
 

@@ -273,6 +273,11 @@ class Validator : Stage {
           checkFactor(s->IsNumber() ? s->GetNumberAsDouble() : -1.0, lo, hi,
                       std::string(ext) + " " + key, where);
       };
+      auto finiteNumber = [&](const Value* e, const char* key, const char* ext) {
+        if (const Value* s = member(*e, key))
+          if (!s->IsNumber() || !finite(s->GetNumberAsDouble()))
+            fail(std::string(ext) + " " + key + " must be a finite number", where);
+      };
       if (const Value* e = extension(m.extensions, "KHR_materials_specular")) {
         number(e, "specularFactor", 0.0, 1.0, "KHR_materials_specular");
         if (const Value* c = member(*e, "specularColorFactor")) {
@@ -299,6 +304,23 @@ class Validator : Stage {
       if (const Value* e = extension(m.extensions, "KHR_materials_clearcoat")) {
         number(e, "clearcoatFactor", 0.0, 1.0, "KHR_materials_clearcoat");
         number(e, "clearcoatRoughnessFactor", 0.0, 1.0, "KHR_materials_clearcoat");
+        if (const Value* t = member(*e, "clearcoatNormalTexture"))
+          if (t->IsObject())
+            finiteNumber(t, "scale", "KHR_materials_clearcoat clearcoatNormalTexture");
+      }
+      if (const Value* e = extension(m.extensions, "KHR_materials_sheen")) {
+        if (const Value* c = member(*e, "sheenColorFactor")) {
+          bool ok = c->IsArray() && c->ArrayLen() == 3;
+          for (int k = 0; ok && k < 3; ++k)
+            ok = c->Get(k).IsNumber() && c->Get(k).GetNumberAsDouble() >= 0.0 &&
+                 c->Get(k).GetNumberAsDouble() <= 1.0;
+          if (!ok) fail("KHR_materials_sheen sheenColorFactor must be 3 numbers in 0..1", where);
+        }
+        number(e, "sheenRoughnessFactor", 0.0, 1.0, "KHR_materials_sheen");
+      }
+      if (const Value* e = extension(m.extensions, "KHR_materials_anisotropy")) {
+        number(e, "anisotropyStrength", 0.0, 1.0, "KHR_materials_anisotropy");
+        finiteNumber(e, "anisotropyRotation", "KHR_materials_anisotropy");
       }
       // KHR_texture_transform on every texture the material uses.
       const std::pair<const char*, const tinygltf::ExtensionMap*> textures[] = {

@@ -141,6 +141,7 @@ void Scene::deformMesh(size_t m, double t, TriangleMesh* out) const {
     }
   }
   for (size_t v = 0; v < nv; ++v) {
+    // A flat primitive's zero normal (no morph deltas, skinned to zero) stays zero.
     const float l = glm::length(out->normals[v]);
     out->normals[v] = l > 0.0f && std::isfinite(l) ? out->normals[v] / l : base.normals[v];
     if (!out->tangents.empty()) {

@@ -42,7 +42,9 @@ struct Bounds {
 struct TriangleMesh {
   std::string name;
   std::vector<glm::vec3> positions;
-  std::vector<glm::vec3> normals;   // one per vertex, unit length
+  // One per vertex, unit length; zero on a primitive without NORMAL, which is shaded flat (by
+  // the geometric normal): every transform and deformation keeps it zero.
+  std::vector<glm::vec3> normals;
   std::vector<glm::vec2> uvs;       // one per vertex (TEXCOORD_0, zero when absent)
   std::vector<glm::vec2> uvs1;      // empty, or one per vertex (TEXCOORD_1)
   std::vector<glm::vec4> tangents;  // empty, or one per vertex (xyz, w = handedness)
@@ -99,7 +101,16 @@ struct Material {
   TextureRef specularColorTexture;       // sRGB
   TextureRef clearcoatTexture;           // linear, R
   TextureRef clearcoatRoughnessTexture;  // linear, G
-  float thickness = 0.0f;                // KHR_materials_volume: thicknessFactor (0: thin-walled)
+  TextureRef clearcoatNormalTexture;     // linear tangent-space normal map of the coat
+  float clearcoatNormalScale = 1.0f;
+  glm::vec3 sheenColor{0.0f};        // KHR_materials_sheen: sheenColorFactor (0: none)
+  float sheenRoughness = 0.0f;       // sheenRoughnessFactor
+  TextureRef sheenColorTexture;      // sRGB, RGB
+  TextureRef sheenRoughnessTexture;  // linear, A
+  float anisotropyStrength = 0.0f;   // KHR_materials_anisotropy: anisotropyStrength
+  float anisotropyRotation = 0.0f;   // radians, counter-clockwise from the tangent
+  TextureRef anisotropyTexture;      // linear: RG direction, B strength
+  float thickness = 0.0f;            // KHR_materials_volume: thicknessFactor (0: thin-walled)
   float attenuationDistance = std::numeric_limits<float>::infinity();
   glm::vec3 attenuationColor{1.0f};
   AlphaMode alphaMode = AlphaMode::Opaque;
@@ -109,6 +120,7 @@ struct Material {
   glm::vec3 emission() const { return emissiveFactor * emissiveStrength; }
   bool isEmissive() const { return emission() != glm::vec3(0.0f); }
   bool isDielectric() const { return transmission > 0.0f; }
+  bool isAnisotropic() const { return anisotropyStrength > 0.0f; }
 };
 
 enum class TextureWrap : uint32_t { Repeat = 0, ClampToEdge = 1, MirroredRepeat = 2 };

@@ -26,6 +26,21 @@ bool usable(const glm::vec3& v) {
 
 void generateTangents(TriangleMesh& mesh, const std::vector<uint8_t>& uvSet) {
   const size_t nv = mesh.vertexCount();
+  // A vertex of a flat primitive has a zero normal: its faces' area-weighted normal stands in
+  // (the device projects the tangent onto each face's plane where it shades).
+  std::vector<glm::vec3> normals(nv, glm::vec3(0.0f));
+  for (size_t v = 0; v < nv && v < mesh.normals.size(); ++v) normals[v] = mesh.normals[v];
+  std::vector<glm::vec3> faceSum(nv, glm::vec3(0.0f));
+  for (size_t t = 0; t < mesh.triangleCount(); ++t) {
+    const uint32_t i[3] = {mesh.indices[3 * t], mesh.indices[3 * t + 1], mesh.indices[3 * t + 2]};
+    const glm::vec3 n = glm::cross(mesh.positions[i[1]] - mesh.positions[i[0]],
+                                   mesh.positions[i[2]] - mesh.positions[i[0]]);
+    if (!std::isfinite(n.x + n.y + n.z)) continue;
+    for (uint32_t v : i) faceSum[v] += n;
+  }
+  for (size_t v = 0; v < nv; ++v)
+    if (!usable(normals[v]))
+      normals[v] = usable(faceSum[v]) ? glm::normalize(faceSum[v]) : glm::vec3(0.0f, 0.0f, 1.0f);
   std::vector<glm::vec3> sumT(nv, glm::vec3(0.0f)), sumB(nv, glm::vec3(0.0f));
   for (size_t t = 0; t < mesh.triangleCount(); ++t) {
     const std::vector<glm::vec2>& uvs =
@@ -47,7 +62,7 @@ void generateTangents(TriangleMesh& mesh, const std::vector<uint8_t>& uvSet) {
       if (!usable(a) || !usable(b)) continue;
       const float angle =
           std::acos(glm::clamp(glm::dot(glm::normalize(a), glm::normalize(b)), -1.0f, 1.0f));
-      const glm::vec3& n = mesh.normals[i[k]];
+      const glm::vec3& n = normals[i[k]];
       const glm::vec3 tu = dpdu - n * glm::dot(n, dpdu), tv = dpdv - n * glm::dot(n, dpdv);
       if (usable(tu)) sumT[i[k]] += glm::normalize(tu) * angle;
       if (usable(tv)) sumB[i[k]] += glm::normalize(tv) * angle;
@@ -55,7 +70,7 @@ void generateTangents(TriangleMesh& mesh, const std::vector<uint8_t>& uvSet) {
   }
   mesh.tangents.resize(nv);
   for (size_t v = 0; v < nv; ++v) {
-    const glm::vec3& n = mesh.normals[v];
+    const glm::vec3& n = normals[v];
     glm::vec3 t = sumT[v] - n * glm::dot(n, sumT[v]);
     t = usable(t) ? glm::normalize(t) : anyPerpendicular(n);
     const float w = glm::dot(glm::cross(n, t), sumB[v]) < 0.0f ? -1.0f : 1.0f;

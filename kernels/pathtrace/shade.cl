@@ -156,7 +156,7 @@ __kernel void pt_shade(PR_SCENE_PARAMS, __global PathState* states, __global con
     const float u0 = rng_next(&rng);
     const float2 u12 = rng_next2(&rng);
     PathStep step;
-    if (!path_step(&f, wo, u0, u12.x, u12.y, PR_RADIANCE, &step)) {
+    if (!path_step(&s, &h, &f, wo, u0, u12.x, u12.y, PR_RADIANCE, &step)) {
       p.alive = 0u;
     } else {
       tp = tp * step.weight;
@@ -167,7 +167,7 @@ __kernel void pt_shade(PR_SCENE_PARAMS, __global PathState* states, __global con
         p.eye_ratio *=
             solid_angle_to_area_pdf(eye_paths_bsdf_pdf(&f, step.wi, wo), p.seg_cos, dist2);
       p.seg_cos = fabs(dot(f.ng, step.wi));
-      p.ray = spawn_ray(h.p, f.ng, step.wi, PR_INF_F);
+      p.ray = surface_ray(&s, &h, step.wi, PR_INF_F);
       p.prev_x = h.p.x;
       p.prev_y = h.p.y;
       p.prev_z = h.p.z;

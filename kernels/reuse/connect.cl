@@ -139,10 +139,12 @@ PR_INLINE float3 eye_point_eval(const EyePoint* x, float3 dir, float* pdf) {
 // -dir with the pdf of leaving along it (and that of arriving from it, pdf_rev), |cos| at its
 // shading normal and the shading-normal correction of light paths. 0 where it faces away from
 // the eye side.
-PR_INLINE int light_point_eval(const LightPoint* y, float3 dir, float3* f, float* pdf,
-                               float* pdf_rev, float* cos_t, float* corr) {
-  if (dot(-dir, y->f.ng) <= 0.0f) return 0;
-  *f = bsdf_eval_both(&y->f.bsdf, y->wprevl, to_local(-dir, y->f.t, y->f.b, y->f.n), pdf, pdf_rev);
+PR_INLINE int light_point_eval(const SceneData* s, const LightPoint* y, float3 dir, float3* f,
+                               float* pdf, float* pdf_rev, float* cos_t, float* corr) {
+  if (dot(-dir, y->f.ng) <= 0.0f && !surface_lifted(s, &y->h, &y->f)) return 0;
+  // The light path's BSDF: the view is towards the eye side (the adjoint of wprev's).
+  *f = bsdf_eval_mode(&y->f.bsdf, y->wprevl, to_local(-dir, y->f.t, y->f.b, y->f.n), PR_IMPORTANCE,
+                      pdf, pdf_rev);
   *cos_t = fabs(dot(y->f.n, dir));
   *corr = shading_normal_correction(y->wprev, -dir, y->f.n, y->f.ng);
   return 1;
@@ -252,10 +254,10 @@ PR_INLINE float3 light_vertex_value(const Connector* cn, const EyePoint* x, cons
   const float dist2 = dot(dxy, dxy);
   if (!(dist2 > 0.0f)) return zero;
   const float3 dir = dxy * (1.0f / sqrt(dist2));  // from x to y
-  if (dot(dir, x->f.ng) <= 0.0f) return zero;
+  if (dot(dir, x->f.ng) <= 0.0f && !surface_lifted(cn->s, &x->h, &x->f)) return zero;
   float3 f_y;
   float pdf_unused, pdf_rev, cos_y, corr;
-  if (!light_point_eval(y, dir, &f_y, &pdf_unused, &pdf_rev, &cos_y, &corr)) return zero;
+  if (!light_point_eval(cn->s, y, dir, &f_y, &pdf_unused, &pdf_rev, &cos_y, &corr)) return zero;
   float pdf_x;
   const float3 f_x = eye_point_eval(x, dir, &pdf_x);
   const float p_l =
@@ -267,7 +269,7 @@ PR_INLINE float3 light_vertex_value(const Connector* cn, const EyePoint* x, cons
                                           fabs(dot(y->h.ng, dir)), dist2, pdf_rev, cn->inv_c)
                         : connection_mis_weight(PR_STRATEGY_L, p_l, p_e, cn->rp->mis_threshold);
   const float3 tpy = make_float3(vk->tp_r, vk->tp_g, vk->tp_b);
-  *ray = spawn_ray_to(x->h.p, x->f.ng, y->h.p, y->f.ng);
+  *ray = surface_segment(cn->s, &x->h, &y->h);
   return connection_value(cn, x->tp, f_x, fabs(dot(x->f.n, dir)), tpy, f_y, cos_y, dist2, corr, mis,
                           scale, clamped);
 }
@@ -473,7 +475,7 @@ PR_INLINE float3 strategy_sampled_vertex(Connector* cn, float3 xp, float pdf_x, 
       const float dist2 = dot(d, d);
       if (!(dist2 > 0.0f)) continue;
       const float3 dir = d * (1.0f / sqrt(dist2));  // from Y to z
-      if (dot(dir, y->f.ng) <= 0.0f) continue;
+      if (dot(dir, y->f.ng) <= 0.0f && !surface_lifted(s, &y->h, &y->f)) continue;
       float3 zng, f_z;
       float pdf_l, cos_z, corr = 1.0f;
       if (k == 0u) {
@@ -489,7 +491,7 @@ PR_INLINE float3 strategy_sampled_vertex(Connector* cn, float3 xp, float pdf_x, 
       } else {
         const LightPoint z = light_point(s, v + k);
         float pdf_rev_unused;
-        if (z.delta || !light_point_eval(&z, dir, &f_z, &pdf_l, &pdf_rev_unused, &cos_z, &corr))
+        if (z.delta || !light_point_eval(s, &z, dir, &f_z, &pdf_l, &pdf_rev_unused, &cos_z, &corr))
           continue;
         zng = z.f.ng;
       }
@@ -500,8 +502,8 @@ PR_INLINE float3 strategy_sampled_vertex(Connector* cn, float3 xp, float pdf_x, 
       const float3 f_y = eye_point_eval(y, dir, &pdf_unused);
       const float3 tpz = make_float3(v[k].tp_r, v[k].tp_g, v[k].tp_b);
       const Ray r = (k == 0u && v[0].prim == PR_INVALID_INDEX)
-                        ? spawn_ray(y->h.p, y->f.ng, dir, sqrt(dist2) * (1.0f - 1e-4f))
-                        : spawn_ray_to(y->h.p, y->f.ng, zp, zng);
+                        ? surface_ray(s, &y->h, dir, sqrt(dist2) * (1.0f - 1e-4f))
+                        : surface_ray_to(s, &y->h, zp, zng);
       uint clamped = 0u;
       const float3 value = connection_value(cn, y->tp, f_y, fabs(dot(y->f.n, dir)), tpz, f_z, cos_z,
                                             dist2, corr, w, history ? 1.0f : cn->inv_c, &clamped);
@@ -585,13 +587,13 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
     const float2 u12 = rng_next2(&rng);
     if (x.depth + 1u >= rp.max_depth) break;
     PathStep step;
-    if (!path_step(&x.f, x.wo, u0, u12.x, u12.y, PR_RADIANCE, &step)) break;
+    if (!path_step(&s, &x.h, &x.f, x.wo, u0, u12.x, u12.y, PR_RADIANCE, &step)) break;
     float3 d = step.wi;
     const float pdf = step.pdf;
     const int delta = step.delta;
     float3 t2 = x.tp * step.weight;
     uint depth = x.depth;
-    Ray ray = spawn_ray(x.h.p, x.f.ng, d, PR_INF_F);
+    Ray ray = surface_ray(&s, &x.h, d, PR_INF_F);
     int found = 0;
     for (uint chain = 0u; depth < rp.max_depth; ++chain) {
       Hit hit;
@@ -632,10 +634,10 @@ __kernel void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global con
       const float w0 = rng_next(&rng);
       const float2 w12 = rng_next2(&rng);
       PathStep chained;
-      if (!path_step(&y.f, y.wo, w0, w12.x, w12.y, PR_RADIANCE, &chained)) break;
+      if (!path_step(&s, &y.h, &y.f, y.wo, w0, w12.x, w12.y, PR_RADIANCE, &chained)) break;
       d = chained.wi;
       t2 = t2 * chained.weight;
-      ray = spawn_ray(h.p, y.f.ng, d, PR_INF_F);
+      ray = surface_ray(&s, &h, d, PR_INF_F);
     }
     if (!found || !(max3(x.tp) < PR_INF_F)) break;
   }

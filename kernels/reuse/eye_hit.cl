@@ -38,10 +38,10 @@ __kernel void eye_hit(PR_SCENE_PARAMS, ReuseParams rp, CameraParams cam, uint sa
     const float u0 = rng_next(&rng);
     const float2 u12 = rng_next2(&rng);
     PathStep step;
-    if (!path_step(&f, wo, u0, u12.x, u12.y, PR_RADIANCE, &step)) break;
+    if (!path_step(&s, &h, &f, wo, u0, u12.x, u12.y, PR_RADIANCE, &step)) break;
     d = step.wi;
     tp = tp * step.weight;
-    ray = spawn_ray(h.p, f.ng, d, PR_INF_F);
+    ray = surface_ray(&s, &h, d, PR_INF_F);
     ++bounces;
   }
   if (e.prim == PR_INVALID_INDEX) {

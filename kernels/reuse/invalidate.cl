@@ -27,16 +27,22 @@ __kernel void invalidate(PR_SCENE_PARAMS, ReuseParams rp, uint test_segments,
   }
   if (ok && test_segments) {  // (a)
     for (uint k = 1u; ok && k < h.vertex_count; ++k) {
-      Ray r = light_segment_ray(vertex_pos(v + k - 1u), v[k - 1u].ng_oct, v[k - 1u].prim,
-                                vertex_dir(v + k));
+      const float3 d = vertex_dir(v + k);
+      Ray r = make_ray(
+          light_segment_origin(&s.sd, vertex_pos(v + k - 1u), v[k - 1u].ng_oct, v[k - 1u].ns_oct,
+                               v[k - 1u].prim, v[k - 1u].inst, v[k - 1u].b1, v[k - 1u].b2, d),
+          d, 0.0f, PR_INF_F);
       r.tmax = v[k].t;  // strictly nearer than the stored hit, as closest-hit traversal decides
       ++rays;
       if (occluded_dynamic(&s.geom, r)) ok = 0;
     }
     if (ok && h.end == PR_END_ESCAPED && h.vertex_count > 0u) {
       const uint last = h.vertex_count - 1u;
-      const Ray r = light_segment_ray(vertex_pos(v + last), v[last].ng_oct, v[last].prim,
-                                      make_float3(h.escape_x, h.escape_y, h.escape_z));
+      const float3 d = make_float3(h.escape_x, h.escape_y, h.escape_z);
+      const Ray r =
+          make_ray(light_segment_origin(&s.sd, vertex_pos(v + last), v[last].ng_oct, v[last].ns_oct,
+                                        v[last].prim, v[last].inst, v[last].b1, v[last].b2, d),
+                   d, 0.0f, PR_INF_F);
       ++rays;
       if (occluded_dynamic(&s.geom, r)) ok = 0;
     }

@@ -108,7 +108,8 @@ __kernel void light_trace(PR_SCENE_PARAMS, ReuseParams rp, __global const float*
   v.b2 = b2;
   out[0] = v;
   uint count = 1u;
-  Ray ray = light_segment_ray(p0, v.ng_oct, prim0, dir);
+  Ray ray = make_ray(light_segment_origin(&s.sd, p0, v.ng_oct, v.ns_oct, prim0, inst0, b1, b2, dir),
+                     dir, 0.0f, PR_INF_F);
   // With eye paths, the light side of L's weight at each vertex (shared/eye_paths.h).
   const int walk_on = rp.eye_paths && eye_paths_light(&L);
   EyePathWalk walk;
@@ -169,7 +170,7 @@ __kernel void light_trace(PR_SCENE_PARAMS, ReuseParams rp, __global const float*
     const float3 wo = -dir;
     const ShadingFrame f = shading_frame(&s, &q, wo);
     PathStep step;
-    if (!path_step(&f, wo, u0, v1, v2, PR_IMPORTANCE, &step)) break;
+    if (!path_step(&s, &q, &f, wo, u0, v1, v2, PR_IMPORTANCE, &step)) break;
     if (walk_on) {
       const int delta = bsdf_is_delta(&f.bsdf);
       float pdf_fwd = 0.0f, pdf_rev = 0.0f;
@@ -184,7 +185,9 @@ __kernel void light_trace(PR_SCENE_PARAMS, ReuseParams rp, __global const float*
     tp = tp * w;
     if (!(max3(tp) > 0.0f) || !(max3(tp) < PR_INF_F)) break;
     dir = step.wi;
-    ray = light_segment_ray(sh.p, v.ng_oct, hit.prim, dir);
+    ray = make_ray(light_segment_origin(&s.sd, sh.p, v.ng_oct, v.ns_oct, hit.prim, hit.inst, hit.u,
+                                        hit.v, dir),
+                   dir, 0.0f, PR_INF_F);
   }
   h.vertex_count = count;
   headers[slot] = h;

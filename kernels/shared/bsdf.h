@@ -1,13 +1,28 @@
-// BSDFs in a local shading frame (normal = +Z): glTF metallic-roughness as Lambert + GGX
-// (glTF 2.0 specification, appendix B: fresnel_mix of a dielectric layer over diffuse, and a
-// conductor with Schlick's Fresnel on baseColor), with KHR_materials_specular's F0 colour and
-// F90 and KHR_materials_clearcoat's GGX coat layered on top as those extensions define it;
-// a delta mirror and a delta dielectric.
-// wo points towards the previous vertex (camera side on eye paths), wi towards the next.
-// Values returned by eval are f (no cosine); pdfs are per solid angle.
+// BSDFs in a local shading frame (normal = +Z, the frame's tangent = +X): glTF metallic-roughness
+// with KHR_materials_specular (the dielectric layer's F0 colour and F90), _clearcoat, _sheen and
+// _anisotropy, in one of two material models (BsdfParams.model):
+//
+// - PR_MODEL_ENERGY (the default) keeps the energy of a white non-absorbing material at every
+//   angle and roughness: GGX with multiple-scattering compensation from precomputed albedo
+//   tables (Kulla and Conty 2017, Turquin 2019, as Cycles' multiscatter GGX does), and layers
+//   combined by albedo scaling (OpenPBR, Enterprise PBR): the coat over the sheen over the base,
+//   the base a conductor or a dielectric specular layer over diffuse, each lower layer weighted
+//   by what the layers above leave at the view direction.
+// - PR_MODEL_GLTF is the glTF 2.0 specification's model as its appendix B and the extensions
+//   write it (single-scattering GGX, fresnel_mix at V.H, the clearcoat's Fresnel at N.V, the
+//   sheen's albedo scaling), kept for conformance comparisons.
+//
+// A delta mirror and a delta dielectric stand for smooth metals and transmission in both.
+// wo points towards the previous vertex (camera side on eye paths), wi towards the next. The
+// layered models are not reciprocal (a layer's albedo is taken at the view direction), so
+// evaluation takes the transport mode: radiance (wo is the view) or importance (light paths:
+// wi is the view, the adjoint BSDF). Values returned by eval are f (no cosine); pdfs are per
+// solid angle and do not depend on the mode.
 #pragma once
 
+#include "shared/bsdf_tables.h"
 #include "shared/math.h"
+#include "shared/microfacet.h"
 #include "shared/sampling.h"
 
 PR_NAMESPACE_BEGIN
@@ -17,56 +32,217 @@ PR_NAMESPACE_BEGIN
 #define PR_BSDF_GLASS 2u
 #define PR_BSDF_LAMBERT 3u  // pure Lambert (--force-diffuse: exact albedo, for furnace tests)
 
-// Transport mode: radiance (eye paths) or importance (light paths); only refraction differs.
+#define PR_MODEL_ENERGY 0u  // energy-conserving layering, multiple-scattering GGX
+#define PR_MODEL_GLTF 1u    // the glTF specification's single-scattering model
+
+// Transport mode: radiance (eye paths) or importance (light paths).
 #define PR_RADIANCE 0
 #define PR_IMPORTANCE 1
 
-// The smallest GGX alpha used for non-delta surfaces: sharper lobes would be delta in practice
-// and only add fireflies.
-#define PR_MIN_ALPHA 0.0025f
-
 typedef struct {
-  float3 base;  // linear base colour
-  float3 f0;    // the dielectric layer's Fresnel at normal incidence (0.04: ior 1.5)
-  float f90;    // ... and at grazing incidence (1)
+  float3 base;    // linear base colour
+  float3 f0;      // the dielectric layer's Fresnel at normal incidence (0.04: ior 1.5)
+  float3 sheen;   // KHR_materials_sheen colour; 0: no sheen
+  float3 coat_n;  // the coat's normal in this frame ((0, 0, 1): the shading normal)
+  float f90;      // the dielectric layer's Fresnel at grazing incidence (1)
   float metallic;
-  float alpha;  // GGX alpha = roughness^2, >= PR_MIN_ALPHA
+  float alpha_x, alpha_y;  // GGX alphas along the frame's tangent and bitangent, >= PR_MIN_ALPHA
   float ior;
-  float coat;        // clearcoat weight; 0: none
-  float coat_alpha;  // the coat's GGX alpha, >= PR_MIN_ALPHA
-  u32 kind;          // PR_BSDF_*
+  float coat;         // clearcoat weight; 0: none
+  float coat_alpha;   // the coat's GGX alpha, >= PR_MIN_ALPHA
+  float sheen_alpha;  // the sheen's alpha (roughness^2), >= PR_MIN_SHEEN_ALPHA
+  u32 kind;           // PR_BSDF_*
+  u32 model;          // PR_MODEL_*
 } BsdfParams;
 
-// The coat's Fresnel (an ior 1.5 dielectric, as KHR_materials_clearcoat fixes it).
-PR_INLINE float coat_fresnel(float w5) {
-  return 0.04f + 0.96f * w5;
+// A rough white dielectric of the default model, every extension off: callers set what differs.
+PR_INLINE BsdfParams bsdf_params_default(void) {
+  BsdfParams p;
+  p.base = make_float3(1.0f, 1.0f, 1.0f);
+  p.f0 = make_float3(0.04f, 0.04f, 0.04f);
+  p.sheen = make_float3(0.0f, 0.0f, 0.0f);
+  p.coat_n = make_float3(0.0f, 0.0f, 1.0f);
+  p.f90 = 1.0f;
+  p.metallic = 0.0f;
+  p.alpha_x = 1.0f;
+  p.alpha_y = 1.0f;
+  p.ior = 1.5f;
+  p.coat = 0.0f;
+  p.coat_alpha = PR_MIN_ALPHA;
+  p.sheen_alpha = 1.0f;
+  p.kind = PR_BSDF_MICROFACET;
+  p.model = PR_MODEL_ENERGY;
+  return p;
+}
+
+// Whether m is of the glTF model; whether it has a sheen, a coat, is anisotropic (each false
+// where the program leaves the feature out).
+PR_INLINE int bsdf_gltf(const BsdfParams* m) {
+#if !PR_HAS_GLTF_MODEL
+  (void)m;
+  return 0;
+#elif !PR_HAS_ENERGY_MODEL
+  (void)m;
+  return 1;
+#else
+  return m->model == PR_MODEL_GLTF;
+#endif
+}
+PR_INLINE int bsdf_has_sheen(const BsdfParams* m) {
+  return PR_HAS_SHEEN && max3(m->sheen) > 0.0f;
+}
+PR_INLINE int bsdf_has_coat(const BsdfParams* m) {
+  return PR_HAS_COAT && m->coat > 0.0f;
 }
 
 PR_INLINE int bsdf_is_delta(const BsdfParams* m) {
   return m->kind == PR_BSDF_MIRROR || m->kind == PR_BSDF_GLASS;
 }
 
-PR_INLINE float ggx_d(float cos_h, float a2) {
-  const float c2 = cos_h * cos_h;
-  const float d = c2 * (a2 - 1.0f) + 1.0f;
-  return a2 / (PR_PI * d * d);
+// ---- Tables (kernels/shared/bsdf_tables.h, made by tools/bsdf_tables): bilinear on a grid
+// uniform in sqrt(cos) from 0 to 1 and in roughness (sqrt(alpha)) from the smallest to 1.
+
+PR_INLINE float bsdf_table_at(float x, int n, int* i) {
+  const float s = (x > 0.0f ? fmin(x, 1.0f) : 0.0f) * (float)(n - 1);  // NaN: 0
+  const int k = (int)s;
+  *i = k < n - 1 ? k : n - 2;
+  return s - (float)*i;
 }
 
-// Smith's Lambda for GGX, for a direction with |cos| = c.
-PR_INLINE float ggx_lambda(float c, float a2) {
-  const float c2 = c * c;
-  const float t2 = fmax(0.0f, 1.0f - c2) / fmax(c2, 1e-12f);
-  return 0.5f * (-1.0f + sqrt(1.0f + a2 * t2));
+PR_INLINE float bsdf_table_roughness(float r) {
+  return (r - PR_TABLE_MIN_ROUGHNESS) * (1.0f / (1.0f - PR_TABLE_MIN_ROUGHNESS));
 }
 
-PR_INLINE float schlick_weight(float c) {
-  const float m = clamp(1.0f - c, 0.0f, 1.0f);
-  const float m2 = m * m;
-  return m2 * m2 * m;
+PR_INLINE float bsdf_table2(PR_CONSTANT const float* t, float mu, float r) {
+  int i, j;
+  const float fx = bsdf_table_at(sqrt(fmax(mu, 0.0f)), PR_BSDF_TABLE_COS, &i);
+  const float fy = bsdf_table_at(bsdf_table_roughness(r), PR_BSDF_TABLE_R, &j);
+  PR_CONSTANT const float* row = t + j * PR_BSDF_TABLE_COS + i;
+  const float a = row[0] + (row[1] - row[0]) * fx;
+  const float b =
+      row[PR_BSDF_TABLE_COS] + (row[PR_BSDF_TABLE_COS + 1] - row[PR_BSDF_TABLE_COS]) * fx;
+  return a + (b - a) * fy;
 }
 
-// Probability of sampling the specular lobe; a function of (material, wo) only, so that
-// eval and sample agree on the mixture pdf.
+PR_INLINE float bsdf_table1(PR_CONSTANT const float* t, float r) {
+  int j;
+  const float fy = bsdf_table_at(bsdf_table_roughness(r), PR_BSDF_TABLE_R, &j);
+  return t[j] + (t[j + 1] - t[j]) * fy;
+}
+
+// Trilinear in a [k][j][i] table of nk x nj x ni at cell (i, j, k) and fractions (fx, fy, fz).
+PR_INLINE float bsdf_table3(PR_CONSTANT const float* t, int ni, int nj, int i, int j, int k,
+                            float fx, float fy, float fz) {
+  PR_CONSTANT const float* c = t + (k * nj + j) * ni + i;
+  const float a0 = c[0] + (c[1] - c[0]) * fx, a1 = c[ni] + (c[ni + 1] - c[ni]) * fx;
+  c += ni * nj;
+  const float b0 = c[0] + (c[1] - c[0]) * fx, b1 = c[ni] + (c[ni + 1] - c[ni]) * fx;
+  const float a = a0 + (a1 - a0) * fy, b = b0 + (b1 - b0) * fy;
+  return a + (b - a) * fz;
+}
+
+// A GGX lobe's albedos seen from cos mu: e with F = 1, es weighted by Schlick's (1 - v.h)^5, and
+// eavg, e's hemispherical average; anisotropic lobes from their azimuth-averaged tables.
+PR_INLINE void ggx_albedo(float ax, float ay, float mu, float* e, float* es, float* eavg) {
+  if (!PR_HAS_ANISOTROPY || ax == ay) {
+    const float r = sqrt(ax);
+    *e = bsdf_table2(pr_ggx_e, mu, r);
+    *es = bsdf_table2(pr_ggx_es, mu, r);
+    *eavg = bsdf_table1(pr_ggx_eavg, r);
+    return;
+  }
+  const float amax = fmax(ax, ay), amin = fmin(ax, ay);
+  int i, j, k;
+  const float fx = bsdf_table_at(sqrt(fmax(mu, 0.0f)), PR_BSDF_ANISO_COS, &i);
+  const float fy = bsdf_table_at(bsdf_table_roughness(sqrt(amax)), PR_BSDF_ANISO_R, &j);
+  const float fz = bsdf_table_at(bsdf_table_roughness(sqrt(amin / amax)), PR_BSDF_ANISO_Q, &k);
+  *e = bsdf_table3(pr_ggx_e_aniso, PR_BSDF_ANISO_COS, PR_BSDF_ANISO_R, i, j, k, fx, fy, fz);
+  *es = bsdf_table3(pr_ggx_es_aniso, PR_BSDF_ANISO_COS, PR_BSDF_ANISO_R, i, j, k, fx, fy, fz);
+  PR_CONSTANT const float* a = pr_ggx_eavg_aniso + k * PR_BSDF_ANISO_R + j;
+  const float a0 = a[0] + (a[1] - a[0]) * fy;
+  const float a1 = a[PR_BSDF_ANISO_R] + (a[PR_BSDF_ANISO_R + 1] - a[PR_BSDF_ANISO_R]) * fy;
+  *eavg = a0 + (a1 - a0) * fz;
+}
+
+// ---- Layers
+
+// The multiple-scattering factor of a GGX lobe with Schlick Fresnel (f0, f90) seen at a
+// direction whose single-scattering albedo with F = 1 is e (average eavg): 1 + Fms (1 - e) / e,
+// Fms the Fresnel of the bounces after the first (Kulla and Conty's appendix, one Fresnel
+// taken out since it multiplies a lobe that has it): a white conductor's albedo is then 1.
+PR_INLINE float3 ggx_ms_factor(float3 f0, float f90, float e, float eavg) {
+  const float3 favg = f0 + (make_float3(f90, f90, f90) - f0) * (1.0f / 21.0f);
+  const float3 one = make_float3(1.0f, 1.0f, 1.0f);
+  const float3 fms = favg * eavg / (one - favg * (1.0f - eavg));
+  return one + fms * ((1.0f - e) / e);
+}
+
+// What the layering needs of one direction w: the layers' directional albedos and the
+// multiple-scattering factors (PR_MODEL_ENERGY); the coat's and sheen's weights (PR_MODEL_GLTF).
+typedef struct {
+  float3 metal_ms, spec_ms;          // multiple-scattering factors of the base's lobes
+  float3 metal_albedo, spec_albedo;  // their albedos
+  float coat_ms, coat_albedo;        // the coat's factor, and its albedo x weight (PR_MODEL_GLTF:
+                                     // weight x Fresnel at N.V)
+  float sheen_albedo;                // max(sheen colour) x the sheen's albedo
+  float sheen_scale;                 // 1, or what brings the sheen's albedo down to 1
+} BsdfLayers;
+
+PR_INLINE BsdfLayers bsdf_layers(const BsdfParams* m, float3 w) {
+  BsdfLayers l;
+  const float3 zero = make_float3(0.0f, 0.0f, 0.0f), one = make_float3(1.0f, 1.0f, 1.0f);
+  l.metal_ms = one;
+  l.spec_ms = one;
+  l.metal_albedo = zero;
+  l.spec_albedo = zero;
+  l.coat_ms = 1.0f;
+  l.coat_albedo = 0.0f;
+  l.sheen_albedo = 0.0f;
+  l.sheen_scale = 1.0f;
+  if (bsdf_has_sheen(m)) {
+    const float sheen = max3(m->sheen);
+    const float e = bsdf_table2(pr_sheen_e, w.z, sqrt(m->sheen_alpha));
+    // The Charlie lobe reflects more than arrives at grazing views when it is smooth (albedo
+    // up to 3.7): the energy model scales it down there.
+    if (!bsdf_gltf(m) && e > 1.0f) l.sheen_scale = 1.0f / e;
+    l.sheen_albedo = sheen * e * l.sheen_scale;
+  }
+  const float cc = dot(w, m->coat_n);
+  if (bsdf_gltf(m)) {
+    if (bsdf_has_coat(m) && cc > 0.0f) l.coat_albedo = m->coat * coat_fresnel(schlick_weight(cc));
+    return l;
+  }
+  float e, es, eavg;
+  ggx_albedo(m->alpha_x, m->alpha_y, w.z, &e, &es, &eavg);
+  e = fmax(e, 1e-3f);
+  if (m->metallic > 0.0f) {
+    l.metal_ms = ggx_ms_factor(m->base, 1.0f, e, eavg);
+    l.metal_albedo = (m->base * e + (one - m->base) * es) * l.metal_ms;
+  }
+  if (m->metallic < 1.0f) {
+    l.spec_ms = ggx_ms_factor(m->f0, m->f90, e, eavg);
+    l.spec_albedo = (m->f0 * e + (make_float3(m->f90, m->f90, m->f90) - m->f0) * es) * l.spec_ms;
+  }
+  if (bsdf_has_coat(m) && cc > 0.0f) {
+    const float rc = sqrt(m->coat_alpha);
+    const float ec = fmax(bsdf_table2(pr_ggx_e, cc, rc), 1e-3f),
+                esc = bsdf_table2(pr_ggx_es, cc, rc);
+    l.coat_ms =
+        ggx_ms_factor(make_float3(0.04f, 0.04f, 0.04f), 1.0f, ec, bsdf_table1(pr_ggx_eavg, rc)).x;
+    l.coat_albedo = m->coat * (0.04f * ec + 0.96f * esc) * l.coat_ms;
+  }
+  return l;
+}
+
+// ---- Lobe choice: probabilities of the coat, the sheen, the base's GGX lobe and the diffuse
+// lobe, a function of (material, wo) only. The sheen is sampled uniformly over the hemisphere:
+// its lobe peaks at grazing directions, which cosine-weighted samples reach too rarely.
+typedef struct {
+  float coat, sheen, spec, diffuse;
+} BsdfLobes;
+
+// The glTF model's choice of its specular lobe over the diffuse one (luminance of the
+// fresnel_mix weights at N.V), and of the coat (its weight x Fresnel, bounded).
 PR_INLINE float bsdf_spec_probability(const BsdfParams* m, float cos_o) {
   const float w5 = schlick_weight(cos_o);
   // (A grey F0, as most materials have, by its one value: luminance would round it.)
@@ -81,25 +257,133 @@ PR_INLINE float bsdf_spec_probability(const BsdfParams* m, float cos_o) {
   return clamp(ws / (ws + wd), 0.1f, 0.9f);
 }
 
-// Probability of sampling the clearcoat lobe (0 without a coat); a function of (material, wo).
 PR_INLINE float bsdf_coat_probability(const BsdfParams* m, float cos_o) {
-  if (!(m->coat > 0.0f)) return 0.0f;
+  if (!bsdf_has_coat(m)) return 0.0f;
   return clamp(2.0f * m->coat * coat_fresnel(schlick_weight(cos_o)), 0.05f, 0.5f);
 }
 
-// GGX specular reflection D G2 / (4 cos_o cos_i) for alpha^2 = a2 at half vector h, and the
-// visible-normal pdf of wi (G1(wo) D / (4 cos_o)).
-PR_INLINE float ggx_reflection(float3 wo, float3 wi, float3 h, float a2, float* pdf) {
-  const float d = ggx_d(h.z, a2);
-  const float lo = ggx_lambda(wo.z, a2), li = ggx_lambda(wi.z, a2);
-  *pdf = d / ((1.0f + lo) * 4.0f * wo.z);
-  return d / (1.0f + lo + li) / (4.0f * wo.z * wi.z);
+PR_INLINE BsdfLobes bsdf_lobes(const BsdfParams* m, float3 wo, const BsdfLayers* l) {
+  BsdfLobes p;
+  if (bsdf_gltf(m)) {
+    const float pc = bsdf_coat_probability(m, dot(wo, m->coat_n));
+    const float psh = l->sheen_albedo > 0.0f ? clamp(l->sheen_albedo, 0.05f, 0.5f) : 0.0f;
+    const float ps = bsdf_spec_probability(m, wo.z);
+    const float rest = (1.0f - pc) * (1.0f - psh);
+    p.coat = pc;
+    p.sheen = (1.0f - pc) * psh;
+    p.spec = rest * ps;
+    p.diffuse = rest * (1.0f - ps);
+    return p;
+  }
+  // In proportion to each layer's share of the albedo, then a tenth spread evenly over the
+  // lobes that reflect anything, so a poor estimate (a textured base) cannot starve one.
+  const float below_coat = 1.0f - l->coat_albedo;
+  const float below_sheen = below_coat * (1.0f - l->sheen_albedo);
+  float wc = l->coat_albedo, wsh = below_coat * l->sheen_albedo;
+  float ws = below_sheen * (m->metallic * luminance(l->metal_albedo) +
+                            (1.0f - m->metallic) * luminance(l->spec_albedo));
+  float wd = below_sheen * (1.0f - m->metallic) *
+             luminance(m->base * (make_float3(1.0f, 1.0f, 1.0f) - l->spec_albedo));
+  wc = fmax(wc, 0.0f);
+  wsh = fmax(wsh, 0.0f);
+  ws = fmax(ws, 0.0f);
+  wd = fmax(wd, 0.0f);
+  const float n = (float)((wc > 0.0f) + (wsh > 0.0f) + (ws > 0.0f) + (wd > 0.0f));
+  const float sum = wc + wsh + ws + wd;
+  if (!(sum > 0.0f)) {
+    // Nothing reflects (a black base): sample the GGX lobe.
+    p.coat = 0.0f;
+    p.sheen = 0.0f;
+    p.spec = 1.0f;
+    p.diffuse = 0.0f;
+    return p;
+  }
+  const float k = 0.9f / sum, floor_share = 0.1f / n;
+  p.coat = wc > 0.0f ? wc * k + floor_share : 0.0f;
+  p.sheen = wsh > 0.0f ? wsh * k + floor_share : 0.0f;
+  p.spec = ws > 0.0f ? ws * k + floor_share : 0.0f;
+  p.diffuse = wd > 0.0f ? wd * k + floor_share : 0.0f;
+  return p;
 }
 
-// f(wo, wi), the pdf of sampling wi given wo and (pdf_rev) that of sampling wo given wi, for
-// the microfacet model: one evaluation where a path needs its density both ways.
-PR_INLINE float3 bsdf_eval_both(const BsdfParams* m, float3 wo, float3 wi, float* pdf,
-                                float* pdf_rev) {
+// The coat's visible-normal pdf of wi from wo (about the coat's normal).
+PR_INLINE float coat_pdf(const BsdfParams* m, float3 wo, float3 wi, float3 h) {
+  const float co = dot(wo, m->coat_n), ci = dot(wi, m->coat_n);
+  if (!(co > 0.0f) || !(ci > 0.0f)) return 0.0f;
+  const float a2 = m->coat_alpha * m->coat_alpha;
+  return ggx_d(dot(h, m->coat_n), a2) / ((1.0f + ggx_lambda(co, a2)) * 4.0f * co);
+}
+
+// The mixture's pdf of sampling wi from wo with lobe probabilities p (h: their half vector).
+PR_INLINE float bsdf_mixture_pdf(const BsdfParams* m, const BsdfLobes* p, float3 wo, float3 wi,
+                                 float3 h) {
+  float pdf = 0.0f;
+  if (PR_HAS_COAT && p->coat > 0.0f) pdf += p->coat * coat_pdf(m, wo, wi, h);
+  if (p->spec > 0.0f) {
+    const float pdf_spec = ggx_d_xy(h, m->alpha_x, m->alpha_y) /
+                           ((1.0f + ggx_lambda_xy(wo, m->alpha_x, m->alpha_y)) * 4.0f * wo.z);
+    pdf += p->spec * pdf_spec;
+  }
+  if (PR_HAS_SHEEN && p->sheen > 0.0f) pdf += p->sheen * (0.5f * PR_INV_PI);
+  return pdf + p->diffuse * (wi.z * PR_INV_PI);
+}
+
+// f with view v = (mode radiance ? wo : wi); lv and li are the layers of wo and wi.
+PR_INLINE float3 bsdf_value(const BsdfParams* m, float3 wo, float3 wi, float3 h, int mode,
+                            const BsdfLayers* lo, const BsdfLayers* li) {
+  const BsdfLayers* lv = mode == PR_RADIANCE ? lo : li;
+  const float3 one = make_float3(1.0f, 1.0f, 1.0f);
+  // The GGX lobe without Fresnel (symmetric in wo and wi).
+  const float ax = m->alpha_x, ay = m->alpha_y;
+  const float d = ggx_d_xy(h, ax, ay);
+  const float g2 = 1.0f / (1.0f + ggx_lambda_xy(wo, ax, ay) + ggx_lambda_xy(wi, ax, ay));
+  const float spec = d * g2 / (4.0f * wo.z * wi.z);
+  const float w5 = schlick_weight(fmax(dot(wo, h), 0.0f));
+  const float3 fd = m->f0 + (make_float3(m->f90, m->f90, m->f90) - m->f0) * w5;
+  const float3 fm = m->base + (one - m->base) * w5;
+  float3 f;
+  if (bsdf_gltf(m)) {
+    // fresnel_mix with a coloured F: specular where reflected, diffuse where not.
+    const float3 dielectric = fd * spec + m->base * ((one - fd) * PR_INV_PI);
+    f = dielectric * (1.0f - m->metallic) + fm * (spec * m->metallic);
+  } else {
+    f = make_float3(0.0f, 0.0f, 0.0f);
+    if (m->metallic > 0.0f) f = fm * lv->metal_ms * (spec * m->metallic);
+    if (m->metallic < 1.0f)
+      f += (fd * lv->spec_ms * spec +
+            m->base * (fmax(one - lv->spec_albedo, make_float3(0.0f, 0.0f, 0.0f)) * PR_INV_PI)) *
+           (1.0f - m->metallic);
+  }
+  if (bsdf_has_sheen(m)) {
+    const float a = m->sheen_alpha;
+    const float s = sheen_lobe(wo.z, wi.z, h.z, a);
+    // The glTF model's scaling is the smaller of both directions' (reciprocal); the energy
+    // model's is the view's.
+    const float keep = bsdf_gltf(m) ? fmin(1.0f - lo->sheen_albedo, 1.0f - li->sheen_albedo)
+                                    : 1.0f - lv->sheen_albedo;
+    f = m->sheen * (s * lv->sheen_scale) + f * fmax(keep, 0.0f);
+  }
+  if (bsdf_has_coat(m)) {
+    const float co = dot(wo, m->coat_n), ci = dot(wi, m->coat_n);
+    float coat_spec = 0.0f;
+    if (co > 0.0f && ci > 0.0f) {
+      float unused;
+      coat_spec = ggx_reflection(co, ci, dot(h, m->coat_n), m->coat_alpha * m->coat_alpha, &unused);
+      // glTF: the coat's lobe weighted by its Fresnel at N.V; energy: the microfacet's Fresnel
+      // with the multiple-scattering factor.
+      coat_spec *= bsdf_gltf(m) ? lv->coat_albedo : m->coat * coat_fresnel(w5) * lv->coat_ms;
+      // The caller weights by the cosine to the shading normal; a tilted coat reflects by the
+      // cosine to its own, on the light's side (wi, or wo for importance).
+      if (m->coat_n.z < 1.0f) coat_spec *= mode == PR_RADIANCE ? ci / wi.z : co / wo.z;
+    }
+    f = f * fmax(1.0f - lv->coat_albedo, 0.0f) + make_float3(coat_spec, coat_spec, coat_spec);
+  }
+  return f;
+}
+
+// bsdf_eval_mode's body.
+PR_INLINE float3 bsdf_eval_impl(const BsdfParams* m, float3 wo, float3 wi, int mode, int want_rev,
+                                float* pdf, float* pdf_rev) {
   *pdf = 0.0f;
   *pdf_rev = 0.0f;
   if (bsdf_is_delta(m) || wo.z <= 0.0f || wi.z <= 0.0f) return make_float3(0.0f, 0.0f, 0.0f);
@@ -108,83 +392,43 @@ PR_INLINE float3 bsdf_eval_both(const BsdfParams* m, float3 wo, float3 wi, float
     *pdf_rev = wo.z * PR_INV_PI;
     return m->base * PR_INV_PI;
   }
-  const float a2 = m->alpha * m->alpha;
   float3 h = wo + wi;
   const float hl = length(h);
   if (hl <= 0.0f) return make_float3(0.0f, 0.0f, 0.0f);
   h = h / hl;
-  const float voh = fmax(dot(wo, h), 0.0f);
-  const float d = ggx_d(h.z, a2);
-  const float lo = ggx_lambda(wo.z, a2), li = ggx_lambda(wi.z, a2);
-  const float g2 = 1.0f / (1.0f + lo + li);
-  const float spec = d * g2 / (4.0f * wo.z * wi.z);
-  const float w5 = schlick_weight(voh);
-  // fresnel_mix with a coloured F: specular where reflected, diffuse where not.
-  const float3 fd = m->f0 + (make_float3(m->f90, m->f90, m->f90) - m->f0) * w5;
-  const float3 fm = m->base + (make_float3(1.0f, 1.0f, 1.0f) - m->base) * w5;
-  const float3 dielectric =
-      fd * spec + m->base * ((make_float3(1.0f, 1.0f, 1.0f) - fd) * PR_INV_PI);
-  float3 f = dielectric * (1.0f - m->metallic) + fm * (spec * m->metallic);
-  // VNDF pdf: G1(wo) D(h) / (4 cos_o). The reverse: the same with wo and wi swapped (h and
-  // v.h are symmetric).
-  const float ps = bsdf_spec_probability(m, wo.z);
-  const float pdf_spec = d / ((1.0f + lo) * 4.0f * wo.z);
-  const float pdf_diff = wi.z * PR_INV_PI;
-  *pdf = ps * pdf_spec + (1.0f - ps) * pdf_diff;
-  const float ps_rev = bsdf_spec_probability(m, wi.z);
-  *pdf_rev = ps_rev * (d / ((1.0f + li) * 4.0f * wi.z)) + (1.0f - ps_rev) * (wo.z * PR_INV_PI);
-  if (m->coat > 0.0f) {
-    // The coat over the rest: mix(base, coat specular, coat x its Fresnel).
-    const float fc = m->coat * coat_fresnel(w5);
-    const float ca2 = m->coat_alpha * m->coat_alpha;
-    float pdf_coat;
-    const float coat_spec = ggx_reflection(wo, wi, h, ca2, &pdf_coat) * fc;
-    f = f * (1.0f - fc) + make_float3(coat_spec, coat_spec, coat_spec);
-    const float pc = bsdf_coat_probability(m, wo.z);
-    *pdf = pc * pdf_coat + (1.0f - pc) * *pdf;
-    const float pc_rev = bsdf_coat_probability(m, wi.z);
-    const float pdf_coat_rev = ggx_d(h.z, ca2) / ((1.0f + ggx_lambda(wi.z, ca2)) * 4.0f * wi.z);
-    *pdf_rev = pc_rev * pdf_coat_rev + (1.0f - pc_rev) * *pdf_rev;
+  // wi's layers where the value (seen from wi, or the glTF sheen's scaling) or pdf_rev needs
+  // them.
+  const BsdfLayers lo = bsdf_layers(m, wo);
+  const int need_li = want_rev || mode == PR_IMPORTANCE || (bsdf_gltf(m) && bsdf_has_sheen(m));
+  const BsdfLayers li = need_li ? bsdf_layers(m, wi) : lo;
+  const float3 f = bsdf_value(m, wo, wi, h, mode, &lo, &li);
+  const BsdfLobes po = bsdf_lobes(m, wo, &lo);
+  *pdf = bsdf_mixture_pdf(m, &po, wo, wi, h);
+  if (want_rev) {
+    const BsdfLobes pi = bsdf_lobes(m, wi, &li);
+    *pdf_rev = bsdf_mixture_pdf(m, &pi, wi, wo, h);
   }
   return f;
 }
 
-// f(wo, wi) and the pdf of sampling wi given wo.
-PR_INLINE float3 bsdf_eval(const BsdfParams* m, float3 wo, float3 wi, float* pdf) {
-  float pdf_rev;  // unused: the compiler drops its arithmetic
-  return bsdf_eval_both(m, wo, wi, pdf, &pdf_rev);
+// A direction from the coat's visible normals, about its own normal.
+PR_INLINE float3 coat_sample(const BsdfParams* m, float3 wo, float u1, float u2) {
+  if (m->coat_n.z >= 1.0f) {
+    const float3 h = ggx_sample_vndf(wo, m->coat_alpha, m->coat_alpha, u1, u2);
+    return h * (2.0f * dot(wo, h)) - wo;
+  }
+  float3 t, b;
+  orthonormal_basis(m->coat_n, &t, &b);
+  const float3 wc = to_local(wo, t, b, m->coat_n);
+  if (!(wc.z > 0.0f)) return make_float3(0.0f, 0.0f, -1.0f);
+  const float3 h =
+      to_world(ggx_sample_vndf(wc, m->coat_alpha, m->coat_alpha, u1, u2), t, b, m->coat_n);
+  return h * (2.0f * dot(wo, h)) - wo;
 }
 
-// Visible-normal sampling of GGX (Heitz 2018, isotropic).
-PR_INLINE float3 ggx_sample_vndf(float3 wo, float alpha, float u1, float u2) {
-  const float3 vh = normalize(make_float3(alpha * wo.x, alpha * wo.y, wo.z));
-  const float lensq = vh.x * vh.x + vh.y * vh.y;
-  const float3 t1 =
-      lensq > 0.0f ? make_float3(-vh.y, vh.x, 0.0f) / sqrt(lensq) : make_float3(1.0f, 0.0f, 0.0f);
-  const float3 t2 = cross(vh, t1);
-  const float r = sqrt(u1), phi = 2.0f * PR_PI * u2;
-  const float p1 = r * cos(phi);
-  float p2 = r * sin(phi);
-  const float s = 0.5f * (1.0f + vh.z);
-  p2 = (1.0f - s) * sqrt(fmax(0.0f, 1.0f - p1 * p1)) + s * p2;
-  const float3 nh = t1 * p1 + t2 * p2 + vh * sqrt(fmax(0.0f, 1.0f - p1 * p1 - p2 * p2));
-  return normalize(make_float3(alpha * nh.x, alpha * nh.y, fmax(1e-6f, nh.z)));
-}
-
-PR_INLINE float fresnel_dielectric(float cos_i, float eta) {
-  // eta = n_t / n_i; cos_i >= 0 on the incident side.
-  const float sin2_t = (1.0f - cos_i * cos_i) / (eta * eta);
-  if (sin2_t >= 1.0f) return 1.0f;
-  const float cos_t = sqrt(1.0f - sin2_t);
-  const float rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-  const float rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-  return 0.5f * (rs * rs + rp * rp);
-}
-
-// Samples wi given wo. Returns 0 when no direction is produced. *weight = f * |cos| / pdf (for
-// delta lobes the same ratio with the delta cancelled), *pdf the solid-angle pdf (0 for delta).
-PR_INLINE int bsdf_sample(const BsdfParams* m, float3 wo, float u0, float u1, float u2, int mode,
-                          float3* wi, float3* weight, float* pdf, int* delta) {
+// bsdf_sample's body.
+PR_INLINE int bsdf_sample_impl(const BsdfParams* m, float3 wo, float u0, float u1, float u2,
+                               int mode, float3* wi, float3* weight, float* pdf, int* delta) {
   *delta = 0;
   *pdf = 0.0f;
   *weight = make_float3(0.0f, 0.0f, 0.0f);
@@ -226,30 +470,77 @@ PR_INLINE int bsdf_sample(const BsdfParams* m, float3 wo, float u0, float u1, fl
     *weight = m->base;
     return 1;
   }
-  const float pc = bsdf_coat_probability(m, wo.z);
+  const BsdfLayers lo = bsdf_layers(m, wo);
+  const BsdfLobes p = bsdf_lobes(m, wo, &lo);
   float3 dir;
-  if (u0 < pc) {
-    const float3 h = ggx_sample_vndf(wo, m->coat_alpha, u1, u2);
-    dir = h * (2.0f * dot(wo, h)) - wo;
-  } else {
-    // The rest of u0 chooses between the base's lobes.
-    const float ub = pc > 0.0f ? (u0 - pc) / (1.0f - pc) : u0;
-    const float ps = bsdf_spec_probability(m, wo.z);
-    if (ub < ps) {
-      const float3 h = ggx_sample_vndf(wo, m->alpha, u1, u2);
-      dir = h * (2.0f * dot(wo, h)) - wo;
+  if (bsdf_gltf(m)) {
+    // The random number's rest after each choice makes the next (the order of the glTF model's
+    // images before the sheen was added).
+    float ub = u0;
+    if (ub < p.coat) {
+      dir = coat_sample(m, wo, u1, u2);
     } else {
-      dir = sample_cosine_hemisphere(u1, u2);
+      if (p.coat > 0.0f) ub = (ub - p.coat) / (1.0f - p.coat);
+      const float rest = 1.0f - p.coat;
+      const float psh = rest > 0.0f ? p.sheen / rest : 0.0f;
+      if (ub < psh) {
+        dir = sample_uniform_hemisphere(u1, u2);
+      } else {
+        if (psh > 0.0f) ub = (ub - psh) / (1.0f - psh);
+        const float ps = bsdf_spec_probability(m, wo.z);
+        if (ub < ps) {
+          const float3 h = ggx_sample_vndf(wo, m->alpha_x, m->alpha_y, u1, u2);
+          dir = h * (2.0f * dot(wo, h)) - wo;
+        } else {
+          dir = sample_cosine_hemisphere(u1, u2);
+        }
+      }
     }
+  } else if (u0 < p.coat) {
+    dir = coat_sample(m, wo, u1, u2);
+  } else if (u0 < p.coat + p.spec) {
+    const float3 h = ggx_sample_vndf(wo, m->alpha_x, m->alpha_y, u1, u2);
+    dir = h * (2.0f * dot(wo, h)) - wo;
+  } else if (u0 < p.coat + p.spec + p.sheen) {
+    dir = sample_uniform_hemisphere(u1, u2);
+  } else {
+    dir = sample_cosine_hemisphere(u1, u2);
   }
   if (dir.z <= 0.0f) return 0;
-  float p = 0.0f;
-  const float3 f = bsdf_eval(m, wo, dir, &p);
-  if (p <= 0.0f) return 0;
+  float p_fwd = 0.0f, p_rev;
+  const float3 f = bsdf_eval_impl(m, wo, dir, mode, 0, &p_fwd, &p_rev);
+  if (p_fwd <= 0.0f) return 0;
   *wi = dir;
-  *pdf = p;
-  *weight = f * (dir.z / p);
+  *pdf = p_fwd;
+  *weight = f * (dir.z / p_fwd);
   return 1;
+}
+
+// f(wo, wi) in transport mode `mode`, the pdf of sampling wi given wo and (pdf_rev) that of
+// sampling wo given wi: one evaluation where a path needs its density both ways.
+PR_INLINE float3 bsdf_eval_mode(const BsdfParams* m, float3 wo, float3 wi, int mode, float* pdf,
+                                float* pdf_rev) {
+  return bsdf_eval_impl(m, wo, wi, mode, 1, pdf, pdf_rev);
+}
+
+// f(wo, wi) for radiance (wo the view) with both pdfs.
+PR_INLINE float3 bsdf_eval_both(const BsdfParams* m, float3 wo, float3 wi, float* pdf,
+                                float* pdf_rev) {
+  return bsdf_eval_impl(m, wo, wi, PR_RADIANCE, 1, pdf, pdf_rev);
+}
+
+// f(wo, wi) for radiance and the pdf of sampling wi given wo.
+PR_INLINE float3 bsdf_eval(const BsdfParams* m, float3 wo, float3 wi, float* pdf) {
+  float pdf_rev;
+  return bsdf_eval_impl(m, wo, wi, PR_RADIANCE, 0, pdf, &pdf_rev);
+}
+
+// Samples wi given wo. Returns 0 when no direction is produced. *weight = f * |cos| / pdf (for
+// delta lobes the same ratio with the delta cancelled) in transport mode `mode`, *pdf the
+// solid-angle pdf (0 for delta).
+PR_INLINE int bsdf_sample(const BsdfParams* m, float3 wo, float u0, float u1, float u2, int mode,
+                          float3* wi, float3* weight, float* pdf, int* delta) {
+  return bsdf_sample_impl(m, wo, u0, u1, u2, mode, wi, weight, pdf, delta);
 }
 
 PR_NAMESPACE_END

@@ -9,6 +9,7 @@ typedef int i32;
 typedef ulong u64;
 #define PR_GLOBAL __global
 #define PR_CONSTANT __constant
+#define PR_TABLE __constant  // a table at program scope
 // Helpers are inlined. Intel's OpenCL CPU compiler (2026.2) miscompiles an out-of-line function
 // that passes a float3, by value or inside a struct it points to, once it vectorises across
 // work-items (lanes read their float3 at a 16-byte stride where 12 were written). PR_CALLABLE
@@ -25,6 +26,7 @@ typedef ulong u64;
 #include <cstdint>
 #define PR_GLOBAL
 #define PR_CONSTANT
+#define PR_TABLE inline const
 #define PR_INLINE inline
 #define PR_CALLABLE inline
 #define PR_NAMESPACE_BEGIN \

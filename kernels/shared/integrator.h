@@ -62,25 +62,155 @@ PR_CALLABLE int trace_occluded(const SceneData* s, Ray ray) {
 #endif
 }
 
+// Rays that leave a surface, in every kernel: from the point, offset a few ulps off the
+// geometric surface on the side the ray leaves to (shared/bvh.h, spawn_ray). Where the ray leaves
+// within PR_TERMINATOR_COS of the geometric surface's plane or below it, on the side of the
+// shading normal that the surface's terminator offset lifts to (surface_lift, shared/shading.h:
+// convex smooth-shaded facets), it starts from the lifted point instead, blended in linearly as
+// the geometric cosine falls from PR_TERMINATOR_COS to 0 (fully below the facet). Coarse facets
+// are then not shadowed by their neighbours where the smooth surface their normals describe
+// would be lit (the shadow terminator); rays well above the facet, which its neighbours cannot
+// block, keep their exact origin, and the lift is computed for the others alone. Measured on the
+// atrium's fluted column: docs/design.md section 6. -DPR_TERMINATOR_OFFSET=0 turns it off.
+#ifndef PR_TERMINATOR_OFFSET
+#define PR_TERMINATOR_OFFSET 1
+#endif
+#define PR_TERMINATOR_COS 0.1f
+
+// Where a ray along d leaves the surface point p (geometric normal ng, shading normal ns) of
+// triangle prim of instance inst at barycentrics (b1, b2), and in *side the geometric normal on
+// the side it leaves from, for the ulp offset.
+PR_INLINE float3 ray_exit(const ShadingData* sd, float3 p, float3 ng, float3 ns, u32 prim, u32 inst,
+                          float b1, float b2, float3 d, float3* side) {
+  const float dg = dot(d, ng);
+  *side = dg < 0.0f ? -ng : ng;
+#if PR_TERMINATOR_OFFSET
+  // Only a ray close to the plane, or on the other side of it than of the shading normal's
+  // horizon, can be moved (a ray above both leaves where a lift would not move it).
+  const float near = PR_TERMINATOR_COS * sqrt(dot(d, d));
+  if (!(fabs(dg) < near) && !(dg * dot(d, ns) <= 0.0f)) return p;
+  const float3 lift = surface_lift(sd, prim, inst, b1, b2);
+  const float lg = dot(lift, ng);
+  if (lg != 0.0f && dot(d, ns) * dot(lift, ns) > 0.0f) {
+    const float3 n = lg < 0.0f ? -ng : ng;  // the lift's side
+    const float a = clamp(1.0f - dot(d, n) / near, 0.0f, 1.0f);
+    if (a > 0.0f) {
+      *side = n;
+      return p + lift * a;
+    }
+  }
+#else
+  (void)sd, (void)ns, (void)prim, (void)inst, (void)b1, (void)b2;
+#endif
+  return p;
+}
+
+// A ray leaving surface h along d, up to tmax.
+PR_INLINE Ray surface_ray(const SceneData* s, const SurfaceHit* h, float3 d, float tmax) {
+  float3 side;
+  const float3 o = ray_exit(&s->sd, h->p, h->ng, h->ns, h->prim, h->inst, h->b1, h->b2, d, &side);
+  return make_ray(offset_ray_origin(o, side), d, 0.0f, tmax);
+}
+
+// A shadow segment from surface h to a point q of a surface with normal nq (either
+// orientation; q offset off it towards h), as spawn_ray_to: t in (0, 1).
+PR_INLINE Ray surface_ray_to(const SceneData* s, const SurfaceHit* h, float3 q, float3 nq) {
+  const float3 d = q - h->p;
+  float3 side;
+  const float3 o = offset_ray_origin(
+      ray_exit(&s->sd, h->p, h->ng, h->ns, h->prim, h->inst, h->b1, h->b2, d, &side), side);
+  const float3 e = offset_ray_origin(q, dot(nq, d) > 0.0f ? -nq : nq);
+  return make_ray(o, e - o, 0.0f, 1.0f);
+}
+
+// A shadow segment between two surface points, each leaving its surface as surface_ray does.
+PR_INLINE Ray surface_segment(const SceneData* s, const SurfaceHit* a, const SurfaceHit* b) {
+  const float3 d = b->p - a->p;
+  float3 sa, sb;
+  const float3 o = offset_ray_origin(
+      ray_exit(&s->sd, a->p, a->ng, a->ns, a->prim, a->inst, a->b1, a->b2, d, &sa), sa);
+  const float3 e = offset_ray_origin(
+      ray_exit(&s->sd, b->p, b->ng, b->ns, b->prim, b->inst, b->b1, b->b2, -d, &sb), sb);
+  return make_ray(o, e - o, 0.0f, 1.0f);
+}
+
 // A shading frame: ns and ng flipped to the side of wo for reflective surfaces; glass keeps
-// its geometric orientation so that the sign of wo tells entering from leaving.
+// its geometric orientation so that the sign of wo tells entering from leaving. Where wo is
+// above a reflective surface but (nearly) below its shading normal's horizon (a smooth-shaded
+// facet seen edge-on), the shading normal is turned towards wo until wo is PR_MIN_VIEW_COS
+// above that horizon: the BSDFs only reflect between directions above their normal, which
+// made such views black. `may_lift`: wo is above the geometric surface, so that a reflection
+// may leave below the geometric surface where the shading normal allows and the surface is
+// lifted on wo's side (surface_lifted). -DPR_TERMINATOR_OFFSET=0 (--shadow-terminator off)
+// turns both off.
+#define PR_MIN_VIEW_COS 0.01f
+
 typedef struct {
   float3 t, b, n;  // shading frame
   float3 ng;
   BsdfParams bsdf;
+  int may_lift;
 } ShadingFrame;
 
 PR_INLINE ShadingFrame shading_frame(const SceneData* s, const SurfaceHit* h, float3 wo) {
   ShadingFrame f;
-  f.bsdf = material_bsdf(&s->sd, h);
+  float2 aniso;
+  f.bsdf = material_bsdf(&s->sd, h, &aniso);
   f.ng = h->ng;
   f.n = h->ns;
-  if (f.bsdf.kind != PR_BSDF_GLASS && dot(wo, f.ng) < 0.0f) {
+  const int flip = f.bsdf.kind != PR_BSDF_GLASS && dot(wo, f.ng) < 0.0f;
+  if (flip) {
     f.ng = -f.ng;
     f.n = -f.n;
   }
+  if (PR_TERMINATOR_OFFSET && f.bsdf.kind != PR_BSDF_GLASS) {
+    const float c = dot(wo, f.n);
+    if (c < PR_MIN_VIEW_COS) f.n = normalize(f.n + wo * (PR_MIN_VIEW_COS - c));
+  }
   orthonormal_basis(f.n, &f.t, &f.b);
+#if PR_HAS_ANISOTROPY
+  // The tangent along the anisotropy direction: the vertex tangent made orthogonal to n, turned
+  // towards the bitangent by the material's rotation (KHR_materials_anisotropy).
+  if (aniso.x != 0.0f || aniso.y != 0.0f) {
+    float tw;
+    const float3 tg = surface_tangent(&s->sd, h, &tw);
+    const float3 to = tg - f.n * dot(f.n, tg);
+    const float tl = length(to);
+    if (tl > 1e-6f && isfinite_f(tl)) {
+      const float3 tu = to / tl;
+      const float3 bt = cross(h->ns, tu) * (tw < 0.0f ? -1.0f : 1.0f);
+      const float3 d = tu * aniso.x + bt * aniso.y;
+      const float3 dn = d - f.n * dot(f.n, d);
+      const float dl = length(dn);
+      if (dl > 1e-6f) {
+        f.t = dn / dl;
+        f.b = cross(f.n, f.t);
+      }
+    }
+  }
+#endif
+#if PR_HAS_COAT
+  // The coat's own normal where the base's differs from it (a normal map on either layer).
+  PR_GLOBAL const Material* m = s->sd.materials + h->material;
+  if (f.bsdf.coat > 0.0f &&
+      (m->normal_texture != PR_NO_TEXTURE || m->coat_normal_texture != PR_NO_TEXTURE)) {
+    float3 nc = surface_coat_normal(&s->sd, h);
+    if (flip) nc = -nc;
+    const float c = dot(wo, nc);
+    if (c < PR_MIN_VIEW_COS) nc = normalize(nc + wo * (PR_MIN_VIEW_COS - c));
+    f.bsdf.coat_n = normalize(to_local(nc, f.t, f.b, f.n));
+  }
+#endif
+  f.may_lift = PR_TERMINATOR_OFFSET && dot(wo, f.ng) > 0.0f;
   return f;
+}
+
+// Whether a reflection from surface h in frame f may leave below the geometric surface (where
+// its shading normal allows): where the surface is lifted on the frame's side, so that the ray
+// leaves from the lifted point (ray_exit) and passes over the neighbouring facets, as it would
+// over the smooth surface the normals describe.
+PR_INLINE int surface_lifted(const SceneData* s, const SurfaceHit* h, const ShadingFrame* f) {
+  return f->may_lift && dot(surface_lift(&s->sd, h->prim, h->inst, h->b1, h->b2), f->n) > 0.0f;
 }
 
 // One step of a path from a shaded point (every kernel continues its paths through this): the
@@ -88,7 +218,10 @@ PR_INLINE ShadingFrame shading_frame(const SceneData* s, const SurfaceHit* h, fl
 // direction in world space with the BSDF weight f cos / pdf, the pdf and whether the lobe was
 // delta. 0 where the BSDF gives no direction or where the direction is on the wrong side of the
 // geometric surface (reflection must stay on wo's side, refraction cross it): a shading normal
-// must not let a path through a surface it only reflects from, or back off one it enters.
+// must not let a path through a surface it only reflects from, or back off one it enters. A
+// reflection below the geometric surface is kept where the surface is lifted (surface_lifted):
+// it leaves from the lifted point (surface_ray), above the facet, as next-event estimation's
+// rays do.
 typedef struct {
   float3 wi;
   float3 weight;
@@ -96,8 +229,8 @@ typedef struct {
   int delta;
 } PathStep;
 
-PR_INLINE int path_step(const ShadingFrame* f, float3 wo, float u0, float u1, float u2, int mode,
-                        PathStep* step) {
+PR_INLINE int path_step(const SceneData* s, const SurfaceHit* h, const ShadingFrame* f, float3 wo,
+                        float u0, float u1, float u2, int mode, PathStep* step) {
   const float3 wol = to_local(wo, f->t, f->b, f->n);
   float3 wil;
   if (!bsdf_sample(&f->bsdf, wol, u0, u1, u2, mode, &wil, &step->weight, &step->pdf, &step->delta))
@@ -105,7 +238,8 @@ PR_INLINE int path_step(const ShadingFrame* f, float3 wo, float u0, float u1, fl
   step->wi = normalize(to_world(wil, f->t, f->b, f->n));
   const int reflect = wil.z * wol.z > 0.0f;
   const float side = dot(step->wi, f->ng) * dot(wo, f->ng);
-  return reflect ? side > 0.0f : side < 0.0f;
+  if (!reflect) return side < 0.0f;
+  return side > 0.0f || surface_lifted(s, h, f);
 }
 
 // Russian roulette (pbrt-v4's rule) where q, the path's throughput relative to its start, fell
@@ -208,7 +342,8 @@ PR_INLINE int next_event(const SceneData* s, const SurfaceHit* h, const ShadingF
   } else if (!light_sample(&l, pmf, h->p, f->n, u1, u2, &ls, &b1, &b2)) {
     return 0;
   }
-  if (dot(ls.wi, f->ng) <= 0.0f) return 0;  // below the geometric surface
+  // Below the geometric surface: only from a lifted point (shading_frame).
+  if (dot(ls.wi, f->ng) <= 0.0f && !surface_lifted(s, h, f)) return 0;
   float3 le = ls.le;
   if (l.type == PR_LIGHT_TRIANGLE) {
     const SurfaceHit e = surface_interp(&s->sd, l.prim, l.inst, b1, b2, 0);
@@ -232,10 +367,9 @@ PR_INLINE int next_event(const SceneData* s, const SurfaceHit* h, const ShadingF
     choice->pdf_bsdf_rev = bsdf_pdf_rev;
   }
   if (l.type == PR_LIGHT_TRIANGLE) {
-    *shadow = spawn_ray_to(h->p, f->ng, ls.pos, ls.normal);
+    *shadow = surface_ray_to(s, h, ls.pos, ls.normal);
   } else {
-    *shadow =
-        spawn_ray(h->p, f->ng, ls.wi, ls.dist < PR_INF_F ? ls.dist * (1.0f - 1e-4f) : PR_INF_F);
+    *shadow = surface_ray(s, h, ls.wi, ls.dist < PR_INF_F ? ls.dist * (1.0f - 1e-4f) : PR_INF_F);
   }
   return 1;
 }

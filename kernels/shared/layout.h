@@ -73,6 +73,12 @@
   F(Material, sigma_a)                \
   F(Material, spec_texture)           \
   F(Material, coat_roughness_uv)      \
+  F(Material, coat_normal_texture)    \
+  F(Material, coat_normal_uv)         \
+  F(Material, sheen)                  \
+  F(Material, sheen_roughness_uv)     \
+  F(Material, aniso_strength)         \
+  F(Material, aniso_uv)               \
   F(TextureInfo, flags)               \
   F(CameraParams, fx)                 \
   F(CameraParams, aspect)             \

@@ -1,6 +1,6 @@
 // Materials as the kernels see them: glTF metallic-roughness with emission, transmission
 // (delta dielectric), alpha cut-out/coverage, textures with their transforms and uv sets, normal
-// maps.
+// maps, and the KHR_materials extensions (specular, clearcoat, sheen, anisotropy, volume).
 #pragma once
 
 #include "shared/common.h"
@@ -13,11 +13,12 @@ PR_NAMESPACE_BEGIN
 #define PR_MAT_MIRROR 8u       // delta reflection (metallic 1, roughness ~0)
 #define PR_MAT_GLASS 16u       // delta dielectric (KHR_materials_transmission)
 #define PR_MAT_EMISSIVE 32u
-#define PR_MAT_LAMBERT 64u  // shaded as pure Lambert with the base colour (--force-diffuse)
+#define PR_MAT_LAMBERT 64u      // shaded as pure Lambert with the base colour (--force-diffuse)
+#define PR_MAT_GLTF_MODEL 128u  // the glTF specification's BSDF (--material-model gltf-reference)
 
 #define PR_NO_TEXTURE (-1)
 
-// 320 bytes.
+// 464 bytes.
 typedef struct {
   float base_r, base_g, base_b, base_a;  // linear baseColorFactor
   float emit_r, emit_g, emit_b;          // emissiveFactor * emissive_strength (radiance)
@@ -49,6 +50,23 @@ typedef struct {
   float spec_color_uv[6];
   float coat_uv[6];
   float coat_roughness_uv[6];
+  // KHR_materials_clearcoat's own normal map (PR_NO_TEXTURE: the coat takes the interpolated
+  // normal), with its scale and transform.
+  i32 coat_normal_texture;
+  float coat_normal_scale;
+  float coat_normal_uv[6];
+  // KHR_materials_sheen: colour (0: none) and roughness, their textures (RGB sRGB; A).
+  float sheen[3];
+  float sheen_roughness;
+  i32 sheen_texture, sheen_roughness_texture;
+  float sheen_uv[6];
+  float sheen_roughness_uv[6];
+  // KHR_materials_anisotropy: strength (0: isotropic), rotation from the tangent (cos, sin), the
+  // texture (RG direction in the tangent frame, B strength).
+  float aniso_strength;
+  float aniso_cos, aniso_sin;
+  i32 aniso_texture;
+  float aniso_uv[6];
 } Material;
 
 #define PR_UV_BASE 1u
@@ -59,6 +77,10 @@ typedef struct {
 #define PR_UV_SPEC_COLOR 32u
 #define PR_UV_COAT 64u
 #define PR_UV_COAT_ROUGHNESS 128u
+#define PR_UV_COAT_NORMAL 256u
+#define PR_UV_SHEEN 512u
+#define PR_UV_SHEEN_ROUGHNESS 1024u
+#define PR_UV_ANISO 2048u
 
 // One texture in the shared texel buffer (RGBA8 packed in u32, row-major). 16 bytes.
 typedef struct {
@@ -75,11 +97,14 @@ typedef struct {
 
 PR_NAMESPACE_END
 
-PR_STATIC_ASSERT(sizeof(pr::dev::Material) == 320, "Material layout");
+PR_STATIC_ASSERT(sizeof(pr::dev::Material) == 464, "Material layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::Material, flags) == 28, "Material layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::Material, alpha_cutoff) == 48, "Material layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::Material, base_uv) == 64, "Material layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::Material, emission_uv) == 112, "Material layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::Material, normal_uv) == 144, "Material layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::Material, spec_f0) == 176, "Material layout");
+PR_STATIC_ASSERT(offsetof(pr::dev::Material, coat_normal_texture) == 320, "Material layout");
+PR_STATIC_ASSERT(offsetof(pr::dev::Material, sheen) == 352, "Material layout");
+PR_STATIC_ASSERT(offsetof(pr::dev::Material, aniso_strength) == 424, "Material layout");
 PR_STATIC_ASSERT(sizeof(pr::dev::TextureInfo) == 16, "TextureInfo layout");

@@ -56,12 +56,18 @@ typedef struct {
 enum { PR_REUSE_COUNTERS(PR_C_ENUM) PR_C_COUNT };
 #undef PR_C_ENUM
 
-// The ray of the segment leaving a stored vertex in direction dir: from the exact point for
-// punctual lights (prim == PR_INVALID_INDEX), else offset off the surface along the decoded
-// geometric normal.
-PR_INLINE Ray light_segment_ray(float3 p, u32 ng_oct, u32 prim, float3 dir) {
-  if (prim == PR_INVALID_INDEX) return make_ray(p, dir, 0.0f, PR_INF_F);
-  return spawn_ray(p, oct_decode(ng_oct), dir, PR_INF_F);
+// Where the segment leaving a stored vertex (at p on triangle prim of instance inst, at
+// barycentrics (b1, b2), with its encoded normals) in direction dir starts: the exact point for
+// punctual lights (prim == PR_INVALID_INDEX), else as surface_ray leaves a surface (ray_exit),
+// with the decoded normals. A point, not a Ray: Oclgrind cannot run the noalias scope that
+// inlining a struct-returning function with these loads leaves behind.
+PR_INLINE float3 light_segment_origin(const ShadingData* sd, float3 p, u32 ng_oct, u32 ns_oct,
+                                      u32 prim, u32 inst, float b1, float b2, float3 dir) {
+  if (prim == PR_INVALID_INDEX) return p;
+  float3 side;
+  const float3 o =
+      ray_exit(sd, p, oct_decode(ng_oct), oct_decode(ns_oct), prim, inst, b1, b2, dir, &side);
+  return offset_ray_origin(o, side);
 }
 
 // The first non-delta eye vertex of a pixel sample, as eye_hit (or, with --eye-paths, the path

@@ -25,6 +25,12 @@ PR_INLINE float3 sample_cosine_hemisphere(float u1, float u2) {
   return make_float3(x, y, z);
 }
 
+// Uniform direction on the hemisphere around +Z; pdf = 1 / (2 pi).
+PR_INLINE float3 sample_uniform_hemisphere(float u1, float u2) {
+  const float z = u1, r = sqrt(fmax(0.0f, 1.0f - z * z)), phi = 2.0f * PR_PI * u2;
+  return make_float3(r * cos(phi), r * sin(phi), z);
+}
+
 // Uniform direction on the unit sphere; pdf = 1 / (4 pi).
 PR_INLINE float3 sample_uniform_sphere(float u1, float u2) {
   const float z = 1.0f - 2.0f * u1;

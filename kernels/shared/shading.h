@@ -27,8 +27,9 @@ typedef struct {
   float2 uv;   // TEXCOORD_0
   float2 uv1;  // TEXCOORD_1
   u32 material;
-  u32 prim;  // shading triangle index
-  u32 inst;  // PR_INVALID_INDEX on the SSG
+  u32 prim;      // shading triangle index
+  u32 inst;      // PR_INVALID_INDEX on the SSG
+  float b1, b2;  // barycentrics of v1 and v2 (surface_lift, for rays that leave the surface)
 } SurfaceHit;
 
 PR_INLINE float3 xform_point12(PR_GLOBAL const float* m, float3 p) {
@@ -136,15 +137,15 @@ PR_INLINE float2 material_uv(PR_GLOBAL const Material* m, u32 set, PR_GLOBAL con
   return texture_uv(xf, (m->uv_sets & set) ? uv1 : uv0);
 }
 
-// The glTF normal map's normal: the texel's tangent-space normal, x and y scaled, in the frame
+// A glTF normal map's normal: the texel's tangent-space normal, x and y scaled, in the frame
 // of the unit interpolated normal n, the tangent t made orthogonal to it and b = tw cross(n, t).
 // n itself where the tangent is degenerate or the mapped normal would cross the geometric
 // surface (ng) to the other side than n.
-PR_INLINE float3 normal_mapped(const ShadingData* sd, PR_GLOBAL const Material* m, float2 uv,
-                               float3 n, float3 t, float tw, float3 ng) {
-  const float4 c = texture_sample(sd, m->normal_texture, uv);
-  const float3 tn = make_float3((2.0f * c.x - 1.0f) * m->normal_scale,
-                                (2.0f * c.y - 1.0f) * m->normal_scale, 2.0f * c.z - 1.0f);
+PR_INLINE float3 normal_mapped(const ShadingData* sd, i32 texture, float scale, float2 uv, float3 n,
+                               float3 t, float tw, float3 ng) {
+  const float4 c = texture_sample(sd, texture, uv);
+  const float3 tn =
+      make_float3((2.0f * c.x - 1.0f) * scale, (2.0f * c.y - 1.0f) * scale, 2.0f * c.z - 1.0f);
   const float3 to = t - n * dot(n, t);
   const float tl = length(to);
   if (!(tl > 1e-6f) || !isfinite_f(tl)) return n;
@@ -155,6 +156,74 @@ PR_INLINE float3 normal_mapped(const ShadingData* sd, PR_GLOBAL const Material* 
   if (!(pl > 0.0f) || !isfinite_f(pl)) return n;
   const float3 r = p / pl;
   return dot(r, ng) * dot(n, ng) > 0.0f ? r : n;
+}
+
+// One corner's share of surface_lift: p (world space) moved onto the tangent plane of a vertex
+// at pv with normal nv where p lies below it, times the barycentric b. Zero for a vertex normal
+// that faces away from the interpolated normal n, and where p lies less than about a hundred
+// ulps of its coordinates below the plane (round-off on a flat triangle; rays leave a surface
+// by 256 ulps anyway).
+PR_INLINE float3 lift_to_tangent_plane(float3 pv, float3 nv, float3 p, float b, float3 n) {
+  const float h = dot(pv - p, nv);  // times |nv|
+  const float scale = fmax(fmax(fabs(p.x), fabs(p.y)), fmax(fabs(p.z), 1.0f / 32.0f));
+  if (!(h > 1e-5f * scale * length(nv)) || !(dot(nv, n) > 0.0f))
+    return make_float3(0.0f, 0.0f, 0.0f);
+  return nv * (b * h / dot(nv, nv));
+}
+
+// The shadow-terminator offset at barycentrics (b1, b2) of a triangle (Hanika 2021, "Hacking the
+// shadow terminator", Ray Tracing Gems II ch. 4): the point projected onto the tangent plane of
+// each vertex it lies below, the projections blended by the barycentrics, as an offset from the
+// point (world space). It lifts the point of a coarse, smooth-shaded convex facet to about
+// where the surface its normals describe would be, so that rays leaving there are not shadowed
+// by the neighbouring facets where that surface would not be; zero on flat and concave parts
+// (the point lies on or above every tangent plane), and at most the triangle's size. Rays use it
+// through the integrator's ray_exit (shared/integrator.h), which computes it only for the rays
+// it can move.
+
+PR_INLINE float3 surface_lift(const ShadingData* sd, u32 prim, u32 inst, float b1, float b2) {
+  const ShadingTriangle tri = sd->triangles[prim];
+  const ShadingVertex a = sd->vertices[tri.v0], b = sd->vertices[tri.v1], c = sd->vertices[tri.v2];
+  const float b0 = 1.0f - b1 - b2;
+  float3 pa = make_float3(a.px, a.py, a.pz), pb = make_float3(b.px, b.py, b.pz),
+         pc = make_float3(c.px, c.py, c.pz);
+  float3 na = make_float3(a.nx, a.ny, a.nz), nb = make_float3(b.nx, b.ny, b.nz),
+         nc = make_float3(c.nx, c.ny, c.nz);
+  // A flat-shaded triangle (one normal at every corner) has none.
+  if (a.nx == b.nx && a.ny == b.ny && a.nz == b.nz && a.nx == c.nx && a.ny == c.ny && a.nz == c.nz)
+    return make_float3(0.0f, 0.0f, 0.0f);
+  if (inst != PR_INVALID_INDEX) {
+    PR_GLOBAL const ShadingInstance* in = sd->instances + inst;
+    pa = xform_point12(in->object_to_world, pa);
+    pb = xform_point12(in->object_to_world, pb);
+    pc = xform_point12(in->object_to_world, pc);
+    na = xform_normal12(in->world_to_object, na);
+    nb = xform_normal12(in->world_to_object, nb);
+    nc = xform_normal12(in->world_to_object, nc);
+  }
+  const float3 p = pa * b0 + pb * b1 + pc * b2;
+  const float3 n = na * b0 + nb * b1 + nc * b2;
+  const float3 l = lift_to_tangent_plane(pa, na, p, b0, n) +
+                   lift_to_tangent_plane(pb, nb, p, b1, n) +
+                   lift_to_tangent_plane(pc, nc, p, b2, n);
+  return isfinite_f(l.x + l.y + l.z) ? l : make_float3(0.0f, 0.0f, 0.0f);
+}
+
+// The interpolated vertex tangent at the surface (world space, not normalised, zero where the
+// mesh has none) and in *tw the bitangent's sign: b = tw cross(n, t).
+PR_INLINE float3 surface_tangent(const ShadingData* sd, const SurfaceHit* s, float* tw) {
+  const ShadingTriangle tri = sd->triangles[s->prim];
+  const ShadingVertex a = sd->vertices[tri.v0], b = sd->vertices[tri.v1], c = sd->vertices[tri.v2];
+  float3 t = make_float3(a.tx, a.ty, a.tz) * (1.0f - s->b1 - s->b2) +
+             make_float3(b.tx, b.ty, b.tz) * s->b1 + make_float3(c.tx, c.ty, c.tz) * s->b2;
+  *tw = a.tw;
+  if (s->inst != PR_INVALID_INDEX) {
+    PR_GLOBAL const ShadingInstance* in = sd->instances + s->inst;
+    t = xform_vector12(in->object_to_world, t);
+    // A mirroring transform turns the bitangent's handedness around.
+    if (det12(in->object_to_world) < 0.0f) *tw = -*tw;
+  }
+  return t;
 }
 
 // The surface at barycentrics (b1, b2) of a triangle (b1 weights v1, b2 weights v2); with its
@@ -186,24 +255,42 @@ PR_INLINE SurfaceHit surface_interp(const ShadingData* sd, u32 prim, u32 inst, f
   s.ng = cl > 0.0f ? cr / cl : make_float3(0.0f, 0.0f, 1.0f);
   const float nl = length(n);
   s.ns = nl > 0.0f && isfinite_f(nl) ? n / nl : s.ng;
+  s.b1 = b1;
+  s.b2 = b2;
   s.uv = make_float2(a.u * b0 + b.u * b1 + c.u * b2, a.v * b0 + b.v * b1 + c.v * b2);
   s.uv1 = make_float2(a.u1 * b0 + b.u1 * b1 + c.u1 * b2, a.v1 * b0 + b.v1 * b1 + c.v1 * b2);
   PR_GLOBAL const Material* m = sd->materials + s.material;
   if (map_normals && m->normal_texture != PR_NO_TEXTURE) {
-    float3 t = make_float3(a.tx, a.ty, a.tz) * b0 + make_float3(b.tx, b.ty, b.tz) * b1 +
-               make_float3(c.tx, c.ty, c.tz) * b2;
-    float tw = a.tw;
-    if (inst != PR_INVALID_INDEX) {
-      PR_GLOBAL const ShadingInstance* in = sd->instances + inst;
-      t = xform_vector12(in->object_to_world, t);
-      // A mirroring transform turns the bitangent's handedness around.
-      if (det12(in->object_to_world) < 0.0f) tw = -tw;
-    }
-    s.ns = normal_mapped(sd, m, material_uv(m, PR_UV_NORMAL, m->normal_uv, s.uv, s.uv1), s.ns, t,
-                         tw, s.ng);
+    float tw;
+    const float3 t = surface_tangent(sd, &s, &tw);
+    s.ns =
+        normal_mapped(sd, m->normal_texture, m->normal_scale,
+                      material_uv(m, PR_UV_NORMAL, m->normal_uv, s.uv, s.uv1), s.ns, t, tw, s.ng);
   }
   if (dot(s.ns, s.ng) < 0.0f) s.ns = -s.ns;
   return s;
+}
+
+// The clearcoat's normal (KHR_materials_clearcoat), world space, on ng's side: the interpolated
+// vertex normal (the base layer's normal map does not apply to the coat), with the coat's own
+// normal map where it has one.
+PR_INLINE float3 surface_coat_normal(const ShadingData* sd, const SurfaceHit* s) {
+  PR_GLOBAL const Material* m = sd->materials + s->material;
+  const ShadingTriangle tri = sd->triangles[s->prim];
+  const ShadingVertex a = sd->vertices[tri.v0], b = sd->vertices[tri.v1], c = sd->vertices[tri.v2];
+  float3 n = make_float3(a.nx, a.ny, a.nz) * (1.0f - s->b1 - s->b2) +
+             make_float3(b.nx, b.ny, b.nz) * s->b1 + make_float3(c.nx, c.ny, c.nz) * s->b2;
+  if (s->inst != PR_INVALID_INDEX) n = xform_normal12(sd->instances[s->inst].world_to_object, n);
+  const float nl = length(n);
+  n = nl > 0.0f && isfinite_f(nl) ? n / nl : s->ng;
+  if (m->coat_normal_texture != PR_NO_TEXTURE) {
+    float tw;
+    const float3 t = surface_tangent(sd, s, &tw);
+    n = normal_mapped(sd, m->coat_normal_texture, m->coat_normal_scale,
+                      material_uv(m, PR_UV_COAT_NORMAL, m->coat_normal_uv, s->uv, s->uv1), n, t, tw,
+                      s->ng);
+  }
+  return dot(n, s->ng) < 0.0f ? -n : n;
 }
 
 PR_INLINE SurfaceHit surface_at(const ShadingData* sd, u32 prim, u32 inst, float b1, float b2) {
@@ -222,10 +309,38 @@ PR_INLINE float4 material_base(const ShadingData* sd, const SurfaceHit* s) {
   return c;
 }
 
-PR_INLINE BsdfParams material_bsdf(const ShadingData* sd, const SurfaceHit* s) {
+// KHR_materials_anisotropy at the surface: the strength (0: isotropic) and the direction as
+// (cos, sin) from the tangent towards the bitangent: the rotation, turned by the texture's
+// direction (RG in [-1, 1]) whose B scales the strength.
+PR_INLINE float material_anisotropy(const ShadingData* sd, const SurfaceHit* s, float2* dir) {
+  PR_GLOBAL const Material* m = sd->materials + s->material;
+  *dir = make_float2(1.0f, 0.0f);
+  float strength = m->aniso_strength;
+  if (!PR_HAS_ANISOTROPY || !(strength > 0.0f)) return 0.0f;
+  float c = m->aniso_cos, sn = m->aniso_sin;
+  if (m->aniso_texture != PR_NO_TEXTURE) {
+    const float4 t = texture_sample(sd, m->aniso_texture,
+                                    material_uv(m, PR_UV_ANISO, m->aniso_uv, s->uv, s->uv1));
+    const float tx = 2.0f * t.x - 1.0f, ty = 2.0f * t.y - 1.0f;
+    const float l = sqrt(tx * tx + ty * ty);
+    if (l > 1e-6f) {
+      const float ux = tx / l, uy = ty / l;
+      const float c2 = c * ux - sn * uy;
+      sn = sn * ux + c * uy;
+      c = c2;
+    }
+    strength *= t.z;
+  }
+  *dir = make_float2(c, sn);
+  return clamp(strength, 0.0f, 1.0f);
+}
+
+// The BSDF's parameters at the surface; in *aniso the anisotropy direction (cos, sin) from the
+// tangent towards the bitangent, (0, 0) where the surface is isotropic.
+PR_INLINE BsdfParams material_bsdf(const ShadingData* sd, const SurfaceHit* s, float2* aniso) {
   PR_GLOBAL const Material* m = sd->materials + s->material;
   const float4 base = material_base(sd, s);
-  BsdfParams p;
+  BsdfParams p = bsdf_params_default();
   p.base = make_float3(base.x, base.y, base.z);
   float metallic = m->metallic, roughness = m->roughness;
   if (m->mr_texture != PR_NO_TEXTURE) {
@@ -236,7 +351,8 @@ PR_INLINE BsdfParams material_bsdf(const ShadingData* sd, const SurfaceHit* s) {
   }
   p.metallic = clamp(metallic, 0.0f, 1.0f);
   roughness = clamp(roughness, 0.0f, 1.0f);
-  p.alpha = fmax(roughness * roughness, PR_MIN_ALPHA);
+  p.alpha_x = fmax(roughness * roughness, PR_MIN_ALPHA);
+  p.alpha_y = p.alpha_x;
   p.ior = m->ior;
   // KHR_materials_specular: F0 = min(((ior-1)/(ior+1))^2 colour, 1) x factor, F90 = factor.
   float3 f0 = make_float3(m->spec_f0[0], m->spec_f0[1], m->spec_f0[2]);
@@ -253,12 +369,12 @@ PR_INLINE BsdfParams material_bsdf(const ShadingData* sd, const SurfaceHit* s) {
             .w;
   p.f0 = make_float3(fmin(f0.x, 1.0f), fmin(f0.y, 1.0f), fmin(f0.z, 1.0f)) * f90;
   p.f90 = f90;
-  float coat = m->coat, coat_roughness = m->coat_roughness;
-  if (m->coat_texture != PR_NO_TEXTURE)
+  float coat = PR_HAS_COAT ? m->coat : 0.0f, coat_roughness = m->coat_roughness;
+  if (PR_HAS_COAT && m->coat_texture != PR_NO_TEXTURE)
     coat *=
         texture_sample(sd, m->coat_texture, material_uv(m, PR_UV_COAT, m->coat_uv, s->uv, s->uv1))
             .x;
-  if (m->coat_roughness_texture != PR_NO_TEXTURE)
+  if (PR_HAS_COAT && m->coat_roughness_texture != PR_NO_TEXTURE)
     coat_roughness *=
         texture_sample(sd, m->coat_roughness_texture,
                        material_uv(m, PR_UV_COAT_ROUGHNESS, m->coat_roughness_uv, s->uv, s->uv1))
@@ -266,6 +382,33 @@ PR_INLINE BsdfParams material_bsdf(const ShadingData* sd, const SurfaceHit* s) {
   p.coat = coat;
   const float cr = clamp(coat_roughness, 0.0f, 1.0f);
   p.coat_alpha = fmax(cr * cr, PR_MIN_ALPHA);
+  // KHR_materials_sheen: colour x texture RGB, roughness x texture A.
+  float3 sheen = make_float3(m->sheen[0], m->sheen[1], m->sheen[2]);
+  if (PR_HAS_SHEEN && max3(sheen) > 0.0f) {
+    float sheen_roughness = m->sheen_roughness;
+    if (m->sheen_texture != PR_NO_TEXTURE) {
+      const float4 t = texture_sample(sd, m->sheen_texture,
+                                      material_uv(m, PR_UV_SHEEN, m->sheen_uv, s->uv, s->uv1));
+      sheen = sheen * make_float3(t.x, t.y, t.z);
+    }
+    if (m->sheen_roughness_texture != PR_NO_TEXTURE)
+      sheen_roughness *= texture_sample(sd, m->sheen_roughness_texture,
+                                        material_uv(m, PR_UV_SHEEN_ROUGHNESS, m->sheen_roughness_uv,
+                                                    s->uv, s->uv1))
+                             .w;
+    p.sheen = make_float3(clamp(sheen.x, 0.0f, 1.0f), clamp(sheen.y, 0.0f, 1.0f),
+                          clamp(sheen.z, 0.0f, 1.0f));
+    const float sr = clamp(sheen_roughness, 0.0f, 1.0f);
+    p.sheen_alpha = fmax(sr * sr, PR_MIN_SHEEN_ALPHA);
+  }
+  // KHR_materials_anisotropy: the roughness along the anisotropy direction (the shading frame's
+  // tangent, shading_frame) mixed towards 1 by strength^2.
+  const float strength = material_anisotropy(sd, s, aniso);
+  if (strength > 0.0f)
+    p.alpha_x = mix(p.alpha_x, 1.0f, strength * strength);
+  else
+    *aniso = make_float2(0.0f, 0.0f);
+  p.model = (m->flags & PR_MAT_GLTF_MODEL) ? PR_MODEL_GLTF : PR_MODEL_ENERGY;
   if (m->flags & PR_MAT_GLASS)
     p.kind = PR_BSDF_GLASS;
   else if (m->flags & PR_MAT_MIRROR)

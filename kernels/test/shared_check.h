@@ -44,17 +44,24 @@ PR_INLINE void shared_check_case(u32 i, PR_GLOBAL const float* cdf, u32 cdf_coun
   check_put3(r, 8, to_local(check_unit(&rng), t, b, n));
 
   // A microfacet BSDF: sample, then evaluate the sample and a cosine-distributed direction.
-  BsdfParams m;
+  BsdfParams m = bsdf_params_default();
   const float cr = rng_next(&rng), cg = rng_next(&rng), cb = rng_next(&rng);
   m.base = make_float3(cr, cg, cb);
   m.metallic = rng_next(&rng);
-  m.alpha = fmax(rng_next(&rng), PR_MIN_ALPHA);
-  m.ior = 1.5f;
-  m.kind = PR_BSDF_MICROFACET;
+  m.alpha_x = fmax(rng_next(&rng), PR_MIN_ALPHA);
+  m.alpha_y = m.alpha_x;
   m.f0 = make_float3(0.04f + 0.3f * rng_next(&rng), 0.04f, 0.1f);
   m.f90 = rng_next(&rng);
   m.coat = rng_next(&rng);
   m.coat_alpha = fmax(rng_next(&rng), PR_MIN_ALPHA);
+  // Every other case: the glTF model; anisotropic, with a sheen and a tilted coat normal.
+  if (i & 1u) m.model = PR_MODEL_GLTF;
+  if (i & 2u) {
+    m.alpha_x = fmin(1.0f, m.alpha_x * 4.0f);
+    m.sheen = make_float3(0.8f, 0.5f, 0.3f);
+    m.sheen_alpha = fmax(rng_next(&rng), PR_MIN_SHEEN_ALPHA);
+    m.coat_n = normalize(make_float3(0.2f, -0.1f, 1.0f));
+  }
   const float o1 = rng_next(&rng), o2 = rng_next(&rng);
   const float3 wo = sample_cosine_hemisphere(o1, o2);
   const float u0 = rng_next(&rng), u1 = rng_next(&rng), u2 = rng_next(&rng);

@@ -1,5 +1,7 @@
 #include "support/gltf_builder.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 
@@ -45,6 +47,10 @@ int GltfBuilder::addMaterial(const MaterialSpec& m) {
     mat["extensions"]["KHR_materials_transmission"] = {{"transmissionFactor", m.transmission}};
     mat["extensions"]["KHR_materials_ior"] = {{"ior", m.ior}};
   }
+  for (const auto& [name, ext] : m.extensions.items()) {
+    mat["extensions"][name] = ext;
+    extensionsUsed_.insert(name);
+  }
   materials_.push_back(mat);
   return static_cast<int>(materials_.size() - 1);
 }
@@ -52,18 +58,74 @@ int GltfBuilder::addMaterial(const MaterialSpec& m) {
 int GltfBuilder::addMesh(const std::vector<glm::vec3>& positions,
                          const std::vector<uint32_t>& indices, int material,
                          const std::vector<glm::vec3>& normals) {
-  glm::vec3 lo(1e30f), hi(-1e30f);
-  for (const auto& p : positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
-  const int pos = addAccessor(positions.data(), positions.size() * 12, 5126, positions.size(),
-                              "VEC3", true, json::array({{lo.x, lo.y, lo.z}, {hi.x, hi.y, hi.z}}));
+  MeshAttributes a;
+  a.normals = normals;
+  return addMesh(positions, indices, material, a);
+}
+
+int GltfBuilder::addMesh(const std::vector<glm::vec3>& positions,
+                         const std::vector<uint32_t>& indices, int material,
+                         const MeshAttributes& a) {
+  auto vec3s = [&](const std::vector<glm::vec3>& v) {
+    glm::vec3 lo(1e30f), hi(-1e30f);
+    for (const auto& p : v) lo = glm::min(lo, p), hi = glm::max(hi, p);
+    return addAccessor(v.data(), v.size() * 12, 5126, v.size(), "VEC3", true,
+                       json::array({{lo.x, lo.y, lo.z}, {hi.x, hi.y, hi.z}}));
+  };
+  const int pos = vec3s(positions);
   const int idx =
       addAccessor(indices.data(), indices.size() * 4, 5125, indices.size(), "SCALAR", false);
   json prim = {{"attributes", {{"POSITION", pos}}}, {"indices", idx}, {"material", material}};
-  if (!normals.empty())
-    prim["attributes"]["NORMAL"] =
-        addAccessor(normals.data(), normals.size() * 12, 5126, normals.size(), "VEC3", true);
+  json& attrs = prim["attributes"];
+  if (!a.normals.empty())
+    attrs["NORMAL"] =
+        addAccessor(a.normals.data(), a.normals.size() * 12, 5126, a.normals.size(), "VEC3", true);
+  if (!a.uvs.empty())
+    attrs["TEXCOORD_0"] =
+        addAccessor(a.uvs.data(), a.uvs.size() * 8, 5126, a.uvs.size(), "VEC2", true);
+  if (!a.tangents.empty())
+    attrs["TANGENT"] = addAccessor(a.tangents.data(), a.tangents.size() * 16, 5126,
+                                   a.tangents.size(), "VEC4", true);
+  if (!a.joints.empty())
+    attrs["JOINTS_0"] =
+        addAccessor(a.joints.data(), a.joints.size() * 8, 5123, a.joints.size(), "VEC4", true);
+  if (!a.weights.empty())
+    attrs["WEIGHTS_0"] =
+        addAccessor(a.weights.data(), a.weights.size() * 16, 5126, a.weights.size(), "VEC4", true);
+  const size_t targets = std::max(a.targetPositions.size(), a.targetNormals.size());
+  for (size_t t = 0; t < targets; ++t) {
+    json target = json::object();
+    if (t < a.targetPositions.size() && !a.targetPositions[t].empty())
+      target["POSITION"] = vec3s(a.targetPositions[t]);
+    if (t < a.targetNormals.size() && !a.targetNormals[t].empty())
+      target["NORMAL"] = addAccessor(a.targetNormals[t].data(), a.targetNormals[t].size() * 12,
+                                     5126, a.targetNormals[t].size(), "VEC3", true);
+    prim["targets"].push_back(target);
+  }
   meshes_.push_back({{"primitives", json::array({prim})}});
   return static_cast<int>(meshes_.size() - 1);
+}
+
+int GltfBuilder::addSphere(float radius, int segments, int rings, int material) {
+  std::vector<glm::vec3> positions;
+  std::vector<uint32_t> indices;
+  MeshAttributes a;
+  for (int j = 0; j <= rings; ++j)
+    for (int i = 0; i <= segments; ++i) {
+      const float u = float(i) / float(segments), v = float(j) / float(rings);
+      const float phi = 6.28318530718f * u, theta = 3.14159265359f * v;
+      const glm::vec3 n(std::sin(theta) * std::cos(phi), std::cos(theta),
+                        -std::sin(theta) * std::sin(phi));
+      positions.push_back(n * radius);
+      a.normals.push_back(n);
+      a.uvs.emplace_back(u, v);
+    }
+  for (int j = 0; j < rings; ++j)
+    for (int i = 0; i < segments; ++i) {
+      const uint32_t k = uint32_t(j * (segments + 1) + i), below = k + uint32_t(segments + 1);
+      indices.insert(indices.end(), {k, below, below + 1, k, below + 1, k + 1});
+    }
+  return addMesh(positions, indices, material, a);
 }
 
 int GltfBuilder::addQuad(glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, int material) {
@@ -122,6 +184,32 @@ int GltfBuilder::addPointLight(glm::vec3 position, glm::vec3 color, float intens
   return static_cast<int>(nodes_.size() - 1);
 }
 
+int GltfBuilder::addDirectionalLight(glm::quat rotation, glm::vec3 color, float intensity) {
+  lights_.push_back(
+      {{"type", "directional"}, {"color", {color.r, color.g, color.b}}, {"intensity", intensity}});
+  nodes_.push_back({{"rotation", {rotation.x, rotation.y, rotation.z, rotation.w}},
+                    {"extensions", {{"KHR_lights_punctual", {{"light", lights_.size() - 1}}}}}});
+  return static_cast<int>(nodes_.size() - 1);
+}
+
+void GltfBuilder::addSkin(int node, const std::vector<int>& joints) {
+  skins_.push_back({{"joints", joints}});
+  nodes_[size_t(node)]["skin"] = skins_.size() - 1;
+}
+
+void GltfBuilder::animateWeights(int node, const std::vector<float>& times,
+                                 const std::vector<std::vector<float>>& keys) {
+  std::vector<float> w;
+  for (const auto& k : keys) w.insert(w.end(), k.begin(), k.end());
+  const int in = addAccessor(times.data(), times.size() * 4, 5126, times.size(), "SCALAR", false,
+                             json::array({{times.front()}, {times.back()}}));
+  const int out = addAccessor(w.data(), w.size() * 4, 5126, w.size(), "SCALAR", false);
+  animations_.push_back(
+      {{"samplers", json::array({{{"input", in}, {"output", out}, {"interpolation", "LINEAR"}}})},
+       {"channels",
+        json::array({{{"sampler", 0}, {"target", {{"node", node}, {"path", "weights"}}}}})}});
+}
+
 void GltfBuilder::animateTranslation(int node, const std::vector<float>& times,
                                      const std::vector<glm::vec3>& keys) {
   const int in = addAccessor(times.data(), times.size() * 4, 5126, times.size(), "SCALAR", false,
@@ -147,6 +235,7 @@ std::string GltfBuilder::write(const std::string& dir, const std::string& name) 
   root["buffers"] = json::array({{{"uri", name + ".bin"}, {"byteLength", bin_.size()}}});
   if (!cameras_.empty()) root["cameras"] = cameras_;
   if (!animations_.empty()) root["animations"] = animations_;
+  if (!skins_.empty()) root["skins"] = skins_;
   json used = json::array();
   if (!lights_.empty()) {
     root["extensions"]["KHR_lights_punctual"] = {{"lights", lights_}};
@@ -155,6 +244,8 @@ std::string GltfBuilder::write(const std::string& dir, const std::string& name) 
   used.push_back("KHR_materials_emissive_strength");
   used.push_back("KHR_materials_transmission");
   used.push_back("KHR_materials_ior");
+  for (const std::string& e : extensionsUsed_)
+    if (std::find(used.begin(), used.end(), e) == used.end()) used.push_back(e);
   root["extensionsUsed"] = used;
   std::ofstream(dir + "/" + name + ".bin", std::ios::binary)
       .write(reinterpret_cast<const char*>(bin_.data()), static_cast<std::streamsize>(bin_.size()));

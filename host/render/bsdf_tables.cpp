@@ -1,0 +1,209 @@
+#include "render/bsdf_tables.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <thread>
+
+#include "shared/microfacet.h"
+#include "shared/sampling.h"
+
+namespace pr {
+
+using namespace pr::dev;
+
+namespace {
+
+// The grid's cosines, uniform in sqrt(mu) (the albedos change fastest at grazing angles); mu = 0
+// stands for its limit (a view this close to grazing).
+float gridCos(int i, int n) {
+  const float x = float(i) / float(n - 1);
+  return std::fmax(x * x, 1e-5f);
+}
+
+// Albedo integrals of GGX with F = 1 seen from wo: E = E[G2 / G1] over visible normals (f cos /
+// pdf of visible-normal sampling), and the same weighted by (1 - v.h)^5.
+void ggxAlbedo(float3 wo, float ax, float ay, int samples, double* e, double* es) {
+  const double lo = ggx_lambda_xy(wo, ax, ay);
+  double se = 0.0, ses = 0.0;
+  for (int a = 0; a < samples; ++a)
+    for (int b = 0; b < samples; ++b) {
+      const float u1 = (float(a) + 0.5f) / float(samples), u2 = (float(b) + 0.5f) / float(samples);
+      const float3 h = ggx_sample_vndf(wo, ax, ay, u1, u2);
+      const float voh = dot(wo, h);
+      const float3 wi = h * (2.0f * voh) - wo;
+      if (!(wi.z > 0.0f)) continue;
+      const double w = (1.0 + lo) / (1.0 + lo + ggx_lambda_xy(wi, ax, ay));
+      se += w;
+      ses += w * schlick_weight(voh);
+    }
+  const double count = double(samples) * double(samples);
+  *e = se / count;
+  *es = ses / count;
+}
+
+float3 viewAt(float mu, float phi) {
+  const float s = std::sqrt(std::fmax(0.0f, 1.0f - mu * mu));
+  return make_float3(s * std::cos(phi), s * std::sin(phi), mu);
+}
+
+// The same averaged over the view's azimuth (a quarter turn holds every case by symmetry).
+void ggxAlbedoAniso(float mu, float ax, float ay, int samples, double* e, double* es) {
+  constexpr int kAzimuths = 8;
+  *e = *es = 0.0;
+  for (int k = 0; k < kAzimuths; ++k) {
+    double ek, esk;
+    ggxAlbedo(viewAt(mu, 0.5f * PR_PI * (float(k) + 0.5f) / kAzimuths), ax, ay, samples, &ek, &esk);
+    *e += ek / kAzimuths;
+    *es += esk / kAzimuths;
+  }
+}
+
+// A grid's roughness: from the tables' smallest to 1.
+float gridRoughness(int j, int n) {
+  return PR_TABLE_MIN_ROUGHNESS + (1.0f - PR_TABLE_MIN_ROUGHNESS) * float(j) / float(n - 1);
+}
+
+// Runs task(0 .. count - 1) on every core: each is a pure function of its index.
+template <class Task>
+void parallelFor(int count, Task task) {
+  std::atomic<int> next{0};
+  std::vector<std::thread> workers;
+  const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+  for (unsigned w = 0; w < threads; ++w)
+    workers.emplace_back([&] {
+      for (int j; (j = next++) < count;) task(j);
+    });
+  for (std::thread& w : workers) w.join();
+}
+
+// The white sheen lobe's albedo from cos mu, by the midpoint rule in (cos, azimuth): the lobe
+// peaks at grazing directions, where cosine-weighted samples are too sparse.
+double sheenAlbedo(float mu, float alpha, int samples) {
+  const float3 wo = make_float3(std::sqrt(std::fmax(0.0f, 1.0f - mu * mu)), 0.0f, mu);
+  const int nz = 2 * samples, nphi = samples;
+  double s = 0.0;
+  for (int a = 0; a < nz; ++a) {
+    const float z = (float(a) + 0.5f) / float(nz), rz = std::sqrt(std::fmax(0.0f, 1.0f - z * z));
+    for (int b = 0; b < nphi; ++b) {
+      // The lobe is symmetric about wo's plane: half the azimuths, twice.
+      const float phi = PR_PI * (float(b) + 0.5f) / float(nphi);
+      const float3 wi = make_float3(rz * std::cos(phi), rz * std::sin(phi), z);
+      const float3 h = normalize(wo + wi);
+      s += double(sheen_lobe(mu, z, h.z, alpha)) * z;
+    }
+  }
+  return s * 2.0 * PR_PI / (double(nz) * double(nphi));
+}
+
+}  // namespace
+
+BsdfTables computeBsdfTables(int cosines, int roughnesses, int samples, int stride) {
+  BsdfTables t;
+  t.cosines = cosines;
+  t.roughnesses = roughnesses;
+  const size_t n2 = size_t(cosines) * size_t(roughnesses);
+  t.ggxE.resize(n2);
+  t.ggxEs.resize(n2);
+  t.ggxEavg.resize(size_t(roughnesses));
+  t.sheenE.resize(n2);
+  parallelFor(roughnesses, [&](int j) {
+    const float r = gridRoughness(j, roughnesses), alpha = r * r;
+    for (int i = 0; i < cosines; ++i) {
+      const size_t k = size_t(j) * size_t(cosines) + size_t(i);
+      if (k % size_t(stride) != 0) continue;
+      const float mu = gridCos(i, cosines);
+      double e, es;
+      ggxAlbedo(viewAt(mu, 0.0f), alpha, alpha, samples, &e, &es);
+      t.ggxE[k] = float(e);
+      t.ggxEs[k] = float(es);
+      t.sheenE[k] = float(sheenAlbedo(mu, alpha, samples));
+    }
+    // The average over cosines by the midpoint rule on a grid finer than the table's.
+    if (j % stride != 0) return;
+    const int points = 2 * cosines;
+    double avg = 0.0;
+    for (int k = 0; k < points; ++k) {
+      const float mu = (float(k) + 0.5f) / float(points);
+      double e, es;
+      ggxAlbedo(viewAt(mu, 0.0f), alpha, alpha, samples / 2, &e, &es);
+      avg += 2.0 * e * mu / points;
+    }
+    t.ggxEavg[size_t(j)] = float(avg);
+  });
+  t.anisoCosines = kBsdfAnisoCos;
+  t.anisoRoughnesses = kBsdfAnisoRoughness;
+  t.anisoRatios = kBsdfAnisoRatio;
+  const int rows = t.anisoRatios * t.anisoRoughnesses;
+  t.anisoE.resize(size_t(rows) * size_t(t.anisoCosines));
+  t.anisoEs.resize(t.anisoE.size());
+  t.anisoEavg.resize(size_t(rows));
+  parallelFor(rows, [&](int row) {
+    const float r = gridRoughness(row % t.anisoRoughnesses, t.anisoRoughnesses);
+    const float q = gridRoughness(row / t.anisoRoughnesses, t.anisoRatios);
+    const float ax = r * r, ay = std::fmax(r * q * r * q, PR_MIN_ALPHA);
+    const int s = samples / 2;
+    for (int i = 0; i < t.anisoCosines; ++i) {
+      if ((size_t(row) * size_t(t.anisoCosines) + size_t(i)) % size_t(stride) != 0) continue;
+      double e, es;
+      ggxAlbedoAniso(gridCos(i, t.anisoCosines), ax, ay, s, &e, &es);
+      t.anisoE[size_t(row) * size_t(t.anisoCosines) + size_t(i)] = float(e);
+      t.anisoEs[size_t(row) * size_t(t.anisoCosines) + size_t(i)] = float(es);
+    }
+    if (row % stride != 0) return;
+    const int points = 2 * t.anisoCosines;
+    double avg = 0.0;
+    for (int k = 0; k < points; ++k) {
+      const float mu = (float(k) + 0.5f) / float(points);
+      double e, es;
+      ggxAlbedoAniso(mu, ax, ay, s / 2, &e, &es);
+      avg += 2.0 * e * mu / points;
+    }
+    t.anisoEavg[size_t(row)] = float(avg);
+  });
+  return t;
+}
+
+std::string bsdfTablesHeader(const BsdfTables& t) {
+  std::string s =
+      "// Generated by tools/bsdf_tables (build/bsdf_tables > kernels/shared/bsdf_tables.h); do "
+      "not\n"
+      "// edit. Directional albedos for the BSDFs' energy compensation and layering\n"
+      "// (kernels/shared/bsdf.h): index [roughness][cos], on a grid of PR_BSDF_TABLE_R x\n"
+      "// PR_BSDF_TABLE_COS points uniform in roughness = sqrt(alpha) from\n"
+      "// PR_TABLE_MIN_ROUGHNESS to 1 and in sqrt(cos) from 0 to 1.\n"
+      "#pragma once\n\n#include \"shared/common.h\"\n\nPR_NAMESPACE_BEGIN\n\n";
+  s += "#define PR_BSDF_TABLE_COS " + std::to_string(t.cosines) + "\n";
+  s += "#define PR_BSDF_TABLE_R " + std::to_string(t.roughnesses) + "\n\n";
+  auto table = [&](const char* name, const char* what, const std::vector<float>& v) {
+    s += std::string("// ") + what + "\n";
+    s += std::string("PR_TABLE float ") + name + "[" + std::to_string(v.size()) + "] = {\n";
+    for (size_t i = 0; i < v.size(); ++i) {
+      char buf[32];
+      std::snprintf(buf, sizeof buf, "%.6ff,", double(v[i]));
+      s += (i % 8 == 0 ? "    " : " ") + std::string(buf);
+      if (i % 8 == 7 || i + 1 == v.size()) s += "\n";
+    }
+    s += "};\n\n";
+  };
+  table("pr_ggx_e", "GGX albedo with F = 1.", t.ggxE);
+  table("pr_ggx_es", "GGX albedo weighted by Schlick's (1 - v.h)^5.", t.ggxEs);
+  table("pr_ggx_eavg", "GGX albedo averaged over the hemisphere (cosine-weighted).", t.ggxEavg);
+  table("pr_sheen_e", "The white Charlie sheen lobe's albedo.", t.sheenE);
+  s += "// Anisotropic GGX, averaged over the view's azimuth: index [ratio][roughness][cos] on a\n"
+       "// grid uniform in sqrt(cos) (PR_BSDF_ANISO_COS points from 0 to 1), in the larger\n"
+       "// roughness and in the ratio of the smaller to it (PR_BSDF_ANISO_R and\n"
+       "// PR_BSDF_ANISO_Q points from PR_TABLE_MIN_ROUGHNESS to 1).\n";
+  s += "#define PR_BSDF_ANISO_COS " + std::to_string(t.anisoCosines) + "\n";
+  s += "#define PR_BSDF_ANISO_R " + std::to_string(t.anisoRoughnesses) + "\n";
+  s += "#define PR_BSDF_ANISO_Q " + std::to_string(t.anisoRatios) + "\n\n";
+  table("pr_ggx_e_aniso", "GGX albedo with F = 1.", t.anisoE);
+  table("pr_ggx_es_aniso", "GGX albedo weighted by Schlick's (1 - v.h)^5.", t.anisoEs);
+  table("pr_ggx_eavg_aniso", "GGX albedo averaged over the hemisphere: [ratio][roughness].",
+        t.anisoEavg);
+  s += "PR_NAMESPACE_END\n";
+  return s;
+}
+
+}  // namespace pr

@@ -1,0 +1,42 @@
+// The directional-albedo tables that the BSDFs' energy compensation and layering read
+// (kernels/shared/bsdf_tables.h): computed here from the same microfacet code the kernels run,
+// written out by tools/bsdf_tables.cpp, and recomputed by the tests to check the committed copy.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace pr {
+
+// The committed tables' grid (cosines x roughnesses) and integration accuracy.
+constexpr int kBsdfTableCos = 64;
+constexpr int kBsdfTableRoughness = 32;
+constexpr int kBsdfTableSamples = 128;
+// Anisotropic GGX: cosines x roughnesses (the larger alpha's) x ratios (of the roughnesses).
+constexpr int kBsdfAnisoCos = 16;
+constexpr int kBsdfAnisoRoughness = 12;
+constexpr int kBsdfAnisoRatio = 8;
+
+struct BsdfTables {
+  int cosines = 0, roughnesses = 0;  // grid points, uniform in sqrt(cos) and in roughness
+  std::vector<float> ggxE;           // GGX albedo with F = 1: [roughness][cos]
+  std::vector<float> ggxEs;          // ... weighted by Schlick's (1 - v.h)^5: [roughness][cos]
+  std::vector<float> ggxEavg;        // 2 \int E(mu) mu dmu: [roughness]
+  std::vector<float> sheenE;         // the white Charlie sheen lobe's albedo: [roughness][cos]
+  // Anisotropic GGX averaged over the view's azimuth, on a grid uniform in sqrt(cos), in the
+  // larger roughness and in the ratio of the smaller to it (both from PR_TABLE_MIN_ROUGHNESS).
+  int anisoCosines = 0, anisoRoughnesses = 0, anisoRatios = 0;
+  std::vector<float> anisoE;     // [ratio][roughness][cos]
+  std::vector<float> anisoEs;    // [ratio][roughness][cos]
+  std::vector<float> anisoEavg;  // [ratio][roughness]
+};
+
+// The tables on a grid of `cosines` x `roughnesses` points (both ends included); `samples` is
+// the side of each integral's stratified grid. With a stride, only every stride-th entry of each
+// table is computed (the others are 0): a check of part of them in less time.
+BsdfTables computeBsdfTables(int cosines, int roughnesses, int samples, int stride = 1);
+
+// The header kernels/shared/bsdf_tables.h holding t.
+std::string bsdfTablesHeader(const BsdfTables& t);
+
+}  // namespace pr
