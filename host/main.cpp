@@ -1,5 +1,6 @@
 // pathreuse: command-line entry. Parses arguments with CLI11, runs one subcommand, and turns
 // every exception into one line on stderr and an exit code (docs/design.md section 1).
+#include <cmath>
 #include <cstdio>
 #include <exception>
 #include <iostream>
@@ -29,9 +30,10 @@ int runDevices(bool json) {
   return pr::kExitOk;
 }
 
-int runInfo(const std::string& path, bool json, double fps) {
+int runInfo(const std::string& path, bool json, double fps, bool allowOutsideUris) {
   if (!(fps > 0.0) || fps > 1000.0) throw pr::InputError("--fps: must be in (0, 1000]");
   pr::LoadOptions options;
+  options.allowOutsideUris = allowOutsideUris;
   options.printWarnings = json;  // the text summary lists them itself
   const pr::Scene scene = pr::loadScene(path, options);
   if (json)
@@ -40,6 +42,24 @@ int runInfo(const std::string& path, bool json, double fps) {
     std::cout << pr::sceneInfoText(scene, fps);
   return pr::kExitOk;
 }
+
+// Numbers a user types: finite (CLI::Range lets NaN through), within bounds that --help shows.
+CLI::Validator finiteIn(double lo, double hi) {
+  const std::string range =
+      "[" + CLI::detail::to_string(lo) + " - " + CLI::detail::to_string(hi) + "]";
+  return CLI::Validator(
+      [lo, hi, range](std::string& text) -> std::string {
+        double v = 0.0;
+        if (!CLI::detail::lexical_cast(text, v) || !std::isfinite(v) || v < lo || v > hi)
+          return "Value " + text + " not in range " + range;
+        return "";
+      },
+      "in " + range);
+}
+
+const char* const kOutsideHelp =
+    "Let the scene's buffer and image URIs name files outside its folder (by default a scene "
+    "reads files in its own folder and below only)";
 
 }  // namespace
 
@@ -59,24 +79,35 @@ int main(int argc, char** argv) {
       app.add_subcommand("info", "What a scene holds: static/dynamic split, lights, animation");
   info->add_option("SCENE", infoScene, "glTF file (.gltf or .glb)")->required();
   info->add_flag("--json", infoJson, "Print as JSON");
-  info->add_option("--fps", infoFps, "Frames per second of the animation (default 24)");
+  info->add_option("--fps", infoFps, "Frames per second of the animation (default 24)")
+      ->check(finiteIn(0.001, 1000));
+  bool infoOutside = false;
+  info->add_flag("--allow-outside-uris", infoOutside, kOutsideHelp);
 
   pr::RenderOptions ro;
   std::string framesText, modeText = "reuse";
   auto* render = app.add_subcommand("render", "Render a range of frames of the scene's animation");
   render->add_option("SCENE", ro.scene, "glTF file (.gltf or .glb)")->required();
+  render->add_flag("--allow-outside-uris", ro.allowOutsideUris, kOutsideHelp);
   render->add_option("--frames", framesText,
                      "Frame range A-B or one frame A (default: the whole animation)");
   render->add_option("--fps", ro.fps, "Frames per second: frame f is at time f / fps")
+      ->check(finiteIn(0.001, 1000))
       ->capture_default_str();
-  render->add_option("--width", ro.width,
-                     "Image width (default: from the camera's aspect, else 640)");
-  render->add_option("--height", ro.height, "Image height (default 480)");
-  render->add_option("--spp", ro.spp, "Samples per pixel per frame")->capture_default_str();
+  render
+      ->add_option("--width", ro.width, "Image width (default: from the camera's aspect, else 640)")
+      ->check(CLI::Range(1, 16384));
+  render->add_option("--height", ro.height, "Image height (default 480)")
+      ->check(CLI::Range(1, 16384));
+  render->add_option("--spp", ro.spp, "Samples per pixel per frame")
+      ->check(CLI::Range(1, 1 << 20))
+      ->capture_default_str();
   render->add_option("--max-depth", ro.maxDepth, "Maximum path length in bounces")
+      ->check(CLI::Range(1, 64))
       ->capture_default_str();
   render
       ->add_option("--seed", ro.seed, "Random seed; the same seed reproduces a frame on one device")
+      ->check(CLI::Range(0u, 4294967295u))
       ->capture_default_str();
   render
       ->add_option("--device", ro.devices,
@@ -125,15 +156,19 @@ int main(int argc, char** argv) {
                    "auto (8 on CPUs, 4 on GPUs)")
       ->check(CLI::IsMember({"auto", "2", "4", "8"}))
       ->capture_default_str();
-  render->add_option("--light-paths", ro.lightPaths,
-                     "Light-path slots kept in the arena (reuse/retrace; default: one per pixel)");
+  render
+      ->add_option("--light-paths", ro.lightPaths,
+                   "Light-path slots kept in the arena (reuse/retrace; default: one per pixel)")
+      ->check(CLI::Range(1, 1 << 26));
   render
       ->add_option("--paths-per-pixel", ro.pathsPerPixel,
                    "Light paths each pixel sample connects to (reuse/retrace)")
+      ->check(CLI::Range(1, 64))
       ->capture_default_str();
   render
       ->add_option("--clamp", ro.clamp,
                    "Upper bound on the connection geometry term (reuse/retrace; 0 = off, unbiased)")
+      ->check(finiteIn(0, 1e30))
       ->capture_default_str();
   render
       ->add_option(
@@ -142,6 +177,7 @@ int main(int argc, char** argv) {
           "connected light vertex R or more times likelier than the light tracer did, the "
           "path is shared with a connection from that sample (fewer fireflies near "
           "corners; 0 = off)")
+      ->check(finiteIn(0, 1e30))
       ->capture_default_str();
   std::string connectionsText = "auto";
   render
@@ -164,6 +200,7 @@ int main(int argc, char** argv) {
                    "With a connection history, the light paths each pixel sample connects to "
                    "shift every this many frames: 1 gives the least error per frame, more keeps "
                    "the noise steady for longer (less flicker)")
+      ->check(CLI::Range(1, 1000))
       ->capture_default_str();
   render->add_flag(
       "--eye-paths,!--no-eye-paths", ro.eyePaths,
@@ -180,18 +217,22 @@ int main(int argc, char** argv) {
   render->add_option("--env-color", ro.envColor,
                      "R,G,B: a uniform environment of this radiance, or the map's tint");
   render->add_option("--env-strength", ro.envStrength, "Scales the environment's radiance")
+      ->check(finiteIn(0, 1e30))
       ->capture_default_str();
   render
       ->add_option("--env-rotate", ro.envRotate,
                    "Turns the environment about +Y by this many degrees (counter-clockwise seen "
                    "from above)")
+      ->check(finiteIn(-1e6, 1e6))
       ->capture_default_str();
-  render->add_option("--camera", ro.camera, "Camera index (default: the scene's first)");
+  render->add_option("--camera", ro.camera, "Camera index (default: the scene's first)")
+      ->check(CLI::Range(0, 1 << 20));
   render->add_option("--out", ro.outPattern, "Output EXR path with a frame number conversion")
       ->capture_default_str();
   render->add_flag("--exr-float", ro.exrFloat, "Write 32-bit float EXR (default: half)");
   render->add_flag("--png", ro.png, "Also write an sRGB PNG beside each EXR");
   render->add_option("--exposure", ro.exposure, "Exposure in stops for the PNG")
+      ->check(finiteIn(-64, 64))
       ->capture_default_str();
   render->add_flag("-q,--quiet", ro.quiet, "No progress line or summary");
   render->add_flag(
@@ -224,13 +265,19 @@ int main(int argc, char** argv) {
   // clang-format on
   portability->add_option("SCENES", po.scenes, "glTF files tested besides the demo scenes");
   portability->add_flag("--no-demo", noDemo, "Test only the given scenes, not the demo scenes");
+  portability->add_flag("--allow-outside-uris", po.allowOutsideUris, kOutsideHelp);
   portability->add_option("--frames", po.frames, "Frames: A, A-B or a list (A,B-C)")
       ->capture_default_str();
-  portability->add_option("--width", po.width, "Image width")->capture_default_str();
-  portability->add_option("--height", po.height,
-                          "Image height (default: from the camera's aspect)");
-  portability->add_option("--spp", po.spp, "Samples per pixel per frame")->capture_default_str();
+  portability->add_option("--width", po.width, "Image width")
+      ->check(CLI::Range(1, 16384))
+      ->capture_default_str();
+  portability->add_option("--height", po.height, "Image height (default: from the camera's aspect)")
+      ->check(CLI::Range(1, 16384));
+  portability->add_option("--spp", po.spp, "Samples per pixel per frame")
+      ->check(CLI::Range(1, 1 << 20))
+      ->capture_default_str();
   portability->add_option("--seed", po.seed, "Random seed (the noise floor uses seed+1 and seed+2)")
+      ->check(CLI::Range(0u, 4294967293u))
       ->capture_default_str();
   portability
       ->add_option("--mode", po.modes,
@@ -243,10 +290,12 @@ int main(int argc, char** argv) {
   portability
       ->add_option("--tolerance", po.tolerance.relMseFactor,
                    "A device disagrees when its relMSE exceeds this multiple of the noise floor")
+      ->check(finiteIn(0.001, 1e6))
       ->capture_default_str();
   portability
       ->add_option("--sigmas", po.tolerance.lumSigmas,
                    "... or when its mean luminance is this many standard errors off")
+      ->check(finiteIn(0.001, 1e6))
       ->capture_default_str();
   portability->add_flag("--json", po.json, "Print one JSON document instead of the table");
   portability->add_option("--out", po.outDir, "Folder for the PNG of the worst difference")
@@ -274,7 +323,7 @@ int main(int argc, char** argv) {
 
   try {
     if (*devices) return runDevices(devicesJson);
-    if (*info) return runInfo(infoScene, infoJson, infoFps);
+    if (*info) return runInfo(infoScene, infoJson, infoFps, infoOutside);
     if (*render) {
       if (!framesText.empty()) {
         ro.frames = pr::parseFrameRange(framesText);

@@ -9,11 +9,7 @@
 namespace pr {
 namespace {
 
-size_t lineCount(const std::string& s) {
-  size_t n = 0;
-  for (char c : s) n += c == '\n';
-  return n;
-}
+using test::lineCount;
 
 TEST(Cli, DevicesListsPocl) {
   auto r = test::runPathreuse("devices");

@@ -20,14 +20,9 @@
 namespace pr {
 namespace {
 
-namespace fs = std::filesystem;
+using test::slurp;
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+namespace fs = std::filesystem;
 
 // Every number in the document is finite.
 void expectFinite(const nlohmann::json& j, const std::string& where) {

@@ -16,16 +16,12 @@
 namespace pr {
 namespace {
 
+using test::lineCount;
+
 namespace fs = std::filesystem;
 
 const std::string kScene = test::sourcePath("scenes/cornell-dynamic.gltf");
 constexpr int kWidth = 64, kHeight = 48, kFrames = 5;
-
-size_t lineCount(const std::string& s) {
-  size_t n = 0;
-  for (char c : s) n += c == '\n';
-  return n;
-}
 
 int sum(const std::vector<int>& v) {
   return std::accumulate(v.begin(), v.end(), 0);

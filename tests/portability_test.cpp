@@ -25,14 +25,10 @@
 namespace pr {
 namespace {
 
+using test::lineCount;
+
 const char* const kTwoDrivers = test::kTwoPoclDrivers;
 using test::twoPoclDevices;
-
-size_t lineCount(const std::string& s) {
-  size_t n = 0;
-  for (char c : s) n += c == '\n';
-  return n;
-}
 
 // A smooth image (a gradient) plus independent noise per pixel and channel: one "render".
 Image noisy(uint32_t seed, double gain = 1.0, int w = 64, int h = 48) {

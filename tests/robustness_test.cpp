@@ -6,7 +6,6 @@
 
 #include <fcntl.h>
 #include <signal.h>
-#include <spawn.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -23,28 +22,17 @@
 
 #include "io/image.h"
 #include "scene/gltf_loader.h"
+#include "support/background.h"
 #include "support/test_env.h"
 #include "util/error.h"
-
-extern char** environ;
 
 namespace pr {
 namespace {
 
+using test::lineCount;
+using test::slurp;
+
 namespace fs = std::filesystem;
-
-size_t lineCount(const std::string& s) {
-  size_t n = 0;
-  for (char c : s) n += c == '\n';
-  return n;
-}
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 // Files in `dir` that are not finished outputs: temporary names start with a dot.
 std::vector<std::string> temporaryFiles(const std::string& dir) {
@@ -56,68 +44,7 @@ std::vector<std::string> temporaryFiles(const std::string& dir) {
   return found;
 }
 
-// The renderer running in the background, its stderr going to a file.
-class Background {
- public:
-  Background(const std::vector<std::string>& args, const std::string& dir)
-      : errFile_(dir + "/stderr") {
-    std::vector<std::string> all = {PATHREUSE_BINARY};
-    all.insert(all.end(), args.begin(), args.end());
-    std::vector<char*> argv;
-    for (auto& a : all) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-    posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
-    posix_spawn_file_actions_addopen(&actions, 2, errFile_.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
-                                     0644);
-    const int rc = posix_spawn(&pid_, argv[0], &actions, nullptr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
-    if (rc != 0) pid_ = -1;
-  }
-  ~Background() {
-    if (pid_ > 0 && !exited_) {
-      kill(pid_, SIGKILL);
-      waitpid(pid_, nullptr, 0);
-    }
-  }
-  bool started() const { return pid_ > 0; }
-  void signal(int sig) { kill(pid_, sig); }
-  std::string err() const { return slurp(errFile_); }
-
-  // Waits until `ready` holds, up to `seconds`; false when the process ended or time ran out.
-  template <class F>
-  bool waitUntil(F ready, double seconds) {
-    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-    while (std::chrono::steady_clock::now() < end) {
-      if (ready()) return true;
-      if (!exited_ && waitpid(pid_, &status_, WNOHANG) == pid_) exited_ = true;
-      if (exited_) return ready();
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-    return false;
-  }
-
-  // The exit code (128 + signal when killed), or -1 when it has not ended within `seconds`.
-  int wait(double seconds) {
-    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-    while (!exited_ && std::chrono::steady_clock::now() < end) {
-      if (waitpid(pid_, &status_, WNOHANG) == pid_)
-        exited_ = true;
-      else
-        std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-    if (!exited_) return -1;
-    return WIFEXITED(status_) ? WEXITSTATUS(status_) : 128 + WTERMSIG(status_);
-  }
-
- private:
-  std::string errFile_;
-  pid_t pid_ = -1;
-  int status_ = 0;
-  bool exited_ = false;
-};
+using test::Background;
 
 const std::string kScene = test::sourcePath("scenes/cornell-dynamic.gltf");
 
@@ -330,6 +257,7 @@ TEST(WriteErrors, FailingExrWriteLeavesNoFile) {
   EXPECT_TRUE(fs::is_empty(dir));
 }
 
+// The size named is the one `pathreuse devices` lists (they were formatted apart: 4.0 / 4.00).
 TEST(DeviceMemory, ArenaTooLargeNamesItAndItsSize) {
   const std::string dir = test::tempDir("oom");
   const auto r = test::runPathreuse("render '" + kScene +
@@ -342,6 +270,13 @@ TEST(DeviceMemory, ArenaTooLargeNamesItAndItsSize) {
       << r.err;
   EXPECT_NE(r.err.find(" GiB"), std::string::npos) << r.err;
   EXPECT_TRUE(fs::is_empty(dir));
+  // "allows is X": X is what `devices` prints as the rendering device's max alloc.
+  const size_t at = r.err.find("allows is ");
+  ASSERT_NE(at, std::string::npos) << r.err;
+  const std::string size = r.err.substr(at + 10, r.err.find('\n', at) - at - 10);
+  const auto list = test::runPathreuse("devices");
+  EXPECT_NE(list.out.find("max alloc " + size + ","), std::string::npos) << size << "\n"
+                                                                         << list.out;
 }
 
 TEST(DeviceMemory, AbsurdSizesAreBadInput) {

@@ -34,15 +34,6 @@ std::string buildLog(const cl::Program& program, const cl::Device& device) {
   return log;
 }
 
-std::string humanSize(uint64_t bytes) {
-  char buf[32];
-  if (bytes >= (1ull << 30))
-    std::snprintf(buf, sizeof buf, "%.2f GiB", bytes / double(1ull << 30));
-  else
-    std::snprintf(buf, sizeof buf, "%.1f MiB", bytes / double(1ull << 20));
-  return buf;
-}
-
 // The cached binary for `key`, or empty if absent or corrupt (a corrupt file is removed).
 std::string loadCachedBinary(const std::string& file) {
   std::string data;
@@ -187,22 +178,22 @@ ProgramBuild Context::buildProgramFromSource(const std::string& source, const st
 cl::Buffer Context::allocate(const std::string& name, uint64_t bytes, cl_mem_flags flags) {
   if (bytes == 0) bytes = 16;  // zero-sized buffers are invalid; keep a valid handle
   if (bytes > device_.maxAllocBytes)
-    throw RuntimeError("device out of memory: " + name + " needs " + humanSize(bytes) +
+    throw RuntimeError("device out of memory: " + name + " needs " + formatBytes(bytes) +
                        " but the largest allocation " + device_.name + " allows is " +
-                       humanSize(device_.maxAllocBytes));
+                       formatBytes(device_.maxAllocBytes));
   // Some drivers allocate on first use; this names the buffer before a later launch fails.
   if (device_.globalMemBytes > 0 &&
       bytes > device_.globalMemBytes - std::min(bytesInUse_, device_.globalMemBytes))
-    throw RuntimeError("device out of memory: " + name + " (" + humanSize(bytes) +
-                       ") does not fit beside the " + humanSize(bytesInUse_) +
-                       " already in use of " + humanSize(device_.globalMemBytes) + " on " +
+    throw RuntimeError("device out of memory: " + name + " (" + formatBytes(bytes) +
+                       ") does not fit beside the " + formatBytes(bytesInUse_) +
+                       " already in use of " + formatBytes(device_.globalMemBytes) + " on " +
                        device_.name);
   cl_int err = CL_SUCCESS;
   cl::Buffer buffer(context_, flags, bytes, nullptr, &err);
   if (err == CL_MEM_OBJECT_ALLOCATION_FAILURE || err == CL_OUT_OF_RESOURCES ||
       err == CL_OUT_OF_HOST_MEMORY)
-    throw RuntimeError("device out of memory: " + name + " (" + humanSize(bytes) +
-                       ") did not fit; " + humanSize(bytesInUse_) + " already in use on " +
+    throw RuntimeError("device out of memory: " + name + " (" + formatBytes(bytes) +
+                       ") did not fit; " + formatBytes(bytesInUse_) + " already in use on " +
                        device_.name);
   CL_CHECK(err);
   bytesInUse_ += bytes;

@@ -7,6 +7,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "util/files.h"
+
 namespace pr {
 
 namespace {
@@ -39,16 +41,6 @@ bool parseUnsigned(const std::string& s, int* out) {
     if (!std::isdigit(static_cast<unsigned char>(c))) return false;
   *out = std::stoi(s);
   return true;
-}
-
-std::string humanBytes(uint64_t bytes) {
-  char buf[32];
-  const double gib = 1024.0 * 1024.0 * 1024.0;
-  if (bytes >= (1ull << 30))
-    std::snprintf(buf, sizeof buf, "%.1f GiB", bytes / gib);
-  else
-    std::snprintf(buf, sizeof buf, "%.0f MiB", bytes / (1024.0 * 1024.0));
-  return buf;
 }
 
 }  // namespace
@@ -177,8 +169,8 @@ std::string describeDevice(const DeviceEntry& d) {
   std::ostringstream os;
   os << "[" << d.index << "] " << d.platformIndex << ":" << d.deviceIndex << "  " << d.name << "  ("
      << d.platformName << ")  " << deviceTypeName(d.type) << ", " << d.computeUnits
-     << " compute units, " << humanBytes(d.globalMemBytes) << " global, max alloc "
-     << humanBytes(d.maxAllocBytes) << ", " << d.openclCVersion;
+     << " compute units, " << formatBytes(d.globalMemBytes) << " global, max alloc "
+     << formatBytes(d.maxAllocBytes) << ", " << d.openclCVersion;
   return os.str();
 }
 

@@ -17,12 +17,40 @@
 
 #include "util/error.h"
 #include "util/files.h"
+#include "util/input_file.h"
 
 namespace pr {
 
 namespace fs = std::filesystem;
 
 namespace {
+
+// An OpenEXR input stream over a file's bytes, read first through the one opener.
+class MemoryIStream : public Imf::IStream {
+ public:
+  MemoryIStream(const std::string& name, std::vector<uint8_t> bytes)
+      : Imf::IStream(name.c_str()), bytes_(std::move(bytes)) {}
+  bool isMemoryMapped() const override { return true; }
+  char* readMemoryMapped(int n) override { return take(n); }
+  bool read(char c[], int n) override {
+    std::memcpy(c, take(n), size_t(n));
+    return pos_ < bytes_.size();
+  }
+  uint64_t tellg() override { return pos_; }
+  void seekg(uint64_t pos) override { pos_ = pos; }
+  void clear() override {}
+
+ private:
+  char* take(int n) {
+    if (n < 0 || pos_ > bytes_.size() || uint64_t(n) > bytes_.size() - pos_)
+      throw std::runtime_error("unexpected end of file");
+    char* at = reinterpret_cast<char*>(bytes_.data() + pos_);
+    pos_ += uint64_t(n);
+    return at;
+  }
+  std::vector<uint8_t> bytes_;
+  uint64_t pos_ = 0;
+};
 
 // An OpenEXR output stream into a string.
 class MemoryOStream : public Imf::OStream {
@@ -106,9 +134,9 @@ void writePng(const std::string& path, const Image& image, float exposure) {
 }
 
 Image readExr(const std::string& path) {
-  if (!fs::exists(path)) throw InputError(path + ": no such file");
+  MemoryIStream stream(path, readInputFile(path, kMaxImageFileBytes));
   try {
-    Imf::InputFile file(path.c_str());
+    Imf::InputFile file(stream);
     const Imath::Box2i dw = file.header().dataWindow();
     const int w = dw.max.x - dw.min.x + 1, h = dw.max.y - dw.min.y + 1;
     if (w <= 0 || h <= 0 || static_cast<long long>(w) * h > (1ll << 28))

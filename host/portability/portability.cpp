@@ -9,6 +9,7 @@
 #include <fstream>
 #include <iostream>
 #include <limits>
+#include <map>
 #include <memory>
 #include <sstream>
 
@@ -21,6 +22,7 @@
 #include "scene/gltf_loader.h"
 #include "util/error.h"
 #include "util/files.h"
+#include "util/input_file.h"
 
 namespace pr {
 
@@ -113,6 +115,7 @@ FrameSet renderSet(const SuiteScene& s, const DeviceEntry& device, const RenderO
 // A saved reference: frames as float EXRs named by scene, mode, seed and frame, and
 // reference.json with the suite's settings (checked on load) and each frame's dropped samples.
 const char* const kManifest = "reference.json";
+constexpr uint64_t kMaxManifestBytes = 64 << 20;
 
 std::string referenceFile(const std::string& label, RenderMode mode, uint32_t seed, int frame) {
   return safeName(label) + "_" + renderModeName(mode) + "_s" + std::to_string(seed) + "_f" +
@@ -129,10 +132,11 @@ class StoredReference {
  public:
   explicit StoredReference(const std::string& dir) : dir_(dir) {
     const fs::path manifest = fs::path(dir) / kManifest;
-    std::ifstream in(manifest);
-    if (!in) throw InputError(manifest.string() + ": cannot read (make one with --save-reference)");
+    const std::string why = whyNotReadable(manifest.string(), kMaxManifestBytes);
+    if (!why.empty())
+      throw InputError(manifest.string() + ": " + why + " (make one with --save-reference)");
     try {
-      in >> json_;
+      json_ = nlohmann::json::parse(readInputFileText(manifest.string(), kMaxManifestBytes));
     } catch (const nlohmann::json::exception& e) {
       throw InputError(manifest.string() + ": not a reference manifest (" + e.what() + ")");
     }
@@ -154,8 +158,10 @@ class StoredReference {
                        json_["settings"].dump() + ", not " + settings.dump() +
                        " (use the same --frames, --width, --height, --spp and --seed)");
   }
+  // Every frame of one scene is the size of the first loaded (and --width wide): a frame of
+  // another size is a damaged reference, named.
   FrameSet load(const std::string& label, RenderMode mode, uint32_t seed,
-                const std::vector<int>& frames) const {
+                const std::vector<int>& frames) {
     FrameSet set;
     for (int f : frames) {
       const std::string name = referenceFile(label, mode, seed, f);
@@ -165,6 +171,17 @@ class StoredReference {
                          ": missing from the saved reference (saved with other "
                          "scenes or modes?)");
       set.images.push_back(readExr(path.string()));
+      const Image& img = set.images.back();
+      const std::string key = label + "/" + renderModeName(mode);
+      if (!sizes_.count(key)) sizes_[key] = {img.width, img.height};
+      const auto [w, h] = sizes_[key];
+      const nlohmann::json& st = json_["settings"];
+      const bool widthOk = !st.contains("width") || !st["width"].is_number_integer() ||
+                           st["width"].get<int>() == img.width;
+      if (img.width != w || img.height != h || !widthOk)
+        throw InputError(path.string() + ": a frame of " + std::to_string(img.width) + "x" +
+                         std::to_string(img.height) + " in a reference of " + std::to_string(w) +
+                         "x" + std::to_string(h) + " frames (damaged or mixed reference)");
       set.dropped.push_back(json_["frames_dropped"][name].get<uint64_t>());
     }
     return set;
@@ -173,6 +190,7 @@ class StoredReference {
  private:
   std::string dir_;
   nlohmann::json json_;
+  std::map<std::string, std::pair<int, int>> sizes_;  // per scene and mode
 };
 
 // How far past its tolerance a comparison is (above 1: it disagrees); ranks the worst.
@@ -260,6 +278,7 @@ int runPortability(const PortabilityOptions& o) {
       if (other.label == s.label) s.label += "#" + std::to_string(scenes.size());
     LoadOptions lo;
     lo.printWarnings = !o.quiet;
+    lo.allowOutsideUris = o.allowOutsideUris;
     s.scene = std::make_unique<Scene>(loadScene(p, lo));
     scenes.push_back(std::move(s));
   }

@@ -15,6 +15,7 @@ namespace pr {
 struct PortabilityOptions {
   std::vector<std::string> scenes;  // added to the demo scenes
   bool demoScenes = true;           // false: only `scenes`
+  bool allowOutsideUris = false;    // LoadOptions::allowOutsideUris
   std::string frames = "0-2,24";    // consecutive frames so reuse reuses, and a later one
   int width = 64;
   int height = 0;  // 0: from the camera's aspect (48 for the demo scenes)

@@ -37,6 +37,7 @@ struct FrameRange {
 
 struct RenderOptions {
   std::string scene;
+  bool allowOutsideUris = false;  // LoadOptions::allowOutsideUris
   FrameRange frames;
   bool framesGiven = false;
   double fps = 24.0;

@@ -24,8 +24,10 @@
 #include "render/path_tracer.h"
 #include "render/session.h"
 #include "scene/gltf_loader.h"
+#include "scene/image_decode.h"
 #include "util/error.h"
 #include "util/files.h"
+#include "util/input_file.h"
 #include "util/interrupt.h"
 
 namespace pr {
@@ -50,6 +52,7 @@ class StatsFile {
     const auto parent = std::filesystem::path(path).parent_path();
     std::error_code ec;
     if (!parent.empty()) std::filesystem::create_directories(parent, ec);
+    if (append) dropPartialLine();
     file_ = std::fopen(path.c_str(), append ? "a" : "w");
     if (!file_) fail();
   }
@@ -66,6 +69,18 @@ class StatsFile {
   }
 
  private:
+  // A run stopped by a full disk may have left half a line: appending to it would join two
+  // records into one unparseable line. Keep the complete lines only.
+  void dropPartialLine() {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path_, ec)) return;
+    std::string text;
+    if (!readFile(path_, &text)) fail();
+    if (text.empty() || text.back() == '\n') return;
+    const size_t keep = text.rfind('\n') == std::string::npos ? 0 : text.rfind('\n') + 1;
+    errno = 0;
+    if (::truncate(path_.c_str(), off_t(keep)) != 0) fail();
+  }
   [[noreturn]] void fail() const {
     throw RuntimeError(path_ +
                        ": cannot write the stats file: " + std::strerror(errno ? errno : EIO));
@@ -81,21 +96,29 @@ std::string frameSpan(int a, int b) {
 // A frame that --resume may skip: a complete EXR of the session's size (and its PNG when asked).
 bool frameDone(const std::string& exr, const RenderOptions& o, int width, int height) {
   if (!std::filesystem::exists(exr)) return false;
-  if (o.png && !std::filesystem::exists(withExtension(exr, ".png"))) return false;
   try {
     const Image img = readExr(exr);
-    return img.width == width && img.height == height;
+    if (img.width != width || img.height != height) return false;
+    if (!o.png) return true;
+    // The PNG whole too: a cut or corrupt one fails its CRCs or lacks its end.
+    DecodedImage png;
+    std::string why;
+    return decodeImageRgba8(readInputFile(withExtension(exr, ".png"), kMaxImageFileBytes), &png,
+                            &why) &&
+           png.width == width && png.height == height;
   } catch (const InputError&) {
-    return false;  // truncated or corrupt: render it again
+    return false;  // missing, truncated or corrupt: render it again
   }
 }
 
 }  // namespace
 
 int runRender(const RenderOptions& o) {
-  installInterruptHandlers();
+  installInterruptHandlers(o.scene);
   validateRenderOptions(o);
-  const Scene scene = loadScene(o.scene);
+  LoadOptions loadOptions;
+  loadOptions.allowOutsideUris = o.allowOutsideUris;
+  const Scene scene = loadScene(o.scene, loadOptions);
   if (sceneHasNoLights(scene) && !o.quiet) {
     if (o.env.empty() && o.envColor.empty())
       std::cerr << "note: " << o.scene
@@ -128,6 +151,7 @@ int runRender(const RenderOptions& o) {
   uint64_t raysSoFar = 0, badSamples = 0;
   int rendered = 0, skipped = 0, badFrames = 0;
   int f = range.first;
+  endLoadingPhase();  // a signal from here on finishes cleanly between launches
   for (; f <= range.last && !interrupted(); ++f) {
     const std::string exr = formatOutPath(o.outPattern, f);
     if (o.resume && frameDone(exr, o, session.width(), session.height())) {

@@ -61,6 +61,9 @@ bool sceneHasNoLights(const Scene& scene) {
 
 void validateRenderOptions(const RenderOptions& o) {
   validateOutPattern(o.outPattern);
+  if (o.png && withExtension(o.outPattern, ".png") == o.outPattern)
+    throw InputError("--out " + o.outPattern +
+                     ": with --png the EXR and its PNG would be one file (name the EXR .exr)");
   if (o.spp < 1 || o.spp > 1 << 20)
     throw InputError("--spp " + std::to_string(o.spp) + ": must be 1 to 1048576");
   if (o.maxDepth < 1 || o.maxDepth > 64)

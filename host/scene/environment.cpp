@@ -2,12 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
-#include <iterator>
 
 #include "io/image.h"
 #include "scene/image_decode.h"
 #include "util/error.h"
+#include "util/input_file.h"
 
 namespace pr {
 
@@ -42,10 +41,7 @@ Environment loadEnvironment(const std::string& path) {
     for (size_t i = 0; i < size_t(e.width) * e.height; ++i)
       for (int c = 0; c < 3; ++c) e.rgb[3 * i + c] = img.rgba[4 * i + c];
   } else if (endsWith(path, ".hdr") || endsWith(path, ".pic")) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(path + ": cannot open the environment map");
-    const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)),
-                                     std::istreambuf_iterator<char>());
+    const std::vector<uint8_t> bytes = readInputFile(path, kMaxImageFileBytes);
     std::string why;
     if (!decodeImageRgbFloat(bytes, &e.width, &e.height, &e.rgb, &why))
       throw InputError(path + ": cannot read the environment map: " + why);

@@ -1,6 +1,7 @@
 #include "scene/gltf_animation.h"
 
 #include <cmath>
+#include <cstdio>
 
 #include "scene/gltf_accessors.h"
 
@@ -23,6 +24,13 @@ AnimationSampler samplerKeys(const Document& doc, const tinygltf::AnimationSampl
              where);
   for (size_t i = 0; i < in.size(); ++i) {
     if (!finite(in[i])) doc.fail("input time " + std::to_string(i) + " is not finite", where);
+    if (std::fabs(in[i]) > kMaxAnimationSeconds) {
+      char t[32];
+      std::snprintf(t, sizeof t, "%g", in[i]);
+      doc.fail("input time " + std::to_string(i) + " is " + t + " s, beyond the " +
+                   std::to_string(int(kMaxAnimationSeconds)) + " s (11.6 days) pathreuse animates",
+               where);
+    }
     if (i > 0 && !(float(in[i]) > float(in[i - 1])))
       doc.fail("input times are not strictly increasing at key " + std::to_string(i), where);
     out.times.push_back(float(in[i]));

@@ -8,12 +8,82 @@
 
 #include "scene/gltf_schema.h"
 #include "util/error.h"
+#include "util/input_file.h"
 
 namespace pr::gltf {
 
 namespace {
 
 namespace fs = std::filesystem;
+
+// Deeper JSON than this is refused before any parser sees it: tinygltf's parser recurses once
+// per level. glTF itself needs 6 levels; extras and extensions rarely more than a dozen.
+constexpr int kMaxJsonDepth = 256;
+
+// The deepest nesting of arrays and objects in `json`, counting no further than `limit + 1`.
+int jsonDepth(const uint8_t* json, size_t length, int limit) {
+  int depth = 0, deepest = 0;
+  bool inString = false;
+  for (size_t i = 0; i < length; ++i) {
+    const uint8_t c = json[i];
+    if (inString) {
+      if (c == '\\')
+        ++i;
+      else if (c == '"')
+        inString = false;
+    } else if (c == '"') {
+      inString = true;
+    } else if (c == '[' || c == '{') {
+      deepest = std::max(deepest, ++depth);
+      if (deepest > limit) break;
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return deepest;
+}
+
+// How external buffers and images are read: through the one opener, and only from the scene's
+// folder and below unless the options allow more. tinygltf tries the URI beside the scene, then
+// beside the working directory; only the first is a file of the scene.
+struct ExternalFiles {
+  const Document* doc;
+  std::string baseDir;
+};
+
+bool externalFileExists(const std::string& path, void* user) {
+  const auto* files = static_cast<const ExternalFiles*>(user);
+  std::error_code ec;
+  if (!fs::exists(fs::symlink_status(path, ec))) return false;
+  if (files->doc->options.allowOutsideUris) return true;
+  const std::string& base = files->baseDir;
+  const std::string prefix = !base.empty() && base.back() == '/' ? base : base + "/";
+  return path.compare(0, prefix.size(), prefix) == 0;
+}
+
+std::string expandFilePath(const std::string& path, void*) {
+  return path;  // URIs are not expanded (no ~, no variables)
+}
+
+bool readExternalFile(std::vector<unsigned char>* out, std::string*, const std::string& path,
+                      void* user) {
+  const auto* files = static_cast<const ExternalFiles*>(user);
+  if (!files->doc->options.allowOutsideUris) {
+    const std::string why = whyOutsideRoot(files->baseDir, path);
+    if (!why.empty()) files->doc->fail("file " + path + " " + why);
+  }
+  try {
+    *out = readInputFile(path, kMaxBufferFileBytes);
+  } catch (const InputError& e) {
+    files->doc->fail(std::string("cannot load a file it names: ") + e.what());
+  }
+  return true;
+}
+
+bool refuseWrite(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+  if (err) *err = "writing is not supported";
+  return false;
+}
 
 bool keepImageBytes(tinygltf::Image* image, const int index, std::string*, std::string*, int, int,
                     const unsigned char* bytes, int size, void* user) {
@@ -46,6 +116,10 @@ class Parser : Stage {
     preflight(bytes);
     tinygltf::TinyGLTF gltf;
     gltf.SetImageLoader(&keepImageBytes, &doc_.images);
+    ExternalFiles files{&doc_, baseDir};
+    tinygltf::FsCallbacks callbacks{&externalFileExists, &expandFilePath, &readExternalFile,
+                                    &refuseWrite, &files};
+    gltf.SetFsCallbacks(callbacks);
     std::string err, warnText;
     bool ok = false;
     try {
@@ -73,14 +147,9 @@ class Parser : Stage {
 
  private:
   void readFileBytes() {
-    std::error_code ec;
-    const fs::file_status st = fs::status(doc_.path, ec);
-    if (ec || !fs::exists(st)) fail("no such file");
-    if (fs::is_directory(st)) fail("is a directory, not a glTF file");
-    std::ifstream in(doc_.path, std::ios::binary);
-    if (!in) fail("cannot open file");
-    bytes_.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-    if (in.bad()) fail("cannot read file");
+    const std::string why = whyNotReadable(doc_.path, kMaxSceneFileBytes);
+    if (why == "is a directory") fail("is a directory, not a glTF file");
+    bytes_ = readInputFile(doc_.path, kMaxSceneFileBytes);
   }
 
   // Before tinygltf: the JSON's types (tinygltf silently drops a property of the wrong type),
@@ -92,6 +161,10 @@ class Parser : Stage {
       // Header (magic, version, length) then the JSON chunk (length, type). A broken container
       // is left to tinygltf's checks, which name the problem.
       if (bytes.size() < 20 || std::memcmp(bytes.data(), "glTF", 4) != 0) return;
+      uint32_t version = 0;
+      std::memcpy(&version, bytes.data() + 4, 4);
+      if (version != 2)
+        fail("GLB container version " + std::to_string(version) + " (only version 2 is supported)");
       uint32_t chunkLength = 0, chunkType = 0;
       std::memcpy(&chunkLength, bytes.data() + 12, 4);
       std::memcpy(&chunkType, bytes.data() + 16, 4);
@@ -99,6 +172,9 @@ class Parser : Stage {
       json = bytes.data() + 20;
       length = chunkLength;
     }
+    if (jsonDepth(json, length, kMaxJsonDepth) > kMaxJsonDepth)
+      fail("JSON nested more than " + std::to_string(kMaxJsonDepth) +
+           " levels deep (the limit pathreuse reads)");
     nlohmann::json j;
     try {
       j = nlohmann::json::parse(json, json + length);

@@ -16,6 +16,9 @@ struct LoadOptions {
   // nullptr = silent. They are kept in Scene::warnings either way.
   std::ostream* warningStream = nullptr;
   bool printWarnings = true;  // to std::cerr when warningStream is null
+  // Buffers and images the file names are read from its folder and below only, unless this is
+  // set (--allow-outside-uris): a scene from elsewhere must not read /etc/passwd into a frame.
+  bool allowOutsideUris = false;
 };
 
 Scene loadScene(const std::string& path, const LoadOptions& options = {});

@@ -557,6 +557,24 @@ class Validator : Stage {
       }
       for (size_t w : walk) state[w] = 2;
     }
+    // Depths, parents first along each walk up (a node's depth is its parent's plus one).
+    std::vector<int> depth(n, -1);
+    for (size_t i = 0; i < n; ++i) {
+      std::vector<size_t> up;
+      size_t k = i;
+      while (depth[k] < 0 && parents_[k] >= 0) {
+        up.push_back(k);
+        k = size_t(parents_[k]);
+      }
+      if (depth[k] < 0) depth[k] = 1;
+      for (auto it = up.rbegin(); it != up.rend(); ++it) {
+        depth[*it] = depth[size_t(parents_[*it])] + 1;
+        if (depth[*it] > kMaxNodeDepth)
+          fail("node hierarchy is more than " + std::to_string(kMaxNodeDepth) +
+                   " levels deep (the limit pathreuse loads)",
+               named("node", int(*it), model_.nodes[*it].name));
+      }
+    }
     for (size_t s = 0; s < model_.scenes.size(); ++s) {
       const auto& sc = model_.scenes[s];
       std::set<int> seen;

@@ -65,10 +65,18 @@ glm::mat4 Scene::nodeLocalTransform(int node, double t) const {
 }
 
 glm::mat4 Scene::nodeWorldTransform(int node, double t) const {
-  const Node& n = nodes.at(static_cast<size_t>(node));
-  if (!n.moves) return n.restWorld;
-  const glm::mat4 local = nodeLocalTransform(node, t);
-  return n.parent < 0 ? local : nodeWorldTransform(n.parent, t) * local;
+  // Up to the first ancestor that does not move (its rest transform holds), then down again;
+  // a loop, not a recursion: hierarchies come from files (kMaxNodeDepth levels).
+  std::vector<int> chain;
+  int k = node;
+  while (k >= 0 && nodes.at(static_cast<size_t>(k)).moves) {
+    chain.push_back(k);
+    k = nodes[static_cast<size_t>(k)].parent;
+  }
+  glm::mat4 world = k >= 0 ? nodes[static_cast<size_t>(k)].restWorld : glm::mat4(1.0f);
+  for (auto it = chain.rbegin(); it != chain.rend(); ++it)
+    world = world * nodeLocalTransform(*it, t);
+  return world;
 }
 
 glm::mat4 Scene::instanceTransform(size_t instance, double t) const {

@@ -191,6 +191,12 @@ struct CameraPose {
   bool perspective = true;
 };
 
+// Limits on what a scene may hold (README.md "Limits"): key times within 1e6 s (11.6 days; at
+// the highest --fps, 1e9 frames, which an int counts), and node hierarchies at most this deep
+// (a transform walks up to the root: deeper chains would cost quadratic time per frame).
+constexpr double kMaxAnimationSeconds = 1e6;
+constexpr int kMaxNodeDepth = 10000;
+
 // A node of the glTF hierarchy (indices are the file's node indices).
 struct Node {
   std::string name;

@@ -7,21 +7,33 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include "util/error.h"
+#include "util/input_file.h"
+#include "util/interrupt.h"
 
 namespace pr {
 
+std::string formatBytes(uint64_t bytes) {
+  char buf[48];
+  if (bytes >= (uint64_t(1) << 30))
+    std::snprintf(buf, sizeof buf, "%.2f GiB", double(bytes) / double(uint64_t(1) << 30));
+  else if (bytes >= (uint64_t(1) << 20))
+    std::snprintf(buf, sizeof buf, "%.1f MiB", double(bytes) / double(uint64_t(1) << 20));
+  else if (bytes >= 1024)
+    std::snprintf(buf, sizeof buf, "%.1f KiB", double(bytes) / 1024.0);
+  else
+    std::snprintf(buf, sizeof buf, "%llu bytes", static_cast<unsigned long long>(bytes));
+  return buf;
+}
+
 bool readFile(const std::string& path, std::string* out) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return false;
-  std::ostringstream os;
-  os << in.rdbuf();
-  if (in.bad()) return false;
-  *out = os.str();
-  return true;
+  try {
+    *out = readInputFileText(path, kMaxBufferFileBytes);
+    return true;
+  } catch (const InputError&) {
+    return false;
+  }
 }
 
 std::string temporaryNameFor(const std::string& path) {
@@ -50,6 +62,7 @@ void createParent(const std::string& path) {
 
 void checkWritable(const std::string& path) {
   createParent(path);
+  const DeferInterrupts defer;
   const std::string tmp = temporaryNameFor(path);
   FILE* f = std::fopen(tmp.c_str(), "wb");
   if (!f) throw RuntimeError(path + ": cannot write: " + std::strerror(errno));
@@ -59,6 +72,7 @@ void checkWritable(const std::string& path) {
 
 void writeFileAtomic(const std::string& path, const std::string& data) {
   createParent(path);
+  const DeferInterrupts defer;
   const std::string tmp = temporaryNameFor(path);
   FILE* f = std::fopen(tmp.c_str(), "wb");
   if (!f) throw RuntimeError(path + ": cannot write: " + std::strerror(errno));

@@ -2,11 +2,15 @@
 // file is either complete or absent.
 #pragma once
 
+#include <cstdint>
 #include <string>
 
 namespace pr {
 
-// Reads a whole file; false when it cannot be read.
+// A byte count for messages: "812 bytes", "3.4 MiB", "4.00 GiB".
+std::string formatBytes(uint64_t bytes);
+
+// Reads a whole regular file (util/input_file.h's opener); false when it cannot be read.
 bool readFile(const std::string& path, std::string* out);
 
 // Writes `data` to `path` through a temporary file in the same folder and a rename. Creates

@@ -66,6 +66,19 @@ std::string tempDir(const std::string& tag) {
   return buf.data();
 }
 
+size_t lineCount(const std::string& s) {
+  size_t n = 0;
+  for (char c : s) n += c == '\n';
+  return n;
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
 CommandResult runPathreuse(const std::string& args, const std::string& env) {
   const std::string dir = tempDir("cli");
   const std::string outFile = dir + "/stdout", errFile = dir + "/stderr";
@@ -79,12 +92,6 @@ CommandResult runPathreuse(const std::string& args, const std::string& env) {
   const int status = std::system(cmd.c_str());
   CommandResult r;
   r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  auto slurp = [](const std::string& f) {
-    std::ifstream in(f);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-  };
   r.out = slurp(outFile);
   r.err = slurp(errFile);
   return r;

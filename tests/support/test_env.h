@@ -31,6 +31,12 @@ struct CommandResult {
 // $PATHREUSE_TEST_DEVICE its renders use that device (as $PATHREUSE_DEVICE) unless `env` names one.
 CommandResult runPathreuse(const std::string& args, const std::string& env = "");
 
+// The lines of `s` (its newline characters): an error must be exactly one.
+size_t lineCount(const std::string& s);
+
+// A whole file's bytes; empty when it cannot be read.
+std::string slurp(const std::string& path);
+
 // PoCL's two drivers as `pathreuse devices` lists them under kTwoPoclDrivers.
 extern const char* const kTwoPoclDrivers;
 
