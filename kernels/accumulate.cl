@@ -3,8 +3,10 @@
 // no two work-items share a pixel). A non-finite sample is dropped and counted, never written.
 // Writes film (float4 per pixel: rgb sum and sample count) and bad_samples (an atomic count,
 // whose total does not depend on thread order).
-__kernel void accumulate(__global const float4* radiance, __global float4* film,
-                         __global uint* bad_samples, uint count, uint pixel_count) {
+#include "shared/common.h"
+
+PR_KERNEL void accumulate(__global const float4* radiance, __global float4* film,
+                          __global uint* bad_samples, uint count, uint pixel_count) {
   const uint i = (uint)get_global_id(0);
   if (i >= count) return;
   const float4 l = radiance[i];

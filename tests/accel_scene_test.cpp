@@ -153,7 +153,8 @@ void expectSceneMatchesBruteForce(const std::string& path, const std::vector<dou
 
 TEST(SceneAccel, CornellNvproMatchesBruteForce) {
   const std::string path = test::sharedScene("cornell-nvpro/cornellBox.gltf");
-  if (path.empty()) GTEST_SKIP() << "../shared/scenes/cornell-nvpro is absent";
+  ASSERT_FALSE(path.empty())
+      << "../shared/scenes/cornell-nvpro is absent: the tests need ../shared beside the project";
   expectSceneMatchesBruteForce(path, {0.0}, 1500);
 }
 
@@ -186,7 +187,8 @@ TEST(SceneAccel, EveryBvhWidthRendersTheDemoAlike) {
 
 TEST(SceneAccel, BoxAnimatedMatchesBruteForceAtSeveralFrames) {
   const std::string path = test::sharedScene("BoxAnimated/BoxAnimated.gltf");
-  if (path.empty()) GTEST_SKIP() << "../shared/scenes/BoxAnimated is absent";
+  ASSERT_FALSE(path.empty())
+      << "../shared/scenes/BoxAnimated is absent: the tests need ../shared beside the project";
   expectSceneMatchesBruteForce(path, {0.0, 0.7, 1.5, 3.0}, 2000);
 }
 

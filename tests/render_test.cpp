@@ -234,7 +234,8 @@ TEST(PathTrace, NoNonFiniteSamplesOnTheDemoScenes) {
 
 TEST(PathTrace, NoNonFiniteSamplesOnCornellNvpro) {
   const std::string scene = test::sharedScene("cornell-nvpro/cornellBox.gltf");
-  if (scene.empty()) GTEST_SKIP() << "../shared/scenes/cornell-nvpro is absent";
+  ASSERT_FALSE(scene.empty())
+      << "../shared/scenes/cornell-nvpro is absent: the tests need ../shared beside the project";
   const std::string dir = test::tempDir("nan-nvpro");
   const auto r = test::runPathreuse(
       "render '" + scene +

@@ -436,7 +436,8 @@ TEST(Reuse, EyePathsAreTheDefault) {
 
 TEST(Reuse, ConvergesToThePathTracerOnCornellNvpro) {
   const std::string scene = test::sharedScene("cornell-nvpro/cornellBox.gltf");
-  if (scene.empty()) GTEST_SKIP() << "../shared/scenes/cornell-nvpro is absent";
+  ASSERT_FALSE(scene.empty())
+      << "../shared/scenes/cornell-nvpro is absent: the tests need ../shared beside the project";
   expectSameImage(scene, "--max-depth 6", 48, 36, 32, 2);
 }
 

@@ -14,7 +14,8 @@ using test::lineCount;
 
 TEST(SceneCli, InfoCornellJson) {
   const std::string path = test::sharedScene("cornell-nvpro/cornellBox.gltf");
-  if (path.empty()) GTEST_SKIP() << "../shared/scenes is absent";
+  ASSERT_FALSE(path.empty())
+      << "../shared/scenes is absent: the tests need ../shared beside the project";
   const auto r = test::runPathreuse("info --json '" + path + "'");
   ASSERT_EQ(r.exitCode, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
@@ -38,7 +39,8 @@ TEST(SceneCli, InfoCornellJson) {
 
 TEST(SceneCli, InfoBoxAnimated) {
   const std::string path = test::sharedScene("BoxAnimated/BoxAnimated.gltf");
-  if (path.empty()) GTEST_SKIP() << "../shared/scenes is absent";
+  ASSERT_FALSE(path.empty())
+      << "../shared/scenes is absent: the tests need ../shared beside the project";
   auto r = test::runPathreuse("info --json --fps 10 '" + path + "'");
   ASSERT_EQ(r.exitCode, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
@@ -71,7 +73,8 @@ TEST(SceneCli, InfoUsageErrors) {
   EXPECT_EQ(r.exitCode, 2);
   EXPECT_EQ(lineCount(r.err), 1u) << r.err;
   const std::string path = test::sharedScene("BoxAnimated/BoxAnimated.gltf");
-  if (path.empty()) GTEST_SKIP() << "../shared/scenes is absent";
+  ASSERT_FALSE(path.empty())
+      << "../shared/scenes is absent: the tests need ../shared beside the project";
   r = test::runPathreuse("info --fps 0 '" + path + "'");
   EXPECT_EQ(r.exitCode, 2);
   EXPECT_EQ(lineCount(r.err), 1u) << r.err;

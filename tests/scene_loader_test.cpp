@@ -53,7 +53,8 @@ void expectRefused(const std::string& path) {
 
 TEST(SceneLoader, CornellNvpro) {
   const std::string path = test::sharedScene("cornell-nvpro/cornellBox.gltf");
-  if (path.empty()) GTEST_SKIP() << "../shared/scenes is absent";
+  ASSERT_FALSE(path.empty())
+      << "../shared/scenes is absent: the tests need ../shared beside the project";
   const auto start = std::chrono::steady_clock::now();
   const Scene s = loadScene(path, quiet());
   const double ms =
@@ -81,7 +82,8 @@ TEST(SceneLoader, CornellNvpro) {
 
 TEST(SceneLoader, BoxAnimatedIsSplit) {
   const std::string path = test::sharedScene("BoxAnimated/BoxAnimated.gltf");
-  if (path.empty()) GTEST_SKIP() << "../shared/scenes is absent";
+  ASSERT_FALSE(path.empty())
+      << "../shared/scenes is absent: the tests need ../shared beside the project";
   const Scene s = loadScene(path, quiet());
   EXPECT_GT(s.dynamicTriangleCount(), 0u);
   EXPECT_EQ(s.dynamicTriangleCount(),
@@ -105,7 +107,8 @@ TEST(SceneLoader, BoxAnimatedIsSplit) {
 // at least one error (severity 0) in their report, so every one must be refused.
 TEST(SceneLoader, KhronosInvalidFilesAreRefused) {
   const std::string dir = test::sharedScene("invalid");
-  if (dir.empty()) GTEST_SKIP() << "../shared/scenes/invalid is absent";
+  ASSERT_FALSE(dir.empty())
+      << "../shared/scenes/invalid is absent: the tests need ../shared beside the project";
   int refused = 0;
   for (const auto& entry : fs::recursive_directory_iterator(dir)) {
     const std::string p = entry.path().string();
@@ -131,8 +134,8 @@ TEST(SceneLoader, KhronosInvalidFilesAreRefused) {
 }
 
 TEST(SceneLoader, AssimpModelsLoadOrAreRefusedCleanly) {
-  if (!fs::exists(kAssimpDir))
-    GTEST_SKIP() << kAssimpDir << " is absent (apt-get install assimp-testmodels)";
+  ASSERT_TRUE(fs::exists(kAssimpDir))
+      << kAssimpDir << " is absent (tools/install-deps.sh installs it)";
   int loaded = 0, refused = 0;
   for (const auto& entry : fs::recursive_directory_iterator(kAssimpDir)) {
     const std::string ext = entry.path().extension().string();
@@ -160,7 +163,8 @@ TEST(SceneLoader, AssimpModelsLoadOrAreRefusedCleanly) {
 }
 
 TEST(SceneLoader, AssimpBrokenModelsAreRefused) {
-  if (!fs::exists(kAssimpDir)) GTEST_SKIP() << kAssimpDir << " is absent";
+  ASSERT_TRUE(fs::exists(kAssimpDir))
+      << kAssimpDir << " is absent (tools/install-deps.sh installs it)";
   const std::string d = kAssimpDir;
   for (const char* rel :
        {"IndexOutOfRange/IndexOutOfRange.gltf", "IndexOutOfRange/AllIndicesOutOfRange.gltf",
@@ -180,7 +184,8 @@ TEST(SceneLoader, AssimpBrokenModelsAreRefused) {
 }
 
 TEST(SceneLoader, AssimpValidModelsLoad) {
-  if (!fs::exists(kAssimpDir)) GTEST_SKIP() << kAssimpDir << " is absent";
+  ASSERT_TRUE(fs::exists(kAssimpDir))
+      << kAssimpDir << " is absent (tools/install-deps.sh installs it)";
   const std::string d = kAssimpDir;
   Scene s;
   ASSERT_EQ(tryLoad(d + "/BoxTextured-glTF/BoxTextured.gltf", &s), "");

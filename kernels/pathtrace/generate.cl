@@ -7,9 +7,9 @@
 #include "shared/path_state.h"
 #include "shared/rng.h"
 
-__kernel void pt_generate(CameraParams cam, uint seed, uint frame, uint sample,
-                          __global PathState* states, __global float4* radiance, uint count,
-                          __global EyeVertex* eye, uint write_eye) {
+PR_KERNEL void pt_generate(CameraParams cam, uint seed, uint frame, uint sample,
+                           __global PathState* states, __global float4* radiance, uint count,
+                           __global EyeVertex* eye, uint write_eye) {
   const uint i = (uint)get_global_id(0);
   if (i >= count) return;
   Rng rng = rng_make(seed, PR_RNG_CAMERA, frame, i, sample);

@@ -3,7 +3,7 @@
 #include "shared/types.h"
 #include "shared/layout.h"
 
-__kernel void struct_layout(__global uint* out) {
+PR_KERNEL void struct_layout(__global uint* out) {
   if (get_global_id(0) != 0) return;
   uint i = 0;
 #define PR_WRITE_SIZE(T) out[i++] = (uint)sizeof(T);

@@ -2,7 +2,7 @@
 // Reads in[3*i..3*i+2]; writes out[4*i..4*i+3] = normalized vector and its max component.
 #include "shared/math.h"
 
-__kernel void math_check(__global const float* in, __global float* out, uint n) {
+PR_KERNEL void math_check(__global const float* in, __global float* out, uint n) {
   const uint i = (uint)get_global_id(0);
   if (i >= n) return;
   const float3 v = normalize(pr_load3(in + 3 * i));

@@ -6,8 +6,8 @@
 // work-item.
 #include "test/shared_check.h"
 
-__kernel void shared_check(__global float* out, uint n, __global const float* cdf, uint cdf_count,
-                           __global const LightNode* nodes, uint node_count) {
+PR_KERNEL void shared_check(__global float* out, uint n, __global const float* cdf, uint cdf_count,
+                            __global const LightNode* nodes, uint node_count) {
   const uint i = (uint)get_global_id(0);
   if (i >= n) return;
   float r[PR_CHECK_STRIDE];

@@ -3,8 +3,8 @@
 // mode 0: whole scene, 1: SSG only, 2: DSG only.
 #include "shared/bvh.h"
 
-__kernel void trace_rays(__global const Ray* rays, __global Hit* hits, __global uint* occluded,
-                         uint n, uint mode, PR_SCENE_GEOM_PARAMS) {
+PR_KERNEL void trace_rays(__global const Ray* rays, __global Hit* hits, __global uint* occluded,
+                          uint n, uint mode, PR_SCENE_GEOM_PARAMS) {
   const uint i = (uint)get_global_id(0);
   if (i >= n) return;
   const SceneGeom g = PR_SCENE_GEOM();
@@ -26,8 +26,8 @@ __kernel void trace_rays(__global const Ray* rays, __global Hit* hits, __global 
 }
 
 // Benchmark kernels (tools/ray_bench): closest hit only, any hit only, on the whole scene.
-__kernel void trace_closest(__global const Ray* rays, __global Hit* hits, uint n,
-                            PR_SCENE_GEOM_PARAMS) {
+PR_KERNEL void trace_closest(__global const Ray* rays, __global Hit* hits, uint n,
+                             PR_SCENE_GEOM_PARAMS) {
   const uint i = (uint)get_global_id(0);
   if (i >= n) return;
   const SceneGeom g = PR_SCENE_GEOM();
@@ -36,8 +36,8 @@ __kernel void trace_closest(__global const Ray* rays, __global Hit* hits, uint n
   hits[i] = hit;
 }
 
-__kernel void trace_any(__global const Ray* rays, __global uint* occluded, uint n,
-                        PR_SCENE_GEOM_PARAMS) {
+PR_KERNEL void trace_any(__global const Ray* rays, __global uint* occluded, uint n,
+                         PR_SCENE_GEOM_PARAMS) {
   const uint i = (uint)get_global_id(0);
   if (i >= n) return;
   const SceneGeom g = PR_SCENE_GEOM();
