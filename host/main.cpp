@@ -176,7 +176,7 @@ int main(int argc, char** argv) {
           "Connection MIS threshold R (reuse/retrace): where the eye's BSDF sample finds a "
           "connected light vertex R or more times likelier than the light tracer did, the "
           "path is shared with a connection from that sample (fewer fireflies near "
-          "corners; 0 = off)")
+          "corners; 0 = off). With --no-eye-paths only: eye paths weigh whole paths instead")
       ->check(finiteIn(0, 1e30))
       ->capture_default_str();
   std::string connectionsText = "auto";
@@ -340,6 +340,9 @@ int main(int argc, char** argv) {
                         : lightSamplerText == "power"      ? pr::LightSampler::Power
                                                            : pr::LightSampler::Auto;
       ro.bvhWidth = bvhWidthText == "auto" ? 0 : std::stoi(bvhWidthText);
+      if (ro.eyePaths && render->count("--connection-mis") > 0 && !ro.quiet)
+        std::cerr << "note: --connection-mis is used with --no-eye-paths only; eye paths weigh "
+                     "whole paths by MIS instead\n";
       ro.connections = connectionsText == "auto"  ? -1
                        : connectionsText == "all" ? 0
                                                   : std::stoi(connectionsText);
