@@ -132,11 +132,14 @@ class StoredReference {
  public:
   explicit StoredReference(const std::string& dir) : dir_(dir) {
     const fs::path manifest = fs::path(dir) / kManifest;
-    const std::string why = whyNotReadable(manifest.string(), kMaxManifestBytes);
-    if (!why.empty())
-      throw InputError(manifest.string() + ": " + why + " (make one with --save-reference)");
+    std::string text;
     try {
-      json_ = nlohmann::json::parse(readInputFileText(manifest.string(), kMaxManifestBytes));
+      text = readInputFileText(manifest.string(), kMaxManifestBytes);
+    } catch (const InputError& e) {
+      throw InputError(std::string(e.what()) + " (make one with --save-reference)");
+    }
+    try {
+      json_ = nlohmann::json::parse(text);
     } catch (const nlohmann::json::exception& e) {
       throw InputError(manifest.string() + ": not a reference manifest (" + e.what() + ")");
     }

@@ -146,11 +146,7 @@ class Parser : Stage {
   }
 
  private:
-  void readFileBytes() {
-    const std::string why = whyNotReadable(doc_.path, kMaxSceneFileBytes);
-    if (why == "is a directory") fail("is a directory, not a glTF file");
-    bytes_ = readInputFile(doc_.path, kMaxSceneFileBytes);
-  }
+  void readFileBytes() { bytes_ = readInputFile(doc_.path, kMaxSceneFileBytes); }
 
   // Before tinygltf: the JSON's types (tinygltf silently drops a property of the wrong type),
   // the version and the required extensions, so these get precise messages.

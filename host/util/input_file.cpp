@@ -47,13 +47,6 @@ struct Fd {
 
 }  // namespace
 
-std::string whyNotReadable(const std::string& path, uint64_t maxBytes) {
-  struct stat st = {};
-  if (::stat(path.c_str(), &st) != 0)
-    return errno == ENOENT ? "no such file" : std::string("cannot open: ") + std::strerror(errno);
-  return whyNot(st, maxBytes);
-}
-
 std::vector<uint8_t> readInputFile(const std::string& path, uint64_t maxBytes) {
   auto fail = [&](const std::string& why) -> void { throw InputError(path + ": " + why); };
   // O_NONBLOCK: opening a FIFO with no writer would otherwise wait for one for ever. The checks

@@ -17,10 +17,6 @@ constexpr uint64_t kMaxBufferFileBytes = (uint64_t(1) << 32) - 1;  // a buffer's
 // Maps and EXRs: a 16384 x 16384 float RGBA frame, the largest pathreuse writes, is 4 GiB raw.
 constexpr uint64_t kMaxImageFileBytes = uint64_t(8) << 30;
 
-// Why `path` cannot be read as a regular file of at most `maxBytes`, or "" when it can (it
-// exists, is a regular file after symbolic links, and is not too large). Opens nothing.
-std::string whyNotReadable(const std::string& path, uint64_t maxBytes);
-
 // Reads the whole regular file at `path`, of at most `maxBytes`. Throws InputError
 // "PATH: reason" (no such file, is a directory, is a FIFO, is N bytes over the limit, a read
 // error, shorter than its size said).
