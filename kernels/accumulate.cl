@@ -4,9 +4,9 @@
 // Writes film (float4 per pixel: rgb sum and sample count) and bad_samples (an atomic count,
 // whose total does not depend on thread order).
 #include "shared/common.h"
+#include "shared/kernel_args.h"
 
-PR_KERNEL void accumulate(__global const float4* radiance, __global float4* film,
-                          __global uint* bad_samples, uint count, uint pixel_count) {
+PR_KERNEL void accumulate(PR_PARAMS(PR_ARGS_ACCUMULATE)) {
   const uint i = (uint)get_global_id(0);
   if (i >= count) return;
   const float4 l = radiance[i];

@@ -57,13 +57,25 @@ void DeviceAccel::uploadFrame(Context& ctx, const DynamicAccel& dsg) {
   instanceCount_ = uint32_t(dsg.instances().size());
 }
 
-cl_uint DeviceAccel::setKernelArgs(Context& ctx, cl::Kernel& kernel, cl_uint first) {
+void DeviceAccel::fillArgs(Context& ctx, kargs::SceneArgs* a) {
   if (staticNodes_.bytes == 0) throw RuntimeError("DeviceAccel: static geometry not uploaded");
   for (Slot* s : {&tlasNodes_, &instances_, &meshNodes_, &meshTris_})
     if (s->bytes == 0) upload(ctx, *s, "dynamic geometry placeholder", nullptr, 0, false);
-  return pr::setKernelArgs(kernel, first, staticNodes_.buffer, staticTris_.buffer,
-                           tlasNodes_.buffer, instances_.buffer, meshNodes_.buffer,
-                           meshTris_.buffer, cl_uint(instanceCount_));
+  a->pr_g_static_nodes = staticNodes_.buffer;
+  a->pr_g_static_tris = staticTris_.buffer;
+  a->pr_g_tlas_nodes = tlasNodes_.buffer;
+  a->pr_g_instances = instances_.buffer;
+  a->pr_g_mesh_nodes = meshNodes_.buffer;
+  a->pr_g_mesh_tris = meshTris_.buffer;
+  a->pr_g_instance_count = instanceCount_;
+}
+
+cl_uint DeviceAccel::setKernelArgs(Context& ctx, cl::Kernel& kernel, cl_uint first) {
+  kargs::SceneArgs a;
+  fillArgs(ctx, &a);
+  return pr::setKernelArgs(kernel, first, a.pr_g_static_nodes, a.pr_g_static_tris,
+                           a.pr_g_tlas_nodes, a.pr_g_instances, a.pr_g_mesh_nodes, a.pr_g_mesh_tris,
+                           a.pr_g_instance_count);
 }
 
 }  // namespace pr::accel

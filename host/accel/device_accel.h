@@ -6,6 +6,7 @@
 
 #include "accel/scene_accel.h"
 #include "cl/context.h"
+#include "cl/kernel_args.h"
 
 namespace pr::accel {
 
@@ -22,9 +23,11 @@ class DeviceAccel {
   // This frame's TLAS and instance records; buffers grow as needed and are reused.
   void uploadFrame(Context& ctx, const DynamicAccel& dsg);
 
-  // Sets the arguments of PR_SCENE_GEOM_PARAMS from argument `first` on; returns the index after
-  // them. Needs uploadStatic; missing DSG parts are bound as small placeholder buffers with
-  // instance count 0.
+  // The geometry's kernel arguments (PR_ARGS_SCENE_GEOM) into `args`. Needs uploadStatic;
+  // missing DSG parts are bound as small placeholder buffers with instance count 0.
+  void fillArgs(Context& ctx, kargs::SceneArgs* args);
+  // The same arguments set from index `first` on, for the test and benchmark kernels, which
+  // take them after their own; returns the index after them.
   cl_uint setKernelArgs(Context& ctx, cl::Kernel& kernel, cl_uint first);
 
   uint32_t instanceCount() const { return instanceCount_; }

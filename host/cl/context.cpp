@@ -110,7 +110,8 @@ cl::Kernel Context::kernel(const std::string& file, const char* name, const std:
 ProgramBuild Context::buildProgramFromSource(const std::string& source, const std::string& options,
                                              const std::string& label) {
   const auto t0 = std::chrono::steady_clock::now();
-  std::string fullOptions = "-cl-std=CL1.2 " + options;
+  // Argument info lets kargs::checkKernelArgs compare each kernel with its table.
+  std::string fullOptions = "-cl-std=CL1.2 -cl-kernel-arg-info " + options;
   // Extra options for diagnosing a platform, e.g. -cl-opt-disable (part of the cache key).
   if (const char* extra = std::getenv("PATHREUSE_CL_OPTIONS"); extra && *extra)
     fullOptions += std::string(" ") + extra;

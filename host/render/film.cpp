@@ -2,6 +2,7 @@
 
 #include <vector>
 
+#include "cl/kernel_args.h"
 #include "util/check.h"
 
 namespace pr {
@@ -10,7 +11,7 @@ Film::Film(Context& ctx, int width, int height)
     : ctx_(ctx), width_(width), height_(height), rowEnd_(height) {
   film_ = ctx_.allocate("film", uint64_t(pixels()) * 16);
   bad_ = ctx_.allocate("bad sample counter", 4);
-  accumulate_ = ctx_.kernel("accumulate.cl", "accumulate");
+  accumulate_ = kargs::kernel<kargs::AccumulateArgs>(ctx_, "accumulate.cl");
   clear();
 }
 
@@ -26,11 +27,13 @@ void Film::clear() {
 }
 
 void Film::accumulate(const cl::Buffer& radiance, StageTimer* timer) {
-  CL_CHECK(accumulate_.setArg(0, radiance));
-  CL_CHECK(accumulate_.setArg(1, film_));
-  CL_CHECK(accumulate_.setArg(2, bad_));
-  CL_CHECK(accumulate_.setArg(3, end()));
-  CL_CHECK(accumulate_.setArg(4, pixels()));
+  kargs::AccumulateArgs a;
+  a.radiance = radiance;
+  a.film = film_;
+  a.bad_samples = bad_;
+  a.count = end();
+  a.pixel_count = pixels();
+  a.set(accumulate_);
   ctx_.launch1D(accumulate_, first(), end(), "accumulate", timer);
 }
 

@@ -373,14 +373,25 @@ dev::CameraParams GpuScene::camera(int cameraIndex, double t, int width, int hei
   return toCameraParams(scene_.cameraAt(cameraIndex, t), width, height);
 }
 
-cl_uint GpuScene::setKernelArgs(cl::Kernel& kernel, cl_uint first) {
-  const cl_uint shading = deviceAccel_.setKernelArgs(ctx_, kernel, first);
-  const cl_uint lights = pr::setKernelArgs(kernel, shading, vertices_, triangles_,
-                                           shadingInstances_, materials_, textures_, texels_);
-  return pr::setKernelArgs(kernel, lights, lightBuffer_, cdfBuffer_, lightNodeBuffer_,
-                           primLightBuffer_, envBuffer_, static_cast<cl_uint>(lights_.size()),
-                           static_cast<cl_uint>(treeLights_), totalPower_,
-                           static_cast<cl_uint>(environmentLight()));
+kargs::SceneArgs GpuScene::kernelArgs() {
+  kargs::SceneArgs a;
+  deviceAccel_.fillArgs(ctx_, &a);
+  a.pr_sd_vertices = vertices_;
+  a.pr_sd_triangles = triangles_;
+  a.pr_sd_instances = shadingInstances_;
+  a.pr_sd_materials = materials_;
+  a.pr_sd_textures = textures_;
+  a.pr_sd_texels = texels_;
+  a.pr_l_lights = lightBuffer_;
+  a.pr_l_cdf = cdfBuffer_;
+  a.pr_l_nodes = lightNodeBuffer_;
+  a.pr_l_prim_light = primLightBuffer_;
+  a.pr_l_env = envBuffer_;
+  a.pr_l_count = static_cast<cl_uint>(lights_.size());
+  a.pr_l_tree_count = static_cast<cl_uint>(treeLights_);
+  a.pr_l_total_power = totalPower_;
+  a.pr_l_env_light = static_cast<cl_uint>(environmentLight());
+  return a;
 }
 
 std::string GpuScene::buildOptions() const {

@@ -48,9 +48,9 @@ class GpuScene {
   // The camera at time t for an image of width x height.
   dev::CameraParams camera(int cameraIndex, double t, int width, int height) const;
 
-  // Kernel arguments from `first` on, in this order: PR_SCENE_GEOM_PARAMS, PR_SHADING_PARAMS,
-  // PR_LIGHT_PARAMS. Returns the next free index.
-  cl_uint setKernelArgs(cl::Kernel& kernel, cl_uint first);
+  // The scene's kernel arguments (PR_ARGS_SCENE) as they are now; copy them into a kernel's
+  // argument struct with kargs::setScene after each setTime.
+  kargs::SceneArgs kernelArgs();
   // Build options every kernel that takes the scene is compiled with.
   std::string buildOptions() const;
   // The light-tracing selection table: running sums of every light's power at time 0, fixed for

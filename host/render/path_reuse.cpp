@@ -38,10 +38,10 @@ PathReuse::PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseS
   slots_ = settings_.lightPaths ? settings_.lightPaths : film.pixels();
   stride_ = static_cast<uint32_t>(settings_.maxDepth - 1);
   const std::string opts = scene.buildOptions();
-  invalidate_ = ctx.kernel("reuse/invalidate.cl", "invalidate", opts);
-  lightTrace_ = ctx.kernel("reuse/light_trace.cl", "light_trace", opts);
-  eyeHit_ = ctx.kernel("reuse/eye_hit.cl", "eye_hit", opts);
-  connect_ = ctx.kernel("reuse/connect.cl", "connect", opts);
+  invalidate_ = kargs::kernel<kargs::InvalidateArgs>(ctx, "reuse/invalidate.cl", opts);
+  lightTrace_ = kargs::kernel<kargs::LightTraceArgs>(ctx, "reuse/light_trace.cl", opts);
+  eyeHit_ = kargs::kernel<kargs::EyeHitArgs>(ctx, "reuse/eye_hit.cl", opts);
+  connect_ = kargs::kernel<kargs::ConnectArgs>(ctx, "reuse/connect.cl", opts);
   auto alloc = [&](const char* name, uint64_t bytes) {
     bytes_ += bytes;
     cl::Buffer b = ctx_.allocate(name, bytes);
@@ -100,14 +100,24 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
   // 1. Which slots must be traced again. With a connection history, retrace learns the same
   // changed slots as reuse (invalidate marks them and leaves the arena alone), so that the
   // histories, and the frames, agree.
+  const kargs::SceneArgs sceneArgs = scene_.kernelArgs();
   const bool history = settings_.historyCap > 0;
   const cl_uint frameStamp = history ? ++frames_ : 0;
   cl_uint toTrace = slots_;
   const cl::Buffer* list = &allSlots_;
   if (!first_ && (!settings_.retraceAll || history)) {
-    setKernelArgs(invalidate_, scene_.setKernelArgs(invalidate_, 0), rp,
-                  cl_uint(scene_.anyInstanceMoved() ? 1 : 0), headers_, vertices_, list_, counters_,
-                  cl_uint(settings_.retraceAll ? 1 : 0), frameStamp, changed_);
+    kargs::InvalidateArgs a;
+    kargs::setScene(&a, sceneArgs);
+    a.rp = rp;
+    a.test_segments = scene_.anyInstanceMoved() ? 1 : 0;
+    a.headers = headers_;
+    a.vertices = vertices_;
+    a.list = list_;
+    a.counters = counters_;
+    a.mark_only = settings_.retraceAll ? 1 : 0;
+    a.frame_stamp = frameStamp;
+    a.changed = changed_;
+    a.set(invalidate_);
     ctx_.launch1D(invalidate_, slots_, "invalidate", &timer);
     if (!settings_.retraceAll) {
       CL_CHECK(ctx_.queue().enqueueReadBuffer(counters_, CL_TRUE, dev::PR_C_LIST * 4, 4, &toTrace));
@@ -119,19 +129,45 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
 
   // 2. Trace them.
   if (toTrace > 0) {
-    setKernelArgs(lightTrace_, scene_.setKernelArgs(lightTrace_, 0), rp, scene_.traceCdf(),
-                  headers_, vertices_, ratios_, *list, toTrace, counters_);
+    kargs::LightTraceArgs a;
+    kargs::setScene(&a, sceneArgs);
+    a.rp = rp;
+    a.trace_cdf = scene_.traceCdf();
+    a.headers = headers_;
+    a.vertices = vertices_;
+    a.ratios = ratios_;
+    a.list = *list;
+    a.list_count = toTrace;
+    a.counters = counters_;
+    a.set(lightTrace_);
     ctx_.launch1D(lightTrace_, toTrace, "light_trace", &timer);
   }
 
   // 3. Per sample: first hits, then connections, then the film.
   // `sample` changes per pass.
-  const cl_uint eyeSample = setKernelArgs(eyeHit_, scene_.setKernelArgs(eyeHit_, 0), rp, camera);
-  setKernelArgs(eyeHit_, eyeSample + 1, eye_, radiance_, counters_);
-  const cl_uint connectSample = setKernelArgs(connect_, scene_.setKernelArgs(connect_, 0), rp);
-  setKernelArgs(connect_, connectSample + 1, eye_, headers_, vertices_, radiance_, counters_,
-                settings_.historyCap, historySlotOffset(rp), frameStamp, changed_, history_,
-                ratios_);
+  kargs::EyeHitArgs eh;
+  kargs::setScene(&eh, sceneArgs);
+  eh.rp = rp;
+  eh.cam = camera;
+  eh.eye = eye_;
+  eh.radiance = radiance_;
+  eh.counters = counters_;
+  eh.set(eyeHit_);
+  kargs::ConnectArgs cn;
+  kargs::setScene(&cn, sceneArgs);
+  cn.rp = rp;
+  cn.eye = eye_;
+  cn.headers = headers_;
+  cn.vertices = vertices_;
+  cn.radiance = radiance_;
+  cn.counters = counters_;
+  cn.history_cap = settings_.historyCap;
+  cn.slot_offset = historySlotOffset(rp);
+  cn.frame_stamp = frameStamp;
+  cn.changed = changed_;
+  cn.history = history_;
+  cn.ratios = ratios_;
+  cn.set(connect_);
   if (eyePaths_) eyePaths_->beginFrame(frame, camera, radiance_, eye_);
   const cl_uint first = film_.first(), n = film_.end();
   for (int s = 0; s < settings_.spp; ++s) {
@@ -140,10 +176,12 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
     if (eyePaths_) {
       eyePaths_->tracePass(s, &timer);
     } else {
-      CL_CHECK(eyeHit_.setArg(eyeSample, cl_uint(s)));
+      eh.sample = cl_uint(s);
+      eh.set(eyeHit_, kargs::kPass);
       ctx_.launch1D(eyeHit_, first, n, "eye_hit", &timer);
     }
-    CL_CHECK(connect_.setArg(connectSample, cl_uint(s)));
+    cn.sample = cl_uint(s);
+    cn.set(connect_, kargs::kPass);
     ctx_.launch1D(connect_, first, n, "connect", &timer);
     film_.accumulate(radiance_, &timer);
     // Wait for each pass, so that an interrupt stops a frame of many samples within one pass.

@@ -12,10 +12,10 @@ PathTracer::PathTracer(Context& ctx, GpuScene& scene, Film& film,
                        const PathTracerSettings& settings)
     : ctx_(ctx), scene_(scene), film_(film), settings_(settings) {
   const std::string opts = scene.buildOptions();
-  generate_ = ctx.kernel("pathtrace/generate.cl", "pt_generate", opts);
-  extend_ = ctx.kernel("pathtrace/extend.cl", "pt_extend", opts);
-  shade_ = ctx.kernel("pathtrace/shade.cl", "pt_shade", opts);
-  shadow_ = ctx.kernel("pathtrace/shadow.cl", "pt_shadow", opts);
+  generate_ = kargs::kernel<kargs::PtGenerateArgs>(ctx, "pathtrace/generate.cl", opts);
+  extend_ = kargs::kernel<kargs::PtExtendArgs>(ctx, "pathtrace/extend.cl", opts);
+  shade_ = kargs::kernel<kargs::PtShadeArgs>(ctx, "pathtrace/shade.cl", opts);
+  shadow_ = kargs::kernel<kargs::PtShadowArgs>(ctx, "pathtrace/shadow.cl", opts);
   const uint64_t n = film.pixels();
   auto alloc = [&](const char* name, uint64_t bytes) {
     bytes_ += bytes;
@@ -37,22 +37,52 @@ void PathTracer::beginFrame(int frame, const dev::CameraParams& camera, const cl
   const cl_uint n = film_.end();
   const cl_uint rngFrame = settings_.fixedNoise ? 0 : cl_uint(frame);
   ctx_.zero(rays_, 16);
-  // Each kernel's own arguments follow the scene's (PR_SCENE_PARAMS); `sample` changes per pass.
-  setKernelArgs(extend_, scene_.setKernelArgs(extend_, 0), states_, hits_, rays_, n);
-  shadeSample_ = setKernelArgs(shade_, scene_.setKernelArgs(shade_, 0), states_, hits_, radiance,
-                               shadows_, n, settings_.seed, rngFrame);
-  setKernelArgs(shade_, shadeSample_ + 1, cl_uint(settings_.maxDepth),
-                cl_uint(settings_.lightPaths), scene_.traceCdf(), scene_.traceTotalPower(), eye);
-  setKernelArgs(shadow_, scene_.setKernelArgs(shadow_, 0), radiance, shadows_, rays_, n);
-  generateSample_ = setKernelArgs(generate_, 0, camera, settings_.seed, rngFrame);
-  setKernelArgs(generate_, generateSample_ + 1, states_, radiance, n, eye,
-                cl_uint(settings_.lightPaths > 0 ? 1 : 0));
+  const kargs::SceneArgs sceneArgs = scene_.kernelArgs();
+  kargs::PtExtendArgs ex;
+  kargs::setScene(&ex, sceneArgs);
+  ex.states = states_;
+  ex.hits = hits_;
+  ex.rays = rays_;
+  ex.count = n;
+  ex.set(extend_);
+  kargs::setScene(&shadeArgs_, sceneArgs);
+  shadeArgs_.states = states_;
+  shadeArgs_.hits = hits_;
+  shadeArgs_.radiance = radiance;
+  shadeArgs_.shadows = shadows_;
+  shadeArgs_.count = n;
+  shadeArgs_.seed = settings_.seed;
+  shadeArgs_.frame = rngFrame;
+  shadeArgs_.max_depth = cl_uint(settings_.maxDepth);
+  shadeArgs_.light_paths = cl_uint(settings_.lightPaths);
+  shadeArgs_.trace_cdf = scene_.traceCdf();
+  shadeArgs_.trace_total = scene_.traceTotalPower();
+  shadeArgs_.eye = eye;
+  shadeArgs_.set(shade_);
+  kargs::PtShadowArgs sh;
+  kargs::setScene(&sh, sceneArgs);
+  sh.radiance = radiance;
+  sh.shadows = shadows_;
+  sh.rays = rays_;
+  sh.count = n;
+  sh.set(shadow_);
+  generateArgs_.cam = camera;
+  generateArgs_.seed = settings_.seed;
+  generateArgs_.frame = rngFrame;
+  generateArgs_.states = states_;
+  generateArgs_.radiance = radiance;
+  generateArgs_.count = n;
+  generateArgs_.eye = eye;
+  generateArgs_.write_eye = settings_.lightPaths > 0 ? 1 : 0;
+  generateArgs_.set(generate_);
 }
 
 void PathTracer::tracePass(int sample, StageTimer* timer) {
   const cl_uint first = film_.first(), n = film_.end();
-  CL_CHECK(generate_.setArg(generateSample_, cl_uint(sample)));
-  CL_CHECK(shade_.setArg(shadeSample_, cl_uint(sample)));
+  // `sample` is the only argument that changes between passes.
+  generateArgs_.sample = shadeArgs_.sample = cl_uint(sample);
+  generateArgs_.set(generate_, kargs::kPass);
+  shadeArgs_.set(shade_, kargs::kPass);
   ctx_.launch1D(generate_, first, n, "generate", timer);
   for (int d = 0; d < settings_.maxDepth; ++d) {
     ctx_.launch1D(extend_, first, n, "extend", timer);

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "cl/context.h"
+#include "cl/kernel_args.h"
 #include "render/film.h"
 #include "render/gpu_scene.h"
 #include "render/integrator.h"
@@ -42,7 +43,9 @@ class PathTracer : public Integrator {
   Film& film_;
   PathTracerSettings settings_;
   cl::Kernel generate_, extend_, shade_, shadow_;
-  cl_uint generateSample_ = 0, shadeSample_ = 0;  // the `sample` arguments' indices
+  // Kept between beginFrame and the passes, which change only `sample`.
+  kargs::PtGenerateArgs generateArgs_;
+  kargs::PtShadeArgs shadeArgs_;
   cl::Buffer states_, hits_, radiance_, shadows_, rays_;
   cl::Buffer noEye_;  // the eye-vertex argument when nothing is written there
   uint64_t bytes_ = 0;

@@ -4,8 +4,7 @@
 #include "shared/integrator.h"
 #include "shared/path_state.h"
 
-PR_KERNEL void pt_extend(PR_SCENE_PARAMS, __global const PathState* states, __global Hit* hits,
-                         __global uint* rays, uint count) {
+PR_KERNEL void pt_extend(PR_PARAMS(PR_ARGS_PT_EXTEND)) {
   const uint i = (uint)get_global_id(0);
   if (i >= count) return;
   Hit hit = hit_none();

@@ -7,9 +7,7 @@
 #include "shared/path_state.h"
 #include "shared/rng.h"
 
-PR_KERNEL void pt_generate(CameraParams cam, uint seed, uint frame, uint sample,
-                           __global PathState* states, __global float4* radiance, uint count,
-                           __global EyeVertex* eye, uint write_eye) {
+PR_KERNEL void pt_generate(PR_PARAMS(PR_ARGS_PT_GENERATE)) {
   const uint i = (uint)get_global_id(0);
   if (i >= count) return;
   Rng rng = rng_make(seed, PR_RNG_CAMERA, frame, i, sample);

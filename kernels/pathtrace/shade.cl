@@ -22,11 +22,7 @@ PR_INLINE float eye_paths_light_side(const Light* l, float3 n_tri, float start, 
          eye_paths_emit_density(l, n_tri, d * (1.0f / sqrt(d2)), cos_x, d2) * rev * eye_ratio;
 }
 
-PR_KERNEL void pt_shade(PR_SCENE_PARAMS, __global PathState* states, __global const Hit* hits,
-                        __global float4* radiance, __global ShadowRay* shadows, uint count,
-                        uint seed, uint frame, uint sample, uint max_depth, uint light_paths,
-                        __global const float* trace_cdf, float trace_total,
-                        __global EyeVertex* eye) {
+PR_KERNEL void pt_shade(PR_PARAMS(PR_ARGS_PT_SHADE)) {
   const uint i = (uint)get_global_id(0);
   if (i >= count) return;
   const SceneData s = PR_SCENE();

@@ -3,8 +3,7 @@
 #include "shared/integrator.h"
 #include "shared/path_state.h"
 
-PR_KERNEL void pt_shadow(PR_SCENE_PARAMS, __global float4* radiance,
-                         __global const ShadowRay* shadows, __global uint* rays, uint count) {
+PR_KERNEL void pt_shadow(PR_PARAMS(PR_ARGS_PT_SHADOW)) {
   const uint i = (uint)get_global_id(0);
   if (i >= count) return;
   const ShadowRay r = shadows[i];

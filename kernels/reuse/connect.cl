@@ -536,11 +536,7 @@ PR_INLINE float3 strategy_next_event(const Connector* cn, const EyePoint* x, Rng
   return x->tp * c;
 }
 
-PR_KERNEL void connect(PR_SCENE_PARAMS, ReuseParams rp, uint sample, __global const EyeVertex* eye,
-                       __global const PathHeader* headers, __global const LightVertex* vertices,
-                       __global float4* radiance, __global uint* counters, uint history_cap,
-                       uint slot_offset, uint frame_stamp, __global const uint* changed,
-                       __global ConnectionHistory* history, __global const EyePathRatio* ratios) {
+PR_KERNEL void connect(PR_PARAMS(PR_ARGS_CONNECT)) {
   const uint i = (uint)get_global_id(0);
   if (i >= rp.pixel_count) return;
   const EyeVertex e = eye[i];

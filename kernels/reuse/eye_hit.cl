@@ -5,9 +5,7 @@
 #include "shared/camera.h"
 #include "shared/reuse.h"
 
-PR_KERNEL void eye_hit(PR_SCENE_PARAMS, ReuseParams rp, CameraParams cam, uint sample,
-                       __global EyeVertex* eye, __global float4* radiance,
-                       __global uint* counters) {
+PR_KERNEL void eye_hit(PR_PARAMS(PR_ARGS_EYE_HIT)) {
   const uint i = (uint)get_global_id(0);
   if (i >= rp.pixel_count) return;
   const SceneData s = PR_SCENE();

@@ -9,10 +9,7 @@
 // anyway) it does that alone, so that both modes learn the same changed slots.
 #include "shared/reuse.h"
 
-PR_KERNEL void invalidate(PR_SCENE_PARAMS, ReuseParams rp, uint test_segments,
-                          __global PathHeader* headers, __global const LightVertex* vertices,
-                          __global uint* list, __global uint* counters, uint mark_only,
-                          uint frame_stamp, __global uint* changed) {
+PR_KERNEL void invalidate(PR_PARAMS(PR_ARGS_INVALIDATE)) {
   const uint slot = (uint)get_global_id(0);
   if (slot >= rp.slots) return;
   const SceneData s = PR_SCENE();

@@ -7,10 +7,7 @@
 // After reuse.h: its FP_CONTRACT OFF (shared/bvh.h) holds for the ratios too.
 #include "shared/eye_paths.h"
 
-PR_KERNEL void light_trace(PR_SCENE_PARAMS, ReuseParams rp, __global const float* trace_cdf,
-                           __global PathHeader* headers, __global LightVertex* vertices,
-                           __global EyePathRatio* ratios, __global const uint* list,
-                           uint list_count, __global uint* counters) {
+PR_KERNEL void light_trace(PR_PARAMS(PR_ARGS_LIGHT_TRACE)) {
   const uint i = (uint)get_global_id(0);
   if (i >= list_count) return;
   const uint slot = list[i];

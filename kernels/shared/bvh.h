@@ -484,28 +484,7 @@ PR_INLINE Ray spawn_ray_to(float3 p, float3 ng, float3 q, float3 nq) {
 PR_NAMESPACE_END
 
 #ifdef PR_DEVICE_CODE
-// Kernel parameters that carry a SceneGeom, and the struct built from them in the kernel body.
-// The host's DeviceAccel::setKernelArgs sets them in this order.
-#define PR_SCENE_GEOM_PARAMS                                                            \
-  __global const BvhNode *pr_static_nodes, __global const BvhTriPacket *pr_static_tris, \
-      __global const BvhNode *pr_tlas_nodes, __global const BvhInstance *pr_instances,  \
-      __global const BvhNode *pr_mesh_nodes, __global const BvhTriPacket *pr_mesh_tris, \
-      uint pr_instance_count
-PR_INLINE SceneGeom pr_scene_geom(__global const BvhNode* sn, __global const BvhTriPacket* st,
-                                  __global const BvhNode* tn, __global const BvhInstance* in,
-                                  __global const BvhNode* mn, __global const BvhTriPacket* mt,
-                                  uint count) {
-  SceneGeom g;
-  g.static_nodes = sn;
-  g.static_tris = st;
-  g.tlas_nodes = tn;
-  g.instances = in;
-  g.mesh_nodes = mn;
-  g.mesh_tris = mt;
-  g.instance_count = count;
-  return g;
-}
-#define PR_SCENE_GEOM()                                                                      \
-  pr_scene_geom(pr_static_nodes, pr_static_tris, pr_tlas_nodes, pr_instances, pr_mesh_nodes, \
-                pr_mesh_tris, pr_instance_count)
+// A SceneGeom from a kernel's geometry parameters (shared/kernel_args.h).
+PR_ARG_GATHER(SceneGeom, pr_scene_geom, PR_ARGS_SCENE_GEOM)
+#define PR_SCENE_GEOM() pr_scene_geom(PR_ARG_VALUES(PR_ARGS_SCENE_GEOM))
 #endif

@@ -377,7 +377,6 @@ PR_INLINE int next_event(const SceneData* s, const SurfaceHit* h, const ShadingF
 PR_NAMESPACE_END
 
 #ifdef PR_DEVICE_CODE
-#define PR_SCENE_PARAMS PR_SCENE_GEOM_PARAMS, PR_SHADING_PARAMS, PR_LIGHT_PARAMS
 PR_INLINE SceneData pr_scene_data(SceneGeom g, ShadingData sd, LightData l) {
   SceneData s;
   s.geom = g;
@@ -385,5 +384,8 @@ PR_INLINE SceneData pr_scene_data(SceneGeom g, ShadingData sd, LightData l) {
   s.lights = l;
   return s;
 }
-#define PR_SCENE() pr_scene_data(PR_SCENE_GEOM(), PR_SHADING(), PR_LIGHTS())
+// The SceneData of a kernel whose table begins with PR_ARGS_SCENE (shared/kernel_args.h).
+#define PR_SCENE()                                                                \
+  pr_scene_data(PR_SCENE_GEOM(), pr_shading_data(PR_ARG_VALUES(PR_ARGS_SHADING)), \
+                pr_light_data(PR_ARG_VALUES(PR_ARGS_LIGHTS)))
 #endif

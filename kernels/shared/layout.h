@@ -31,6 +31,8 @@
   S(PathHeader)              \
   S(LightVertex)             \
   S(EyeVertex)               \
+  S(EyePathRatio)            \
+  S(ConnectionHistory)       \
   S(ReuseParams)
 
 #define PR_SHARED_FIELDS(F)           \
@@ -129,6 +131,10 @@
   F(EyeVertex, ns_oct)                \
   F(EyeVertex, depth)                 \
   F(EyeVertex, b2)                    \
+  F(EyePathRatio, h)                  \
+  F(ConnectionHistory, tp_r)          \
+  F(ConnectionHistory, slot)          \
+  F(ConnectionHistory, frame)         \
   F(Light, moved)                     \
   F(Light, leaf)                      \
   F(ReuseParams, clamp)               \

@@ -543,30 +543,7 @@ PR_INLINE float light_choice_pmf(const LightData* d, u32 light, float3 p, float3
 PR_NAMESPACE_END
 
 #ifdef PR_DEVICE_CODE
-#define PR_LIGHT_PARAMS                                                             \
-  __global const Light *pr_lights, __global const float *pr_light_cdf,              \
-      __global const LightNode *pr_light_nodes, __global const uint *pr_prim_light, \
-      __global const float *pr_env, uint pr_light_count, uint pr_light_tree_count,  \
-      float pr_total_power, uint pr_env_light
-PR_INLINE LightData pr_light_data(__global const Light* l, __global const float* cdf,
-                                  __global const LightNode* nodes, __global const uint* prim_light,
-                                  __global const float* env, uint count, uint tree_count,
-                                  float total, uint env_light) {
-  LightData d;
-  d.lights = l;
-  d.cdf = cdf;
-  d.nodes = nodes;
-  d.prim_light = prim_light;
-  d.env = env;
-  d.count = count;
-  d.tree_count = tree_count;
-  d.total_power = total;
-  d.env_light = env_light;
-  return d;
-}
-#define PR_LIGHTS()                                                                             \
-  pr_light_data(pr_lights, pr_light_cdf, pr_light_nodes, pr_prim_light, pr_env, pr_light_count, \
-                pr_light_tree_count, pr_total_power, pr_env_light)
+PR_ARG_GATHER(LightData, pr_light_data, PR_ARGS_LIGHTS)
 #endif
 
 PR_STATIC_ASSERT(sizeof(pr::dev::Light) == 96, "Light layout");

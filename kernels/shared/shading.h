@@ -439,24 +439,5 @@ PR_INLINE float3 material_emission_factor(const ShadingData* sd, u32 material) {
 PR_NAMESPACE_END
 
 #ifdef PR_DEVICE_CODE
-#define PR_SHADING_PARAMS                                                                          \
-  __global const ShadingVertex *pr_vertices, __global const ShadingTriangle *pr_triangles,         \
-      __global const ShadingInstance *pr_shading_instances, __global const Material *pr_materials, \
-      __global const TextureInfo *pr_textures, __global const uint *pr_texels
-PR_INLINE ShadingData pr_shading_data(__global const ShadingVertex* v,
-                                      __global const ShadingTriangle* t,
-                                      __global const ShadingInstance* i, __global const Material* m,
-                                      __global const TextureInfo* tx, __global const uint* tl) {
-  ShadingData sd;
-  sd.vertices = v;
-  sd.triangles = t;
-  sd.instances = i;
-  sd.materials = m;
-  sd.textures = tx;
-  sd.texels = tl;
-  return sd;
-}
-#define PR_SHADING()                                                                          \
-  pr_shading_data(pr_vertices, pr_triangles, pr_shading_instances, pr_materials, pr_textures, \
-                  pr_texels)
+PR_ARG_GATHER(ShadingData, pr_shading_data, PR_ARGS_SHADING)
 #endif

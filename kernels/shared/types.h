@@ -4,6 +4,7 @@
 #pragma once
 
 #include "shared/common.h"
+#include "shared/kernel_args.h"
 
 PR_NAMESPACE_BEGIN
 

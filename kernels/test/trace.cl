@@ -4,7 +4,7 @@
 #include "shared/bvh.h"
 
 PR_KERNEL void trace_rays(__global const Ray* rays, __global Hit* hits, __global uint* occluded,
-                          uint n, uint mode, PR_SCENE_GEOM_PARAMS) {
+                          uint n, uint mode, PR_PARAMS(PR_ARGS_SCENE_GEOM)) {
   const uint i = (uint)get_global_id(0);
   if (i >= n) return;
   const SceneGeom g = PR_SCENE_GEOM();
@@ -27,7 +27,7 @@ PR_KERNEL void trace_rays(__global const Ray* rays, __global Hit* hits, __global
 
 // Benchmark kernels (tools/ray_bench): closest hit only, any hit only, on the whole scene.
 PR_KERNEL void trace_closest(__global const Ray* rays, __global Hit* hits, uint n,
-                             PR_SCENE_GEOM_PARAMS) {
+                             PR_PARAMS(PR_ARGS_SCENE_GEOM)) {
   const uint i = (uint)get_global_id(0);
   if (i >= n) return;
   const SceneGeom g = PR_SCENE_GEOM();
@@ -37,7 +37,7 @@ PR_KERNEL void trace_closest(__global const Ray* rays, __global Hit* hits, uint 
 }
 
 PR_KERNEL void trace_any(__global const Ray* rays, __global uint* occluded, uint n,
-                         PR_SCENE_GEOM_PARAMS) {
+                         PR_PARAMS(PR_ARGS_SCENE_GEOM)) {
   const uint i = (uint)get_global_id(0);
   if (i >= n) return;
   const SceneGeom g = PR_SCENE_GEOM();

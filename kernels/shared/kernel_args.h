@@ -1,0 +1,192 @@
+// Every kernel's parameters, one table per kernel: the kernels' parameter lists, the host's
+// argument structs and setters (host/cl/kernel_args.h) and the start-up check of each built
+// kernel against its table (clGetKernelArgInfo) all come from these lists, so that an argument
+// is named once and never counted by hand.
+//
+// An entry is X(role, kind, type, name):
+//   role  GEOM, SHADING, LIGHTS: the scene (GpuScene sets them; kernels get SceneData);
+//         FRAME: set once per frame; PASS: changes between the passes of one frame.
+//   kind  IN: `__global const type*`; OUT: `__global type*` (written, maybe read); VAL: `type`.
+// Scene entries' parameters are named pr_g_*, pr_sd_*, pr_l_* (PR_ARG_NAME) and reach kernel
+// code only through PR_SCENE() / PR_SCENE_GEOM().
+#pragma once
+
+// The scene's geometry: the two BVHs (SSG, and DSG's top level over instances of mesh BVHs).
+#define PR_ARGS_SCENE_GEOM(X)            \
+  X(GEOM, IN, BvhNode, static_nodes)     \
+  X(GEOM, IN, BvhTriPacket, static_tris) \
+  X(GEOM, IN, BvhNode, tlas_nodes)       \
+  X(GEOM, IN, BvhInstance, instances)    \
+  X(GEOM, IN, BvhNode, mesh_nodes)       \
+  X(GEOM, IN, BvhTriPacket, mesh_tris)   \
+  X(GEOM, VAL, uint, instance_count)
+
+// What shading reads: vertices, triangles, per-instance records, materials, textures.
+#define PR_ARGS_SHADING(X)                   \
+  X(SHADING, IN, ShadingVertex, vertices)    \
+  X(SHADING, IN, ShadingTriangle, triangles) \
+  X(SHADING, IN, ShadingInstance, instances) \
+  X(SHADING, IN, Material, materials)        \
+  X(SHADING, IN, TextureInfo, textures)      \
+  X(SHADING, IN, uint, texels)
+
+// The light table, its light BVH and the environment.
+#define PR_ARGS_LIGHTS(X)            \
+  X(LIGHTS, IN, Light, lights)       \
+  X(LIGHTS, IN, float, cdf)          \
+  X(LIGHTS, IN, LightNode, nodes)    \
+  X(LIGHTS, IN, uint, prim_light)    \
+  X(LIGHTS, IN, float, env)          \
+  X(LIGHTS, VAL, uint, count)        \
+  X(LIGHTS, VAL, uint, tree_count)   \
+  X(LIGHTS, VAL, float, total_power) \
+  X(LIGHTS, VAL, uint, env_light)
+
+#define PR_ARGS_SCENE(X) PR_ARGS_SCENE_GEOM(X) PR_ARGS_SHADING(X) PR_ARGS_LIGHTS(X)
+
+// ---- Path reuse (kernels/reuse/) ----
+
+#define PR_ARGS_INVALIDATE(X)         \
+  PR_ARGS_SCENE(X)                    \
+  X(FRAME, VAL, ReuseParams, rp)      \
+  X(FRAME, VAL, uint, test_segments)  \
+  X(FRAME, OUT, PathHeader, headers)  \
+  X(FRAME, IN, LightVertex, vertices) \
+  X(FRAME, OUT, uint, list)           \
+  X(FRAME, OUT, uint, counters)       \
+  X(FRAME, VAL, uint, mark_only)      \
+  X(FRAME, VAL, uint, frame_stamp)    \
+  X(FRAME, OUT, uint, changed)
+
+#define PR_ARGS_LIGHT_TRACE(X)         \
+  PR_ARGS_SCENE(X)                     \
+  X(FRAME, VAL, ReuseParams, rp)       \
+  X(FRAME, IN, float, trace_cdf)       \
+  X(FRAME, OUT, PathHeader, headers)   \
+  X(FRAME, OUT, LightVertex, vertices) \
+  X(FRAME, OUT, EyePathRatio, ratios)  \
+  X(FRAME, IN, uint, list)             \
+  X(FRAME, VAL, uint, list_count)      \
+  X(FRAME, OUT, uint, counters)
+
+#define PR_ARGS_EYE_HIT(X)         \
+  PR_ARGS_SCENE(X)                 \
+  X(FRAME, VAL, ReuseParams, rp)   \
+  X(FRAME, VAL, CameraParams, cam) \
+  X(PASS, VAL, uint, sample)       \
+  X(FRAME, OUT, EyeVertex, eye)    \
+  X(FRAME, OUT, float4, radiance)  \
+  X(FRAME, OUT, uint, counters)
+
+#define PR_ARGS_CONNECT(X)                  \
+  PR_ARGS_SCENE(X)                          \
+  X(FRAME, VAL, ReuseParams, rp)            \
+  X(PASS, VAL, uint, sample)                \
+  X(FRAME, IN, EyeVertex, eye)              \
+  X(FRAME, IN, PathHeader, headers)         \
+  X(FRAME, IN, LightVertex, vertices)       \
+  X(FRAME, OUT, float4, radiance)           \
+  X(FRAME, OUT, uint, counters)             \
+  X(FRAME, VAL, uint, history_cap)          \
+  X(FRAME, VAL, uint, slot_offset)          \
+  X(FRAME, VAL, uint, frame_stamp)          \
+  X(FRAME, IN, uint, changed)               \
+  X(FRAME, OUT, ConnectionHistory, history) \
+  X(FRAME, IN, EyePathRatio, ratios)
+
+// ---- The wavefront path tracer (kernels/pathtrace/) ----
+
+#define PR_ARGS_PT_GENERATE(X)     \
+  X(FRAME, VAL, CameraParams, cam) \
+  X(FRAME, VAL, uint, seed)        \
+  X(FRAME, VAL, uint, frame)       \
+  X(PASS, VAL, uint, sample)       \
+  X(FRAME, OUT, PathState, states) \
+  X(FRAME, OUT, float4, radiance)  \
+  X(FRAME, VAL, uint, count)       \
+  X(FRAME, OUT, EyeVertex, eye)    \
+  X(FRAME, VAL, uint, write_eye)
+
+#define PR_ARGS_PT_EXTEND(X)      \
+  PR_ARGS_SCENE(X)                \
+  X(FRAME, IN, PathState, states) \
+  X(FRAME, OUT, Hit, hits)        \
+  X(FRAME, OUT, uint, rays)       \
+  X(FRAME, VAL, uint, count)
+
+#define PR_ARGS_PT_SHADE(X)         \
+  PR_ARGS_SCENE(X)                  \
+  X(FRAME, OUT, PathState, states)  \
+  X(FRAME, IN, Hit, hits)           \
+  X(FRAME, OUT, float4, radiance)   \
+  X(FRAME, OUT, ShadowRay, shadows) \
+  X(FRAME, VAL, uint, count)        \
+  X(FRAME, VAL, uint, seed)         \
+  X(FRAME, VAL, uint, frame)        \
+  X(PASS, VAL, uint, sample)        \
+  X(FRAME, VAL, uint, max_depth)    \
+  X(FRAME, VAL, uint, light_paths)  \
+  X(FRAME, IN, float, trace_cdf)    \
+  X(FRAME, VAL, float, trace_total) \
+  X(FRAME, OUT, EyeVertex, eye)
+
+#define PR_ARGS_PT_SHADOW(X)       \
+  PR_ARGS_SCENE(X)                 \
+  X(FRAME, OUT, float4, radiance)  \
+  X(FRAME, IN, ShadowRay, shadows) \
+  X(FRAME, OUT, uint, rays)        \
+  X(FRAME, VAL, uint, count)
+
+// ---- The film (kernels/accumulate.cl) ----
+
+#define PR_ARGS_ACCUMULATE(X)      \
+  X(FRAME, IN, float4, radiance)   \
+  X(FRAME, OUT, float4, film)      \
+  X(FRAME, OUT, uint, bad_samples) \
+  X(FRAME, VAL, uint, count)       \
+  X(FRAME, VAL, uint, pixel_count)
+
+// Every kernel with a table: K(kernel name, the host's argument struct, its table).
+#define PR_KERNEL_TABLES(K)                           \
+  K(invalidate, InvalidateArgs, PR_ARGS_INVALIDATE)   \
+  K(light_trace, LightTraceArgs, PR_ARGS_LIGHT_TRACE) \
+  K(eye_hit, EyeHitArgs, PR_ARGS_EYE_HIT)             \
+  K(connect, ConnectArgs, PR_ARGS_CONNECT)            \
+  K(pt_generate, PtGenerateArgs, PR_ARGS_PT_GENERATE) \
+  K(pt_extend, PtExtendArgs, PR_ARGS_PT_EXTEND)       \
+  K(pt_shade, PtShadeArgs, PR_ARGS_PT_SHADE)          \
+  K(pt_shadow, PtShadowArgs, PR_ARGS_PT_SHADOW)       \
+  K(accumulate, AccumulateArgs, PR_ARGS_ACCUMULATE)
+
+// A parameter's name: scene entries carry their group's prefix (geometry and shading both have
+// `instances`), the others their own name.
+#define PR_ARG_NAME(role, name) PR_ARG_NAME_##role(name)
+#define PR_ARG_NAME_GEOM(name) pr_g_##name
+#define PR_ARG_NAME_SHADING(name) pr_sd_##name
+#define PR_ARG_NAME_LIGHTS(name) pr_l_##name
+#define PR_ARG_NAME_FRAME(name) name
+#define PR_ARG_NAME_PASS(name) name
+
+// A list X(...) X(...) ... whose entries each begin with a comma, without its first comma.
+#define PR_ARG_DROP_FIRST_(first, ...) __VA_ARGS__
+#define PR_ARG_DROP_FIRST(...) PR_ARG_DROP_FIRST_(__VA_ARGS__)
+
+#ifdef PR_DEVICE_CODE
+#define PR_ARG_DECL_IN(type) __global const type*
+#define PR_ARG_DECL_OUT(type) __global type*
+#define PR_ARG_DECL_VAL(type) type
+#define PR_ARG_PARAM_(role, kind, type, name) , PR_ARG_DECL_##kind(type) PR_ARG_NAME(role, name)
+#define PR_ARG_VALUE_(role, kind, type, name) , PR_ARG_NAME(role, name)
+#define PR_ARG_FIELD_(role, kind, type, name) d.name = PR_ARG_NAME(role, name);
+
+// The parameter list of a kernel (or helper) from its table, and the names to pass them on.
+#define PR_PARAMS(table) PR_ARG_DROP_FIRST(~table(PR_ARG_PARAM_))
+#define PR_ARG_VALUES(table) PR_ARG_DROP_FIRST(~table(PR_ARG_VALUE_))
+
+// The scene's structs, filled from their parameters field by field (field name = entry name).
+#define PR_ARG_GATHER(Type, fn, table)  \
+  PR_INLINE Type fn(PR_PARAMS(table)) { \
+    Type d;                             \
+    table(PR_ARG_FIELD_) return d;      \
+  }
+#endif
