@@ -1,6 +1,6 @@
-// The evaluation benchmark's short form (tools/evaluate.py --quick): every output is written and
-// its numbers are sane. Never a timing. Needs /usr/bin/python3 with numpy and matplotlib
-// (tools/install-deps.sh), or the Python that $PATHREUSE_PYTHON names (a machine whose system
+// The evaluation benchmark's short form (tools/bench/evaluate.py --quick): every output is written
+// and its numbers are sane. Never a timing. Needs /usr/bin/python3 with numpy and matplotlib
+// (tools/setup/install-deps.sh), or the Python that $PATHREUSE_PYTHON names (a machine whose system
 // Python lacks them); without them the script exits 1 and this test fails.
 #include <gtest/gtest.h>
 
@@ -48,9 +48,11 @@ TEST(Evaluate, QuickFormWritesEveryOutputWithSaneNumbers) {
   const std::string build = fs::path(PATHREUSE_BINARY).parent_path().string();
   const std::string log = dir + "/log.txt";
   const char* python = std::getenv("PATHREUSE_PYTHON");
-  const std::string cmd = std::string(python && *python ? python : "/usr/bin/python3") + " '" +
-                          test::sourcePath("tools/evaluate.py") + "' --quick --quiet --out-dir '" +
-                          dir + "' --build '" + build + "' >'" + log + "' 2>&1";
+  // A module of the tools package, run from the repository root.
+  const std::string cmd = "cd '" + test::sourcePath("") + "' && " +
+                          std::string(python && *python ? python : "/usr/bin/python3") +
+                          " -m tools.bench.evaluate --quick --quiet --out-dir '" + dir +
+                          "' --build '" + build + "' >'" + log + "' 2>&1";
   const int status = std::system(cmd.c_str());
   ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << cmd << "\n" << slurp(log);
 
