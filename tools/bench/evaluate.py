@@ -7,7 +7,8 @@ flicker, equal-time and equal-error comparisons. Writes results.md, results.json
   /usr/bin/python3 -m tools.bench.evaluate --quick --out-dir /tmp/eval   # smoke form, < 1 min
 
 Needs numpy and matplotlib (Debian: python3-numpy python3-matplotlib, installed by
-tools/setup/install-deps.sh), hence /usr/bin/python3. Reads EXRs through `exr_compare --raw`.
+tools/setup/install-deps.sh), hence /usr/bin/python3. Reads EXRs through `exr_compare --raw`
+and measures relMSE with `exr_compare` (the renderer's own comparison).
 
 Runs are interleaved across modes (reuse, pathtrace, ... per seed) so that load from other
 users of the machine hits all modes alike; every time is the median of >= 3 runs (seeds double

@@ -1,6 +1,7 @@
-"""Metrics of the evaluation: relMSE (plain and without the worst 1% of pixels), flicker, the
-runs of one setting and their quality row, the equal-time spp search, the equal-error times and
-the summary of timing runs. Images are float32 arrays (H, W, 3)."""
+"""Metrics of the evaluation: relMSE (plain and without the worst 1% of pixels, as exr_compare
+measures them), flicker, the runs of one setting and their quality row, the equal-time spp
+search, the equal-error times and the summary of timing runs. Images are float32 arrays
+(H, W, 3)."""
 
 import math
 from dataclasses import dataclass, field
@@ -12,19 +13,8 @@ from ..benchlib import frame_breakdown, kernel_s, median
 from .results import (EqualError, EqualTime, EqualTimeRound, ErrorPoint, QualityRow, Stats,
                       TimeToTarget, TimingSummary, TrimmedEqualError)
 
-EPS = 0.01               # the +0.01 in relMSE and F
+EPS = 0.01               # the +0.01 in F, as in relMSE
 LOWEST = "at or below the lowest spp"
-
-
-def relmse(img, ref):
-    return float(np.mean((img - ref) ** 2 / (ref ** 2 + EPS)))
-
-
-def relmse_trimmed(img, ref, drop=0.01):
-    """relMSE without the worst 1% of pixels: how much of the error a few fireflies hold."""
-    v = np.mean((img - ref) ** 2 / (ref ** 2 + EPS), axis=2).ravel()
-    keep = v.size - int(v.size * drop)
-    return float(np.mean(np.partition(v, keep - 1)[:keep]))
 
 
 def flicker(prev, cur, rprev, rcur):
@@ -34,10 +24,12 @@ def flicker(prev, cur, rprev, rcur):
     return float(np.mean(d ** 2 / (m ** 2 + EPS)))
 
 
-def quality(imgs, refs):
-    """Per-frame relMSE, per-frame trimmed relMSE, per-pair flicker."""
-    e = [relmse(i, r) for i, r in zip(imgs, refs)]
-    et = [relmse_trimmed(i, r) for i, r in zip(imgs, refs)]
+def quality(diffs, imgs, refs):
+    """Per-frame relMSE, per-frame trimmed relMSE, per-pair flicker. diffs: exr_compare's
+    measures of each frame against its reference (run.Runner.diff): relMSE is computed in one
+    place, host/portability/compare.cpp, for the renderer, its tests and these tools."""
+    e = [d["relmse"] for d in diffs]
+    et = [d["relmse_trimmed"] for d in diffs]
     fl = [flicker(imgs[t - 1], imgs[t], refs[t - 1], refs[t]) for t in range(1, len(imgs))]
     return e, et, fl
 
@@ -60,9 +52,9 @@ class SettingRuns:
     flk: list = field(default_factory=list)    # per run: per-pair flicker
     imgs: dict = field(default_factory=dict)   # seed -> images (first seed only)
 
-    def add(self, seed, recs, imgs, refs, keep_imgs):
+    def add(self, seed, recs, diffs, imgs, refs, keep_imgs):
         self.times.append(body_time(recs))
-        e, et, f = quality(imgs, refs)
+        e, et, f = quality(diffs, imgs, refs)
         self.err.append(e)
         self.errt.append(et)
         self.flk.append(f)

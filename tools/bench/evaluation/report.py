@@ -119,7 +119,8 @@ def quality_section(r):
          f"{len(sc.frames) - 1} pairs); reference: pathtrace at {sc.ref_spp} spp, seed "
          f"{REF_SEED}. relMSE: mean over frames, then over seeds; F: mean over pairs, then over "
          f"seeds; [min-max] over seeds. s/frame: median [min-max] over the seeds' runs.", "",
-         "relMSE (trim 1%): the same without each frame's worst 1% of pixels; median frame: the "
+         "relMSE (trim 1%): the same sum without each frame's worst 1% of pixels, divided by all "
+         "pixels (as `pathreuse portability`'s relMSE*); median frame: the "
          "median of the per-frame relMSE over frames and seeds (both show how much a few "
          "fireflies decide the mean).", "",
          "| mode | spp | s/frame | relMSE | relMSE (trim 1%) | median frame relMSE | F | F / relMSE |",
@@ -257,7 +258,8 @@ def write_markdown(path, ev, gl):
          f"- load: 1-min load average before each run, median {median(loads):.2f} "
          f"[{min(loads):.2f}-{max(loads):.2f}] on {os.cpu_count()} CPUs (shared cores)",
          f"- total evaluation time: {ev.elapsed:.0f} s", "",
-         "Definitions. relMSE = mean over pixels and RGB channels of (I - R)^2 / (R^2 + 0.01). "
+         "Definitions. relMSE = mean over pixels and RGB channels of (I - R)^2 / (R^2 + 0.01), "
+         "measured by `exr_compare` (the renderer's own comparison, host/portability/compare.cpp). "
          "Flicker F = mean over consecutive pairs (t-1, t), pixels and channels of "
          "((I_t - I_{t-1}) - (R_t - R_{t-1}))^2 / (((R_t + R_{t-1}) / 2)^2 + 0.01): real "
          "lighting change cancels, only noise that changes between frames counts. A frozen "

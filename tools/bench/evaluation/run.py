@@ -1,6 +1,7 @@
 """Running the renderer for the evaluation: the scenes and their checks, one render process
-(stats read, EXRs read through `exr_compare --raw`), references cached on disk, and one scene's
-runs: the spp sweep, the equal-time rounds and the timing runs, interleaved across modes."""
+(stats read, EXRs read through `exr_compare --raw` and measured against their references by
+`exr_compare`), references cached on disk, and one scene's runs: the spp sweep, the equal-time
+rounds and the timing runs, interleaved across modes."""
 
 import hashlib
 import json
@@ -73,9 +74,12 @@ class Runner:
         self.n = 0
         self.loads = []   # 1-min load average before each run
 
-    def render(self, scene, mode, spp, seed, first, last, fixed=False, keep=True, extra=()):
+    def render(self, scene, mode, spp, seed, first, last, fixed=False, keep=True, extra=(),
+               refs=None, save=None):
         """One process rendering frames first..last; returns (stats records, images or None,
-        process seconds)."""
+        process seconds, diffs or None). keep: read the images. refs: the reference EXRs of
+        frames first..last; diffs then holds each frame's exr_compare measures against its
+        reference (self.diff). save: paths to copy the frames' EXRs to."""
         self.n += 1
         out = self.tmp / f"run{self.n}"
         out.mkdir()
@@ -98,20 +102,42 @@ class Runner:
         recs = [json.loads(x) for x in stats.read_text().splitlines() if x.strip()]
         if len(recs) != last - first + 1:
             die(f"expected {last - first + 1} stats lines from: {' '.join(cmd)}", 1)
-        imgs = None
-        if keep:
-            pairs = []
-            for f in range(first, last + 1):
-                pairs += [str(out / f"f_{f:04d}.exr"), str(out / f"f_{f:04d}.raw")]
-            subprocess.run([str(self.cmp), "--raw", *pairs], check=True)
-            imgs = [load_raw(out / f"f_{f:04d}.raw") for f in range(first, last + 1)]
+        exrs = [out / f"f_{f:04d}.exr" for f in range(first, last + 1)]
+        diffs = [self.diff(e, r) for e, r in zip(exrs, refs)] if refs is not None else None
+        for e, dest in zip(exrs, save or []):
+            tmp = Path(f"{dest}.tmp")
+            shutil.copyfile(e, tmp)
+            os.replace(tmp, dest)  # no half-written cache entry
+        imgs = self.read(exrs) if keep else None
         shutil.rmtree(out)
         if not self.args.quiet:
             body = [r["wall_s"] for r in recs[1:]] or [recs[0]["wall_s"]]
             print(f"  {Path(scene).stem:16s} {mode:9s} spp {spp:3d} seed {seed}"
                   f"{' fixed' if fixed else '':6s} frames {first}-{last}: "
                   f"median {median(body):.3f} s/frame, process {wall:.1f} s", flush=True)
-        return recs, imgs, wall
+        return recs, imgs, wall, diffs
+
+    def read(self, exrs):
+        """The images of EXR files, through exr_compare --raw."""
+        self.n += 1
+        raws = [self.tmp / f"read{self.n}_{i}.raw" for i in range(len(exrs))]
+        subprocess.run([str(self.cmp), "--raw", *[str(p) for pair in zip(exrs, raws) for p in pair]],
+                       check=True)
+        imgs = [load_raw(r) for r in raws]
+        for r in raws:
+            r.unlink()
+        return imgs
+
+    def diff(self, exr, ref):
+        """exr_compare's measures of an EXR against its reference EXR (its JSON: relmse,
+        relmse_trimmed, mad, ...), the one relMSE that the renderer and its tests use too."""
+        proc = subprocess.run([str(self.cmp), str(exr), str(ref)], capture_output=True, text=True)
+        if proc.returncode != 0:
+            die(f"exr_compare {exr} {ref} failed ({proc.returncode}): {proc.stderr.strip()}", 1)
+        d = json.loads(proc.stdout)
+        if d["non_finite"]:
+            die(f"{exr} against {ref}: {d['non_finite']} non-finite values", 1)
+        return d
 
 
 def file_sha(path):
@@ -133,44 +159,47 @@ def consecutive_groups(frames):
 
 
 def references(runner, sc, cache):
-    """Reference frames of a scene: pathtrace at ref spp, seed REF_SEED, cached per frame."""
+    """Reference frames of a scene: pathtrace at ref spp, seed REF_SEED, cached per frame as
+    float EXRs (what exr_compare measures against). Returns (their paths, their images, key)."""
     a = runner.args
     key = hashlib.sha1(json.dumps([file_sha(sc.path), a.width, sc.ref_spp, a.max_depth,
                                    REF_SEED, "pathtrace"]).encode()).hexdigest()[:16]
-    paths = [cache / f"{sc.key}_{key}_f{f:04d}.npy" for f in sc.frames]
-    missing = [f for f, p in zip(sc.frames, paths) if not p.is_file()]
+    path = {f: cache / f"{sc.key}_{key}_f{f:04d}.exr" for f in sc.frames}
+    missing = [f for f in sc.frames if not path[f].is_file()]
     if missing:
         print(f"  references for {sc.key}: {len(missing)} frame(s) at {sc.ref_spp} spp",
               flush=True)
         cache.mkdir(parents=True, exist_ok=True)
         # Consecutive runs of missing frames render in one process each.
         for first, last in consecutive_groups(missing):
-            _, imgs, _ = runner.render(sc.path, "pathtrace", sc.ref_spp, REF_SEED, first, last)
-            for f, img in zip(range(first, last + 1), imgs):
-                np.save(cache / f"{sc.key}_{key}_f{f:04d}.npy", img)
-    return [np.load(p) for p in paths], key
+            runner.render(sc.path, "pathtrace", sc.ref_spp, REF_SEED, first, last, keep=False,
+                          save=[path[f] for f in range(first, last + 1)])
+    paths = [path[f] for f in sc.frames]
+    return paths, runner.read(paths), key
 
 
 class SceneRuns:
     """The quality runs of one scene, gathered per setting."""
 
-    def __init__(self, runner, sc, refs, seeds):
-        self.runner, self.sc, self.refs, self.seeds = runner, sc, refs, seeds
+    def __init__(self, runner, sc, ref_exrs, refs, seeds):
+        self.runner, self.sc, self.seeds = runner, sc, seeds
+        self.ref_exrs, self.refs = ref_exrs, refs  # the references' EXR files and images
         self.settings = {}
 
     def setting(self, mode, spp, fixed=False):
         return setting(self.settings, mode, spp, fixed)
 
     def render(self, mode, spp, seed, fixed=False, keep=True):
+        """keep: read the images and measure them against the references."""
         return self.runner.render(self.sc.path, mode, spp, seed, self.sc.frames[0], self.sc.frames[-1],
-                                  fixed, keep)
+                                  fixed, keep, refs=self.ref_exrs if keep else None)
 
-    def add(self, mode, spp, seed, recs, imgs, fixed=False):
-        self.setting(mode, spp, fixed).add(seed, recs, imgs, self.refs, seed == self.seeds[0])
+    def add(self, mode, spp, seed, recs, imgs, diffs, fixed=False):
+        self.setting(mode, spp, fixed).add(seed, recs, diffs, imgs, self.refs, seed == self.seeds[0])
 
     def run(self, mode, spp, seed, fixed=False):
-        recs, imgs, _ = self.render(mode, spp, seed, fixed)
-        self.add(mode, spp, seed, recs, imgs, fixed)
+        recs, imgs, _, diffs = self.render(mode, spp, seed, fixed)
+        self.add(mode, spp, seed, recs, imgs, diffs, fixed)
         return imgs
 
     def sweep(self, spp, sweep):
@@ -198,12 +227,12 @@ class SceneRuns:
             rt, pt_t = [], []
             have = len(self.setting("pathtrace", k).err) >= len(self.seeds)  # images already measured
             for seed in self.seeds:
-                recs, _, _ = self.render("reuse", spp, seed, keep=False)
+                recs, _, _, _ = self.render("reuse", spp, seed, keep=False)
                 rt.append(metrics.body_time(recs))
-                recs, imgs, _ = self.render("pathtrace", k, seed, keep=not have)
+                recs, imgs, _, diffs = self.render("pathtrace", k, seed, keep=not have)
                 pt_t.append(metrics.body_time(recs))
                 if not have:
-                    self.add("pathtrace", k, seed, recs, imgs)
+                    self.add("pathtrace", k, seed, recs, imgs, diffs)
                 if len(self.setting("pathtrace", k, True).err) < len(self.seeds):
                     self.run("pathtrace", k, seed, fixed=True)
             rounds.append(metrics.equal_time_round(k, rt, pt_t))
@@ -220,16 +249,16 @@ def timing_runs(runner, sc, args):
     runs = {m: [] for m in MODES}
     for _ in range(args.repeats):
         for m in MODES:
-            recs, _, wall = runner.render(sc.path, m, args.spp, args.seeds[0], tfirst, tlast,
-                                          keep=False)
+            recs, _, wall, _ = runner.render(sc.path, m, args.spp, args.seeds[0], tfirst, tlast,
+                                             keep=False)
             runs[m].append((recs, wall))
     return {m: metrics.summarize_timing(runs[m]) for m in MODES}
 
 
 def evaluate_scene(runner, sc, cache, args):
     print(f"{sc.key}: frames {sc.frames[0]}-{sc.frames[-1]}", flush=True)
-    refs, ref_key = references(runner, sc, cache)
-    q = SceneRuns(runner, sc, refs, args.seeds)
+    ref_exrs, refs, ref_key = references(runner, sc, cache)
+    q = SceneRuns(runner, sc, ref_exrs, refs, args.seeds)
     identical = q.sweep(args.spp, sc.sweep)
     rounds = q.equal_time_rounds(args.spp, sc.sweep, args.equal_time_rounds)
     equal_time = metrics.equal_time(q.settings, rounds, args.spp)
