@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 """Connection strategies against the path tracer: relMSE and relMSE x kernel seconds of one
 frame against a path-traced reference, for `reuse` with every connection traced
 (`--connections all`) and with K resampled ones, with and without a connection history, on the

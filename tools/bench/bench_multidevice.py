@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 """Benchmark of several devices in one render: PoCL's two drivers (POCL_DEVICES="pthread
 basic") together against each alone, in reuse and pathtrace modes, on the demo animation.
 Prints a markdown report: per-frame wall time, the overhead of two devices against the faster

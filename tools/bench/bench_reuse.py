@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 """Benchmark of light-path reuse: reuse against retrace (and pathtrace for
 reference) on the demo animation and the large atrium, plus a small (C, N_L) sweep on the
 demo. Writes a markdown report.

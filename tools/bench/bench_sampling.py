@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 """Sampling quality of the path tracer: relMSE per sample and relMSE x seconds against a
 high-spp reference, on the scenes where emitter sampling and stratification matter.
 

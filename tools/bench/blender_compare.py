@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 """Compares pathreuse's glTF materials with Blender 5.2's Cycles, material by material.
 
 For every material of a catalogue (dielectrics, metals, KHR_materials_specular, _clearcoat,

@@ -1,4 +1,3 @@
-#!/usr/bin/python3
 """Evaluation of pathreuse against the paper's claims: time per frame of reuse,
 retrace and pathtrace (the paper's Figure 9), error against a high-sample reference, temporal
 flicker, equal-time and equal-error comparisons. Writes results.md, results.json and PNG plots.

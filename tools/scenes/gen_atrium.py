@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 """Generates a large atrium test scene (not committed): a courtyard surrounded by two
 storeys of columns and arches, galleries, outer walls, curtains, an opening in the roof
 lit by an emissive sky quad (or a directional sun, or at night by several hundred small

@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 """Generates the committed material scenes of the tests (tests/data/materials/):
 
   zoo.gltf         a row of spheres of glTF metallic-roughness materials (rough and glossy

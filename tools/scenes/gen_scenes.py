@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 """Generates the committed demo scenes scenes/cornell-dynamic.gltf, scenes/cornell-orbit.gltf
 and scenes/cornell-skinned.gltf (a skinned tentacle swaying and a morphing ball in the box),
 validates them, and with --check tells whether the committed copies are stale.
