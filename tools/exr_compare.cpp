@@ -1,10 +1,16 @@
-// exr_compare: the mean of one OpenEXR image, or how two differ (relMSE, mean absolute
-// difference, mean of each). For scripts and notes: one JSON object on stdout.
+// exr_compare: the mean of one OpenEXR image, or how A differs from the reference B (relMSE,
+// relMSE without the worst 1% of pixels, mean absolute difference, mean of each). For scripts
+// and notes: one JSON object on stdout.
 //   exr_compare A.exr [B.exr]
 //   exr_compare --raw A.exr A.raw [B.exr B.raw ...]
+// The differences are pr::compareImages's (host/portability/compare.cpp), the one relMSE of the
+// project: `pathreuse portability`, the tests and, through this program, the Python tools
+// (tools/bench/) all measure with it. relmse = mean over pixels and RGB of (A - B)^2 / (B^2 +
+// 0.01); relmse_trimmed = the same sum without the 1% of pixels with the largest terms, still
+// over all pixels; both over the pixels whose values are finite in both images, the others
+// counted in non_finite.
 // --raw writes width and height (uint32, little-endian) then float32 RGB, row by row from the
-// top, so that scripts without an EXR reader (tools/evaluate.py, numpy) can load the pixels.
-#include <cmath>
+// top, so that scripts without an EXR reader (tools/bench/evaluate.py, numpy) can load the pixels.
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
@@ -15,6 +21,7 @@
 #include <nlohmann/json.hpp>
 
 #include "io/image.h"
+#include "portability/compare.h"
 #include "util/error.h"
 
 namespace {
@@ -69,18 +76,14 @@ int main(int argc, char** argv) {
         std::cerr << "error: " << argv[2] << ": size differs from " << argv[1] << "\n";
         return 2;
       }
-      double rel = 0, mad = 0;
-      size_t n = 0;
-      for (size_t i = 0; i < a.rgba.size(); i += 4)
-        for (int c = 0; c < 3; ++c, ++n) {
-          const double d = double(a.rgba[i + c]) - b.rgba[i + c];
-          rel += d * d / (double(b.rgba[i + c]) * b.rgba[i + c] + 0.01);
-          mad += std::fabs(d);
-        }
+      const pr::ImageDiff d = pr::compareImages(a, b);
       out["b"] = argv[2];
       out["mean_b"] = mean(b);
-      out["relmse"] = rel / double(n);
-      out["mad"] = mad / double(n);
+      out["relmse"] = d.relMse;
+      out["relmse_trimmed"] = d.relMseTrimmed;
+      out["mad"] = d.mad;
+      out["non_finite"] = d.nonFinite;
+      out["identical"] = d.identical;
     }
     std::cout << out.dump() << "\n";
   } catch (const std::exception& e) {

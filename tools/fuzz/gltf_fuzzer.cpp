@@ -1,7 +1,7 @@
 // libFuzzer target for the glTF loader: any bytes, as .gltf text or GLB, must either load or
 // fail with one pr::InputError. Any other exception, a crash, a sanitizer report, a timeout or
 // an allocation beyond -rss_limit_mb is a finding. Built by -DPATHREUSE_FUZZ=ON (clang);
-// run by tools/fuzz.sh.
+// run by tools/fuzz/fuzz.sh.
 //
 // Structure-aware: an input that parses as JSON is mutated as a glTF document (a number set to
 // an edge value, an index moved past its array, an array emptied or grown, a member dropped or

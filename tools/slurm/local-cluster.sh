@@ -4,7 +4,7 @@
 # and for its test. Nothing outside DIR is touched; nothing needs root.
 #   tools/slurm/local-cluster.sh start DIR   # prints `export SLURM_CONF=DIR/slurm.conf`
 #   tools/slurm/local-cluster.sh stop DIR
-# Needs Debian's slurmctld, slurmd, slurm-client and munge (tools/install-deps.sh).
+# Needs Debian's slurmctld, slurmd, slurm-client and munge (tools/setup/install-deps.sh).
 set -euo pipefail
 cmd="${1:?usage: local-cluster.sh start|stop DIR}"
 dir="${2:?usage: local-cluster.sh start|stop DIR}"
@@ -34,7 +34,7 @@ fi
 [ "$cmd" = start ] || { echo "local-cluster.sh: unknown command $cmd (start or stop)" >&2; exit 2; }
 for p in munged mungekey slurmctld slurmd sbatch; do
   command -v "$p" >/dev/null || [ -x "/usr/sbin/$p" ] ||
-    { echo "local-cluster.sh: $p not found (bash tools/install-deps.sh installs Slurm and munge)" >&2; exit 2; }
+    { echo "local-cluster.sh: $p not found (bash tools/setup/install-deps.sh installs Slurm and munge)" >&2; exit 2; }
 done
 export PATH="$PATH:/usr/sbin"
 user="$(id -un)"

@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Builds build-asan/ with AddressSanitizer and UndefinedBehaviorSanitizer (-DPATHREUSE_SANITIZE=ON)
+# and runs the test suite there. Any report fails the test that triggers it: UBSan halts on the
+# first error, ASan always does.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+# -O1 -g1: quicker to compile than RelWithDebInfo, still line numbers in reports.
+cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=None -DCMAKE_CXX_FLAGS="-O1 -g1" -DCMAKE_C_FLAGS="-O1 -g1" \
+  -DPATHREUSE_SANITIZE=ON -DPATHREUSE_TOOLS=OFF >/dev/null
+cmake --build build-asan -j"$(nproc)"
+# Leak checking is off: the OpenCL ICD loader and PoCL keep their allocations until exit.
+export ASAN_OPTIONS="detect_leaks=0:abort_on_error=0:strict_string_checks=1:detect_stack_use_after_return=0"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+cd build-asan
+# PoCL only: the platforms are compared in tools/ci/test.sh, with the same host code.
+ctest --output-on-failure -j"$(nproc)" --timeout 900 -E PortabilityCli.EveryPlatformAgrees

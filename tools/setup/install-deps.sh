@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# Installs the Debian packages that pathreuse's build, tests and PoCL need (python3-venv for
+# tools/setup/intel-opencl.sh, the second platform of the tests; oclgrind for tools/ci/oclgrind-check.sh;
+# clang-format for tools/ci/format-check.sh; Slurm and munge for tools/slurm/'s single-node test
+# cluster).
+# Idempotent: runs apt-get only when something is missing.
+set -euo pipefail
+
+packages=(
+  build-essential cmake pkg-config git
+  ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers pocl-opencl-icd
+  libglm-dev libtinygltf-dev nlohmann-json3-dev libstb-dev
+  libopenexr-dev libcli11-dev libgtest-dev zlib1g-dev
+  assimp-testmodels python3
+  python3-matplotlib python3-numpy
+  python3-venv oclgrind clang-format
+  slurmctld slurmd slurm-client munge
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+echo "install-deps: installing ${missing[*]}"
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
