@@ -507,7 +507,7 @@ TEST(BsdfGltfModel, SingleScatteringAndTheCoatsFresnelAtNdotV) {
   }
 }
 
-// The committed tables are what tools/bsdf_tables writes (host/render/bsdf_tables.cpp): they
+// The committed tables are what tools/tables/bsdf_tables writes (host/render/bsdf_tables.cpp): they
 // were made from this microfacet code, at the committed grid and accuracy. Every 4th entry of
 // each table is recomputed (all of them take 20 s; any change to the code that makes them
 // changes nearly all).

@@ -1,6 +1,6 @@
 // --fixed-noise: the camera samples' random numbers ignore the frame, so an unchanged view gives
 // the same image every frame, while the scene still moves with the frame number. The
-// evaluation (tools/evaluate.py) uses it to show what freezing the noise does to flicker.
+// evaluation (tools/bench/evaluate.py) uses it to show what freezing the noise does to flicker.
 #include <gtest/gtest.h>
 
 #include <string>

@@ -1,4 +1,4 @@
-// The light BVH in whole renders, on the many-lights atrium (tools/gen_atrium.py --light
+// The light BVH in whole renders, on the many-lights atrium (tools/scenes/gen_atrium.py --light
 // lanterns: hundreds of small emitters, point and spot lights, an emitter on a moving
 // instance): it converges to the same image as choosing lights by power, with less noise at
 // the same sample count, path reuse still equals re-tracing bit for bit with it, and still
@@ -17,7 +17,7 @@
 namespace pr {
 namespace {
 
-// tools/gen_atrium.py at a small tessellation (its emitters do not depend on the size) with
+// tools/scenes/gen_atrium.py at a small tessellation (its emitters do not depend on the size) with
 // --light `light`, generated once per test program.
 std::string generatedAtrium(const std::string& light) {
   static std::map<std::string, std::string> paths;
@@ -25,8 +25,9 @@ std::string generatedAtrium(const std::string& light) {
   if (found != paths.end()) return found->second;
   const std::string dir = test::tempDir(light + "-atrium-scene");
   const std::string out = dir + "/atrium.gltf";
-  const std::string cmd = "python3 '" + test::sourcePath("tools/gen_atrium.py") +
-                          "' --size 0.05 --light " + light + " --out '" + out + "' >/dev/null";
+  const std::string cmd = "cd '" + test::sourcePath("") +
+                          "' && python3 -m tools.scenes.gen_atrium --size 0.05 --light " + light +
+                          " --out '" + out + "' >/dev/null";
   if (std::system(cmd.c_str()) != 0) {
     ADD_FAILURE() << "could not generate the atrium: " << cmd;
     return "";

@@ -148,7 +148,7 @@ TEST(MaterialFurnace, EveryClassAndRoughnessReflectsAllThatArrives) {
 
 // --material-model gltf-reference renders what the single-scattering model rendered before the
 // energy-conserving one became the default: tests/data/materials/ holds that model's frames
-// of its scene (tools/gen_material_zoo.py), rendered on PoCL before the shadow-terminator
+// of its scene (tools/scenes/gen_material_zoo.py), rendered on PoCL before the shadow-terminator
 // correction (so with it off here); another platform may differ by round-off.
 TEST(MaterialModel, GltfReferenceReproducesTheSingleScatteringImages) {
   const std::string scene = test::sourcePath("tests/data/materials/zoo.gltf");

@@ -234,7 +234,7 @@ TEST(PortabilityCli, TwoPoclDriversAgreeOnTheSuite) {
 }
 
 // The default suite (both demo scenes, frames 0-2 and 24, every mode) on the first device of
-// every OpenCL platform found. tools/test.sh sets PATHREUSE_REQUIRE_PLATFORMS=2 after setting up
+// every OpenCL platform found. tools/ci/test.sh sets PATHREUSE_REQUIRE_PLATFORMS=2 after setting up
 // Intel's CPU runtime beside PoCL, so there a missing platform fails instead of skipping.
 TEST(PortabilityCli, EveryPlatformAgreesOnTheDefaultSuite) {
   const auto list = test::runPathreuse("devices --json");
@@ -253,8 +253,8 @@ TEST(PortabilityCli, EveryPlatformAgreesOnTheDefaultSuite) {
   ASSERT_GE(platforms.size(), need)
       << "PATHREUSE_REQUIRE_PLATFORMS=" << need << " but found: " << list.out;
   if (platforms.size() < 2)
-    GTEST_SKIP()
-        << "one OpenCL platform only; tools/intel-opencl.sh sets up a second (Intel's CPU runtime)";
+    GTEST_SKIP() << "one OpenCL platform only; tools/setup/intel-opencl.sh sets up a second "
+                    "(Intel's CPU runtime)";
   const auto r = test::runPathreuse("portability --json --quiet" + devices + " --out '" +
                                     test::tempDir("port-platforms") + "'");
   ASSERT_EQ(r.exitCode, 0) << r.out << r.err;

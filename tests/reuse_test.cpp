@@ -351,7 +351,8 @@ TEST(Reuse, AConnectionHistoryDropsTheVerticesOfRetracedSlots) {
 // The history's light paths shift every --connection-history-period frames, and only then: in
 // renders whose periods group frames 0-3 alike the frames are bit-identical, and the first frame
 // where the groups part is the first that differs. (What a longer period buys, less flicker for
-// more error per frame, is measured by tools/evaluate.py and tools/bench_connections.py.)
+// more error per frame, is measured by tools/bench/evaluate.py and
+// tools/bench/bench_connections.py.)
 TEST(Reuse, AConnectionHistoryShiftsItsLightPathsOncePerPeriod) {
   const std::string scene = test::sourcePath("scenes/cornell-dynamic.gltf");
   const std::string args =

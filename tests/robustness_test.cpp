@@ -327,7 +327,7 @@ TEST(LoaderFromMemory, BrokenBytesAreAnInputErrorNamingTheFile) {
   }
 }
 
-// Found by tools/fuzz.sh: an index of 2e78 was cast to int64 before its range was checked,
+// Found by tools/fuzz/fuzz.sh: an index of 2e78 was cast to int64 before its range was checked,
 // which is undefined behaviour (UBSan in build-asan stops here if it comes back).
 TEST(LoaderFromMemory, HugeIndexIsAnInputError) {
   for (const char* text : {R"({"asset":{"version":"2.0"},"scene":2e78})",

@@ -135,7 +135,7 @@ TEST(SceneLoader, KhronosInvalidFilesAreRefused) {
 
 TEST(SceneLoader, AssimpModelsLoadOrAreRefusedCleanly) {
   ASSERT_TRUE(fs::exists(kAssimpDir))
-      << kAssimpDir << " is absent (tools/install-deps.sh installs it)";
+      << kAssimpDir << " is absent (tools/setup/install-deps.sh installs it)";
   int loaded = 0, refused = 0;
   for (const auto& entry : fs::recursive_directory_iterator(kAssimpDir)) {
     const std::string ext = entry.path().extension().string();
@@ -164,7 +164,7 @@ TEST(SceneLoader, AssimpModelsLoadOrAreRefusedCleanly) {
 
 TEST(SceneLoader, AssimpBrokenModelsAreRefused) {
   ASSERT_TRUE(fs::exists(kAssimpDir))
-      << kAssimpDir << " is absent (tools/install-deps.sh installs it)";
+      << kAssimpDir << " is absent (tools/setup/install-deps.sh installs it)";
   const std::string d = kAssimpDir;
   for (const char* rel :
        {"IndexOutOfRange/IndexOutOfRange.gltf", "IndexOutOfRange/AllIndicesOutOfRange.gltf",
@@ -185,7 +185,7 @@ TEST(SceneLoader, AssimpBrokenModelsAreRefused) {
 
 TEST(SceneLoader, AssimpValidModelsLoad) {
   ASSERT_TRUE(fs::exists(kAssimpDir))
-      << kAssimpDir << " is absent (tools/install-deps.sh installs it)";
+      << kAssimpDir << " is absent (tools/setup/install-deps.sh installs it)";
   const std::string d = kAssimpDir;
   Scene s;
   ASSERT_EQ(tryLoad(d + "/BoxTextured-glTF/BoxTextured.gltf", &s), "");

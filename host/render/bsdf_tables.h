@@ -1,6 +1,7 @@
 // The directional-albedo tables that the BSDFs' energy compensation and layering read
 // (kernels/shared/bsdf_tables.h): computed here from the same microfacet code the kernels run,
-// written out by tools/bsdf_tables.cpp, and recomputed by the tests to check the committed copy.
+// written out by tools/tables/bsdf_tables.cpp, and recomputed by the tests to check the committed
+// copy.
 #pragma once
 
 #include <string>

@@ -17,7 +17,7 @@ int defaultBvhWidth(bool gpu) {
 }
 
 int defaultConnections(bool gpu) {
-  // Measured with tools/bench_connections.py (docs/design.md section 5): on an H200 two
+  // Measured with tools/bench/bench_connections.py (docs/design.md section 5): on an H200 two
   // resampled connections reached a given error 1.6-2.0x sooner than tracing every candidate;
   // on a CPU (PoCL) tracing all was 1.15x better on the demo scenes and 1.2x worse on the atrium.
   return gpu ? 2 : 0;

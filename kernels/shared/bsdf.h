@@ -99,7 +99,7 @@ PR_INLINE int bsdf_is_delta(const BsdfParams* m) {
   return m->kind == PR_BSDF_MIRROR || m->kind == PR_BSDF_GLASS;
 }
 
-// ---- Tables (kernels/shared/bsdf_tables.h, made by tools/bsdf_tables): bilinear on a grid
+// ---- Tables (kernels/shared/bsdf_tables.h, made by tools/tables/bsdf_tables): bilinear on a grid
 // uniform in sqrt(cos) from 0 to 1 and in roughness (sqrt(alpha)) from the smallest to 1.
 
 PR_INLINE float bsdf_table_at(float x, int n, int* i) {

@@ -1,5 +1,5 @@
 // Microfacet distributions shared by the BSDFs (kernels/shared/bsdf.h) and the tool that
-// tabulates their albedos (tools/bsdf_tables.cpp): GGX (isotropic and anisotropic, with
+// tabulates their albedos (tools/tables/bsdf_tables.cpp): GGX (isotropic and anisotropic, with
 // visible-normal sampling), Schlick's Fresnel weight and the dielectric Fresnel, and the
 // Charlie sheen distribution.
 #pragma once

@@ -79,7 +79,7 @@ PR_INLINE u32 rng_u32_at(const Rng* r, u32 dim) {
 
 #if defined(PR_DEVICE_CODE) && defined(PR_BITREVERSE_TABLE)
 // Oclgrind 21.10 cannot run llvm.bitreverse, which LLVM makes of the shifts below (and which is
-// one instruction on GPUs): tools/oclgrind-check.sh builds with -DPR_BITREVERSE_TABLE.
+// one instruction on GPUs): tools/ci/oclgrind-check.sh builds with -DPR_BITREVERSE_TABLE.
 #define PR_R2(n) n, n + 2 * 64, n + 1 * 64, n + 3 * 64
 #define PR_R4(n) PR_R2(n), PR_R2(n + 2 * 16), PR_R2(n + 1 * 16), PR_R2(n + 3 * 16)
 #define PR_R6(n) PR_R4(n), PR_R4(n + 2 * 4), PR_R4(n + 1 * 4), PR_R4(n + 3 * 4)

@@ -25,7 +25,7 @@ PR_KERNEL void trace_rays(__global const Ray* rays, __global Hit* hits, __global
   occluded[i] = occ;
 }
 
-// Benchmark kernels (tools/ray_bench): closest hit only, any hit only, on the whole scene.
+// Benchmark kernels (tools/bench/ray_bench): closest hit only, any hit only, on the whole scene.
 PR_KERNEL void trace_closest(__global const Ray* rays, __global Hit* hits, uint n,
                              PR_PARAMS(PR_ARGS_SCENE_GEOM)) {
   const uint i = (uint)get_global_id(0);
