@@ -61,44 +61,94 @@ const char* const kOutsideHelp =
     "Let the scene's buffer and image URIs name files outside its folder (by default a scene "
     "reads files in its own folder and below only)";
 
-}  // namespace
+// Options declared after this are listed under `group` in the subcommand's --help. A heading
+// only: unlike add_option_group, parsing and error messages stay as they are.
+void listUnder(CLI::App* command, const char* group) {
+  command->option_defaults()->group(group);
+}
 
-int main(int argc, char** argv) {
-  CLI::App app{"pathreuse: global illumination of animated glTF scenes by reusing light paths"};
-  app.require_subcommand(1);
-  app.set_version_flag("--version", "pathreuse 0.1.0");
+// --- devices and info ---
 
-  bool devicesJson = false;
+struct InfoArgs {
+  std::string scene;
+  bool json = false;
+  double fps = 24.0;
+  bool allowOutsideUris = false;
+};
+
+CLI::App* addDevicesCommand(CLI::App& app, bool& json) {
   auto* devices = app.add_subcommand("devices", "List every OpenCL platform and device");
-  devices->add_flag("--json", devicesJson, "Print the list as JSON");
+  devices->add_flag("--json", json, "Print the list as JSON");
+  return devices;
+}
 
-  std::string infoScene;
-  bool infoJson = false;
-  double infoFps = 24.0;
+CLI::App* addInfoCommand(CLI::App& app, InfoArgs& a) {
   auto* info =
       app.add_subcommand("info", "What a scene holds: static/dynamic split, lights, animation");
-  info->add_option("SCENE", infoScene, "glTF file (.gltf or .glb)")->required();
-  info->add_flag("--json", infoJson, "Print as JSON");
-  info->add_option("--fps", infoFps, "Frames per second of the animation (default 24)")
+  info->add_option("SCENE", a.scene, "glTF file (.gltf or .glb)")->required();
+  info->add_flag("--json", a.json, "Print as JSON");
+  info->add_option("--fps", a.fps, "Frames per second of the animation (default 24)")
       ->check(finiteIn(0.001, 1000));
-  bool infoOutside = false;
-  info->add_flag("--allow-outside-uris", infoOutside, kOutsideHelp);
+  info->add_flag("--allow-outside-uris", a.allowOutsideUris, kOutsideHelp);
+  return info;
+}
 
+// --- render ---
+
+// The render options as typed; toRenderOptions turns the texts into RenderOptions' enums.
+struct RenderArgs {
   pr::RenderOptions ro;
-  std::string framesText, modeText = "reuse";
-  auto* render = app.add_subcommand("render", "Render a range of frames of the scene's animation");
-  render->add_option("SCENE", ro.scene, "glTF file (.gltf or .glb)")->required();
-  render->add_flag("--allow-outside-uris", ro.allowOutsideUris, kOutsideHelp);
-  render->add_option("--frames", framesText,
+  std::string frames;
+  std::string mode = "reuse", lightSampler = "auto", materialModel = "energy";
+  std::string terminator = "on", bvhWidth = "auto", connections = "auto";
+  CLI::Option* connectionMis = nullptr;  // to tell whether it was given
+};
+
+void addSceneOptions(CLI::App* render, RenderArgs& a) {
+  listUnder(render, "Scene and frames");
+  render->add_flag("--allow-outside-uris", a.ro.allowOutsideUris, kOutsideHelp);
+  render->add_option("--frames", a.frames,
                      "Frame range A-B or one frame A (default: the whole animation)");
-  render->add_option("--fps", ro.fps, "Frames per second: frame f is at time f / fps")
+  render->add_option("--fps", a.ro.fps, "Frames per second: frame f is at time f / fps")
       ->check(finiteIn(0.001, 1000))
       ->capture_default_str();
+  render->add_option("--camera", a.ro.camera, "Camera index (default: the scene's first)")
+      ->check(CLI::Range(0, 1 << 20));
+}
+
+void addOutputOptions(CLI::App* render, RenderArgs& a) {
+  pr::RenderOptions& ro = a.ro;
+  listUnder(render, "Output");
   render
       ->add_option("--width", ro.width, "Image width (default: from the camera's aspect, else 640)")
       ->check(CLI::Range(1, 16384));
   render->add_option("--height", ro.height, "Image height (default 480)")
       ->check(CLI::Range(1, 16384));
+  render->add_option("--out", ro.outPattern, "Output EXR path with a frame number conversion")
+      ->capture_default_str();
+  render->add_flag("--exr-float", ro.exrFloat, "Write 32-bit float EXR (default: half)");
+  render->add_flag("--png", ro.png, "Also write an sRGB PNG beside each EXR");
+  render->add_option("--exposure", ro.exposure, "Exposure in stops for the PNG")
+      ->check(finiteIn(-64, 64))
+      ->capture_default_str();
+  render->add_option("--stats", ro.statsFile, "Write one JSON line per frame to this file");
+  render->add_flag(
+      "--resume", ro.resume,
+      "Skip frames whose complete EXR already exists (a truncated one is rendered again); "
+      "append to the stats file");
+  render->add_flag("-q,--quiet", ro.quiet, "No progress line or summary");
+}
+
+void addSamplingOptions(CLI::App* render, RenderArgs& a) {
+  pr::RenderOptions& ro = a.ro;
+  listUnder(render, "Sampling");
+  render
+      ->add_option("--mode", a.mode,
+                   "reuse: light paths kept across frames, re-traced only where moving objects "
+                   "disturb them; retrace: the same with every path re-traced each frame; "
+                   "pathtrace: unidirectional path tracing (the baseline)")
+      ->check(CLI::IsMember({"reuse", "retrace", "pathtrace"}))
+      ->capture_default_str();
   render->add_option("--spp", ro.spp, "Samples per pixel per frame")
       ->check(CLI::Range(1, 1 << 20))
       ->capture_default_str();
@@ -109,23 +159,11 @@ int main(int argc, char** argv) {
       ->add_option("--seed", ro.seed, "Random seed; the same seed reproduces a frame on one device")
       ->check(CLI::Range(0u, 4294967295u))
       ->capture_default_str();
+  render->add_flag("--fixed-noise", ro.fixedNoise,
+                   "Key the camera samples' random numbers by frame 0 on every frame (the same "
+                   "noise pattern each frame; the scene still animates)");
   render
-      ->add_option("--device", ro.devices,
-                   "OpenCL device: index, P:D, cpu, gpu or part of its name (default: "
-                   "$PATHREUSE_DEVICE, else the first GPU, else the first CPU); repeatable, "
-                   "each device renders a share of every frame's rows; 'all': every device")
-      ->allow_extra_args(false)
-      ->envname("PATHREUSE_DEVICE");
-  render
-      ->add_option("--mode", modeText,
-                   "reuse: light paths kept across frames, re-traced only where moving objects "
-                   "disturb them; retrace: the same with every path re-traced each frame; "
-                   "pathtrace: unidirectional path tracing (the baseline)")
-      ->check(CLI::IsMember({"reuse", "retrace", "pathtrace"}))
-      ->capture_default_str();
-  std::string lightSamplerText = "auto";
-  render
-      ->add_option("--light-sampler", lightSamplerText,
+      ->add_option("--light-sampler", a.lightSampler,
                    "How a shaded point chooses the light it samples: bvh (by the light it can "
                    "get from each, through a light BVH), exhaustive (by the light it can get "
                    "from each, every light weighed: for few lights), power (by power alone) or "
@@ -133,29 +171,12 @@ int main(int argc, char** argv) {
                    "at most 4, power between)")
       ->check(CLI::IsMember({"auto", "bvh", "exhaustive", "power"}))
       ->capture_default_str();
-  std::string materialModelText = "energy";
-  render
-      ->add_option("--material-model", materialModelText,
-                   "The BSDF: energy (multiple-scattering GGX, layers by albedo scaling; as "
-                   "Blender's Cycles and OpenPBR) or gltf-reference (the glTF specification's "
-                   "single-scattering model, for conformance comparisons)")
-      ->check(CLI::IsMember({"energy", "gltf-reference"}))
-      ->capture_default_str();
-  std::string terminatorText = "on";
-  render
-      ->add_option("--shadow-terminator", terminatorText,
-                   "Coarse smooth-shaded facets: on (rays leave from the smooth surface the "
-                   "vertex normals describe, facets seen edge-on keep their light) or off (the "
-                   "flat facets' shadows, as renders before the correction)")
-      ->check(CLI::IsMember({"on", "off"}))
-      ->capture_default_str();
-  std::string bvhWidthText = "auto";
-  render
-      ->add_option("--bvh-width", bvhWidthText,
-                   "Children per BVH node: 8 (float8 slab tests, for CPUs), 4 (for GPUs), 2, or "
-                   "auto (8 on CPUs, 4 on GPUs)")
-      ->check(CLI::IsMember({"auto", "2", "4", "8"}))
-      ->capture_default_str();
+}
+
+// Connections between eye and stored light paths: the reuse and retrace modes only.
+void addReuseOptions(CLI::App* render, RenderArgs& a) {
+  pr::RenderOptions& ro = a.ro;
+  listUnder(render, "Reuse and retrace");
   render
       ->add_option("--light-paths", ro.lightPaths,
                    "Light-path slots kept in the arena (reuse/retrace; default: one per pixel)")
@@ -170,18 +191,18 @@ int main(int argc, char** argv) {
                    "Upper bound on the connection geometry term (reuse/retrace; 0 = off, unbiased)")
       ->check(finiteIn(0, 1e30))
       ->capture_default_str();
+  a.connectionMis =
+      render
+          ->add_option(
+              "--connection-mis", ro.connectionMis,
+              "Connection MIS threshold R (reuse/retrace): where the eye's BSDF sample finds a "
+              "connected light vertex R or more times likelier than the light tracer did, the "
+              "path is shared with a connection from that sample (fewer fireflies near "
+              "corners; 0 = off). With --no-eye-paths only: eye paths weigh whole paths instead")
+          ->check(finiteIn(0, 1e30))
+          ->capture_default_str();
   render
-      ->add_option(
-          "--connection-mis", ro.connectionMis,
-          "Connection MIS threshold R (reuse/retrace): where the eye's BSDF sample finds a "
-          "connected light vertex R or more times likelier than the light tracer did, the "
-          "path is shared with a connection from that sample (fewer fireflies near "
-          "corners; 0 = off). With --no-eye-paths only: eye paths weigh whole paths instead")
-      ->check(finiteIn(0, 1e30))
-      ->capture_default_str();
-  std::string connectionsText = "auto";
-  render
-      ->add_option("--connections", connectionsText,
+      ->add_option("--connections", a.connections,
                    "Connections to the stored light vertices per eye vertex (reuse/retrace): "
                    "1 to 4 shadow rays, each to a candidate chosen in proportion to its "
                    "unshadowed contribution, all (one shadow ray per candidate), or auto (all "
@@ -209,6 +230,32 @@ int main(int argc, char** argv) {
       "where they sample a path better, and eye paths elsewhere (dark corners, occluded rooms). "
       "On by default; --no-eye-paths: the connections alone at the first eye vertex, with "
       "next-event estimation, strategy E and the delta-chain extension there");
+}
+
+void addMaterialOptions(CLI::App* render, RenderArgs& a) {
+  listUnder(render, "Materials");
+  render
+      ->add_option("--material-model", a.materialModel,
+                   "The BSDF: energy (multiple-scattering GGX, layers by albedo scaling; as "
+                   "Blender's Cycles and OpenPBR) or gltf-reference (the glTF specification's "
+                   "single-scattering model, for conformance comparisons)")
+      ->check(CLI::IsMember({"energy", "gltf-reference"}))
+      ->capture_default_str();
+  render
+      ->add_option("--shadow-terminator", a.terminator,
+                   "Coarse smooth-shaded facets: on (rays leave from the smooth surface the "
+                   "vertex normals describe, facets seen edge-on keep their light) or off (the "
+                   "flat facets' shadows, as renders before the correction)")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
+  render->add_flag(
+      "--force-diffuse", a.ro.forceDiffuse,
+      "Shade every non-delta material as pure Lambert with its base colour (a diagnostic)");
+}
+
+void addEnvironmentOptions(CLI::App* render, RenderArgs& a) {
+  pr::RenderOptions& ro = a.ro;
+  listUnder(render, "Environment");
   render->add_option(
       "--env", ro.env,
       "Environment light: an equirectangular map (.exr or .hdr; +Y up, its centre looking along "
@@ -225,46 +272,87 @@ int main(int argc, char** argv) {
                    "from above)")
       ->check(finiteIn(-1e6, 1e6))
       ->capture_default_str();
-  render->add_option("--camera", ro.camera, "Camera index (default: the scene's first)")
-      ->check(CLI::Range(0, 1 << 20));
-  render->add_option("--out", ro.outPattern, "Output EXR path with a frame number conversion")
-      ->capture_default_str();
-  render->add_flag("--exr-float", ro.exrFloat, "Write 32-bit float EXR (default: half)");
-  render->add_flag("--png", ro.png, "Also write an sRGB PNG beside each EXR");
-  render->add_option("--exposure", ro.exposure, "Exposure in stops for the PNG")
-      ->check(finiteIn(-64, 64))
-      ->capture_default_str();
-  render->add_flag("-q,--quiet", ro.quiet, "No progress line or summary");
-  render->add_flag(
-      "--force-diffuse", ro.forceDiffuse,
-      "Shade every non-delta material as pure Lambert with its base colour (a diagnostic)");
-  render->add_option("--stats", ro.statsFile, "Write one JSON line per frame to this file");
-  render->add_flag(
-      "--resume", ro.resume,
-      "Skip frames whose complete EXR already exists (a truncated one is rendered again); "
-      "append to the stats file");
-  render->add_flag("--fixed-noise", ro.fixedNoise,
-                   "Key the camera samples' random numbers by frame 0 on every frame (the same "
-                   "noise pattern each frame; the scene still animates)");
+}
 
+void addRenderDeviceOptions(CLI::App* render, RenderArgs& a) {
+  listUnder(render, "Devices");
+  render
+      ->add_option("--device", a.ro.devices,
+                   "OpenCL device: index, P:D, cpu, gpu or part of its name (default: "
+                   "$PATHREUSE_DEVICE, else the first GPU, else the first CPU); repeatable, "
+                   "each device renders a share of every frame's rows; 'all': every device")
+      ->allow_extra_args(false)
+      ->envname("PATHREUSE_DEVICE");
+  render
+      ->add_option("--bvh-width", a.bvhWidth,
+                   "Children per BVH node: 8 (float8 slab tests, for CPUs), 4 (for GPUs), 2, or "
+                   "auto (8 on CPUs, 4 on GPUs)")
+      ->check(CLI::IsMember({"auto", "2", "4", "8"}))
+      ->capture_default_str();
+}
+
+CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
+  auto* render = app.add_subcommand("render", "Render a range of frames of the scene's animation");
+  render->add_option("SCENE", a.ro.scene, "glTF file (.gltf or .glb)")->required();
+  addSceneOptions(render, a);
+  addOutputOptions(render, a);
+  addSamplingOptions(render, a);
+  addReuseOptions(render, a);
+  addMaterialOptions(render, a);
+  addEnvironmentOptions(render, a);
+  addRenderDeviceOptions(render, a);
+  return render;
+}
+
+pr::RenderOptions toRenderOptions(const RenderArgs& a) {
+  pr::RenderOptions ro = a.ro;
+  if (!a.frames.empty()) {
+    ro.frames = pr::parseFrameRange(a.frames);
+    ro.framesGiven = true;
+  }
+  ro.mode = a.mode == "pathtrace" ? pr::RenderMode::PathTrace
+            : a.mode == "retrace" ? pr::RenderMode::Retrace
+                                  : pr::RenderMode::Reuse;
+  ro.materialModel =
+      a.materialModel == "gltf-reference" ? pr::MaterialModel::Gltf : pr::MaterialModel::Energy;
+  ro.shadowTerminator = a.terminator == "on";
+  ro.lightSampler = a.lightSampler == "bvh"          ? pr::LightSampler::Bvh
+                    : a.lightSampler == "exhaustive" ? pr::LightSampler::Exhaustive
+                    : a.lightSampler == "power"      ? pr::LightSampler::Power
+                                                     : pr::LightSampler::Auto;
+  ro.bvhWidth = a.bvhWidth == "auto" ? 0 : std::stoi(a.bvhWidth);
+  if (ro.eyePaths && a.connectionMis->count() > 0 && !ro.quiet)
+    std::cerr << "note: --connection-mis is used with --no-eye-paths only; eye paths weigh "
+                 "whole paths by MIS instead\n";
+  ro.connections = a.connections == "auto"  ? -1
+                   : a.connections == "all" ? 0
+                                            : std::stoi(a.connections);
+  return ro;
+}
+
+// --- portability ---
+
+struct PortabilityArgs {
   pr::PortabilityOptions po;
   bool noDemo = false;
-  auto* portability = app.add_subcommand(
-      "portability", "Render a fixed suite on every OpenCL device and compare the images");
-  portability->footer(
-      // clang-format off
-      "Renders a fixed suite on every OpenCL device and compares each device's frames with the\n"
-      "first's. Round-off may send paths another way on another device, so the check is\n"
-      "statistical: the first device renders the suite again with seeds seed+1 and seed+2, and\n"
-      "these independent estimates give each frame's noise floor. A device whose paths diverge\n"
-      "is at worst another seed; a fault adds a systematic error. Leaving out the 1% most\n"
-      "extreme pixels (fireflies), a device disagrees when its relMSE > TOLERANCE x the floor's,\n"
-      "when its mean luminance is more than SIGMAS standard errors off, or on any NaN/Inf.\n"
-      "Exit 0: all agree (or only one device: nothing to compare); 1: a device disagrees;\n"
-      "2: bad input.");
-  // clang-format on
-  portability->add_option("SCENES", po.scenes, "glTF files tested besides the demo scenes");
-  portability->add_flag("--no-demo", noDemo, "Test only the given scenes, not the demo scenes");
+};
+
+const char* const kPortabilityFooter =
+    "Renders a fixed suite on every OpenCL device and compares each device's frames with the\n"
+    "first's. Round-off may send paths another way on another device, so the check is\n"
+    "statistical: the first device renders the suite again with seeds seed+1 and seed+2, and\n"
+    "these independent estimates give each frame's noise floor. A device whose paths diverge\n"
+    "is at worst another seed; a fault adds a systematic error. Leaving out the 1% most\n"
+    "extreme pixels (fireflies), a device disagrees when its relMSE > TOLERANCE x the floor's,\n"
+    "when its mean luminance is more than SIGMAS standard errors off, or on any NaN/Inf.\n"
+    "Exit 0: all agree (or only one device: nothing to compare); 1: a device disagrees;\n"
+    "2: bad input.";
+
+// What is rendered: scenes, frames, size, samples and modes.
+void addSuiteOptions(CLI::App* portability, PortabilityArgs& a) {
+  pr::PortabilityOptions& po = a.po;
+  listUnder(portability, "Suite");
+  portability->add_flag("--no-demo", a.noDemo, "Test only the given scenes, not the demo scenes");
   portability->add_flag("--allow-outside-uris", po.allowOutsideUris, kOutsideHelp);
   portability->add_option("--frames", po.frames, "Frames: A, A-B or a list (A,B-C)")
       ->capture_default_str();
@@ -283,6 +371,12 @@ int main(int argc, char** argv) {
       ->add_option("--mode", po.modes,
                    "reuse, retrace or pathtrace; repeatable (default: all three)")
       ->check(CLI::IsMember({"reuse", "retrace", "pathtrace"}));
+}
+
+// Which devices, what they are compared with, and how closely.
+void addComparisonOptions(CLI::App* portability, PortabilityArgs& a) {
+  pr::PortabilityOptions& po = a.po;
+  listUnder(portability, "Devices and comparison");
   portability->add_option(
       "--device", po.devices,
       "Device (index, P:D, cpu, gpu or part of its name); repeatable, the first is the "
@@ -297,16 +391,70 @@ int main(int argc, char** argv) {
                    "... or when its mean luminance is this many standard errors off")
       ->check(finiteIn(0.001, 1e6))
       ->capture_default_str();
-  portability->add_flag("--json", po.json, "Print one JSON document instead of the table");
-  portability->add_option("--out", po.outDir, "Folder for the PNG of the worst difference")
-      ->capture_default_str();
-  portability->add_flag("-q,--quiet", po.quiet, "No progress lines on stderr");
   portability->add_option("--save-reference", po.saveReferenceDir,
                           "Also write the reference device's frames (and noise-floor seeds) to "
                           "this folder, to compare a device on another machine with");
   portability->add_option("--reference", po.referenceDir,
                           "Compare every device with the frames saved in this folder by "
                           "--save-reference, instead of with the first device");
+}
+
+void addReportOptions(CLI::App* portability, PortabilityArgs& a) {
+  pr::PortabilityOptions& po = a.po;
+  listUnder(portability, "Output");
+  portability->add_flag("--json", po.json, "Print one JSON document instead of the table");
+  portability->add_option("--out", po.outDir, "Folder for the PNG of the worst difference")
+      ->capture_default_str();
+  portability->add_flag("-q,--quiet", po.quiet, "No progress lines on stderr");
+}
+
+CLI::App* addPortabilityCommand(CLI::App& app, PortabilityArgs& a) {
+  auto* portability = app.add_subcommand(
+      "portability", "Render a fixed suite on every OpenCL device and compare the images");
+  portability->footer(kPortabilityFooter);
+  portability->add_option("SCENES", a.po.scenes, "glTF files tested besides the demo scenes");
+  addSuiteOptions(portability, a);
+  addComparisonOptions(portability, a);
+  addReportOptions(portability, a);
+  return portability;
+}
+
+// --- running ---
+
+// Runs `command`, turning its exceptions into one line on stderr and an exit code.
+template <typename Command>
+int runReportingErrors(Command command) {
+  try {
+    return command();
+  } catch (const pr::InputError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return pr::kExitBadInput;
+  } catch (const pr::RuntimeError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return pr::kExitRuntime;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "error: out of host memory\n";
+    return pr::kExitRuntime;
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return pr::kExitRuntime;
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"pathreuse: global illumination of animated glTF scenes by reusing light paths"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "pathreuse 0.1.0");
+  bool devicesJson = false;
+  InfoArgs infoArgs;
+  RenderArgs renderArgs;
+  PortabilityArgs portabilityArgs;
+  const CLI::App* devices = addDevicesCommand(app, devicesJson);
+  const CLI::App* info = addInfoCommand(app, infoArgs);
+  const CLI::App* render = addRenderCommand(app, renderArgs);
+  const CLI::App* portability = addPortabilityCommand(app, portabilityArgs);
 
   try {
     app.parse(argc, argv);
@@ -321,49 +469,15 @@ int main(int argc, char** argv) {
     return pr::kExitBadInput;
   }
 
-  try {
+  return runReportingErrors([&]() -> int {
     if (*devices) return runDevices(devicesJson);
-    if (*info) return runInfo(infoScene, infoJson, infoFps, infoOutside);
-    if (*render) {
-      if (!framesText.empty()) {
-        ro.frames = pr::parseFrameRange(framesText);
-        ro.framesGiven = true;
-      }
-      ro.mode = modeText == "pathtrace" ? pr::RenderMode::PathTrace
-                : modeText == "retrace" ? pr::RenderMode::Retrace
-                                        : pr::RenderMode::Reuse;
-      ro.materialModel = materialModelText == "gltf-reference" ? pr::MaterialModel::Gltf
-                                                               : pr::MaterialModel::Energy;
-      ro.shadowTerminator = terminatorText == "on";
-      ro.lightSampler = lightSamplerText == "bvh"          ? pr::LightSampler::Bvh
-                        : lightSamplerText == "exhaustive" ? pr::LightSampler::Exhaustive
-                        : lightSamplerText == "power"      ? pr::LightSampler::Power
-                                                           : pr::LightSampler::Auto;
-      ro.bvhWidth = bvhWidthText == "auto" ? 0 : std::stoi(bvhWidthText);
-      if (ro.eyePaths && render->count("--connection-mis") > 0 && !ro.quiet)
-        std::cerr << "note: --connection-mis is used with --no-eye-paths only; eye paths weigh "
-                     "whole paths by MIS instead\n";
-      ro.connections = connectionsText == "auto"  ? -1
-                       : connectionsText == "all" ? 0
-                                                  : std::stoi(connectionsText);
-      return pr::runRender(ro);
-    }
+    if (*info)
+      return runInfo(infoArgs.scene, infoArgs.json, infoArgs.fps, infoArgs.allowOutsideUris);
+    if (*render) return pr::runRender(toRenderOptions(renderArgs));
     if (*portability) {
-      po.demoScenes = !noDemo;
-      return pr::runPortability(po);
+      portabilityArgs.po.demoScenes = !portabilityArgs.noDemo;
+      return pr::runPortability(portabilityArgs.po);
     }
-  } catch (const pr::InputError& e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return pr::kExitBadInput;
-  } catch (const pr::RuntimeError& e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return pr::kExitRuntime;
-  } catch (const std::bad_alloc&) {
-    std::cerr << "error: out of host memory\n";
-    return pr::kExitRuntime;
-  } catch (const std::exception& e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return pr::kExitRuntime;
-  }
-  return pr::kExitOk;
+    return pr::kExitOk;
+  });
 }

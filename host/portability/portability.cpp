@@ -259,16 +259,51 @@ std::vector<std::string> demoScenePaths() {
                    tried + "); pass scenes with --no-demo");
 }
 
-int runPortability(const PortabilityOptions& o) {
-  validate(o);
-  const std::vector<int> frames = parseFrameList(o.frames);
+namespace {
+
+// What the suite is, fixed before its first render.
+struct Suite {
+  explicit Suite(const PortabilityOptions& options) : o(options) {}
+  const PortabilityOptions& o;
+  std::vector<int> frames;
   std::vector<RenderMode> modes;
-  for (const auto& m : o.modes) {
+  std::vector<SuiteScene> scenes;
+  // --reference: the saved frames every device is compared with.
+  std::unique_ptr<StoredReference> stored;
+  bool save = false;        // --save-reference
+  nlohmann::json settings;  // suiteSettings: saved with a reference, checked against one
+  // The first renders the reference unless `stored`.
+  std::vector<const DeviceEntry*> devices;
+  RenderOptions base;
+  // Against saved frames every device is compared; else every device but the first.
+  size_t firstCompared = 1;
+  bool compare = false;
+};
+
+// What the suite found.
+struct Results {
+  std::vector<Row> rows;
+  // The comparison furthest past its tolerance gets its difference written.
+  double worstBadness = -1.0;
+  size_t worstIndex = 0;
+  Image worstImage;
+  double worstScale = 1.0;
+  int width = 0, height = 0;  // of the reference frames
+  // --save-reference: the manifest's dropped samples per saved frame.
+  nlohmann::json savedDropped = nlohmann::json::object();
+};
+
+std::vector<RenderMode> suiteModes(const std::vector<std::string>& names) {
+  std::vector<RenderMode> modes;
+  for (const auto& m : names) {
     const RenderMode mode = parseMode(m);
     if (std::find(modes.begin(), modes.end(), mode) == modes.end()) modes.push_back(mode);
   }
   if (modes.empty()) modes = {RenderMode::Reuse, RenderMode::Retrace, RenderMode::PathTrace};
+  return modes;
+}
 
+std::vector<SuiteScene> loadSuiteScenes(const PortabilityOptions& o) {
   std::vector<std::string> paths;
   if (o.demoScenes) paths = demoScenePaths();
   paths.insert(paths.end(), o.scenes.begin(), o.scenes.end());
@@ -285,21 +320,10 @@ int runPortability(const PortabilityOptions& o) {
     s.scene = std::make_unique<Scene>(loadScene(p, lo));
     scenes.push_back(std::move(s));
   }
+  return scenes;
+}
 
-  std::unique_ptr<StoredReference> stored;
-  if (!o.referenceDir.empty()) stored = std::make_unique<StoredReference>(o.referenceDir);
-  const bool save = !o.saveReferenceDir.empty();
-  const nlohmann::json settings = suiteSettings(frames, o.width, o.height, o.spp, o.seed);
-  if (stored) stored->check(settings);
-
-  const auto all = enumerateDevices();
-  if (all.empty()) throw NoDeviceError();
-  std::vector<const DeviceEntry*> devices;
-  if (o.devices.empty())
-    for (const auto& d : all) devices.push_back(&d);
-  else
-    for (const auto& spec : o.devices) devices.push_back(&selectDevice(all, spec));
-
+RenderOptions suiteRenderOptions(const PortabilityOptions& o) {
   RenderOptions base;
   base.width = o.width;
   base.height = o.height;
@@ -310,220 +334,273 @@ int runPortability(const PortabilityOptions& o) {
   // compares implementations, not per-device defaults.
   base.connections = 0;
   validateRenderOptions(base);
+  return base;
+}
 
-  // Against saved frames every device is compared; else every device but the first.
-  const size_t firstCompared = stored ? 0 : 1;
-  const bool compare = devices.size() > firstCompared;
-  nlohmann::json savedDropped = nlohmann::json::object();
-  if (save) fs::create_directories(o.saveReferenceDir);
-  std::vector<Row> rows;
-  double worstBadness =
-      -1.0;  // the comparison furthest past its tolerance gets its difference written
-  const Row* worstRow = nullptr;
-  size_t worstIndex = 0;
-  Image worstImage;
-  double worstScale = 1.0;
-  int width = 0, height = 0;
-  for (size_t si = 0; si < scenes.size(); ++si) {
-    const SuiteScene& s = scenes[si];
-    for (RenderMode mode : modes) {
-      RenderOptions ro = base;
-      ro.scene = s.path;
-      ro.mode = mode;
-      auto reference = [&](uint32_t seed) {
-        if (stored) return stored->load(s.label, mode, seed, frames);
-        RenderOptions r = ro;
-        r.seed = seed;
-        FrameSet set = renderSet(s, *devices[0], r, frames, o.quiet);
-        for (size_t fi = 0; save && fi < frames.size(); ++fi) {
-          const std::string name = referenceFile(s.label, mode, seed, frames[fi]);
-          writeExr((fs::path(o.saveReferenceDir) / name).string(), set.images[fi],
-                   ExrPixels::Float);
-          savedDropped[name] = set.dropped[fi];
-        }
-        return set;
-      };
-      const FrameSet ref = reference(o.seed);
-      width = ref.images.front().width;
-      height = ref.images.front().height;
-      if (!compare && !save) continue;
-      // The noise floor: the reference again with other seeds.
-      std::vector<std::vector<Image>> others;
-      for (uint32_t k = 1; k <= kFloorSeeds; ++k) others.push_back(reference(o.seed + k).images);
-      if (!compare) continue;
-      const std::vector<NoiseFloor> floors = measureNoiseFloors(ref.images, others);
-      for (size_t di = firstCompared; di < devices.size(); ++di) {
-        const FrameSet dev = renderSet(s, *devices[di], ro, frames, o.quiet);
-        for (size_t fi = 0; fi < frames.size(); ++fi) {
-          if (dev.images[fi].width != width || dev.images[fi].height != height)
-            throw InputError("the reference frames are " + std::to_string(width) + "x" +
-                             std::to_string(height) + ", the device's " +
-                             std::to_string(dev.images[fi].width) + "x" +
-                             std::to_string(dev.images[fi].height));
-          Row r;
-          r.scene = si;
-          r.mode = mode;
-          r.frame = frames[fi];
-          r.device = di;
-          r.diff = compareImages(dev.images[fi], ref.images[fi]);
-          r.floor = floors[fi];
-          r.dropped = dev.dropped[fi];
-          r.refDropped = ref.dropped[fi];
-          r.verdict = judge(r.diff, r.floor, o.tolerance, r.dropped, r.refDropped);
-          const double b = badness(r, o.tolerance);
-          if (b > worstBadness) {
-            worstBadness = b;
-            worstIndex = rows.size();
-            worstImage = differenceImage(dev.images[fi], ref.images[fi], &worstScale);
-          }
-          rows.push_back(r);
-        }
-      }
+// The reference frames of one scene and mode at `seed`: the saved ones, else rendered on the
+// first device (and written out with --save-reference).
+FrameSet referenceFrames(const Suite& suite, const SuiteScene& s, const RenderOptions& ro,
+                         uint32_t seed, Results& res) {
+  if (suite.stored) return suite.stored->load(s.label, ro.mode, seed, suite.frames);
+  RenderOptions r = ro;
+  r.seed = seed;
+  FrameSet set = renderSet(s, *suite.devices[0], r, suite.frames, suite.o.quiet);
+  for (size_t fi = 0; suite.save && fi < suite.frames.size(); ++fi) {
+    const std::string name = referenceFile(s.label, ro.mode, seed, suite.frames[fi]);
+    writeExr((fs::path(suite.o.saveReferenceDir) / name).string(), set.images[fi],
+             ExrPixels::Float);
+    res.savedDropped[name] = set.dropped[fi];
+  }
+  return set;
+}
+
+// Renders one scene and mode on device `di` and compares every frame with the reference's.
+void compareDevice(const Suite& suite, size_t si, const RenderOptions& ro, size_t di,
+                   const FrameSet& ref, const std::vector<NoiseFloor>& floors, Results& res) {
+  const FrameSet dev =
+      renderSet(suite.scenes[si], *suite.devices[di], ro, suite.frames, suite.o.quiet);
+  for (size_t fi = 0; fi < suite.frames.size(); ++fi) {
+    if (dev.images[fi].width != res.width || dev.images[fi].height != res.height)
+      throw InputError("the reference frames are " + std::to_string(res.width) + "x" +
+                       std::to_string(res.height) + ", the device's " +
+                       std::to_string(dev.images[fi].width) + "x" +
+                       std::to_string(dev.images[fi].height));
+    Row r;
+    r.scene = si;
+    r.mode = ro.mode;
+    r.frame = suite.frames[fi];
+    r.device = di;
+    r.diff = compareImages(dev.images[fi], ref.images[fi]);
+    r.floor = floors[fi];
+    r.dropped = dev.dropped[fi];
+    r.refDropped = ref.dropped[fi];
+    r.verdict = judge(r.diff, r.floor, suite.o.tolerance, r.dropped, r.refDropped);
+    const double b = badness(r, suite.o.tolerance);
+    if (b > res.worstBadness) {
+      res.worstBadness = b;
+      res.worstIndex = res.rows.size();
+      res.worstImage = differenceImage(dev.images[fi], ref.images[fi], &res.worstScale);
     }
+    res.rows.push_back(r);
   }
-  if (save) {
-    const DeviceEntry& d = *devices[0];
-    const nlohmann::json manifest = {
-        {"settings", settings},
-        {"device",
-         {{"name", d.name}, {"platform", d.platformName}, {"driver_version", d.driverVersion}}},
-        {"frames_dropped", savedDropped}};
-    writeFileAtomic((fs::path(o.saveReferenceDir) / kManifest).string(), manifest.dump(2) + "\n");
-  }
+}
 
-  std::string worstPng;
-  if (!rows.empty()) {
-    worstRow = &rows[worstIndex];
-    worstPng = (fs::path(o.outDir) /
-                ("worst_" + safeName(scenes[worstRow->scene].label) + "_" +
-                 renderModeName(worstRow->mode) + "_f" + std::to_string(worstRow->frame) + "_dev" +
-                 std::to_string(devices[worstRow->device]->index) + ".png"))
-                   .string();
-    writePng(worstPng, worstImage);
-  }
+void runSceneMode(const Suite& suite, size_t si, RenderMode mode, Results& res) {
+  const SuiteScene& s = suite.scenes[si];
+  RenderOptions ro = suite.base;
+  ro.scene = s.path;
+  ro.mode = mode;
+  const uint32_t seed = suite.o.seed;
+  const FrameSet ref = referenceFrames(suite, s, ro, seed, res);
+  res.width = ref.images.front().width;
+  res.height = ref.images.front().height;
+  if (!suite.compare && !suite.save) return;
+  // The noise floor: the reference again with other seeds.
+  std::vector<std::vector<Image>> others;
+  for (uint32_t k = 1; k <= kFloorSeeds; ++k)
+    others.push_back(referenceFrames(suite, s, ro, seed + k, res).images);
+  if (!suite.compare) return;
+  const std::vector<NoiseFloor> floors = measureNoiseFloors(ref.images, others);
+  for (size_t di = suite.firstCompared; di < suite.devices.size(); ++di)
+    compareDevice(suite, si, ro, di, ref, floors, res);
+}
 
-  size_t disagree = 0, identical = 0;
-  for (const auto& r : rows) {
-    disagree += !r.verdict.agree;
-    identical += r.diff.identical;
-  }
-  const int exitCode = disagree > 0 ? kExitRuntime : kExitOk;
+void writeManifest(const Suite& suite, const nlohmann::json& savedDropped) {
+  const DeviceEntry& d = *suite.devices[0];
+  const nlohmann::json manifest = {
+      {"settings", suite.settings},
+      {"device",
+       {{"name", d.name}, {"platform", d.platformName}, {"driver_version", d.driverVersion}}},
+      {"frames_dropped", savedDropped}};
+  writeFileAtomic((fs::path(suite.o.saveReferenceDir) / kManifest).string(),
+                  manifest.dump(2) + "\n");
+}
 
-  if (o.json) {
-    nlohmann::ordered_json j;
-    j["settings"] = {{"frames", frames}, {"width", width},
-                     {"height", height}, {"spp", o.spp},
-                     {"seed", o.seed},   {"noise_floor_seeds", {o.seed + 1, o.seed + kFloorSeeds}}};
-    j["tolerance"] = {{"relmse_factor", o.tolerance.relMseFactor},
-                      {"luminance_sigmas", o.tolerance.lumSigmas},
-                      {"relmse_slack", o.tolerance.relMseSlack}};
-    nlohmann::ordered_json devs = nlohmann::ordered_json::array();
-    for (size_t i = 0; i < devices.size(); ++i)
-      devs.push_back({{"index", devices[i]->index},
-                      {"name", devices[i]->name},
-                      {"platform", devices[i]->platformName},
-                      {"driver_version", devices[i]->driverVersion},
-                      {"reference", i == 0 && !stored}});
-    j["devices"] = devs;
-    if (stored) j["reference"] = {{"saved_in", o.referenceDir}, {"device", stored->device()}};
-    if (save) j["saved_reference"] = o.saveReferenceDir;
-    nlohmann::ordered_json sc = nlohmann::ordered_json::array();
-    for (const auto& s : scenes) sc.push_back({{"label", s.label}, {"path", s.path}});
-    j["scenes"] = sc;
-    nlohmann::ordered_json md = nlohmann::ordered_json::array();
-    for (RenderMode m : modes) md.push_back(renderModeName(m));
-    j["modes"] = md;
-    nlohmann::ordered_json results = nlohmann::ordered_json::array();
-    for (const auto& r : rows)
-      results.push_back({{"scene", scenes[r.scene].label},
-                         {"mode", renderModeName(r.mode)},
-                         {"frame", r.frame},
-                         {"device", devices[r.device]->index},
-                         {"rel_mse", r.diff.relMse},
-                         {"rel_mse_trimmed", r.diff.relMseTrimmed},
-                         {"noise_floor_rel_mse", r.floor.relMse},
-                         {"noise_floor_rel_mse_trimmed", r.floor.relMseTrimmed},
-                         {"rel_mse_ratio", number(r.verdict.relMseRatio)},
-                         {"mad", r.diff.mad},
-                         {"mean_luminance", r.diff.meanLum},
-                         {"reference_mean_luminance", r.diff.refMeanLum},
-                         {"luminance_difference_trimmed", r.diff.lumDiff},
-                         {"noise_floor_luminance_stderr", r.floor.lumStdErr},
-                         {"noise_floor_luminance_stderr_pixels", r.floor.lumStdErrPixels},
-                         {"noise_floor_luminance_stderr_seeds", r.floor.lumStdErrSeeds},
-                         {"luminance_z", number(r.verdict.lumZ)},
-                         {"non_finite", r.diff.nonFinite},
-                         {"dropped_samples", r.dropped},
-                         {"identical", r.diff.identical},
-                         {"agree", r.verdict.agree},
-                         {"reasons", r.verdict.reasons}});
-    j["results"] = results;
-    if (worstRow)
-      j["worst"] = {{"scene", scenes[worstRow->scene].label},
-                    {"mode", renderModeName(worstRow->mode)},
-                    {"frame", worstRow->frame},
-                    {"device", devices[worstRow->device]->index},
-                    {"png", worstPng},
-                    {"png_scale", worstScale}};
-    else
-      j["worst"] = nullptr;
-    j["summary"] = {{"comparisons", rows.size()},
-                    {"identical", identical},
-                    {"disagree", disagree},
-                    {"agree", disagree == 0},
-                    {"nothing_to_compare", !compare}};
-    std::cout << j.dump(2) << "\n";
-    return exitCode;
-  }
+// Writes the worst comparison's difference image; returns its path ("" without comparisons).
+std::string writeWorstPng(const Suite& suite, const Results& res) {
+  if (res.rows.empty()) return "";
+  const Row& worst = res.rows[res.worstIndex];
+  const std::string png = (fs::path(suite.o.outDir) /
+                           ("worst_" + safeName(suite.scenes[worst.scene].label) + "_" +
+                            renderModeName(worst.mode) + "_f" + std::to_string(worst.frame) +
+                            "_dev" + std::to_string(suite.devices[worst.device]->index) + ".png"))
+                              .string();
+  writePng(png, res.worstImage);
+  return png;
+}
 
-  std::cout << "devices:";
-  for (size_t i = 0; i < devices.size(); ++i)
-    std::cout << (i ? ", " : " ") << "[" << devices[i]->index << "] " << devices[i]->name
-              << (i == 0 && !stored ? " (reference)" : "");
-  std::cout << "\n";
-  if (stored)
-    std::cout << "reference: frames saved in " << o.referenceDir << " on " << stored->device()
-              << "\n";
-  if (save) std::cout << "saved the reference frames to " << o.saveReferenceDir << "\n";
-  if (!compare) {
-    std::cout
-        << "nothing to compare: only one device; rendered the suite on it (" << scenes.size()
-        << " scene(s) x " << modes.size() << " mode(s) x " << frames.size()
-        << " frame(s)). Name a second one with --device, e.g. POCL_DEVICES=\"pthread basic\".\n";
-    return kExitOk;
+nlohmann::ordered_json rowJson(const Suite& suite, const Row& r) {
+  return {{"scene", suite.scenes[r.scene].label},
+          {"mode", renderModeName(r.mode)},
+          {"frame", r.frame},
+          {"device", suite.devices[r.device]->index},
+          {"rel_mse", r.diff.relMse},
+          {"rel_mse_trimmed", r.diff.relMseTrimmed},
+          {"noise_floor_rel_mse", r.floor.relMse},
+          {"noise_floor_rel_mse_trimmed", r.floor.relMseTrimmed},
+          {"rel_mse_ratio", number(r.verdict.relMseRatio)},
+          {"mad", r.diff.mad},
+          {"mean_luminance", r.diff.meanLum},
+          {"reference_mean_luminance", r.diff.refMeanLum},
+          {"luminance_difference_trimmed", r.diff.lumDiff},
+          {"noise_floor_luminance_stderr", r.floor.lumStdErr},
+          {"noise_floor_luminance_stderr_pixels", r.floor.lumStdErrPixels},
+          {"noise_floor_luminance_stderr_seeds", r.floor.lumStdErrSeeds},
+          {"luminance_z", number(r.verdict.lumZ)},
+          {"non_finite", r.diff.nonFinite},
+          {"dropped_samples", r.dropped},
+          {"identical", r.diff.identical},
+          {"agree", r.verdict.agree},
+          {"reasons", r.verdict.reasons}};
+}
+
+void printJson(const Suite& suite, const Results& res, const std::string& worstPng,
+               size_t identical, size_t disagree) {
+  const PortabilityOptions& o = suite.o;
+  nlohmann::ordered_json j;
+  j["settings"] = {
+      {"frames", suite.frames}, {"width", res.width},
+      {"height", res.height},   {"spp", o.spp},
+      {"seed", o.seed},         {"noise_floor_seeds", {o.seed + 1, o.seed + kFloorSeeds}}};
+  j["tolerance"] = {{"relmse_factor", o.tolerance.relMseFactor},
+                    {"luminance_sigmas", o.tolerance.lumSigmas},
+                    {"relmse_slack", o.tolerance.relMseSlack}};
+  nlohmann::ordered_json devs = nlohmann::ordered_json::array();
+  for (size_t i = 0; i < suite.devices.size(); ++i)
+    devs.push_back({{"index", suite.devices[i]->index},
+                    {"name", suite.devices[i]->name},
+                    {"platform", suite.devices[i]->platformName},
+                    {"driver_version", suite.devices[i]->driverVersion},
+                    {"reference", i == 0 && !suite.stored}});
+  j["devices"] = devs;
+  if (suite.stored)
+    j["reference"] = {{"saved_in", o.referenceDir}, {"device", suite.stored->device()}};
+  if (suite.save) j["saved_reference"] = o.saveReferenceDir;
+  nlohmann::ordered_json sc = nlohmann::ordered_json::array();
+  for (const auto& s : suite.scenes) sc.push_back({{"label", s.label}, {"path", s.path}});
+  j["scenes"] = sc;
+  nlohmann::ordered_json md = nlohmann::ordered_json::array();
+  for (RenderMode m : suite.modes) md.push_back(renderModeName(m));
+  j["modes"] = md;
+  nlohmann::ordered_json results = nlohmann::ordered_json::array();
+  for (const auto& r : res.rows) results.push_back(rowJson(suite, r));
+  j["results"] = results;
+  if (!res.rows.empty()) {
+    const Row& worst = res.rows[res.worstIndex];
+    j["worst"] = {{"scene", suite.scenes[worst.scene].label},
+                  {"mode", renderModeName(worst.mode)},
+                  {"frame", worst.frame},
+                  {"device", suite.devices[worst.device]->index},
+                  {"png", worstPng},
+                  {"png_scale", res.worstScale}};
+  } else {
+    j["worst"] = nullptr;
   }
-  std::cout << "suite: " << width << "x" << height << ", " << o.spp << " spp, seed " << o.seed
-            << "; floor = reference at seeds " << o.seed + 1 << "-" << o.seed + kFloorSeeds
-            << "; * = without the worst 1% of pixels\n"
-            << "a device disagrees when relMSE* > " << o.tolerance.relMseFactor
-            << " x floor*, when its mean luminance is " << o.tolerance.lumSigmas
-            << " standard errors off (lum z), or on any NaN/Inf\n";
+  j["summary"] = {{"comparisons", res.rows.size()},
+                  {"identical", identical},
+                  {"disagree", disagree},
+                  {"agree", disagree == 0},
+                  {"nothing_to_compare", !suite.compare}};
+  std::cout << j.dump(2) << "\n";
+}
+
+void printRows(const Suite& suite, const Results& res) {
   char line[256];
   std::snprintf(line, sizeof line, "%-18s %-9s %5s %4s %10s %10s %10s %6s %10s %6s %4s %s", "scene",
                 "mode", "frame", "dev", "relMSE", "relMSE*", "floor*", "ratio", "MAD", "lum z",
                 "same", "verdict");
   std::cout << line << "\n";
-  for (const auto& r : rows) {
+  for (const auto& r : res.rows) {
     std::string verdict = r.verdict.agree ? "agree" : "DISAGREE";
     for (size_t i = 0; i < r.verdict.reasons.size(); ++i)
       verdict += (i ? "; " : ": ") + r.verdict.reasons[i];
     std::snprintf(line, sizeof line, "%-18s %-9s %5d %4d %10s %10s %10s %6s %10s %6s %4s ",
-                  scenes[r.scene].label.c_str(), renderModeName(r.mode), r.frame,
-                  devices[r.device]->index, sci(r.diff.relMse).c_str(),
+                  suite.scenes[r.scene].label.c_str(), renderModeName(r.mode), r.frame,
+                  suite.devices[r.device]->index, sci(r.diff.relMse).c_str(),
                   sci(r.diff.relMseTrimmed).c_str(), sci(r.floor.relMseTrimmed).c_str(),
                   fixed(r.verdict.relMseRatio, 2).c_str(), sci(r.diff.mad).c_str(),
                   fixed(r.verdict.lumZ, 2).c_str(), r.diff.identical ? "yes" : "no");
     std::cout << line << verdict << "\n";
   }
+}
+
+void printTable(const Suite& suite, const Results& res, const std::string& worstPng,
+                size_t identical, size_t disagree) {
+  const PortabilityOptions& o = suite.o;
+  const auto& devices = suite.devices;
+  std::cout << "devices:";
+  for (size_t i = 0; i < devices.size(); ++i)
+    std::cout << (i ? ", " : " ") << "[" << devices[i]->index << "] " << devices[i]->name
+              << (i == 0 && !suite.stored ? " (reference)" : "");
+  std::cout << "\n";
+  if (suite.stored)
+    std::cout << "reference: frames saved in " << o.referenceDir << " on " << suite.stored->device()
+              << "\n";
+  if (suite.save) std::cout << "saved the reference frames to " << o.saveReferenceDir << "\n";
+  if (!suite.compare) {
+    std::cout
+        << "nothing to compare: only one device; rendered the suite on it (" << suite.scenes.size()
+        << " scene(s) x " << suite.modes.size() << " mode(s) x " << suite.frames.size()
+        << " frame(s)). Name a second one with --device, e.g. POCL_DEVICES=\"pthread basic\".\n";
+    return;
+  }
+  std::cout << "suite: " << res.width << "x" << res.height << ", " << o.spp << " spp, seed "
+            << o.seed << "; floor = reference at seeds " << o.seed + 1 << "-"
+            << o.seed + kFloorSeeds << "; * = without the worst 1% of pixels\n"
+            << "a device disagrees when relMSE* > " << o.tolerance.relMseFactor
+            << " x floor*, when its mean luminance is " << o.tolerance.lumSigmas
+            << " standard errors off (lum z), or on any NaN/Inf\n";
+  printRows(suite, res);
   std::cout << "worst difference: " << worstPng;
-  if (worstRow->diff.identical)
+  if (res.rows[res.worstIndex].diff.identical)
     std::cout << " (black: every frame is bit-identical)\n";
   else
-    std::cout << " (|device - reference| x " << sci(worstScale) << ")\n";
-  std::cout << (disagree ? "FAIL: " : "OK: ") << disagree << " of " << rows.size()
+    std::cout << " (|device - reference| x " << sci(res.worstScale) << ")\n";
+  std::cout << (disagree ? "FAIL: " : "OK: ") << disagree << " of " << res.rows.size()
             << " comparisons disagree (" << identical << " bit-identical) across " << devices.size()
             << " devices\n";
-  return exitCode;
+}
+
+}  // namespace
+
+int runPortability(const PortabilityOptions& o) {
+  validate(o);
+  Suite suite(o);
+  suite.frames = parseFrameList(o.frames);
+  suite.modes = suiteModes(o.modes);
+  suite.scenes = loadSuiteScenes(o);
+  if (!o.referenceDir.empty()) suite.stored = std::make_unique<StoredReference>(o.referenceDir);
+  suite.save = !o.saveReferenceDir.empty();
+  suite.settings = suiteSettings(suite.frames, o.width, o.height, o.spp, o.seed);
+  if (suite.stored) suite.stored->check(suite.settings);
+
+  const auto all = enumerateDevices();
+  if (all.empty()) throw NoDeviceError();
+  if (o.devices.empty())
+    for (const auto& d : all) suite.devices.push_back(&d);
+  else
+    for (const auto& spec : o.devices) suite.devices.push_back(&selectDevice(all, spec));
+  suite.base = suiteRenderOptions(o);
+  suite.firstCompared = suite.stored ? 0 : 1;
+  suite.compare = suite.devices.size() > suite.firstCompared;
+
+  if (suite.save) fs::create_directories(o.saveReferenceDir);
+  Results res;
+  for (size_t si = 0; si < suite.scenes.size(); ++si)
+    for (RenderMode mode : suite.modes) runSceneMode(suite, si, mode, res);
+  if (suite.save) writeManifest(suite, res.savedDropped);
+  const std::string worstPng = writeWorstPng(suite, res);
+
+  size_t disagree = 0, identical = 0;
+  for (const auto& r : res.rows) {
+    disagree += !r.verdict.agree;
+    identical += r.diff.identical;
+  }
+  if (o.json)
+    printJson(suite, res, worstPng, identical, disagree);
+  else
+    printTable(suite, res, worstPng, identical, disagree);
+  return disagree > 0 ? kExitRuntime : kExitOk;
 }
 
 }  // namespace pr

@@ -111,54 +111,120 @@ bool frameDone(const std::string& exr, const RenderOptions& o, int width, int he
   }
 }
 
-}  // namespace
+// A scene without lights: lit by a white environment unless asked otherwise, said once.
+void noteUnlitScene(const Scene& scene, const RenderOptions& o) {
+  if (!sceneHasNoLights(scene) || o.quiet) return;
+  if (o.env.empty() && o.envColor.empty())
+    std::cerr << "note: " << o.scene
+              << ": no lights; lit by a uniform white environment (--env none keeps it dark)\n";
+  else if (o.env == "none")
+    std::cerr << "warning: " << o.scene << ": no lights and --env none; frames will be black\n";
+}
 
-int runRender(const RenderOptions& o) {
-  installInterruptHandlers(o.scene);
-  validateRenderOptions(o);
-  LoadOptions loadOptions;
-  loadOptions.allowOutsideUris = o.allowOutsideUris;
-  const Scene scene = loadScene(o.scene, loadOptions);
-  if (sceneHasNoLights(scene) && !o.quiet) {
-    if (o.env.empty() && o.envColor.empty())
-      std::cerr << "note: " << o.scene
-                << ": no lights; lit by a uniform white environment (--env none keeps it dark)\n";
-    else if (o.env == "none")
-      std::cerr << "warning: " << o.scene << ": no lights and --env none; frames will be black\n";
-  }
-  // Unwritable output is found before the kernels are built, not after the first frame.
-  checkWritable(formatOutPath(o.outPattern, o.framesGiven ? o.frames.first : 0));
-  std::unique_ptr<StatsFile> stats;
-  if (!o.statsFile.empty()) stats = std::make_unique<StatsFile>(o.statsFile, o.resume);
-  const auto devices = enumerateDevices();
-  MultiDeviceSession session(scene, selectDevices(devices, o.devices), o);
-  const FrameRange range = session.frameRange();
-  if (!o.quiet) {
-    std::cerr << "rendering " << o.scene << " frames " << range.first << "-" << range.last << " at "
-              << session.width() << "x" << session.height() << ", " << o.spp << " spp, mode "
-              << renderModeName(o.mode) << ", on ";
-    for (size_t i = 0; i < session.deviceCount(); ++i)
-      std::cerr << (i ? " + " : "") << session.device(i).name;
-    if (auto* reuse = dynamic_cast<PathReuse*>(&session.session(0).integrator()))
-      std::cerr << "; arena " << reuse->slots() << " slots x " << reuse->stride()
-                << " vertices = " << (reuse->arenaBytes() >> 20) << " MiB";
-    std::cerr << "\n";
-  }
+void printStart(const RenderOptions& o, MultiDeviceSession& session, const FrameRange& range) {
+  std::cerr << "rendering " << o.scene << " frames " << range.first << "-" << range.last << " at "
+            << session.width() << "x" << session.height() << ", " << o.spp << " spp, mode "
+            << renderModeName(o.mode) << ", on ";
+  for (size_t i = 0; i < session.deviceCount(); ++i)
+    std::cerr << (i ? " + " : "") << session.device(i).name;
+  if (auto* reuse = dynamic_cast<PathReuse*>(&session.session(0).integrator()))
+    std::cerr << "; arena " << reuse->slots() << " slots x " << reuse->stride()
+              << " vertices = " << (reuse->arenaBytes() >> 20) << " MiB";
+  std::cerr << "\n";
+}
 
-  const bool progress = !o.quiet && isatty(STDERR_FILENO);
-  const int total = range.last - range.first + 1;
-  const auto start = std::chrono::steady_clock::now();
+// The stats file's line for one frame.
+std::string statsLine(int f, const RenderOptions& o, const FrameStats& fs,
+                      const std::vector<DeviceFrame>& parts, int height) {
+  nlohmann::ordered_json j;
+  j["frame"] = f;
+  j["mode"] = renderModeName(o.mode);
+  j["wall_s"] = fs.wallSeconds;
+  j["stages_s"] = fs.stageSeconds;
+  j["host_s"] = fs.hostSeconds;
+  if (!fs.buildSeconds.empty()) j["build_s"] = fs.buildSeconds;
+  j["rays"] = fs.rays;
+  if (!fs.counters.empty()) j["counters"] = fs.counters;
+  j["device_bytes"] = fs.deviceBytes;
+  j["bad_samples"] = fs.badSamples;
+  // Per device: its rows, their share of the image, its wall and kernel times.
+  nlohmann::ordered_json list = nlohmann::ordered_json::array();
+  for (const DeviceFrame& p : parts) {
+    nlohmann::ordered_json d;
+    d["index"] = p.index;
+    d["name"] = p.name;
+    d["row_begin"] = p.rowBegin;
+    d["rows"] = p.rowEnd - p.rowBegin;
+    d["share"] = double(p.rowEnd - p.rowBegin) / height;
+    d["wall_s"] = p.wallSeconds;
+    d["stages_s"] = p.stats.stageSeconds;
+    d["rays"] = p.stats.rays;
+    list.push_back(std::move(d));
+  }
+  j["devices"] = std::move(list);
+  return j.dump();
+}
+
+// What the frames of one run came to, for the progress line and the summary.
+struct Tally {
+  std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
   uint64_t raysSoFar = 0, badSamples = 0;
   int rendered = 0, skipped = 0, badFrames = 0;
+};
+
+void printProgress(const FrameRange& range, const Tally& t, int f) {
+  const int total = range.last - range.first + 1;
+  const int done = f - range.first + 1;
+  const double elapsed =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t.start).count();
+  const double eta = t.rendered > 0 ? elapsed / t.rendered * (total - done) : 0.0;
+  std::fprintf(stderr, "\rframe %d of %d (#%d)  %.2f Mrays/s  elapsed %s  ETA %s   ", done, total,
+               f, elapsed > 0 ? t.raysSoFar / elapsed * 1e-6 : 0.0, clock(elapsed).c_str(),
+               clock(eta).c_str());
+  std::fflush(stderr);
+}
+
+// Frames before f are complete (rendered now or found complete); f onwards are not.
+int reportInterrupt(const RenderOptions& o, const FrameRange& range, int f) {
+  const int sig = interruptSignal();
+  std::cerr << "interrupted by "
+            << (sig == SIGTERM  ? "SIGTERM"
+                : sig == SIGINT ? "SIGINT"
+                                : "signal")
+            << ": "
+            << (f > range.first ? "frames " + frameSpan(range.first, f - 1) + " complete"
+                                : "no frame complete")
+            << " in " << o.outPattern << "; " << frameSpan(f, range.last)
+            << " not rendered (run again with --resume to finish)\n";
+  return 128 + sig;
+}
+
+void printSummary(const RenderOptions& o, const FrameRange& range, const Tally& t) {
+  const int total = range.last - range.first + 1;
+  std::cerr << "rendered " << t.rendered << " frame(s) to "
+            << formatOutPath(o.outPattern, range.first)
+            << (total > 1 ? " ... " + formatOutPath(o.outPattern, range.last) : "");
+  if (t.skipped > 0) std::cerr << "; " << t.skipped << " already complete, skipped";
+  std::cerr << "\n";
+  if (t.badSamples > 0)
+    std::cerr << "warning: " << t.badSamples << " non-finite samples were dropped in "
+              << t.badFrames << " frame(s)\n";
+}
+
+// Renders the session's frames in order, each written as soon as it is done.
+int renderFrames(const RenderOptions& o, MultiDeviceSession& session, const FrameRange& range,
+                 StatsFile* stats) {
+  const bool progress = !o.quiet && isatty(STDERR_FILENO);
+  Tally t;
   int f = range.first;
   endLoadingPhase();  // a signal from here on finishes cleanly between launches
   for (; f <= range.last && !interrupted(); ++f) {
     const std::string exr = formatOutPath(o.outPattern, f);
     if (o.resume && frameDone(exr, o, session.width(), session.height())) {
-      ++skipped;
+      ++t.skipped;
       continue;
     }
-    if (skipped > 0 && rendered == 0 && o.connectionHistory > 0 &&
+    if (t.skipped > 0 && t.rendered == 0 && o.connectionHistory > 0 &&
         o.mode != RenderMode::PathTrace && !o.quiet)
       std::cerr << "note: --resume: the connection history starts afresh at frame " << f
                 << " (frames from here differ from an uninterrupted run's, unbiased)\n";
@@ -169,84 +235,44 @@ int runRender(const RenderOptions& o) {
     if (interrupted()) break;  // the film may be partial: drop the frame
     writeExr(exr, img, o.exrFloat ? ExrPixels::Float : ExrPixels::Half);
     if (o.png) writePng(withExtension(exr, ".png"), img, o.exposure);
-    ++rendered;
+    ++t.rendered;
     fs.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    uint64_t frameRays = 0;
-    for (const auto& [k, v] : fs.rays) frameRays += v;
-    raysSoFar += frameRays;
-    if (stats) {
-      nlohmann::ordered_json j;
-      j["frame"] = f;
-      j["mode"] = renderModeName(o.mode);
-      j["wall_s"] = fs.wallSeconds;
-      j["stages_s"] = fs.stageSeconds;
-      j["host_s"] = fs.hostSeconds;
-      if (!fs.buildSeconds.empty()) j["build_s"] = fs.buildSeconds;
-      j["rays"] = fs.rays;
-      if (!fs.counters.empty()) j["counters"] = fs.counters;
-      j["device_bytes"] = fs.deviceBytes;
-      j["bad_samples"] = fs.badSamples;
-      // Per device: its rows, their share of the image, its wall and kernel times.
-      nlohmann::ordered_json list = nlohmann::ordered_json::array();
-      for (const DeviceFrame& p : parts) {
-        nlohmann::ordered_json d;
-        d["index"] = p.index;
-        d["name"] = p.name;
-        d["row_begin"] = p.rowBegin;
-        d["rows"] = p.rowEnd - p.rowBegin;
-        d["share"] = double(p.rowEnd - p.rowBegin) / session.height();
-        d["wall_s"] = p.wallSeconds;
-        d["stages_s"] = p.stats.stageSeconds;
-        d["rays"] = p.stats.rays;
-        list.push_back(std::move(d));
-      }
-      j["devices"] = std::move(list);
-      stats->writeLine(j.dump());
-    }
+    for (const auto& [k, v] : fs.rays) t.raysSoFar += v;
+    if (stats) stats->writeLine(statsLine(f, o, fs, parts, session.height()));
     if (fs.badSamples > 0) {
-      badSamples += fs.badSamples;
-      ++badFrames;
+      t.badSamples += fs.badSamples;
+      ++t.badFrames;
       if (!o.quiet)
         std::cerr << (progress ? "\n" : "") << "warning: frame " << f << ": " << fs.badSamples
                   << " non-finite samples were dropped\n";
     }
-    if (progress) {
-      const int done = f - range.first + 1;
-      const double elapsed =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      const double eta = rendered > 0 ? elapsed / rendered * (total - done) : 0.0;
-      std::fprintf(stderr, "\rframe %d of %d (#%d)  %.2f Mrays/s  elapsed %s  ETA %s   ", done,
-                   total, f, elapsed > 0 ? raysSoFar / elapsed * 1e-6 : 0.0, clock(elapsed).c_str(),
-                   clock(eta).c_str());
-      std::fflush(stderr);
-    }
+    if (progress) printProgress(range, t, f);
   }
   if (progress) std::fprintf(stderr, "\n");
-  if (interrupted() && f <= range.last) {  // a signal after the last frame changes nothing
-    // Frames before f are complete (rendered now or found complete); f onwards are not.
-    const int sig = interruptSignal();
-    std::cerr << "interrupted by "
-              << (sig == SIGTERM  ? "SIGTERM"
-                  : sig == SIGINT ? "SIGINT"
-                                  : "signal")
-              << ": "
-              << (f > range.first ? "frames " + frameSpan(range.first, f - 1) + " complete"
-                                  : "no frame complete")
-              << " in " << o.outPattern << "; " << frameSpan(f, range.last)
-              << " not rendered (run again with --resume to finish)\n";
-    return 128 + sig;
-  }
-  if (!o.quiet) {
-    std::cerr << "rendered " << rendered << " frame(s) to "
-              << formatOutPath(o.outPattern, range.first)
-              << (total > 1 ? " ... " + formatOutPath(o.outPattern, range.last) : "");
-    if (skipped > 0) std::cerr << "; " << skipped << " already complete, skipped";
-    std::cerr << "\n";
-    if (badSamples > 0)
-      std::cerr << "warning: " << badSamples << " non-finite samples were dropped in " << badFrames
-                << " frame(s)\n";
-  }
+  // A signal after the last frame changes nothing.
+  if (interrupted() && f <= range.last) return reportInterrupt(o, range, f);
+  if (!o.quiet) printSummary(o, range, t);
   return kExitOk;
+}
+
+}  // namespace
+
+int runRender(const RenderOptions& o) {
+  installInterruptHandlers(o.scene);
+  validateRenderOptions(o);
+  LoadOptions loadOptions;
+  loadOptions.allowOutsideUris = o.allowOutsideUris;
+  const Scene scene = loadScene(o.scene, loadOptions);
+  noteUnlitScene(scene, o);
+  // Unwritable output is found before the kernels are built, not after the first frame.
+  checkWritable(formatOutPath(o.outPattern, o.framesGiven ? o.frames.first : 0));
+  std::unique_ptr<StatsFile> stats;
+  if (!o.statsFile.empty()) stats = std::make_unique<StatsFile>(o.statsFile, o.resume);
+  const auto devices = enumerateDevices();
+  MultiDeviceSession session(scene, selectDevices(devices, o.devices), o);
+  const FrameRange range = session.frameRange();
+  if (!o.quiet) printStart(o, session, range);
+  return renderFrames(o, session, range, stats.get());
 }
 
 }  // namespace pr

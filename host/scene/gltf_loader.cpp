@@ -122,211 +122,64 @@ class Converter : Stage {
     return defaultMaterial_;
   }
 
+  // What the primitives of one mesh have between them. Every vertex gets each attribute that any
+  // primitive has (filled in where its own lacks it), so the mesh's arrays stay parallel.
+  struct MeshLayout {
+    bool anyTangents = false, anyUv1 = false, anyNormalMap = false;
+    // Skin and morph data: as many JOINTS_n sets as the primitive with most, the targets'
+    // POSITION (and NORMAL where any primitive has it) deltas.
+    size_t jointSets = 0, targets = 0;
+    bool targetNormals = false;
+  };
+
+  // One primitive's vertices as they are appended: the first is at `base` in the mesh.
+  struct PrimitiveVertices {
+    const tinygltf::Primitive& p;
+    const std::string& where;
+    size_t vcount = 0;
+    uint32_t base = 0;
+    bool hasNormals = false;
+  };
+
+  MeshLayout meshLayout(const tinygltf::Mesh& mesh) {
+    MeshLayout l;
+    for (const auto& p : mesh.primitives) {
+      // glTF: a primitive without NORMAL is shaded flat and its TANGENT ignored.
+      l.anyTangents =
+          l.anyTangents || (p.attributes.count("TANGENT") && p.attributes.count("NORMAL"));
+      l.anyUv1 = l.anyUv1 || p.attributes.count("TEXCOORD_1");
+      // A tangent frame is needed by normal maps, the coat's normal map and anisotropy.
+      const Material& m = scene_.materials[size_t(materialIndex(p.material))];
+      l.anyNormalMap = l.anyNormalMap || m.normalTexture.valid() ||
+                       m.clearcoatNormalTexture.valid() || m.isAnisotropic();
+    }
+    for (const auto& p : mesh.primitives) {
+      while (p.attributes.count("JOINTS_" + std::to_string(l.jointSets)) &&
+             p.attributes.count("WEIGHTS_" + std::to_string(l.jointSets)))
+        ++l.jointSets;
+      l.targets = std::max(l.targets, p.targets.size());
+      for (const auto& t : p.targets) l.targetNormals = l.targetNormals || t.count("NORMAL");
+    }
+    return l;
+  }
+
   // Object-space triangles of one glTF mesh (all TRIANGLES primitives).
   TriangleMesh convertMesh(int meshIndex) {
     const auto& mesh = model_.meshes[size_t(meshIndex)];
     TriangleMesh out;
     out.name = mesh.name;
-    bool anyTangents = false, anyUv1 = false, anyNormalMap = false;
-    for (const auto& p : mesh.primitives) {
-      // glTF: a primitive without NORMAL is shaded flat and its TANGENT ignored.
-      anyTangents = anyTangents || (p.attributes.count("TANGENT") && p.attributes.count("NORMAL"));
-      anyUv1 = anyUv1 || p.attributes.count("TEXCOORD_1");
-      // A tangent frame is needed by normal maps, the coat's normal map and anisotropy.
-      const Material& m = scene_.materials[size_t(materialIndex(p.material))];
-      anyNormalMap = anyNormalMap || m.normalTexture.valid() || m.clearcoatNormalTexture.valid() ||
-                     m.isAnisotropic();
-    }
+    const MeshLayout layout = meshLayout(mesh);
     std::vector<uint8_t> normalUvSet;   // per triangle: the uv set its tangents follow
     std::vector<uint8_t> givenTangent;  // per vertex: TANGENT from the file is used
-    // Skin and morph data: as many JOINTS_n sets as the primitive with most, the targets'
-    // POSITION (and NORMAL where any primitive has it) deltas.
-    size_t jointSets = 0, targets = 0;
-    bool targetNormals = false;
-    for (const auto& p : mesh.primitives) {
-      while (p.attributes.count("JOINTS_" + std::to_string(jointSets)) &&
-             p.attributes.count("WEIGHTS_" + std::to_string(jointSets)))
-        ++jointSets;
-      targets = std::max(targets, p.targets.size());
-      for (const auto& t : p.targets) targetNormals = targetNormals || t.count("NORMAL");
-    }
-    out.influences = int(4 * jointSets);
-    out.morphPositions.resize(targets);
-    out.morphNormals.resize(targets);
+    out.influences = int(4 * layout.jointSets);
+    out.morphPositions.resize(layout.targets);
+    out.morphNormals.resize(layout.targets);
     for (double w : mesh.weights) out.morphWeights.push_back(float(w));
-    for (size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
-      const auto& p = mesh.primitives[pi];
-      const std::string where =
-          named("mesh", meshIndex, mesh.name) + ", primitive " + std::to_string(pi);
-      const int mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
-      if (mode != TINYGLTF_MODE_TRIANGLES) {
-        static const char* names[] = {"POINTS",    "LINES",          "LINE_LOOP",   "LINE_STRIP",
-                                      "TRIANGLES", "TRIANGLE_STRIP", "TRIANGLE_FAN"};
-        // One line per mode, however many primitives use it.
-        if (skippedModes_.insert(mode).second)
-          warn(std::string("skipping primitives with mode ") + names[mode] +
-               ": only TRIANGLES are rendered (first: " + where + ")");
-        continue;
-      }
-      const auto pos = p.attributes.find("POSITION");
-      if (pos == p.attributes.end()) {
-        warn("skipping a primitive without POSITION (" + where + ")");
-        continue;
-      }
-      const std::vector<double> positions = readAccessor(model_, pos->second);
-      const size_t vcount = positions.size() / 3;
-      for (double x : positions)
-        if (!finite(x) || std::abs(x) > 3.0e38)
-          fail("POSITION has a value that is not finite", where + ", POSITION");
-      std::vector<uint32_t> idx;
-      if (p.indices >= 0) {
-        const std::vector<double> raw = readAccessor(model_, p.indices);
-        idx.reserve(raw.size());
-        for (size_t i = 0; i < raw.size(); ++i) {
-          if (raw[i] >= double(vcount))
-            fail("index " + std::to_string(uint64_t(raw[i])) + " at position " + std::to_string(i) +
-                     " is out of range (" + std::to_string(vcount) + " vertices)",
-                 where + ", indices accessor " + std::to_string(p.indices));
-          idx.push_back(uint32_t(raw[i]));
-        }
-      } else {
-        idx.resize(vcount);
-        for (size_t i = 0; i < vcount; ++i) idx[i] = uint32_t(i);
-      }
-      if (idx.size() % 3 != 0) {
-        warn("primitive has " + std::to_string(idx.size()) +
-             " indices, not a multiple of 3: the rest is ignored (" + where + ")");
-        idx.resize(idx.size() - idx.size() % 3);
-      }
-      const uint32_t base = uint32_t(out.positions.size());
-      if (uint64_t(base) + vcount > 0xffffffffull) fail("mesh has too many vertices", where);
-      for (size_t v = 0; v < vcount; ++v)
-        out.positions.emplace_back(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]);
-
-      // Normals: given ones normalised, degenerate ones area-weighted from faces. Without
-      // NORMAL the primitive is flat: zero normals, which every transform keeps zero, make the
-      // device shade by the geometric normal of the triangle as it is then (deformed or not).
-      const auto normalAttr = p.attributes.find("NORMAL");
-      const bool hasNormals = normalAttr != p.attributes.end();
-      if (!hasNormals) {
-        out.normals.resize(out.positions.size(), glm::vec3(0.0f));
-      } else {
-        std::vector<glm::vec3> faceNormals(vcount, glm::vec3(0.0f));
-        for (size_t t = 0; t + 2 < idx.size(); t += 3) {
-          const glm::vec3 a = out.positions[base + idx[t]], b = out.positions[base + idx[t + 1]],
-                          c = out.positions[base + idx[t + 2]];
-          const glm::vec3 n = glm::cross(b - a, c - a);  // length = twice the area
-          if (!std::isfinite(n.x + n.y + n.z)) continue;
-          for (int k = 0; k < 3; ++k) faceNormals[idx[t + size_t(k)]] += n;
-        }
-        const std::vector<double> normals = readAccessor(model_, normalAttr->second);
-        for (size_t v = 0; v < vcount; ++v) {
-          glm::vec3 n(normals[3 * v], normals[3 * v + 1], normals[3 * v + 2]);
-          float len = glm::length(n);
-          if (!(len > 1e-12f) || !std::isfinite(len)) {
-            n = faceNormals[v];
-            len = glm::length(n);
-          }
-          out.normals.push_back(len > 0.0f && std::isfinite(len) ? n / len
-                                                                 : glm::vec3(0.0f, 0.0f, 1.0f));
-        }
-      }
-      if (const auto it = p.attributes.find("TEXCOORD_0"); it != p.attributes.end()) {
-        const std::vector<double> uv = readAccessor(model_, it->second);
-        for (size_t v = 0; v < vcount; ++v) {
-          if (!finite(uv[2 * v]) || !finite(uv[2 * v + 1]))
-            fail("TEXCOORD_0 is not finite", where + ", TEXCOORD_0");
-          out.uvs.emplace_back(uv[2 * v], uv[2 * v + 1]);
-        }
-      } else {
-        out.uvs.resize(out.positions.size(), glm::vec2(0.0f));
-      }
-      if (anyUv1) {
-        std::vector<double> uv;
-        if (const auto it = p.attributes.find("TEXCOORD_1"); it != p.attributes.end())
-          uv = readAccessor(model_, it->second);
-        for (size_t v = 0; v < vcount; ++v) {
-          if (uv.empty()) {
-            out.uvs1.push_back(out.uvs[base + v]);  // TEXCOORD_0 stands in
-            continue;
-          }
-          if (!finite(uv[2 * v]) || !finite(uv[2 * v + 1]))
-            fail("TEXCOORD_1 is not finite", where + ", TEXCOORD_1");
-          out.uvs1.emplace_back(uv[2 * v], uv[2 * v + 1]);
-        }
-      }
-      if (jointSets > 0) {
-        std::vector<std::vector<double>> js(jointSets), ws(jointSets);
-        for (size_t set = 0; set < jointSets; ++set) {
-          const auto j = p.attributes.find("JOINTS_" + std::to_string(set));
-          const auto w = p.attributes.find("WEIGHTS_" + std::to_string(set));
-          if (j != p.attributes.end() && w != p.attributes.end()) {
-            js[set] = readAccessor(model_, j->second);
-            ws[set] = readAccessor(model_, w->second);
-          }
-        }
-        for (size_t v = 0; v < vcount; ++v) {
-          double sum = 0.0;
-          const size_t first = out.jointWeights.size();
-          for (size_t set = 0; set < jointSets; ++set)
-            for (size_t c = 0; c < 4; ++c) {
-              const bool have = !js[set].empty();
-              const double w = have ? ws[set][4 * v + c] : 0.0;
-              if (!finite(w) || w < 0.0)
-                fail("WEIGHTS_" + std::to_string(set) + " has a negative or non-finite weight",
-                     where);
-              out.joints.push_back(have ? uint32_t(js[set][4 * v + c]) : 0u);
-              out.jointWeights.push_back(float(w));
-              sum += w;
-            }
-          // The spec asks for weights that add to 1; normalise what is given.
-          if (sum > 0.0)
-            for (size_t k = first; k < out.jointWeights.size(); ++k)
-              out.jointWeights[k] = float(out.jointWeights[k] / sum);
-        }
-      }
-      for (size_t ti = 0; ti < targets; ++ti) {
-        const auto* t = ti < p.targets.size() ? &p.targets[ti] : nullptr;
-        std::vector<double> dp, dn;
-        if (t && t->count("POSITION")) dp = readAccessor(model_, t->at("POSITION"));
-        // NORMAL deltas of a flat primitive are ignored: its normals stay zero.
-        if (t && t->count("NORMAL") && hasNormals) dn = readAccessor(model_, t->at("NORMAL"));
-        for (size_t v = 0; v < vcount; ++v) {
-          glm::vec3 d(0.0f), n(0.0f);
-          if (!dp.empty()) d = glm::vec3(dp[3 * v], dp[3 * v + 1], dp[3 * v + 2]);
-          if (!dn.empty()) n = glm::vec3(dn[3 * v], dn[3 * v + 1], dn[3 * v + 2]);
-          if (!finite(d.x) || !finite(d.y) || !finite(d.z) || !finite(n.x) || !finite(n.y) ||
-              !finite(n.z))
-            fail("morph target " + std::to_string(ti) + " is not finite", where);
-          out.morphPositions[ti].push_back(d);
-          if (targetNormals) out.morphNormals[ti].push_back(n);
-        }
-      }
-      std::vector<double> tan;
-      if (const auto it = p.attributes.find("TANGENT"); it != p.attributes.end() && hasNormals)
-        tan = readAccessor(model_, it->second);
-      givenTangent.insert(givenTangent.end(), vcount, uint8_t(!tan.empty()));
-      if (anyTangents) {
-        for (size_t v = 0; v < vcount; ++v) {
-          glm::vec4 t(1.0f, 0.0f, 0.0f, 1.0f);
-          if (!tan.empty()) {
-            glm::vec3 xyz(tan[4 * v], tan[4 * v + 1], tan[4 * v + 2]);
-            const float len = glm::length(xyz);
-            if (len > 0.0f && std::isfinite(len))
-              t = glm::vec4(xyz / len, tan[4 * v + 3] < 0.0 ? -1.0f : 1.0f);
-          }
-          out.tangents.push_back(t);
-        }
-      }
-      const uint32_t mat = uint32_t(materialIndex(p.material));
-      for (uint32_t i : idx) out.indices.push_back(base + i);
-      out.materials.insert(out.materials.end(), idx.size() / 3, mat);
-      normalUvSet.insert(normalUvSet.end(), idx.size() / 3,
-                         uint8_t(tangentUvSet(scene_.materials[mat])));
-    }
+    for (size_t pi = 0; pi < mesh.primitives.size(); ++pi)
+      appendPrimitive(out, meshIndex, pi, layout, normalUvSet, givenTangent);
     // glTF asks for MikkTSpace tangents where a normal-mapped mesh has none: generated for
     // every vertex whose primitive gives none (or gives them without NORMAL).
-    if (anyNormalMap &&
+    if (layout.anyNormalMap &&
         std::find(givenTangent.begin(), givenTangent.end(), uint8_t(0)) != givenTangent.end()) {
       const std::vector<glm::vec4> given = std::move(out.tangents);
       generateTangents(out, normalUvSet);
@@ -334,6 +187,216 @@ class Converter : Stage {
         if (givenTangent[v]) out.tangents[v] = given[v];
     }
     return out;
+  }
+
+  // Appends primitive `pi` of the mesh to `out`, or skips it with a warning where it is no
+  // triangles or has no positions.
+  void appendPrimitive(TriangleMesh& out, int meshIndex, size_t pi, const MeshLayout& layout,
+                       std::vector<uint8_t>& normalUvSet, std::vector<uint8_t>& givenTangent) {
+    const auto& mesh = model_.meshes[size_t(meshIndex)];
+    const auto& p = mesh.primitives[pi];
+    const std::string where =
+        named("mesh", meshIndex, mesh.name) + ", primitive " + std::to_string(pi);
+    const int mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
+    if (mode != TINYGLTF_MODE_TRIANGLES) {
+      static const char* names[] = {"POINTS",    "LINES",          "LINE_LOOP",   "LINE_STRIP",
+                                    "TRIANGLES", "TRIANGLE_STRIP", "TRIANGLE_FAN"};
+      // One line per mode, however many primitives use it.
+      if (skippedModes_.insert(mode).second)
+        warn(std::string("skipping primitives with mode ") + names[mode] +
+             ": only TRIANGLES are rendered (first: " + where + ")");
+      return;
+    }
+    const auto pos = p.attributes.find("POSITION");
+    if (pos == p.attributes.end()) {
+      warn("skipping a primitive without POSITION (" + where + ")");
+      return;
+    }
+    const std::vector<double> positions = readAccessor(model_, pos->second);
+    PrimitiveVertices pv{p, where};
+    pv.vcount = positions.size() / 3;
+    for (double x : positions)
+      if (!finite(x) || std::abs(x) > 3.0e38)
+        fail("POSITION has a value that is not finite", where + ", POSITION");
+    const std::vector<uint32_t> idx = readIndices(p, pv.vcount, where);
+    pv.base = uint32_t(out.positions.size());
+    if (uint64_t(pv.base) + pv.vcount > 0xffffffffull) fail("mesh has too many vertices", where);
+    for (size_t v = 0; v < pv.vcount; ++v)
+      out.positions.emplace_back(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]);
+    appendNormals(out, pv, idx);
+    appendUvs(out, pv, layout.anyUv1);
+    appendSkin(out, pv, layout.jointSets);
+    appendMorphTargets(out, pv, layout);
+    appendTangents(out, pv, layout.anyTangents, givenTangent);
+    const uint32_t mat = uint32_t(materialIndex(p.material));
+    for (uint32_t i : idx) out.indices.push_back(pv.base + i);
+    out.materials.insert(out.materials.end(), idx.size() / 3, mat);
+    normalUvSet.insert(normalUvSet.end(), idx.size() / 3,
+                       uint8_t(tangentUvSet(scene_.materials[mat])));
+  }
+
+  // The primitive's indices (0, 1, 2 ... without an index accessor), whole triangles only.
+  std::vector<uint32_t> readIndices(const tinygltf::Primitive& p, size_t vcount,
+                                    const std::string& where) {
+    std::vector<uint32_t> idx;
+    if (p.indices >= 0) {
+      const std::vector<double> raw = readAccessor(model_, p.indices);
+      idx.reserve(raw.size());
+      for (size_t i = 0; i < raw.size(); ++i) {
+        if (raw[i] >= double(vcount))
+          fail("index " + std::to_string(uint64_t(raw[i])) + " at position " + std::to_string(i) +
+                   " is out of range (" + std::to_string(vcount) + " vertices)",
+               where + ", indices accessor " + std::to_string(p.indices));
+        idx.push_back(uint32_t(raw[i]));
+      }
+    } else {
+      idx.resize(vcount);
+      for (size_t i = 0; i < vcount; ++i) idx[i] = uint32_t(i);
+    }
+    if (idx.size() % 3 != 0) {
+      warn("primitive has " + std::to_string(idx.size()) +
+           " indices, not a multiple of 3: the rest is ignored (" + where + ")");
+      idx.resize(idx.size() - idx.size() % 3);
+    }
+    return idx;
+  }
+
+  // Normals: given ones normalised, degenerate ones area-weighted from faces. Without NORMAL
+  // the primitive is flat: zero normals, which every transform keeps zero, make the device
+  // shade by the geometric normal of the triangle as it is then (deformed or not).
+  void appendNormals(TriangleMesh& out, PrimitiveVertices& pv, const std::vector<uint32_t>& idx) {
+    const auto normalAttr = pv.p.attributes.find("NORMAL");
+    pv.hasNormals = normalAttr != pv.p.attributes.end();
+    if (!pv.hasNormals) {
+      out.normals.resize(out.positions.size(), glm::vec3(0.0f));
+      return;
+    }
+    const uint32_t base = pv.base;
+    std::vector<glm::vec3> faceNormals(pv.vcount, glm::vec3(0.0f));
+    for (size_t t = 0; t + 2 < idx.size(); t += 3) {
+      const glm::vec3 a = out.positions[base + idx[t]], b = out.positions[base + idx[t + 1]],
+                      c = out.positions[base + idx[t + 2]];
+      const glm::vec3 n = glm::cross(b - a, c - a);  // length = twice the area
+      if (!std::isfinite(n.x + n.y + n.z)) continue;
+      for (int k = 0; k < 3; ++k) faceNormals[idx[t + size_t(k)]] += n;
+    }
+    const std::vector<double> normals = readAccessor(model_, normalAttr->second);
+    for (size_t v = 0; v < pv.vcount; ++v) {
+      glm::vec3 n(normals[3 * v], normals[3 * v + 1], normals[3 * v + 2]);
+      float len = glm::length(n);
+      if (!(len > 1e-12f) || !std::isfinite(len)) {
+        n = faceNormals[v];
+        len = glm::length(n);
+      }
+      out.normals.push_back(len > 0.0f && std::isfinite(len) ? n / len
+                                                             : glm::vec3(0.0f, 0.0f, 1.0f));
+    }
+  }
+
+  // TEXCOORD_0 (zero where absent) and, where any primitive of the mesh has it, TEXCOORD_1.
+  void appendUvs(TriangleMesh& out, const PrimitiveVertices& pv, bool anyUv1) {
+    const auto& p = pv.p;
+    if (const auto it = p.attributes.find("TEXCOORD_0"); it != p.attributes.end()) {
+      const std::vector<double> uv = readAccessor(model_, it->second);
+      for (size_t v = 0; v < pv.vcount; ++v) {
+        if (!finite(uv[2 * v]) || !finite(uv[2 * v + 1]))
+          fail("TEXCOORD_0 is not finite", pv.where + ", TEXCOORD_0");
+        out.uvs.emplace_back(uv[2 * v], uv[2 * v + 1]);
+      }
+    } else {
+      out.uvs.resize(out.positions.size(), glm::vec2(0.0f));
+    }
+    if (!anyUv1) return;
+    std::vector<double> uv;
+    if (const auto it = p.attributes.find("TEXCOORD_1"); it != p.attributes.end())
+      uv = readAccessor(model_, it->second);
+    for (size_t v = 0; v < pv.vcount; ++v) {
+      if (uv.empty()) {
+        out.uvs1.push_back(out.uvs[pv.base + v]);  // TEXCOORD_0 stands in
+        continue;
+      }
+      if (!finite(uv[2 * v]) || !finite(uv[2 * v + 1]))
+        fail("TEXCOORD_1 is not finite", pv.where + ", TEXCOORD_1");
+      out.uvs1.emplace_back(uv[2 * v], uv[2 * v + 1]);
+    }
+  }
+
+  // Joints and weights of `jointSets` sets per vertex (zero weights for sets it lacks).
+  void appendSkin(TriangleMesh& out, const PrimitiveVertices& pv, size_t jointSets) {
+    if (jointSets == 0) return;
+    std::vector<std::vector<double>> js(jointSets), ws(jointSets);
+    for (size_t set = 0; set < jointSets; ++set) {
+      const auto j = pv.p.attributes.find("JOINTS_" + std::to_string(set));
+      const auto w = pv.p.attributes.find("WEIGHTS_" + std::to_string(set));
+      if (j != pv.p.attributes.end() && w != pv.p.attributes.end()) {
+        js[set] = readAccessor(model_, j->second);
+        ws[set] = readAccessor(model_, w->second);
+      }
+    }
+    for (size_t v = 0; v < pv.vcount; ++v) {
+      double sum = 0.0;
+      const size_t first = out.jointWeights.size();
+      for (size_t set = 0; set < jointSets; ++set)
+        for (size_t c = 0; c < 4; ++c) {
+          const bool have = !js[set].empty();
+          const double w = have ? ws[set][4 * v + c] : 0.0;
+          if (!finite(w) || w < 0.0)
+            fail("WEIGHTS_" + std::to_string(set) + " has a negative or non-finite weight",
+                 pv.where);
+          out.joints.push_back(have ? uint32_t(js[set][4 * v + c]) : 0u);
+          out.jointWeights.push_back(float(w));
+          sum += w;
+        }
+      // The spec asks for weights that add to 1; normalise what is given.
+      if (sum > 0.0)
+        for (size_t k = first; k < out.jointWeights.size(); ++k)
+          out.jointWeights[k] = float(out.jointWeights[k] / sum);
+    }
+  }
+
+  // Position (and normal) deltas of every morph target of the mesh; zero where the primitive
+  // lacks the target.
+  void appendMorphTargets(TriangleMesh& out, const PrimitiveVertices& pv,
+                          const MeshLayout& layout) {
+    for (size_t ti = 0; ti < layout.targets; ++ti) {
+      const auto* t = ti < pv.p.targets.size() ? &pv.p.targets[ti] : nullptr;
+      std::vector<double> dp, dn;
+      if (t && t->count("POSITION")) dp = readAccessor(model_, t->at("POSITION"));
+      // NORMAL deltas of a flat primitive are ignored: its normals stay zero.
+      if (t && t->count("NORMAL") && pv.hasNormals) dn = readAccessor(model_, t->at("NORMAL"));
+      for (size_t v = 0; v < pv.vcount; ++v) {
+        glm::vec3 d(0.0f), n(0.0f);
+        if (!dp.empty()) d = glm::vec3(dp[3 * v], dp[3 * v + 1], dp[3 * v + 2]);
+        if (!dn.empty()) n = glm::vec3(dn[3 * v], dn[3 * v + 1], dn[3 * v + 2]);
+        if (!finite(d.x) || !finite(d.y) || !finite(d.z) || !finite(n.x) || !finite(n.y) ||
+            !finite(n.z))
+          fail("morph target " + std::to_string(ti) + " is not finite", pv.where);
+        out.morphPositions[ti].push_back(d);
+        if (layout.targetNormals) out.morphNormals[ti].push_back(n);
+      }
+    }
+  }
+
+  // TANGENT where the primitive has it with NORMAL (normalised, w = handedness sign), else
+  // +X; `givenTangent` records which vertices' are the file's.
+  void appendTangents(TriangleMesh& out, const PrimitiveVertices& pv, bool anyTangents,
+                      std::vector<uint8_t>& givenTangent) {
+    std::vector<double> tan;
+    if (const auto it = pv.p.attributes.find("TANGENT");
+        it != pv.p.attributes.end() && pv.hasNormals)
+      tan = readAccessor(model_, it->second);
+    givenTangent.insert(givenTangent.end(), pv.vcount, uint8_t(!tan.empty()));
+    if (!anyTangents) return;
+    for (size_t v = 0; v < pv.vcount; ++v) {
+      glm::vec4 t(1.0f, 0.0f, 0.0f, 1.0f);
+      if (!tan.empty()) {
+        glm::vec3 xyz(tan[4 * v], tan[4 * v + 1], tan[4 * v + 2]);
+        const float len = glm::length(xyz);
+        if (len > 0.0f && std::isfinite(len))
+          t = glm::vec4(xyz / len, tan[4 * v + 3] < 0.0 ? -1.0f : 1.0f);
+      }
+      out.tangents.push_back(t);
+    }
   }
 
   // The uv set a material's generated tangents follow: its normal map's, else its coat normal

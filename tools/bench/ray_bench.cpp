@@ -28,6 +28,7 @@
 #include <memory>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -567,238 +568,311 @@ struct SetResult {
   double agreeHit = -1.0, agreePrim = -1.0;  // fractions; -1: no reference
 };
 
-}  // namespace
+#ifndef PATHREUSE_HAVE_EMBREE
+class EmbreeTracer;  // no reference: always null
+#endif
 
-int main(int argc, char** argv) {
-  CLI::App app{"ray_bench: BVH build and ray throughput of the SSG + DSG"};
+struct BenchArgs {
   std::string scenePath, deviceSpec, jsonPath;
   double frameTime = 0.0;
   int width = 640, height = 480, repeats = 5, levels = 3, instances = 16, embreeThreads = 2;
   bool noEmbree = false;
   accel::BuildOptions build;
-  app.add_option("scene", scenePath, "glTF scene (none: the synthetic sphere flake)");
-  app.add_option("--frame-time", frameTime, "Animation time of the DSG instances and camera (s)");
-  app.add_option("--width", width, "Camera ray image width")->check(CLI::PositiveNumber);
-  app.add_option("--height", height, "Camera ray image height")->check(CLI::PositiveNumber);
-  app.add_option("--repeats", repeats, "Timed launches per set, after one warm-up")
+};
+
+void addOptions(CLI::App& app, BenchArgs& a) {
+  app.add_option("scene", a.scenePath, "glTF scene (none: the synthetic sphere flake)");
+  app.add_option("--frame-time", a.frameTime, "Animation time of the DSG instances and camera (s)");
+  app.add_option("--width", a.width, "Camera ray image width")->check(CLI::PositiveNumber);
+  app.add_option("--height", a.height, "Camera ray image height")->check(CLI::PositiveNumber);
+  app.add_option("--repeats", a.repeats, "Timed launches per set, after one warm-up")
       ->check(CLI::PositiveNumber);
-  app.add_option("--device", deviceSpec,
+  app.add_option("--device", a.deviceSpec,
                  "OpenCL device (index, platform:device, cpu, gpu or name)");
-  app.add_option("--json", jsonPath, "Also write the results as JSON");
-  app.add_option("--levels", levels,
+  app.add_option("--json", a.jsonPath, "Also write the results as JSON");
+  app.add_option("--levels", a.levels,
                  "Synthetic scene: sphere-flake levels (3: about 236k triangles)");
-  app.add_option("--instances", instances,
+  app.add_option("--instances", a.instances,
                  "Synthetic scene: dynamic instances of a 2k-triangle sphere");
-  app.add_option("--embree-threads", embreeThreads, "Threads of the Embree reference")
+  app.add_option("--embree-threads", a.embreeThreads, "Threads of the Embree reference")
       ->check(CLI::PositiveNumber);
-  app.add_option("--bvh-width", build.width, "Children per BVH node (2, 4 or 8)")
+  app.add_option("--bvh-width", a.build.width, "Children per BVH node (2, 4 or 8)")
       ->check(CLI::IsMember({2, 4, 8}));
-  app.add_option("--leaf-size", build.maxLeafSize,
+  app.add_option("--leaf-size", a.build.maxLeafSize,
                  "BVH builder: largest leaf (tuning experiments)");
-  app.add_option("--traversal-cost", build.traversalCost,
+  app.add_option("--traversal-cost", a.build.traversalCost,
                  "BVH builder: SAH node cost per triangle test");
-  app.add_flag("--no-embree", noEmbree, "Skip the Embree reference");
+  app.add_flag("--no-embree", a.noEmbree, "Skip the Embree reference");
+}
+
+// The scene's BVHs, built as the renderer builds them (render/gpu_scene.cpp): SSG, each mesh,
+// TLAS at the frame time; then uploaded.
+struct Accels {
+  explicit Accels(int width) : dsg(width), dacc(width) {}
+  accel::StaticAccel ssg;
+  accel::DynamicAccel dsg;
+  accel::DeviceAccel dacc;
+  double ssgSeconds = 0.0, meshSeconds = 0.0, tlasSeconds = 0.0;  // build times
+  uint32_t meshNodes = 0;
+};
+
+void buildAccels(Context& ctx, const BenchScene& s, const accel::BuildOptions& build, Accels& acc) {
+  double t0 = now();
+  acc.ssg.build(s.positions, s.indices, build);
+  acc.ssgSeconds = now() - t0;
+  t0 = now();
+  for (const DynMesh& m : s.meshes) acc.dsg.addMesh(m.positions, m.indices, m.primBase, build);
+  acc.meshSeconds = now() - t0;
+  std::vector<double> tlasTimes;
+  for (int i = 0; i < 51; ++i) {
+    t0 = now();
+    acc.dsg.setInstances(s.instances);
+    tlasTimes.push_back(now() - t0);
+  }
+  acc.tlasSeconds = median(tlasTimes);
+  acc.meshNodes = acc.dsg.meshNodeCount();
+
+  acc.dacc.uploadStatic(ctx, acc.ssg);
+  acc.dacc.uploadMeshes(ctx, acc.dsg);
+  acc.dacc.uploadFrame(ctx, acc.dsg);
+  ctx.finish();
+}
+
+// Triangles of the DSG's meshes, and of its instances (a mesh once per instance).
+std::pair<size_t, size_t> dynamicTriangles(const BenchScene& s) {
+  size_t dynTris = 0, instTris = 0;
+  for (const DynMesh& m : s.meshes) dynTris += m.indices.size() / 3;
+  for (const auto& in : s.instances) instTris += s.meshes[in.mesh].indices.size() / 3;
+  return {dynTris, instTris};
+}
+
+void printAccels(const BenchScene& s, const Accels& acc, double loadSeconds) {
+  const auto [dynTris, instTris] = dynamicTriangles(s);
+  const auto& st = acc.ssg.stats();
+  std::printf("scene: %s (loaded in %.2f s)\n", s.name.c_str(), loadSeconds);
+  std::printf(
+      "SSG:  %zu triangles, build %.1f ms, binary tree of %u nodes, %u leaves, depth %d, SAH "
+      "cost %.1f; "
+      "%u nodes %d wide, stack need %d\n",
+      s.indices.size() / 3, acc.ssgSeconds * 1e3, st.nodes, st.leaves, st.depth,
+      sahCost(acc.ssg.nodes(), 0), acc.ssg.wide().nodeCount(), acc.ssg.wide().width,
+      acc.ssg.wide().stackNeed);
+  std::printf(
+      "DSG:  %zu meshes (%zu triangles), mesh BVHs %.2f ms, %u nodes; %zu instances (%zu "
+      "triangles), "
+      "TLAS %.3f ms, %u nodes, depth %d\n",
+      s.meshes.size(), dynTris, acc.meshSeconds * 1e3, acc.meshNodes, s.instances.size(), instTris,
+      acc.tlasSeconds * 1e3, acc.dsg.tlasStats().nodes, acc.dsg.tlasStats().depth);
+  std::printf("device memory: SSG %.2f MiB, DSG meshes %.2f MiB, per frame %.1f KiB\n",
+              double(acc.dacc.staticBytes()) / (1 << 20), double(acc.dacc.meshBytes()) / (1 << 20),
+              double(acc.dacc.frameBytes()) / 1024.0);
+  std::printf("emitters: %zu triangles, %zu point lights\n", s.emitters.size(),
+              s.pointLights.size());
+}
+
+#ifdef PATHREUSE_HAVE_EMBREE
+// Embree's answers for the same rays against ours: how many agree on hit or miss (occluded or
+// not), and on the primitive hit. Leaves Embree warmed up for both of its ways to trace, and
+// eh and eo sized for the timed runs.
+void compareWithEmbree(EmbreeTracer& embree, const std::vector<Ray>& rays,
+                       const std::vector<Hit>& hits, const std::vector<cl_uint>& occ,
+                       SetResult& res, std::vector<Hit>& eh, std::vector<cl_uint>& eo) {
+  embree.run(rays, res.anyHit, 1, &eh, &eo);  // warm-up, and the answers to compare
+  size_t sameHit = 0, samePrim = 0;
+  for (size_t i = 0; i < rays.size(); ++i) {
+    if (res.anyHit) {
+      sameHit += size_t((occ[i] != 0) == (eo[i] != 0));
+      continue;
+    }
+    sameHit += size_t((hits[i].prim == PR_INVALID_INDEX) == (eh[i].prim == PR_INVALID_INDEX));
+    samePrim += size_t(hits[i].prim == eh[i].prim && hits[i].inst == eh[i].inst);
+  }
+  const double n = double(std::max<size_t>(rays.size(), 1));
+  res.agreeHit = double(sameHit) / n;
+  res.agreePrim = res.anyHit ? res.agreeHit : double(samePrim) / n;
+  embree.run(rays, res.anyHit, 8, &eh, &eo);
+}
+#endif
+
+// Times one ray set: a warm-up launch (whose answers give the hit fraction), then `repeats`
+// timed launches of ours, each followed by Embree's where there is a reference.
+void measureSet(DeviceTracer& ours, EmbreeTracer* embree, const std::vector<Ray>& rays, int repeats,
+                SetResult& res) {
+  res.rays = rays.size();
+  ours.setRays(rays);
+  ours.run(res.anyHit);  // warm-up
+  const std::vector<Hit> hits = ours.hits();
+  const std::vector<cl_uint> occ = ours.occluded();
+  size_t hitCount = 0;
+  for (size_t i = 0; i < rays.size(); ++i)
+    hitCount += res.anyHit ? size_t(occ[i] != 0) : size_t(hits[i].prim != PR_INVALID_INDEX);
+  res.hitFraction = double(hitCount) / double(std::max<size_t>(rays.size(), 1));
+#ifdef PATHREUSE_HAVE_EMBREE
+  std::vector<Hit> eh;
+  std::vector<cl_uint> eo;
+  if (embree) compareWithEmbree(*embree, rays, hits, occ, res, eh, eo);
+#else
+  (void)embree;
+#endif
+  // Ours and the reference alternate, so drifting load hits both alike.
+  for (int r = 0; r < repeats; ++r) {
+    res.ours.mrays.push_back(ours.run(res.anyHit));
+#ifdef PATHREUSE_HAVE_EMBREE
+    if (embree) {
+      res.embree1.mrays.push_back(embree->run(rays, res.anyHit, 1, &eh, &eo));
+      res.embree8.mrays.push_back(embree->run(rays, res.anyHit, 8, &eh, &eo));
+    }
+#endif
+  }
+}
+
+void printResults(const std::vector<SetResult>& results) {
+  std::printf("\n%-7s %-7s %8s %6s | %-24s", "rays", "query", "count", "hit%",
+              "ours Mrays/s med [min-max]");
+  const bool ref = !results[0].embree1.mrays.empty();
+  if (ref)
+    std::printf(" | %-9s %-9s %-6s %-9s %-9s", "Embree-1", "Embree-8", "ratio", "agree",
+                "same-prim");
+  std::printf("\n");
+  for (const SetResult& r : results) {
+    char ourCol[64];
+    std::snprintf(ourCol, sizeof ourCol, "%7.2f [%.2f-%.2f]", r.ours.med(), r.ours.min(),
+                  r.ours.max());
+    std::printf("%-7s %-7s %8zu %5.1f%% | %-24s", r.name, r.anyHit ? "any" : "closest", r.rays,
+                100.0 * r.hitFraction, ourCol);
+    if (ref) {
+      const double best = std::max(r.embree1.med(), r.embree8.med());
+      std::printf(" | %9.2f %9.2f %6.3f %8.4f%% %8.4f%%", r.embree1.med(), r.embree8.med(),
+                  best > 0.0 ? r.ours.med() / best : 0.0, 100.0 * r.agreeHit, 100.0 * r.agreePrim);
+    }
+    std::printf("\n");
+  }
+  if (ref)
+    std::printf(
+        "ratio = ours / the better of Embree-1 (rtcIntersect1) and Embree-8 (8-wide packets)\n");
+}
+
+json accelsJson(const BenchScene& s, const Accels& acc) {
+  const auto [dynTris, instTris] = dynamicTriangles(s);
+  const auto& st = acc.ssg.stats();
+  json j;
+  j["ssg"] = {{"triangles", s.indices.size() / 3},
+              {"build_ms", acc.ssgSeconds * 1e3},
+              {"nodes", st.nodes},
+              {"leaves", st.leaves},
+              {"depth", st.depth},
+              {"sah_cost", sahCost(acc.ssg.nodes(), 0)},
+              {"wide_nodes", acc.ssg.wide().nodeCount()},
+              {"width", acc.ssg.wide().width},
+              {"stack_need", acc.ssg.wide().stackNeed}};
+  j["dsg"] = {{"meshes", s.meshes.size()},
+              {"mesh_triangles", dynTris},
+              {"mesh_build_ms", acc.meshSeconds * 1e3},
+              {"mesh_nodes", acc.meshNodes},
+              {"instances", s.instances.size()},
+              {"instance_triangles", instTris},
+              {"tlas_build_ms", acc.tlasSeconds * 1e3},
+              {"tlas_nodes", acc.dsg.tlasStats().nodes}};
+  j["device_bytes"] = {{"ssg", acc.dacc.staticBytes()},
+                       {"dsg_meshes", acc.dacc.meshBytes()},
+                       {"per_frame", acc.dacc.frameBytes()}};
+  return j;
+}
+
+json setJson(const SetResult& r, bool ref) {
+  json e = {{"query", r.anyHit ? "any" : "closest"},
+            {"rays", r.rays},
+            {"hit_fraction", r.hitFraction},
+            {"ours_mrays", r.ours.toJson()}};
+  if (ref) {
+    e["embree1_mrays"] = r.embree1.toJson();
+    e["embree8_mrays"] = r.embree8.toJson();
+    e["agree_hit"] = r.agreeHit;
+    e["agree_prim"] = r.agreePrim;
+  }
+  return e;
+}
+
+void writeJson(const BenchArgs& a, const std::string& deviceName, const char* cap,
+               const BenchScene& s, const Accels& acc, const EmbreeTracer* embree,
+               const std::vector<SetResult>& results) {
+  json j;
+  j["device"] = deviceName;
+  j["pocl_max_pthread_count"] = cap ? cap : "";
+  j["scene"] = s.name;
+  j["frame_time"] = a.frameTime;
+  j["image"] = {a.width, a.height};
+  j.update(accelsJson(s, acc));
+#ifdef PATHREUSE_HAVE_EMBREE
+  if (embree)
+    j["embree"] = {{"version", RTC_VERSION_STRING},
+                   {"threads", a.embreeThreads},
+                   {"build_ms", embree->buildSeconds() * 1e3},
+                   {"bytes", g_embreeBytes.load()}};
+#else
+  (void)embree;
+#endif
+  const bool ref = !results[0].embree1.mrays.empty();
+  for (const SetResult& r : results) j["sets"][r.name] = setJson(r, ref);
+  std::ofstream(a.jsonPath) << j.dump(2) << "\n";
+}
+
+int runBench(const BenchArgs& a) {
+  const auto devices = enumerateDevices();
+  Context ctx(selectDevice(devices, a.deviceSpec));
+  const std::string deviceName = describeDevice(ctx.device());
+  const char* cap = std::getenv("POCL_MAX_PTHREAD_COUNT");
+  std::printf("device: %s (POCL_MAX_PTHREAD_COUNT=%s)\n", deviceName.c_str(), cap ? cap : "unset");
+
+  const double t0 = now();
+  const BenchScene s =
+      a.scenePath.empty() ? synthetic(a.levels, a.instances) : fromGltf(a.scenePath, a.frameTime);
+  const double loadSeconds = now() - t0;
+  Accels acc(a.build.width);
+  buildAccels(ctx, s, a.build, acc);
+  printAccels(s, acc, loadSeconds);
+
+  DeviceTracer ours(ctx, acc.dacc);
+  const RaySets sets = makeRays(s, ours, a.width, a.height);
+  std::printf("rays: %zu camera (%d x %d, %.1f%% hit), %zu shadow, %zu bounce\n",
+              sets.camera.size(), a.width, a.height,
+              100.0 * double(sets.camera.size()) / double(std::max<size_t>(sets.pixels, 1)),
+              sets.shadow.size(), sets.bounce.size());
+
+#ifdef PATHREUSE_HAVE_EMBREE
+  std::unique_ptr<EmbreeTracer> embree;
+  if (!a.noEmbree) embree = std::make_unique<EmbreeTracer>(s, a.embreeThreads);
+  if (embree)
+    std::printf(
+        "Embree %d.%d.%d, %d threads: build (quality high) %.1f ms (meshes %.1f ms), %.2f MiB\n",
+        RTC_VERSION_MAJOR, RTC_VERSION_MINOR, RTC_VERSION_PATCH, a.embreeThreads,
+        embree->buildSeconds() * 1e3, embree->meshSeconds() * 1e3,
+        double(g_embreeBytes.load()) / (1 << 20));
+  EmbreeTracer* reference = embree.get();
+#else
+  EmbreeTracer* reference = nullptr;
+#endif
+
+  std::vector<SetResult> results{{"camera", false}, {"shadow", true}, {"bounce", false}};
+  const std::vector<Ray>* raysOf[3] = {&sets.camera, &sets.shadow, &sets.bounce};
+  for (size_t k = 0; k < results.size(); ++k)
+    measureSet(ours, reference, *raysOf[k], a.repeats, results[k]);
+  printResults(results);
+  if (!a.jsonPath.empty()) writeJson(a, deviceName, cap, s, acc, reference, results);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"ray_bench: BVH build and ray throughput of the SSG + DSG"};
+  BenchArgs args;
+  addOptions(app, args);
   CLI11_PARSE(app, argc, argv);
   try {
-    const auto devices = enumerateDevices();
-    Context ctx(selectDevice(devices, deviceSpec));
-    const std::string deviceName = describeDevice(ctx.device());
-    const char* cap = std::getenv("POCL_MAX_PTHREAD_COUNT");
-    std::printf("device: %s (POCL_MAX_PTHREAD_COUNT=%s)\n", deviceName.c_str(),
-                cap ? cap : "unset");
-
-    double t0 = now();
-    const BenchScene s =
-        scenePath.empty() ? synthetic(levels, instances) : fromGltf(scenePath, frameTime);
-    const double loadSeconds = now() - t0;
-    size_t dynTris = 0, instTris = 0;
-    for (const DynMesh& m : s.meshes) dynTris += m.indices.size() / 3;
-    for (const auto& in : s.instances) instTris += s.meshes[in.mesh].indices.size() / 3;
-
-    // Builds as the renderer does (render/gpu_scene.cpp): SSG, each mesh, TLAS at the frame time.
-    accel::StaticAccel ssg;
-    t0 = now();
-    ssg.build(s.positions, s.indices, build);
-    const double ssgSeconds = now() - t0;
-    accel::DynamicAccel dsg(build.width);
-    t0 = now();
-    for (const DynMesh& m : s.meshes) dsg.addMesh(m.positions, m.indices, m.primBase, build);
-    const double meshSeconds = now() - t0;
-    std::vector<double> tlasTimes;
-    for (int i = 0; i < 51; ++i) {
-      t0 = now();
-      dsg.setInstances(s.instances);
-      tlasTimes.push_back(now() - t0);
-    }
-    const double tlasSeconds = median(tlasTimes);
-    uint32_t meshNodes = dsg.meshNodeCount();
-
-    accel::DeviceAccel dacc(build.width);
-    dacc.uploadStatic(ctx, ssg);
-    dacc.uploadMeshes(ctx, dsg);
-    dacc.uploadFrame(ctx, dsg);
-    ctx.finish();
-
-    const auto& st = ssg.stats();
-    std::printf("scene: %s (loaded in %.2f s)\n", s.name.c_str(), loadSeconds);
-    std::printf(
-        "SSG:  %zu triangles, build %.1f ms, binary tree of %u nodes, %u leaves, depth %d, SAH "
-        "cost %.1f; "
-        "%u nodes %d wide, stack need %d\n",
-        s.indices.size() / 3, ssgSeconds * 1e3, st.nodes, st.leaves, st.depth,
-        sahCost(ssg.nodes(), 0), ssg.wide().nodeCount(), ssg.wide().width, ssg.wide().stackNeed);
-    std::printf(
-        "DSG:  %zu meshes (%zu triangles), mesh BVHs %.2f ms, %u nodes; %zu instances (%zu "
-        "triangles), "
-        "TLAS %.3f ms, %u nodes, depth %d\n",
-        s.meshes.size(), dynTris, meshSeconds * 1e3, meshNodes, s.instances.size(), instTris,
-        tlasSeconds * 1e3, dsg.tlasStats().nodes, dsg.tlasStats().depth);
-    std::printf("device memory: SSG %.2f MiB, DSG meshes %.2f MiB, per frame %.1f KiB\n",
-                double(dacc.staticBytes()) / (1 << 20), double(dacc.meshBytes()) / (1 << 20),
-                double(dacc.frameBytes()) / 1024.0);
-    std::printf("emitters: %zu triangles, %zu point lights\n", s.emitters.size(),
-                s.pointLights.size());
-
-    DeviceTracer ours(ctx, dacc);
-    const RaySets sets = makeRays(s, ours, width, height);
-    std::printf("rays: %zu camera (%d x %d, %.1f%% hit), %zu shadow, %zu bounce\n",
-                sets.camera.size(), width, height,
-                100.0 * double(sets.camera.size()) / double(std::max<size_t>(sets.pixels, 1)),
-                sets.shadow.size(), sets.bounce.size());
-
-#ifdef PATHREUSE_HAVE_EMBREE
-    std::unique_ptr<EmbreeTracer> embree;
-    if (!noEmbree) embree = std::make_unique<EmbreeTracer>(s, embreeThreads);
-    if (embree)
-      std::printf(
-          "Embree %d.%d.%d, %d threads: build (quality high) %.1f ms (meshes %.1f ms), %.2f MiB\n",
-          RTC_VERSION_MAJOR, RTC_VERSION_MINOR, RTC_VERSION_PATCH, embreeThreads,
-          embree->buildSeconds() * 1e3, embree->meshSeconds() * 1e3,
-          double(g_embreeBytes.load()) / (1 << 20));
-#else
-    (void)noEmbree;
-    (void)embreeThreads;
-#endif
-
-    std::vector<SetResult> results{{"camera", false}, {"shadow", true}, {"bounce", false}};
-    const std::vector<Ray>* raysOf[3] = {&sets.camera, &sets.shadow, &sets.bounce};
-    for (size_t k = 0; k < results.size(); ++k) {
-      SetResult& res = results[k];
-      const std::vector<Ray>& rays = *raysOf[k];
-      res.rays = rays.size();
-      ours.setRays(rays);
-      ours.run(res.anyHit);  // warm-up
-      const std::vector<Hit> hits = ours.hits();
-      const std::vector<cl_uint> occ = ours.occluded();
-      size_t hitCount = 0;
-      for (size_t i = 0; i < rays.size(); ++i)
-        hitCount += res.anyHit ? size_t(occ[i] != 0) : size_t(hits[i].prim != PR_INVALID_INDEX);
-      res.hitFraction = double(hitCount) / double(std::max<size_t>(rays.size(), 1));
-#ifdef PATHREUSE_HAVE_EMBREE
-      std::vector<Hit> eh;
-      std::vector<cl_uint> eo;
-      if (embree) {
-        embree->run(rays, res.anyHit, 1, &eh, &eo);  // warm-up, and the answers to compare
-        size_t sameHit = 0, samePrim = 0;
-        for (size_t i = 0; i < rays.size(); ++i) {
-          if (res.anyHit) {
-            sameHit += size_t((occ[i] != 0) == (eo[i] != 0));
-            continue;
-          }
-          sameHit += size_t((hits[i].prim == PR_INVALID_INDEX) == (eh[i].prim == PR_INVALID_INDEX));
-          samePrim += size_t(hits[i].prim == eh[i].prim && hits[i].inst == eh[i].inst);
-        }
-        const double n = double(std::max<size_t>(rays.size(), 1));
-        res.agreeHit = double(sameHit) / n;
-        res.agreePrim = res.anyHit ? res.agreeHit : double(samePrim) / n;
-        embree->run(rays, res.anyHit, 8, &eh, &eo);
-      }
-#endif
-      // Ours and the reference alternate, so drifting load hits both alike.
-      for (int r = 0; r < repeats; ++r) {
-        res.ours.mrays.push_back(ours.run(res.anyHit));
-#ifdef PATHREUSE_HAVE_EMBREE
-        if (embree) {
-          res.embree1.mrays.push_back(embree->run(rays, res.anyHit, 1, &eh, &eo));
-          res.embree8.mrays.push_back(embree->run(rays, res.anyHit, 8, &eh, &eo));
-        }
-#endif
-      }
-    }
-
-    std::printf("\n%-7s %-7s %8s %6s | %-24s", "rays", "query", "count", "hit%",
-                "ours Mrays/s med [min-max]");
-    const bool ref = !results[0].embree1.mrays.empty();
-    if (ref)
-      std::printf(" | %-9s %-9s %-6s %-9s %-9s", "Embree-1", "Embree-8", "ratio", "agree",
-                  "same-prim");
-    std::printf("\n");
-    for (const SetResult& r : results) {
-      char ourCol[64];
-      std::snprintf(ourCol, sizeof ourCol, "%7.2f [%.2f-%.2f]", r.ours.med(), r.ours.min(),
-                    r.ours.max());
-      std::printf("%-7s %-7s %8zu %5.1f%% | %-24s", r.name, r.anyHit ? "any" : "closest", r.rays,
-                  100.0 * r.hitFraction, ourCol);
-      if (ref) {
-        const double best = std::max(r.embree1.med(), r.embree8.med());
-        std::printf(" | %9.2f %9.2f %6.3f %8.4f%% %8.4f%%", r.embree1.med(), r.embree8.med(),
-                    best > 0.0 ? r.ours.med() / best : 0.0, 100.0 * r.agreeHit,
-                    100.0 * r.agreePrim);
-      }
-      std::printf("\n");
-    }
-    if (ref)
-      std::printf(
-          "ratio = ours / the better of Embree-1 (rtcIntersect1) and Embree-8 (8-wide packets)\n");
-
-    if (!jsonPath.empty()) {
-      json j;
-      j["device"] = deviceName;
-      j["pocl_max_pthread_count"] = cap ? cap : "";
-      j["scene"] = s.name;
-      j["frame_time"] = frameTime;
-      j["image"] = {width, height};
-      j["ssg"] = {{"triangles", s.indices.size() / 3},
-                  {"build_ms", ssgSeconds * 1e3},
-                  {"nodes", st.nodes},
-                  {"leaves", st.leaves},
-                  {"depth", st.depth},
-                  {"sah_cost", sahCost(ssg.nodes(), 0)},
-                  {"wide_nodes", ssg.wide().nodeCount()},
-                  {"width", ssg.wide().width},
-                  {"stack_need", ssg.wide().stackNeed}};
-      j["dsg"] = {{"meshes", s.meshes.size()},          {"mesh_triangles", dynTris},
-                  {"mesh_build_ms", meshSeconds * 1e3}, {"mesh_nodes", meshNodes},
-                  {"instances", s.instances.size()},    {"instance_triangles", instTris},
-                  {"tlas_build_ms", tlasSeconds * 1e3}, {"tlas_nodes", dsg.tlasStats().nodes}};
-      j["device_bytes"] = {{"ssg", dacc.staticBytes()},
-                           {"dsg_meshes", dacc.meshBytes()},
-                           {"per_frame", dacc.frameBytes()}};
-#ifdef PATHREUSE_HAVE_EMBREE
-      if (embree)
-        j["embree"] = {{"version", RTC_VERSION_STRING},
-                       {"threads", embreeThreads},
-                       {"build_ms", embree->buildSeconds() * 1e3},
-                       {"bytes", g_embreeBytes.load()}};
-#endif
-      for (const SetResult& r : results) {
-        json e = {{"query", r.anyHit ? "any" : "closest"},
-                  {"rays", r.rays},
-                  {"hit_fraction", r.hitFraction},
-                  {"ours_mrays", r.ours.toJson()}};
-        if (ref) {
-          e["embree1_mrays"] = r.embree1.toJson();
-          e["embree8_mrays"] = r.embree8.toJson();
-          e["agree_hit"] = r.agreeHit;
-          e["agree_prim"] = r.agreePrim;
-        }
-        j["sets"][r.name] = e;
-      }
-      std::ofstream(jsonPath) << j.dump(2) << "\n";
-    }
+    return runBench(args);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "ray_bench: %s\n", e.what());
     return 1;
   }
-  return 0;
 }
