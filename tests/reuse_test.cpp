@@ -247,6 +247,12 @@ void expectSameImage(const std::string& scene, const std::string& args, int w, i
                                     "conv-reuse");
   const std::string b = renderReuse(scene, f, size + " --mode pathtrace --seed 77", "conv-pt");
   const Image ia = test::frameImage(a, frame), ib = test::frameImage(b, frame);
+  // Two black (or two empty) images would agree everywhere: both must be lit, with noise.
+  for (const Image* im : {&ia, &ib}) {
+    const Moments whole = regionMean(*im, 0, 0, w, h, 1);
+    EXPECT_GT(whole.mean, 1e-3) << scene << ": an unlit image";
+    EXPECT_GT(whole.stderr_, 0.0) << scene << ": a constant image";
+  }
   int worstRegion = -1;
   double worst = 0;
   for (int ry = 0; ry < 4; ++ry)

@@ -75,9 +75,7 @@ PathReuse::PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseS
   }
 }
 
-void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameStats* stats) {
-  StageTimer timer;
-  ctx_.zero(counters_, dev::PR_C_COUNT * 4);
+dev::ReuseParams PathReuse::frameParams(int frame) const {
   dev::ReuseParams rp{};
   rp.seed = settings_.seed;
   rp.slots = slots_;
@@ -96,6 +94,14 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
   rp.trace_total = scene_.traceTotalPower();
   rp.scene_radius = scene_.sceneRadius();
   rp.cx = scene_.sceneCentre().x, rp.cy = scene_.sceneCentre().y, rp.cz = scene_.sceneCentre().z;
+
+  return rp;
+}
+
+void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameStats* stats) {
+  StageTimer timer;
+  ctx_.zero(counters_, dev::PR_C_COUNT * 4);
+  const dev::ReuseParams rp = frameParams(frame);
 
   // 1. Which slots must be traced again. With a connection history, retrace learns the same
   // changed slots as reuse (invalidate marks them and leaves the arena alone), so that the
@@ -143,6 +149,14 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
     ctx_.launch1D(lightTrace_, toTrace, "light_trace", &timer);
   }
 
+  if (!tracePasses(frame, camera, rp, sceneArgs, frameStamp, &timer)) return;
+  if (eyePaths_) eyePaths_->reportRays(stats);
+  report(&timer, toTrace, stats);
+}
+
+bool PathReuse::tracePasses(int frame, const dev::CameraParams& camera, const dev::ReuseParams& rp,
+                            const kargs::SceneArgs& sceneArgs, cl_uint frameStamp,
+                            StageTimer* timer) {
   // 3. Per sample: first hits, then connections, then the film.
   // `sample` changes per pass.
   kargs::EyeHitArgs eh;
@@ -174,24 +188,27 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
     // With eye paths, the path tracer's pass writes the sample's radiance and its first eye
     // vertex, where eye_hit would.
     if (eyePaths_) {
-      eyePaths_->tracePass(s, &timer);
+      eyePaths_->tracePass(s, timer);
     } else {
       eh.sample = cl_uint(s);
       eh.set(eyeHit_, kargs::kPass);
-      ctx_.launch1D(eyeHit_, first, n, "eye_hit", &timer);
+      ctx_.launch1D(eyeHit_, first, n, "eye_hit", timer);
     }
     cn.sample = cl_uint(s);
     cn.set(connect_, kargs::kPass);
-    ctx_.launch1D(connect_, first, n, "connect", &timer);
-    film_.accumulate(radiance_, &timer);
+    ctx_.launch1D(connect_, first, n, "connect", timer);
+    film_.accumulate(radiance_, timer);
     // Wait for each pass, so that an interrupt stops a frame of many samples within one pass.
     ctx_.finish();
-    if (interrupted()) return;
+    if (interrupted()) return false;
   }
-  if (eyePaths_) eyePaths_->reportRays(stats);
+  return true;
+}
+
+void PathReuse::report(StageTimer* timer, cl_uint toTrace, FrameStats* stats) {
   cl_uint c[dev::PR_C_COUNT] = {};
   CL_CHECK(ctx_.queue().enqueueReadBuffer(counters_, CL_TRUE, 0, sizeof c, c));
-  auto times = timer.collect();
+  auto times = timer->collect();
   if (!stats) return;
   for (const auto& [k, v] : times) stats->stageSeconds[k] += v;
     // Every counter where kernels/shared/reuse.h's list says.

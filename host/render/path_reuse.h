@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "cl/context.h"
+#include "cl/kernel_args.h"
 #include "render/film.h"
 #include "render/gpu_scene.h"
 #include "render/integrator.h"
@@ -54,6 +55,13 @@ class PathReuse : public Integrator {
  private:
   // The slot offset of the light paths each pixel sample connects to, this frame.
   cl_uint historySlotOffset(const dev::ReuseParams& rp) const;
+  dev::ReuseParams frameParams(int frame) const;
+  // The frame's sample passes: first hits (or the eye paths), connections, the film. False when
+  // interrupted.
+  bool tracePasses(int frame, const dev::CameraParams& camera, const dev::ReuseParams& rp,
+                   const kargs::SceneArgs& sceneArgs, cl_uint frameStamp, StageTimer* timer);
+  // Reads the counters and adds them and the stage times to stats.
+  void report(StageTimer* timer, cl_uint toTrace, FrameStats* stats);
 
   Context& ctx_;
   GpuScene& scene_;

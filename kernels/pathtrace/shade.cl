@@ -22,6 +22,74 @@ PR_INLINE float eye_paths_light_side(const Light* l, float3 n_tri, float start, 
          eye_paths_emit_density(l, n_tri, d * (1.0f / sqrt(d2)), cos_x, d2) * rev * eye_ratio;
 }
 
+// Escaped: the environment's light, MIS-weighted against next-event estimation, into *add;
+// 0 where it gives none.
+PR_INLINE int pt_escaped(const SceneData* s, const PathState* p, float3* add) {
+  const float3 d = make_float3(p->ray.dx, p->ray.dy, p->ray.dz);
+  const float3 le = environment_radiance(s, d);
+  if (!(max3(le) > 0.0f)) return 0;
+  float w = 1.0f;
+  if (!(p->flags & PR_PATH_SPECULAR))
+    w = power_heuristic(p->last_pdf,
+                        environment_pdf(s, make_float3(p->prev_x, p->prev_y, p->prev_z),
+                                        make_float3(p->prev_nx, p->prev_ny, p->prev_nz), d));
+  *add = make_float3(p->tp_r, p->tp_g, p->tp_b) * le * w;
+  return 1;
+}
+
+// The weight of emission found at h along d (dist2 from the previous vertex): against next-event
+// estimation, and where the connections can make the path too (joinable), times their share.
+PR_INLINE float pt_emission_weight(const SceneData* s, const PathState* p, const SurfaceHit* h,
+                                   float3 d, float dist2, int joinable, u32 light_paths,
+                                   __global const float* trace_cdf, float trace_total) {
+  const float3 prev = make_float3(p->prev_x, p->prev_y, p->prev_z);
+  const float3 prev_n = make_float3(p->prev_nx, p->prev_ny, p->prev_nz);
+  float w = 1.0f;
+  if (!(p->flags & PR_PATH_SPECULAR))
+    w = power_heuristic(p->last_pdf, emitter_pdf(s, h, prev, prev_n));
+  const u32 li = joinable ? emitter_light(s, h) : PR_INVALID_INDEX;
+  if (li != PR_INVALID_INDEX) {
+    // The connections' share of the path (eye_paths.h); the eye path's N and H split the rest.
+    const Light l = s->lights.lights[li];
+    const float3 n_tri = eye_paths_light_normal(s, &l);
+    const float start = eye_paths_start_density(&l, li, trace_cdf, trace_total);
+    const int spec = (p->flags & PR_PATH_SPECULAR) != 0u;
+    const float dens_h =
+        spec ? 1.0f : solid_angle_to_area_pdf(p->last_pdf, fabs(dot(n_tri, d)), dist2);
+    const float dens_l = eye_paths_light_side(&l, n_tri, start, light_paths, p->eye_ratio, h->p,
+                                              prev, p->seg_cos, 1.0f);
+    const float dens_n = spec ? 0.0f : start;
+    if (dens_l > 0.0f) w *= 1.0f - eye_path_share(dens_n / dens_l, dens_h / dens_l);
+  }
+  return w;
+}
+
+// The weight of a next-event sample at a joinable vertex h: the power heuristic against BSDF
+// sampling, times what the connections leave of the path.
+PR_INLINE float pt_next_event_weight(const SceneData* s, const PathState* p, const SurfaceHit* h,
+                                     const ShadingFrame* f, const NextEventChoice* ch, int has_rev,
+                                     float dist2, u32 light_paths, __global const float* trace_cdf,
+                                     float trace_total) {
+  const Light l = s->lights.lights[ch->light];
+  float w = ch->delta ? 1.0f : power_heuristic(ch->pdf_light, ch->pdf_bsdf);
+  if (eye_paths_light(&l)) {
+    const float3 n_tri =
+        l.type == PR_LIGHT_TRIANGLE ? eye_paths_light_normal(s, &l) : make_float3(0.0f, 0.0f, 1.0f);
+    const float3 dz = ch->pos - h->p;
+    const float dz2 = dot(dz, dz);
+    const float3 wi = dz * (1.0f / sqrt(dz2));
+    const float dens_n = eye_paths_start_density(&l, ch->light, trace_cdf, trace_total);
+    const float dens_h = l.type == PR_LIGHT_TRIANGLE
+                             ? solid_angle_to_area_pdf(ch->pdf_bsdf, fabs(dot(n_tri, wi)), dz2)
+                             : 0.0f;
+    const float rev = has_rev ? solid_angle_to_area_pdf(ch->pdf_bsdf_rev, p->seg_cos, dist2) : 1.0f;
+    const float dens_l = eye_paths_light_side(&l, n_tri, dens_n, light_paths, p->eye_ratio, ch->pos,
+                                              h->p, fabs(dot(f->ng, wi)), rev);
+    if (dens_l > 0.0f) w *= 1.0f - eye_path_share(dens_n / dens_l, dens_h / dens_l);
+  }
+  return w;
+}
+
 PR_KERNEL void pt_shade(PR_PARAMS(PR_ARGS_PT_SHADE)) {
   const uint i = (uint)get_global_id(0);
   if (i >= count) return;
@@ -32,18 +100,8 @@ PR_KERNEL void pt_shade(PR_PARAMS(PR_ARGS_PT_SHADE)) {
 
   const Hit hit = hits[i];
   if (hit.prim == PR_INVALID_INDEX) {
-    // Escaped: the environment's light, MIS-weighted against next-event estimation.
-    const float3 d = make_float3(p.ray.dx, p.ray.dy, p.ray.dz);
-    const float3 le = environment_radiance(&s, d);
-    if (max3(le) > 0.0f) {
-      float w = 1.0f;
-      if (!(p.flags & PR_PATH_SPECULAR))
-        w = power_heuristic(p.last_pdf,
-                            environment_pdf(&s, make_float3(p.prev_x, p.prev_y, p.prev_z),
-                                            make_float3(p.prev_nx, p.prev_ny, p.prev_nz), d));
-      const float3 add = make_float3(p.tp_r, p.tp_g, p.tp_b) * le * w;
-      radiance[i] += (float4)(add.x, add.y, add.z, 0.0f);
-    }
+    float3 add;
+    if (pt_escaped(&s, &p, &add)) radiance[i] += (float4)(add.x, add.y, add.z, 0.0f);
     p.alive = 0u;
     states[i] = p;
     return;
@@ -54,8 +112,6 @@ PR_KERNEL void pt_shade(PR_PARAMS(PR_ARGS_PT_SHADE)) {
   const float3 wo = -d;
   const SurfaceHit h = surface_at(&s.sd, hit.prim, hit.inst, hit.u, hit.v);
   float3 tp = make_float3(p.tp_r, p.tp_g, p.tp_b) * volume_transmittance(&s, &h, d, hit.t);
-  const float3 prev = make_float3(p.prev_x, p.prev_y, p.prev_z);
-  const float3 prev_n = make_float3(p.prev_nx, p.prev_ny, p.prev_nz);
   const float dist2 = hit.t * hit.t;
   // Connections can make the paths that end after x_t, t >= 2 (x_t: the vertex `ray` left).
   const int joinable =
@@ -64,23 +120,8 @@ PR_KERNEL void pt_shade(PR_PARAMS(PR_ARGS_PT_SHADE)) {
   PR_GLOBAL const Material* mat = s.sd.materials + h.material;
   if (mat->flags & PR_MAT_EMISSIVE) {
     const float3 le = surface_emission(&s, &h);
-    float w = 1.0f;
-    if (!(p.flags & PR_PATH_SPECULAR))
-      w = power_heuristic(p.last_pdf, emitter_pdf(&s, &h, prev, prev_n));
-    const u32 li = joinable ? emitter_light(&s, &h) : PR_INVALID_INDEX;
-    if (li != PR_INVALID_INDEX) {
-      // The connections' share of the path (eye_paths.h); the eye path's N and H split the rest.
-      const Light l = s.lights.lights[li];
-      const float3 n_tri = eye_paths_light_normal(&s, &l);
-      const float start = eye_paths_start_density(&l, li, trace_cdf, trace_total);
-      const int spec = (p.flags & PR_PATH_SPECULAR) != 0u;
-      const float dens_h =
-          spec ? 1.0f : solid_angle_to_area_pdf(p.last_pdf, fabs(dot(n_tri, d)), dist2);
-      const float dens_l = eye_paths_light_side(&l, n_tri, start, light_paths, p.eye_ratio, h.p,
-                                                prev, p.seg_cos, 1.0f);
-      const float dens_n = spec ? 0.0f : start;
-      if (dens_l > 0.0f) w *= 1.0f - eye_path_share(dens_n / dens_l, dens_h / dens_l);
-    }
+    const float w =
+        pt_emission_weight(&s, &p, &h, d, dist2, joinable, light_paths, trace_cdf, trace_total);
     const float3 add = tp * le * w;
     radiance[i] += (float4)(add.x, add.y, add.z, 0.0f);
   }
@@ -118,26 +159,8 @@ PR_KERNEL void pt_shade(PR_PARAMS(PR_ARGS_PT_SHADE)) {
       if (next_event(&s, &h, &f, wo, !here_joinable, &rng, &shadow, &c, &ch)) {
         if (here_joinable) {
           // The path tracer's weight, times what the connections leave of the path.
-          const Light l = s.lights.lights[ch.light];
-          float w = ch.delta ? 1.0f : power_heuristic(ch.pdf_light, ch.pdf_bsdf);
-          if (eye_paths_light(&l)) {
-            const float3 n_tri = l.type == PR_LIGHT_TRIANGLE ? eye_paths_light_normal(&s, &l)
-                                                             : make_float3(0.0f, 0.0f, 1.0f);
-            const float3 dz = ch.pos - h.p;
-            const float dz2 = dot(dz, dz);
-            const float3 wi = dz * (1.0f / sqrt(dz2));
-            const float dens_n = eye_paths_start_density(&l, ch.light, trace_cdf, trace_total);
-            const float dens_h =
-                l.type == PR_LIGHT_TRIANGLE
-                    ? solid_angle_to_area_pdf(ch.pdf_bsdf, fabs(dot(n_tri, wi)), dz2)
-                    : 0.0f;
-            const float rev =
-                has_rev ? solid_angle_to_area_pdf(ch.pdf_bsdf_rev, p.seg_cos, dist2) : 1.0f;
-            const float dens_l = eye_paths_light_side(&l, n_tri, dens_n, light_paths, p.eye_ratio,
-                                                      ch.pos, h.p, fabs(dot(f.ng, wi)), rev);
-            if (dens_l > 0.0f) w *= 1.0f - eye_path_share(dens_n / dens_l, dens_h / dens_l);
-          }
-          c = c * w;
+          c = c * pt_next_event_weight(&s, &p, &h, &f, &ch, has_rev, dist2, light_paths, trace_cdf,
+                                       trace_total);
         }
         c = tp * c;
         shadows[i].ray = shadow;

@@ -7,6 +7,90 @@
 // After reuse.h: its FP_CONTRACT OFF (shared/bvh.h) holds for the ratios too.
 #include "shared/eye_paths.h"
 
+// A light sub-path's first vertex: its point on light L (chosen with probability pmf), the
+// normal stored with it, the first direction and the throughput Le / (pmf x pdf).
+typedef struct {
+  float3 p, n, dir, tp;
+  uint prim, inst;  // the emitting triangle, where L is one
+  float b1, b2;
+} LightEmission;
+
+PR_INLINE LightEmission light_emit(const SceneData* s, const Light* L, const ReuseParams* rp,
+                                   float pmf, float u1, float u2, float u3, float u4, float u5) {
+  LightEmission e;
+  e.n = make_float3(0.0f, 0.0f, 1.0f);
+  e.tp = make_float3(0.0f, 0.0f, 0.0f);
+  e.prim = e.inst = PR_INVALID_INDEX;
+  e.b1 = e.b2 = 0.0f;
+  if (L->type == PR_LIGHT_TRIANGLE) {
+    const float2 b = sample_triangle(u1, u2);
+    e.b1 = b.x;
+    e.b2 = b.y;
+    const SurfaceHit sh = surface_at(&s->sd, L->prim, L->inst, e.b1, e.b2);
+    e.p = sh.p;
+    // Both faces emit: one is chosen, in the quantised form the arena keeps, so that connect
+    // evaluates the pdf of this very direction.
+    e.n = oct_decode(oct_encode(u3 < 0.5f ? sh.ng : -sh.ng));
+    const float pdf_dir = light_sample_emit_dir(L, e.n, u4, u5, &e.dir);
+    // Le cos / (pmf / area x pdf_dir), with pdf_dir = cos / (2 pi).
+    e.tp = pdf_dir > 0.0f ? material_emission(&s->sd, &sh) * (2.0f * PR_PI * L->area / pmf)
+                          : make_float3(0.0f, 0.0f, 0.0f);
+    e.prim = L->prim;
+    e.inst = L->inst;
+  } else if (L->type == PR_LIGHT_DIRECTIONAL || L->type == PR_LIGHT_ENV) {
+    // Parallel rays from a disk that covers the scene's bounding sphere; the environment's
+    // direction from its importance map (Le / pdf of the direction).
+    float3 le = make_float3(L->le_r, L->le_g, L->le_b);
+    if (L->type == PR_LIGHT_ENV) {
+      float3 wi = make_float3(0.0f, 1.0f, 0.0f);
+      float pdf_w;
+      if (!env_sample(L, s->lights.env, u4, u5, &wi, &pdf_w, &le)) pdf_w = 0.0f;
+      e.dir = -wi;
+      le = pdf_w > 0.0f ? le / pdf_w : make_float3(0.0f, 0.0f, 0.0f);
+    } else {
+      light_sample_emit_dir(L, e.n, u4, u5, &e.dir);
+    }
+    float3 t, bt;
+    orthonormal_basis(e.dir, &t, &bt);
+    const float3 d = sample_cosine_hemisphere(u1, u2);  // its xy is uniform on the unit disk
+    const float r = rp->scene_radius;
+    e.p = make_float3(rp->cx, rp->cy, rp->cz) - e.dir * (1.01f * r) + (t * d.x + bt * d.y) * r;
+    e.tp = le * (PR_PI * r * r / pmf);
+  } else {
+    e.p = make_float3(L->p0x, L->p0y, L->p0z);
+    const float pdf_dir = light_sample_emit_dir(L, e.n, u4, u5, &e.dir);
+    const float att = L->type == PR_LIGHT_SPOT
+                          ? spot_attenuation(dot(e.dir, make_float3(L->e1x, L->e1y, L->e1z)),
+                                             L->cos_inner, L->cos_outer)
+                          : 1.0f;
+    e.tp = make_float3(L->le_r, L->le_g, L->le_b) * (att / (pmf * pdf_dir));
+  }
+  return e;
+}
+
+// The arena's record of a vertex at p, reached along dir after t.
+PR_INLINE LightVertex light_vertex(float3 p, float t, float3 dir, uint ng_oct, uint ns_oct,
+                                   float3 tp, uint prim, uint inst, float b1, float b2) {
+  LightVertex v;
+  v.px = p.x;
+  v.py = p.y;
+  v.pz = p.z;
+  v.t = t;
+  v.wx = dir.x;
+  v.wy = dir.y;
+  v.wz = dir.z;
+  v.ng_oct = ng_oct;
+  v.ns_oct = ns_oct;
+  v.tp_r = tp.x;
+  v.tp_g = tp.y;
+  v.tp_b = tp.z;
+  v.prim = prim;
+  v.inst = inst;
+  v.b1 = b1;
+  v.b2 = b2;
+  return v;
+}
+
 PR_KERNEL void light_trace(PR_PARAMS(PR_ARGS_LIGHT_TRACE)) {
   const uint i = (uint)get_global_id(0);
   if (i >= list_count) return;
@@ -37,76 +121,20 @@ PR_KERNEL void light_trace(PR_PARAMS(PR_ARGS_LIGHT_TRACE)) {
   h.light = li;
 
   // Vertex 0 on the light, and the first direction (shared/lights.h).
-  float3 p0, n0 = make_float3(0.0f, 0.0f, 1.0f), dir;
-  float3 tp = make_float3(0.0f, 0.0f, 0.0f);
-  uint prim0 = PR_INVALID_INDEX, inst0 = PR_INVALID_INDEX;
-  float b1 = 0.0f, b2 = 0.0f;
-  if (L.type == PR_LIGHT_TRIANGLE) {
-    const float2 b = sample_triangle(u1, u2);
-    b1 = b.x;
-    b2 = b.y;
-    const SurfaceHit e = surface_at(&s.sd, L.prim, L.inst, b1, b2);
-    p0 = e.p;
-    // Both faces emit: one is chosen, in the quantised form the arena keeps, so that connect
-    // evaluates the pdf of this very direction.
-    n0 = oct_decode(oct_encode(u3 < 0.5f ? e.ng : -e.ng));
-    const float pdf_dir = light_sample_emit_dir(&L, n0, u4, u5, &dir);
-    // Le cos / (pmf / area x pdf_dir), with pdf_dir = cos / (2 pi).
-    tp = pdf_dir > 0.0f ? material_emission(&s.sd, &e) * (2.0f * PR_PI * L.area / pmf)
-                        : make_float3(0.0f, 0.0f, 0.0f);
-    prim0 = L.prim;
-    inst0 = L.inst;
-  } else if (L.type == PR_LIGHT_DIRECTIONAL || L.type == PR_LIGHT_ENV) {
-    // Parallel rays from a disk that covers the scene's bounding sphere; the environment's
-    // direction from its importance map (Le / pdf of the direction).
-    float3 le = make_float3(L.le_r, L.le_g, L.le_b);
-    if (L.type == PR_LIGHT_ENV) {
-      float3 wi = make_float3(0.0f, 1.0f, 0.0f);
-      float pdf_w;
-      if (!env_sample(&L, s.lights.env, u4, u5, &wi, &pdf_w, &le)) pdf_w = 0.0f;
-      dir = -wi;
-      le = pdf_w > 0.0f ? le / pdf_w : make_float3(0.0f, 0.0f, 0.0f);
-    } else {
-      light_sample_emit_dir(&L, n0, u4, u5, &dir);
-    }
-    float3 t, bt;
-    orthonormal_basis(dir, &t, &bt);
-    const float3 d = sample_cosine_hemisphere(u1, u2);  // its xy is uniform on the unit disk
-    const float r = rp.scene_radius;
-    p0 = make_float3(rp.cx, rp.cy, rp.cz) - dir * (1.01f * r) + (t * d.x + bt * d.y) * r;
-    tp = le * (PR_PI * r * r / pmf);
-  } else {
-    p0 = make_float3(L.p0x, L.p0y, L.p0z);
-    const float pdf_dir = light_sample_emit_dir(&L, n0, u4, u5, &dir);
-    const float att =
-        L.type == PR_LIGHT_SPOT
-            ? spot_attenuation(dot(dir, make_float3(L.e1x, L.e1y, L.e1z)), L.cos_inner, L.cos_outer)
-            : 1.0f;
-    tp = make_float3(L.le_r, L.le_g, L.le_b) * (att / (pmf * pdf_dir));
-  }
+  const LightEmission em = light_emit(&s, &L, &rp, pmf, u1, u2, u3, u4, u5);
+  float3 tp = em.tp, dir = em.dir;
   if (!(pmf > 0.0f) || !(max3(tp) > 0.0f) || !(max3(tp) < PR_INF_F)) {
     headers[slot] = h;
     return;
   }
-  LightVertex v;
-  v.px = p0.x;
-  v.py = p0.y;
-  v.pz = p0.z;
-  v.t = 0.0f;
-  v.wx = v.wy = v.wz = 0.0f;
-  v.ng_oct = oct_encode(n0);
-  v.ns_oct = v.ng_oct;
-  v.tp_r = tp.x;
-  v.tp_g = tp.y;
-  v.tp_b = tp.z;
-  v.prim = prim0;
-  v.inst = inst0;
-  v.b1 = b1;
-  v.b2 = b2;
+  const uint n0_oct = oct_encode(em.n);
+  LightVertex v = light_vertex(em.p, 0.0f, make_float3(0.0f, 0.0f, 0.0f), n0_oct, n0_oct, tp,
+                               em.prim, em.inst, em.b1, em.b2);
   out[0] = v;
   uint count = 1u;
-  Ray ray = make_ray(light_segment_origin(&s.sd, p0, v.ng_oct, v.ns_oct, prim0, inst0, b1, b2, dir),
-                     dir, 0.0f, PR_INF_F);
+  Ray ray = make_ray(
+      light_segment_origin(&s.sd, em.p, v.ng_oct, v.ns_oct, em.prim, em.inst, em.b1, em.b2, dir),
+      dir, 0.0f, PR_INF_F);
   // With eye paths, the light side of L's weight at each vertex (shared/eye_paths.h).
   const int walk_on = rp.eye_paths && eye_paths_light(&L);
   EyePathWalk walk;
@@ -130,22 +158,8 @@ PR_KERNEL void light_trace(PR_PARAMS(PR_ARGS_LIGHT_TRACE)) {
     }
     const SurfaceHit sh = surface_at(&s.sd, hit.prim, hit.inst, hit.u, hit.v);
     tp = tp * volume_transmittance(&s, &sh, dir, hit.t);
-    v.px = sh.p.x;
-    v.py = sh.p.y;
-    v.pz = sh.p.z;
-    v.t = hit.t;
-    v.wx = dir.x;
-    v.wy = dir.y;
-    v.wz = dir.z;
-    v.ng_oct = oct_encode(sh.ng);
-    v.ns_oct = oct_encode(sh.ns);
-    v.tp_r = tp.x;
-    v.tp_g = tp.y;
-    v.tp_b = tp.z;
-    v.prim = hit.prim;
-    v.inst = hit.inst;
-    v.b1 = hit.u;
-    v.b2 = hit.v;
+    v = light_vertex(sh.p, hit.t, dir, oct_encode(sh.ng), oct_encode(sh.ns), tp, hit.prim, hit.inst,
+                     hit.u, hit.v);
     out[k] = v;
     if (walk_on) ratio_out[k] = eye_path_walk_arrive(&walk, k, dir, hit.t, oct_decode(v.ng_oct));
     count = k + 1u;
