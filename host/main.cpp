@@ -152,7 +152,9 @@ void addSamplingOptions(CLI::App* render, RenderArgs& a) {
   render->add_option("--spp", ro.spp, "Samples per pixel per frame")
       ->check(CLI::Range(1, 1 << 20))
       ->capture_default_str();
-  render->add_option("--max-depth", ro.maxDepth, "Maximum path length in bounces")
+  render
+      ->add_option("--max-depth", ro.maxDepth,
+                   "Longest path, in surface vertices with the light's (direct light only: 2)")
       ->check(CLI::Range(1, 64))
       ->capture_default_str();
   render

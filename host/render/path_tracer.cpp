@@ -27,7 +27,7 @@ PathTracer::PathTracer(Context& ctx, GpuScene& scene, Film& film,
   hits_ = alloc("path hits", n * sizeof(dev::Hit));
   radiance_ = alloc("sample radiance", n * 16);
   shadows_ = alloc("shadow rays", n * sizeof(dev::ShadowRay));
-  rays_ = alloc("ray counters", 16);
+  rays_ = alloc("ray counters", dev::PR_PT_COUNT * 4);
   noEye_ = alloc("no eye vertices", 64);
 }
 
@@ -36,7 +36,7 @@ void PathTracer::beginFrame(int frame, const dev::CameraParams& camera, const cl
   // The film's pixels [first, n) only; buffers are indexed by pixel over the whole image.
   const cl_uint n = film_.end();
   const cl_uint rngFrame = settings_.fixedNoise ? 0 : cl_uint(frame);
-  ctx_.zero(rays_, 16);
+  ctx_.zero(rays_, dev::PR_PT_COUNT * 4);
   const kargs::SceneArgs sceneArgs = scene_.kernelArgs();
   kargs::PtExtendArgs ex;
   kargs::setScene(&ex, sceneArgs);
@@ -92,12 +92,12 @@ void PathTracer::tracePass(int sample, StageTimer* timer) {
 }
 
 void PathTracer::reportRays(FrameStats* stats) {
-  cl_uint rays[4] = {0, 0, 0, 0};
-  CL_CHECK(ctx_.queue().enqueueReadBuffer(rays_, CL_TRUE, 0, 16, rays));
+  cl_uint rays[dev::PR_PT_COUNT] = {};
+  CL_CHECK(ctx_.queue().enqueueReadBuffer(rays_, CL_TRUE, 0, sizeof rays, rays));
   if (!stats) return;
-  stats->rays["camera"] += rays[0];
-  stats->rays["bounce"] += rays[1];
-  stats->rays["shadow"] += rays[2];
+#define PR_PT_REPORT(name, key) stats->rays[key] += rays[dev::PR_PT_##name];
+  PR_PT_COUNTERS(PR_PT_REPORT)
+#undef PR_PT_REPORT
 }
 
 void PathTracer::renderFrame(int frame, const dev::CameraParams& camera, FrameStats* stats) {

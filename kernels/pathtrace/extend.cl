@@ -1,6 +1,6 @@
 // pt_extend: one work-item per path. Reads the path's ray; writes its closest hit (prim ==
-// PR_INVALID_INDEX when it escapes or the path is dead) and counts the ray in rays[0] (camera)
-// or rays[1] (bounce).
+// PR_INVALID_INDEX when it escapes or the path is dead) and counts the ray in rays[PR_PT_CAMERA]
+// or rays[PR_PT_BOUNCE].
 #include "shared/integrator.h"
 #include "shared/path_state.h"
 
@@ -10,7 +10,7 @@ PR_KERNEL void pt_extend(PR_PARAMS(PR_ARGS_PT_EXTEND)) {
   Hit hit = hit_none();
   if (states[i].alive) {
     const SceneData s = PR_SCENE();
-    atomic_inc(rays + (states[i].depth == 0u ? 0 : 1));
+    atomic_inc(rays + (states[i].depth == 0u ? PR_PT_CAMERA : PR_PT_BOUNCE));
     if (!trace_closest(&s, states[i].ray, &hit)) hit = hit_none();
   }
   hits[i] = hit;

@@ -6,6 +6,15 @@
 
 PR_NAMESPACE_BEGIN
 
+// The path tracer's ray counters (its `rays` buffer) and their --stats names.
+#define PR_PT_COUNTERS(X) \
+  X(CAMERA, "camera")     \
+  X(BOUNCE, "bounce")     \
+  X(SHADOW, "shadow")
+#define PR_PT_ENUM(name, key) PR_PT_##name,
+enum { PR_PT_COUNTERS(PR_PT_ENUM) PR_PT_COUNT };
+#undef PR_PT_ENUM
+
 // 112 bytes.
 typedef struct {
   Ray ray;

@@ -25,9 +25,10 @@ typedef struct {
 
 #define PR_INVALID_INDEX 0xffffffffu
 
-// BVH width: children per node. CPUs take 8 (one float8 slab test per node, AVX), GPUs 2 (a
-// binary node holding both children's boxes, as Aila and Laine 2009 lay it out for SIMT); 4 is
-// the third choice. The host builds the layout the device's kernels were compiled for
+// BVH width: children per node. CPUs take 8 (one float8 slab test per node, AVX), GPUs 4
+// (host/render/options.cpp: faster than 2 and 8 on an H200); 2 is the binary node holding both
+// children's boxes, as Aila and Laine 2009 lay it out for SIMT. The host builds the layout the
+// device's kernels were compiled for
 // (-DPR_BVH_WIDTH=N); the host's CPU reference traverses the default.
 #ifndef PR_BVH_WIDTH
 #define PR_BVH_WIDTH 8
