@@ -8,6 +8,8 @@ cd "$(dirname "$0")/../.."
 bash tools/setup/install-deps.sh
 status=0
 bash tools/ci/format-check.sh || status=1
+# No function over 120 lines, host or kernel (docs/design.md section 7).
+python3 tools/ci/function_length.py || status=1
 bash tools/setup/build.sh
 OCL_ICD_VENDORS=$(bash tools/setup/intel-opencl.sh)
 export OCL_ICD_VENDORS
