@@ -182,7 +182,7 @@ bool PathReuse::tracePasses(int frame, const dev::CameraParams& camera, const de
   cn.history = history_;
   cn.ratios = ratios_;
   cn.set(connect_);
-  if (eyePaths_) eyePaths_->beginFrame(frame, camera, radiance_, eye_);
+  if (eyePaths_) eyePaths_->beginFrame(frame, camera, sceneArgs, radiance_, eye_);
   const cl_uint first = film_.first(), n = film_.end();
   for (int s = 0; s < settings_.spp; ++s) {
     // With eye paths, the path tracer's pass writes the sample's radiance and its first eye

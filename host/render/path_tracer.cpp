@@ -31,13 +31,13 @@ PathTracer::PathTracer(Context& ctx, GpuScene& scene, Film& film,
   noEye_ = alloc("no eye vertices", 64);
 }
 
-void PathTracer::beginFrame(int frame, const dev::CameraParams& camera, const cl::Buffer& radiance,
+void PathTracer::beginFrame(int frame, const dev::CameraParams& camera,
+                            const kargs::SceneArgs& sceneArgs, const cl::Buffer& radiance,
                             const cl::Buffer& eye) {
   // The film's pixels [first, n) only; buffers are indexed by pixel over the whole image.
   const cl_uint n = film_.end();
   const cl_uint rngFrame = settings_.fixedNoise ? 0 : cl_uint(frame);
   ctx_.zero(rays_, dev::PR_PT_COUNT * 4);
-  const kargs::SceneArgs sceneArgs = scene_.kernelArgs();
   kargs::PtExtendArgs ex;
   kargs::setScene(&ex, sceneArgs);
   ex.states = states_;
@@ -102,7 +102,7 @@ void PathTracer::reportRays(FrameStats* stats) {
 
 void PathTracer::renderFrame(int frame, const dev::CameraParams& camera, FrameStats* stats) {
   StageTimer timer;
-  beginFrame(frame, camera, radiance_, noEye_);
+  beginFrame(frame, camera, scene_.kernelArgs(), radiance_, noEye_);
   for (int s = 0; s < settings_.spp; ++s) {
     tracePass(s, &timer);
     film_.accumulate(radiance_, &timer);

@@ -31,8 +31,9 @@ class PathTracer : public Integrator {
   // One frame's kernel arguments, with the samples' radiance written to `radiance` (one float4
   // per pixel) and, with lightPaths > 0, each sample's first non-delta vertex to `eye` (one
   // EyeVertex per pixel); then one pass per sample index, which leaves both for the caller.
-  void beginFrame(int frame, const dev::CameraParams& camera, const cl::Buffer& radiance,
-                  const cl::Buffer& eye);
+  // sceneArgs: the scene's arguments for this frame (GpuScene::kernelArgs).
+  void beginFrame(int frame, const dev::CameraParams& camera, const kargs::SceneArgs& sceneArgs,
+                  const cl::Buffer& radiance, const cl::Buffer& eye);
   void tracePass(int sample, StageTimer* timer);
   // The rays the passes since beginFrame traced, into stats.
   void reportRays(FrameStats* stats);

@@ -37,7 +37,7 @@ PR_NAMESPACE_BEGIN
 
 // Device buffers of both structures. Build it inside a kernel from the kernel's arguments
 // (OpenCL C 1.2 allows pointers to __global in private structs, not in kernel arguments):
-// see PR_SCENE_GEOM_PARAMS / pr_scene_geom below.
+// see PR_SCENE_GEOM() below and PR_ARGS_SCENE_GEOM (shared/kernel_args.h).
 typedef struct {
   PR_GLOBAL const BvhNode* static_nodes;  // root at 0; an empty SSG is a node with no child
   PR_GLOBAL const BvhTriPacket* static_tris;

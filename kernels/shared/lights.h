@@ -465,7 +465,7 @@ PR_INLINE u32 light_tree_resample(PR_GLOBAL const LightNode* nodes, PR_GLOBAL co
   return ok && *weight > 0.0f ? chosen : PR_INVALID_INDEX;
 }
 
-// The light table as kernels see it (built from PR_LIGHT_PARAMS).
+// The light table as kernels see it (built from PR_ARGS_LIGHTS, shared/kernel_args.h).
 typedef struct {
   PR_GLOBAL const Light* lights;
   PR_GLOBAL const float* cdf;        // running sum of power; cdf[count - 1] == total_power

@@ -10,7 +10,7 @@
 
 PR_NAMESPACE_BEGIN
 
-// Device buffers for shading; built in the kernel from its arguments (PR_SHADING_PARAMS).
+// Device buffers for shading; built in the kernel from its arguments (PR_ARGS_SHADING).
 typedef struct {
   PR_GLOBAL const ShadingVertex* vertices;
   PR_GLOBAL const ShadingTriangle* triangles;

@@ -28,8 +28,8 @@ typedef struct {
 // BVH width: children per node. CPUs take 8 (one float8 slab test per node, AVX), GPUs 4
 // (host/render/options.cpp: faster than 2 and 8 on an H200); 2 is the binary node holding both
 // children's boxes, as Aila and Laine 2009 lay it out for SIMT. The host builds the layout the
-// device's kernels were compiled for
-// (-DPR_BVH_WIDTH=N); the host's CPU reference traverses the default.
+// device's kernels were compiled for (-DPR_BVH_WIDTH=N); the host's CPU reference traverses
+// the default.
 #ifndef PR_BVH_WIDTH
 #define PR_BVH_WIDTH 8
 #endif
