@@ -4,6 +4,7 @@
 
 #include "cl/kernel_args.h"
 #include "shared/path_state.h"
+#include "util/check.h"
 #include "util/interrupt.h"
 
 namespace pr {
@@ -27,6 +28,9 @@ PathTracer::PathTracer(Context& ctx, GpuScene& scene, Film& film,
   hits_ = alloc("path hits", n * sizeof(dev::Hit));
   radiance_ = alloc("sample radiance", n * 16);
   shadows_ = alloc("shadow rays", n * sizeof(dev::ShadowRay));
+  for (cl::Buffer& q : queues_) q = alloc("path queue", n * 4);
+  shadowQueue_ = alloc("shadow queue", n * 4);
+  queueSizes_ = alloc("queue sizes", dev::PR_QUEUE_COUNT * 4);
   rays_ = alloc("ray counters", dev::PR_PT_COUNT * 4);
   noEye_ = alloc("no eye vertices", 64);
 }
@@ -38,19 +42,18 @@ void PathTracer::beginFrame(int frame, const dev::CameraParams& camera,
   const cl_uint n = film_.end();
   const cl_uint rngFrame = settings_.fixedNoise ? 0 : cl_uint(frame);
   ctx_.zero(rays_, dev::PR_PT_COUNT * 4);
-  kargs::PtExtendArgs ex;
-  kargs::setScene(&ex, sceneArgs);
-  ex.states = states_;
-  ex.hits = hits_;
-  ex.rays = rays_;
-  ex.count = n;
-  ex.set(extend_);
+  kargs::setScene(&extendArgs_, sceneArgs);
+  extendArgs_.states = states_;
+  extendArgs_.hits = hits_;
+  extendArgs_.rays = rays_;
+  extendArgs_.set(extend_, kargs::kScene | kargs::kFrame);
   kargs::setScene(&shadeArgs_, sceneArgs);
   shadeArgs_.states = states_;
   shadeArgs_.hits = hits_;
   shadeArgs_.radiance = radiance;
   shadeArgs_.shadows = shadows_;
-  shadeArgs_.count = n;
+  shadeArgs_.shadow_queue = shadowQueue_;
+  shadeArgs_.queue_sizes = queueSizes_;
   shadeArgs_.seed = settings_.seed;
   shadeArgs_.frame = rngFrame;
   shadeArgs_.max_depth = cl_uint(settings_.maxDepth);
@@ -58,14 +61,13 @@ void PathTracer::beginFrame(int frame, const dev::CameraParams& camera,
   shadeArgs_.trace_cdf = scene_.traceCdf();
   shadeArgs_.trace_total = scene_.traceTotalPower();
   shadeArgs_.eye = eye;
-  shadeArgs_.set(shade_);
-  kargs::PtShadowArgs sh;
-  kargs::setScene(&sh, sceneArgs);
-  sh.radiance = radiance;
-  sh.shadows = shadows_;
-  sh.rays = rays_;
-  sh.count = n;
-  sh.set(shadow_);
+  shadeArgs_.set(shade_, kargs::kScene | kargs::kFrame);
+  kargs::setScene(&shadowArgs_, sceneArgs);
+  shadowArgs_.radiance = radiance;
+  shadowArgs_.shadows = shadows_;
+  shadowArgs_.rays = rays_;
+  shadowArgs_.shadow_queue = shadowQueue_;
+  shadowArgs_.set(shadow_, kargs::kScene | kargs::kFrame);
   generateArgs_.cam = camera;
   generateArgs_.seed = settings_.seed;
   generateArgs_.frame = rngFrame;
@@ -74,20 +76,40 @@ void PathTracer::beginFrame(int frame, const dev::CameraParams& camera,
   generateArgs_.count = n;
   generateArgs_.eye = eye;
   generateArgs_.write_eye = settings_.lightPaths > 0 ? 1 : 0;
+  generateArgs_.queue = queues_[0];
+  generateArgs_.first = film_.first();
   generateArgs_.set(generate_);
 }
 
 void PathTracer::tracePass(int sample, StageTimer* timer) {
   const cl_uint first = film_.first(), n = film_.end();
-  // `sample` is the only argument that changes between passes.
   generateArgs_.sample = shadeArgs_.sample = cl_uint(sample);
   generateArgs_.set(generate_, kargs::kPass);
-  shadeArgs_.set(shade_, kargs::kPass);
   ctx_.launch1D(generate_, first, n, "generate", timer);
-  for (int d = 0; d < settings_.maxDepth; ++d) {
-    ctx_.launch1D(extend_, first, n, "extend", timer);
-    ctx_.launch1D(shade_, first, n, "shade", timer);
-    ctx_.launch1D(shadow_, first, n, "shadow", timer);
+  // Each bounce runs over the paths still live (a queue pt_shade compacts), and traces the shadow
+  // rays it wrote; the queues' sizes come back to size the next launches, and a pass ends once no
+  // path is live.
+  cl_uint live = n - first;
+  for (int d = 0; d < settings_.maxDepth && live > 0; ++d) {
+    const cl::Buffer& queue = queues_[d % 2];
+    extendArgs_.queue = queue;
+    extendArgs_.count = live;
+    extendArgs_.set(extend_, kargs::kPass);
+    ctx_.launch1D(extend_, 0, live, "extend", timer);
+    static const cl_uint kZero[dev::PR_QUEUE_COUNT] = {};
+    CL_CHECK(ctx_.queue().enqueueWriteBuffer(queueSizes_, CL_FALSE, 0, sizeof kZero, kZero));
+    shadeArgs_.queue = queue;
+    shadeArgs_.count = live;
+    shadeArgs_.next_queue = queues_[(d + 1) % 2];
+    shadeArgs_.set(shade_, kargs::kPass);
+    ctx_.launch1D(shade_, 0, live, "shade", timer);
+    cl_uint sizes[dev::PR_QUEUE_COUNT] = {};
+    CL_CHECK(ctx_.queue().enqueueReadBuffer(queueSizes_, CL_TRUE, 0, sizeof sizes, sizes));
+    PR_CHECK(sizes[dev::PR_QUEUE_LIVE] <= live && sizes[dev::PR_QUEUE_SHADOW] <= live);
+    shadowArgs_.count = sizes[dev::PR_QUEUE_SHADOW];
+    shadowArgs_.set(shadow_, kargs::kPass);
+    ctx_.launch1D(shadow_, 0, sizes[dev::PR_QUEUE_SHADOW], "shadow", timer);
+    live = sizes[dev::PR_QUEUE_LIVE];
   }
 }
 

@@ -1,6 +1,7 @@
 // The baseline: a unidirectional wavefront path tracer (--mode pathtrace), the paper's
-// "traditional path tracing". Stages: generate, then per bounce extend, shade, shadow; then
-// accumulate into the film. Next-event estimation with MIS, Russian roulette.
+// "traditional path tracing". Stages: generate, then per bounce extend, shade, shadow over queues
+// of the live paths (as pbrt-v4's wavefront); then accumulate into the film. Next-event estimation
+// with MIS, Russian roulette.
 #pragma once
 
 #include "cl/context.h"
@@ -44,11 +45,16 @@ class PathTracer : public Integrator {
   Film& film_;
   PathTracerSettings settings_;
   cl::Kernel generate_, extend_, shade_, shadow_;
-  // Kept between beginFrame and the passes, which change only `sample`.
+  // Kept between beginFrame and the passes, which change the sample index and the queues.
   kargs::PtGenerateArgs generateArgs_;
+  kargs::PtExtendArgs extendArgs_;
   kargs::PtShadeArgs shadeArgs_;
+  kargs::PtShadowArgs shadowArgs_;
   cl::Buffer states_, hits_, radiance_, shadows_, rays_;
-  cl::Buffer noEye_;  // the eye-vertex argument when nothing is written there
+  cl::Buffer queues_[2];    // the live paths' indices, at this bounce and the next
+  cl::Buffer shadowQueue_;  // the paths with a shadow ray at this bounce
+  cl::Buffer queueSizes_;   // PR_QUEUE_* (kernels/shared/path_state.h)
+  cl::Buffer noEye_;        // the eye-vertex argument when nothing is written there
   uint64_t bytes_ = 0;
 };
 

@@ -1,11 +1,14 @@
-// pt_shade: one work-item per live path. Reads the path and its hit; adds emission (MIS-weighted
-// against next-event estimation) to the sample's radiance, writes a shadow ray for next-event
-// estimation, samples the BSDF for the next ray and applies Russian roulette.
+// pt_shade: one work-item per live path (the bounce's queue). Reads the path and its hit; adds
+// emission (MIS-weighted against next-event estimation) to the sample's radiance, writes a shadow
+// ray for next-event estimation, samples the BSDF for the next ray and applies Russian roulette.
 // With light_paths = C > 0 (--eye-paths), the eye path's ends on a light are weighted against
 // the reuse connections that make the same paths too (shared/eye_paths.h): the path keeps the
 // ratio of the two ways' densities of its vertices beyond x_1 as it goes.
 // With light_paths > 0, x_1 (the first non-delta vertex) is written to the sample's EyeVertex for
-// connect. Writes the PathState, the radiance and the ShadowRay of the same index.
+// connect. Writes the PathState, the radiance and the ShadowRay of the same index, and appends
+// the path to next_queue if it goes on and to shadow_queue if it has a shadow ray (their order
+// varies from run to run; what each path computes does not: its random numbers are keyed by its
+// pixel and sample).
 #include "shared/eye_paths.h"
 #include "shared/reuse.h"
 #include "shared/path_state.h"
@@ -91,12 +94,11 @@ PR_INLINE float pt_next_event_weight(const SceneData* s, const PathState* p, con
 }
 
 PR_KERNEL void pt_shade(PR_PARAMS(PR_ARGS_PT_SHADE)) {
-  const uint i = (uint)get_global_id(0);
-  if (i >= count) return;
+  const uint j = (uint)get_global_id(0);
+  if (j >= count) return;
+  const uint i = queue[j];
   const SceneData s = PR_SCENE();
   PathState p = states[i];
-  shadows[i].valid = 0u;
-  if (!p.alive) return;
 
   const Hit hit = hits[i];
   if (hit.prim == PR_INVALID_INDEX) {
@@ -167,7 +169,7 @@ PR_KERNEL void pt_shade(PR_PARAMS(PR_ARGS_PT_SHADE)) {
         shadows[i].c_r = c.x;
         shadows[i].c_g = c.y;
         shadows[i].c_b = c.z;
-        shadows[i].valid = 1u;
+        shadow_queue[atomic_inc(queue_sizes + PR_QUEUE_SHADOW)] = i;
       }
     } else {
       rng_skip(&rng, PR_NEXT_EVENT_DRAWS);  // the same dimensions whatever the material
@@ -203,4 +205,5 @@ PR_KERNEL void pt_shade(PR_PARAMS(PR_ARGS_PT_SHADE)) {
   p.tp_b = tp.z;
   p.rng_dim = rng.dim;
   states[i] = p;
+  if (p.alive) next_queue[atomic_inc(queue_sizes + PR_QUEUE_LIVE)] = i;
 }

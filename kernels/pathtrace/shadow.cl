@@ -1,13 +1,13 @@
-// pt_shadow: one work-item per path. Reads its ShadowRay; if it is valid and unoccluded, adds
-// its contribution to the sample's radiance. Writes radiance; counts the ray in rays[PR_PT_SHADOW].
+// pt_shadow: one work-item per path that pt_shade gave a shadow ray (shadow_queue). If the ray is
+// unoccluded, adds its contribution to the sample's radiance. Counts it in rays[PR_PT_SHADOW].
 #include "shared/integrator.h"
 #include "shared/path_state.h"
 
 PR_KERNEL void pt_shadow(PR_PARAMS(PR_ARGS_PT_SHADOW)) {
-  const uint i = (uint)get_global_id(0);
-  if (i >= count) return;
+  const uint j = (uint)get_global_id(0);
+  if (j >= count) return;
+  const uint i = shadow_queue[j];
   const ShadowRay r = shadows[i];
-  if (!r.valid) return;
   const SceneData s = PR_SCENE();
   atomic_inc(rays + PR_PT_SHADOW);
   if (trace_occluded(&s, r.ray)) return;

@@ -5,7 +5,8 @@
 //
 // An entry is X(role, kind, type, name):
 //   role  GEOM, SHADING, LIGHTS: the scene (GpuScene sets them; kernels get SceneData);
-//         FRAME: set once per frame; PASS: changes between the passes of one frame.
+//         FRAME: set once per frame; PASS: changes between the launches of one frame (the
+//         sample index of each pass; the wavefront's queues and their sizes at each bounce).
 //   kind  IN: `__global const type*`; OUT: `__global type*` (written, maybe read); VAL: `type`.
 // Scene entries' parameters are named pr_g_*, pr_sd_*, pr_l_* (PR_ARG_NAME) and reach kernel
 // code only through PR_SCENE() / PR_SCENE_GEOM().
@@ -95,6 +96,9 @@
   X(FRAME, IN, EyePathRatio, ratios)
 
 // ---- The wavefront path tracer (kernels/pathtrace/) ----
+// Paths are indexed by pixel; each bounce's stages run over queues of path indices (`queue`,
+// `count` of them), which pt_shade compacts: the live paths into next_queue, the paths with a
+// shadow ray into shadow_queue, counted in queue_sizes (PR_QUEUE_*, shared/path_state.h).
 
 #define PR_ARGS_PT_GENERATE(X)     \
   X(FRAME, VAL, CameraParams, cam) \
@@ -105,14 +109,17 @@
   X(FRAME, OUT, float4, radiance)  \
   X(FRAME, VAL, uint, count)       \
   X(FRAME, OUT, EyeVertex, eye)    \
-  X(FRAME, VAL, uint, write_eye)
+  X(FRAME, VAL, uint, write_eye)   \
+  X(FRAME, OUT, uint, queue)       \
+  X(FRAME, VAL, uint, first)
 
 #define PR_ARGS_PT_EXTEND(X)      \
   PR_ARGS_SCENE(X)                \
   X(FRAME, IN, PathState, states) \
   X(FRAME, OUT, Hit, hits)        \
   X(FRAME, OUT, uint, rays)       \
-  X(FRAME, VAL, uint, count)
+  X(PASS, IN, uint, queue)        \
+  X(PASS, VAL, uint, count)
 
 #define PR_ARGS_PT_SHADE(X)         \
   PR_ARGS_SCENE(X)                  \
@@ -120,7 +127,11 @@
   X(FRAME, IN, Hit, hits)           \
   X(FRAME, OUT, float4, radiance)   \
   X(FRAME, OUT, ShadowRay, shadows) \
-  X(FRAME, VAL, uint, count)        \
+  X(PASS, IN, uint, queue)          \
+  X(PASS, VAL, uint, count)         \
+  X(PASS, OUT, uint, next_queue)    \
+  X(FRAME, OUT, uint, shadow_queue) \
+  X(FRAME, OUT, uint, queue_sizes)  \
   X(FRAME, VAL, uint, seed)         \
   X(FRAME, VAL, uint, frame)        \
   X(PASS, VAL, uint, sample)        \
@@ -135,7 +146,8 @@
   X(FRAME, OUT, float4, radiance)  \
   X(FRAME, IN, ShadowRay, shadows) \
   X(FRAME, OUT, uint, rays)        \
-  X(FRAME, VAL, uint, count)
+  X(FRAME, IN, uint, shadow_queue) \
+  X(PASS, VAL, uint, count)
 
 // ---- The film (kernels/accumulate.cl) ----
 

@@ -117,7 +117,7 @@
   F(LightNode, r2)                    \
   F(LightNode, parent)                \
   F(ShadowRay, c_r)                   \
-  F(ShadowRay, valid)                 \
+  F(ShadowRay, pad)                   \
   F(PathHeader, end)                  \
   F(PathHeader, valid)                \
   F(PathHeader, escape_z)             \

@@ -15,6 +15,9 @@ PR_NAMESPACE_BEGIN
 enum { PR_PT_COUNTERS(PR_PT_ENUM) PR_PT_COUNT };
 #undef PR_PT_ENUM
 
+// The sizes of the queues pt_shade appends to (its queue_sizes buffer).
+enum { PR_QUEUE_LIVE, PR_QUEUE_SHADOW, PR_QUEUE_COUNT };
+
 // 112 bytes.
 typedef struct {
   Ray ray;
@@ -22,7 +25,7 @@ typedef struct {
   float last_pdf;  // solid-angle pdf of the BSDF sample that made `ray`; 0 after delta/camera
   u32 depth;       // surface interactions so far
   u32 pixel;
-  u32 alive;
+  u32 alive;                        // 0: ended at the last bounce (in no queue since)
   u32 rng_dim;                      // next random dimension of this sample
   u32 flags;                        // PR_PATH_*
   float prev_x, prev_y, prev_z;     // the vertex `ray` leaves and its shading normal (for the
@@ -38,11 +41,12 @@ typedef struct {
 #define PR_PATH_SPECULAR 1u  // the last bounce was delta (or the ray is the camera ray)
 #define PR_EYE_JOINABLE 1u   // x_2 is non-delta: stored light paths can make this path's ends
 
-// A shadow ray with the contribution it carries if unoccluded. 48 bytes.
+// A shadow ray with the contribution it carries if unoccluded (traced where the path is in the
+// bounce's shadow queue). 48 bytes.
 typedef struct {
   Ray ray;
   float c_r, c_g, c_b;
-  u32 valid;
+  u32 pad;
 } ShadowRay;
 
 PR_NAMESPACE_END
