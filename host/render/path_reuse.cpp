@@ -1,5 +1,6 @@
 #include "render/path_reuse.h"
 
+#include <algorithm>
 #include <numeric>
 
 #include "cl/kernel_args.h"
@@ -12,6 +13,10 @@
 namespace pr {
 
 namespace {
+
+// The most device memory that connect's records (--eye-paths) take: the pixel samples of one
+// launch are as many as fit.
+constexpr uint64_t kConnectRecordBudget = uint64_t(128) << 20;
 
 // A counter of the light paths (the same on every device that holds them).
 void setLightPathCounter(FrameStats* stats, const char* key, uint64_t value) {
@@ -41,7 +46,11 @@ PathReuse::PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseS
   invalidate_ = kargs::kernel<kargs::InvalidateArgs>(ctx, "reuse/invalidate.cl", opts);
   lightTrace_ = kargs::kernel<kargs::LightTraceArgs>(ctx, "reuse/light_trace.cl", opts);
   eyeHit_ = kargs::kernel<kargs::EyeHitArgs>(ctx, "reuse/eye_hit.cl", opts);
-  connect_ = kargs::kernel<kargs::ConnectArgs>(ctx, "reuse/connect.cl", opts);
+  // With eye paths, connect traces no ray: its terms go to connect_shadow (kernels/reuse).
+  connect_ = kargs::kernel<kargs::ConnectArgs>(
+      ctx, "reuse/connect.cl", opts + (settings_.eyePaths ? " -DPR_CONNECT_DEFERRED=1" : ""));
+  if (settings_.eyePaths)
+    connectShadow_ = kargs::kernel<kargs::ConnectShadowArgs>(ctx, "reuse/connect_shadow.cl", opts);
   auto alloc = [&](const char* name, uint64_t bytes) {
     bytes_ += bytes;
     cl::Buffer b = ctx_.allocate(name, bytes);
@@ -67,6 +76,18 @@ PathReuse::PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseS
   changed_ = alloc("changed slot stamps", uint64_t(history ? slots_ : 1) * 4);
   const uint64_t records = history ? uint64_t(film.pixels()) * settings_.spp : 1;
   history_ = alloc("connection history", records * sizeof(dev::ConnectionHistory));
+  if (settings_.eyePaths) {
+    // Per pixel sample: L's connections at x, each a term (at most C per stored vertex k >= 1)
+    // and their sum's end, the history's one term, a reservoir's terms and their sum's end.
+    recordCap_ = settings_.pathsPerPixel * (stride_ - 1) + 1 + 1 + settings_.resample + 1;
+    const uint64_t perSample = uint64_t(recordCap_) * sizeof(dev::ConnectRecord);
+    recordPixels_ = static_cast<uint32_t>(
+        std::clamp<uint64_t>(kConnectRecordBudget / perSample, 1, film.pixels()));
+  }
+  records_ =
+      alloc("connection records", std::max<uint64_t>(uint64_t(recordPixels_) * recordCap_, 1) *
+                                      sizeof(dev::ConnectRecord));
+  recordCounts_ = alloc("connection record counts", uint64_t(recordPixels_) * 4);
   if (settings_.eyePaths) {
     PathTracerSettings pt{settings_.spp, settings_.maxDepth, settings_.seed, settings_.fixedNoise};
     pt.lightPaths = settings_.pathsPerPixel;
@@ -181,7 +202,20 @@ bool PathReuse::tracePasses(int frame, const dev::CameraParams& camera, const de
   cn.changed = changed_;
   cn.history = history_;
   cn.ratios = ratios_;
-  cn.set(connect_);
+  cn.records = records_;
+  cn.record_counts = recordCounts_;
+  cn.record_cap = recordCap_;
+  cn.set(connect_, kargs::kScene | kargs::kFrame);
+  kargs::ConnectShadowArgs cs;
+  if (eyePaths_) {
+    kargs::setScene(&cs, sceneArgs);
+    cs.records = records_;
+    cs.record_counts = recordCounts_;
+    cs.record_cap = recordCap_;
+    cs.radiance = radiance_;
+    cs.counters = counters_;
+    cs.set(connectShadow_, kargs::kScene | kargs::kFrame);
+  }
   if (eyePaths_) eyePaths_->beginFrame(frame, camera, sceneArgs, radiance_, eye_);
   const cl_uint first = film_.first(), n = film_.end();
   for (int s = 0; s < settings_.spp; ++s) {
@@ -195,8 +229,18 @@ bool PathReuse::tracePasses(int frame, const dev::CameraParams& camera, const de
       ctx_.launch1D(eyeHit_, first, n, "eye_hit", timer);
     }
     cn.sample = cl_uint(s);
-    cn.set(connect_, kargs::kPass);
-    ctx_.launch1D(connect_, first, n, "connect", timer);
+    // Without eye paths connect traces its rays itself (one launch); with them, each launch's
+    // terms are traced by connect_shadow before the next launch reuses the records.
+    const cl_uint chunk = eyePaths_ ? recordPixels_ : n - first;
+    for (cl_uint c0 = first; c0 < n; c0 += chunk) {
+      cn.record_first = cs.record_first = c0;
+      cn.record_end = cs.record_end = std::min(n, c0 + chunk);
+      cn.set(connect_, kargs::kPass);
+      ctx_.launch1D(connect_, c0, cn.record_end, "connect", timer);
+      if (!eyePaths_) continue;
+      cs.set(connectShadow_, kargs::kPass);
+      ctx_.launch1D(connectShadow_, c0, cs.record_end, "connect_shadow", timer);
+    }
     film_.accumulate(radiance_, timer);
     // Wait for each pass, so that an interrupt stops a frame of many samples within one pass.
     ctx_.finish();
@@ -208,6 +252,7 @@ bool PathReuse::tracePasses(int frame, const dev::CameraParams& camera, const de
 void PathReuse::report(StageTimer* timer, cl_uint toTrace, FrameStats* stats) {
   cl_uint c[dev::PR_C_COUNT] = {};
   CL_CHECK(ctx_.queue().enqueueReadBuffer(counters_, CL_TRUE, 0, sizeof c, c));
+  PR_CHECK(c[dev::PR_C_RECORD_OVERFLOW] == 0);  // recordCap_ bounds connect's terms
   auto times = timer->collect();
   if (!stats) return;
   for (const auto& [k, v] : times) stats->stageSeconds[k] += v;

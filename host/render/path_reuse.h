@@ -70,9 +70,13 @@ class PathReuse : public Integrator {
   uint32_t slots_ = 0, stride_ = 0;
   bool first_ = true;
   uint32_t frames_ = 0;  // frames rendered with a connection history: its clock
-  cl::Kernel invalidate_, lightTrace_, eyeHit_, connect_;
+  cl::Kernel invalidate_, lightTrace_, eyeHit_, connect_, connectShadow_;
   cl::Buffer headers_, vertices_, ratios_, list_, allSlots_, eye_, radiance_, counters_;
   cl::Buffer changed_, history_;  // the connection history's slot stamps and pixel reservoirs
+  // connect's terms for connect_shadow (--eye-paths): recordCap_ per pixel sample, for
+  // recordPixels_ samples a launch (without eye paths, one unread element).
+  cl::Buffer records_, recordCounts_;
+  uint32_t recordCap_ = 0, recordPixels_ = 1;
   std::unique_ptr<PathTracer> eyePaths_;  // --eye-paths: the eye paths of every sample
   uint64_t bytes_ = 0;
 };

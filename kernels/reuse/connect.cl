@@ -31,6 +31,12 @@
 // share against the eye path's ways of making the same path (eye_path_weight, from the ratios
 // light_trace kept beside each vertex; shared/eye_paths.h).
 #include "shared/reuse.h"
+
+// Built with 1 for --eye-paths (PathReuse): connect then traces no ray, and leaves the estimate's
+// terms, shadow rays with what each adds, to connect_shadow (shared/reuse.h, ConnectRecord).
+#ifndef PR_CONNECT_DEFERRED
+#define PR_CONNECT_DEFERRED 0
+#endif
 // After reuse.h: its FP_CONTRACT OFF (shared/bvh.h) holds for these weights too.
 #include "shared/connection_mis.h"
 #include "shared/eye_paths.h"
@@ -77,7 +83,41 @@ typedef struct {
   HistoryReservoir hr;  // strategy L's connections at the first eye vertex, carried
   HistoryReservoir he;  // strategy E's there, this frame's alone
   __global const EyePathRatio* ratios;  // --eye-paths: beside the vertices (light_trace)
+  // The estimate's terms (ConnectRecord, shared/reuse.h): with PR_CONNECT_DEFERRED written to
+  // rec for connect_shadow (at most cap of them), else traced and summed into L and g here.
+  __global ConnectRecord* rec;
+  uint n_rec, cap, overflow;
+  uint members;  // terms in the partial sum g since it was last closed
+  float3 L, g;
 } Connector;
+
+// One term of the estimate, of value v where `ray` (if not 0) is unoccluded.
+PR_INLINE void connect_term(Connector* cn, float3 v, const Ray* ray, u32 op) {
+  if ((op & PR_REC_SUM_MASK) == PR_REC_GROUP) ++cn->members;
+#if PR_CONNECT_DEFERRED
+  if (cn->n_rec >= cn->cap) {
+    cn->overflow = 1u;
+    return;
+  }
+  __global ConnectRecord* r = cn->rec + cn->n_rec++;
+  if (ray) r->ray = *ray;
+  r->c_r = v.x;
+  r->c_g = v.y;
+  r->c_b = v.z;
+  r->op = op | (ray ? PR_REC_RAY : 0u);
+#else
+  if (ray && trace_occluded(cn->s, *ray)) return;
+  if (op & PR_REC_COUNTED) ++cn->n.unoccluded;
+  connect_record_apply(&cn->L, &cn->g, v, op);
+#endif
+}
+
+// Ends a partial sum: L += g (where it had terms).
+PR_INLINE void connect_close(Connector* cn) {
+  if (cn->members == 0u) return;
+  cn->members = 0u;
+  connect_term(cn, make_float3(0.0f, 0.0f, 0.0f), 0, PR_REC_CLOSE);
+}
 
 // A shaded point on the eye side of a connection.
 typedef struct {
@@ -163,9 +203,9 @@ PR_INLINE float light_emit_pdf(const SceneData* s, u32 light, __global const Lig
   return light_pdf_emit_dir(&l, oct_decode(v0->ng_oct), dir);
 }
 
-// A connection with unshadowed contribution c along shadow ray `ray`: traced now (no
-// resampling; returns what it adds) or offered to the reservoir (returns 0).
-PR_INLINE float3 connection_trace_or_keep(Connector* cn, float3 c, Ray ray, u32 strategy) {
+// A connection with unshadowed contribution c along shadow ray `ray`: a term of the open partial
+// sum (no resampling) or offered to the reservoir.
+PR_INLINE void connection_trace_or_keep(Connector* cn, float3 c, Ray ray, u32 strategy) {
   ++cn->n.candidates;
   const u32 mis = strategy == PR_STRATEGY_E;
   if (cn->rp->resample > 0u) {
@@ -184,13 +224,11 @@ PR_INLINE float3 connection_trace_or_keep(Connector* cn, float3 c, Ray ray, u32 
         }
       }
     }
-    return make_float3(0.0f, 0.0f, 0.0f);
+    return;
   }
   ++cn->n.rays;
   cn->n.mis_rays += mis;
-  if (trace_occluded(cn->s, ray)) return make_float3(0.0f, 0.0f, 0.0f);
-  ++cn->n.unoccluded;
-  return c;
+  connect_term(cn, c, &ray, PR_REC_GROUP | PR_REC_COUNTED);
 }
 
 // One connection's unshadowed contribution from its two sides (each side's BSDF and |cos|, the
@@ -207,30 +245,29 @@ PR_INLINE float3 connection_value(const Connector* cn, float3 tp_eye, float3 f_e
   return tp_eye * f_eye * f_light * tp_light * (g * corr * scale * w);
 }
 
-// A connection of contribution c along `ray`: traced now or kept (connection_trace_or_keep).
-PR_INLINE float3 connection(Connector* cn, float3 c, uint clamped, Ray ray, u32 strategy) {
+// A connection of contribution c along `ray`: a term now or kept (connection_trace_or_keep).
+PR_INLINE void connection(Connector* cn, float3 c, uint clamped, Ray ray, u32 strategy) {
   cn->n.clamped += clamped;
-  if (!(max3(c) > 0.0f)) return make_float3(0.0f, 0.0f, 0.0f);
-  return connection_trace_or_keep(cn, c, ray, strategy);
+  if (!(max3(c) > 0.0f)) return;
+  connection_trace_or_keep(cn, c, ray, strategy);
 }
 
-// Traces the reservoir's connections; returns their resampled contribution and empties it.
-PR_INLINE float3 reservoir_resolve(Connector* cn) {
+// The reservoir's connections, each with its resampled contribution, as one partial sum; empties
+// the reservoir.
+PR_INLINE void reservoir_resolve(Connector* cn) {
   Reservoir* res = &cn->res;
-  float3 out = make_float3(0.0f, 0.0f, 0.0f);
   if (res->candidates > 0u) {
     for (u32 k = 0u; k < cn->rp->resample; ++k) {
       ++cn->n.rays;
       cn->n.mis_rays += res->strategy[k] == PR_STRATEGY_E;
-      if (trace_occluded(cn->s, res->ray[k])) continue;
-      ++cn->n.unoccluded;
-      out += make_float3(res->c[3 * k], res->c[3 * k + 1], res->c[3 * k + 2]) *
-             (res->w_sum / (res->w[k] * (float)cn->rp->resample));
+      const float3 c = make_float3(res->c[3 * k], res->c[3 * k + 1], res->c[3 * k + 2]) *
+                       (res->w_sum / (res->w[k] * (float)cn->rp->resample));
+      connect_term(cn, c, &res->ray[k], PR_REC_GROUP | PR_REC_COUNTED);
     }
+    connect_close(cn);
   }
   res->w_sum = 0.0f;
   res->candidates = 0u;
-  return out;
 }
 
 // Whether the light of the path in `slot` takes part in --eye-paths' weights (shared/eye_paths.h).
@@ -318,11 +355,10 @@ PR_INLINE void history_offer(Connector* cn, HistoryReservoir* hr, float3 c, Ray 
 }
 
 // Strategy L: connections from the eye point x to the vertices k >= 1 of the sample's light
-// paths; offered to the connection history where `history` is set.
-PR_INLINE float3 strategy_light_vertices(Connector* cn, const EyePoint* x, int history) {
+// paths, one partial sum; offered to the connection history where `history` is set.
+PR_INLINE void strategy_light_vertices(Connector* cn, const EyePoint* x, int history) {
   const SceneData* s = cn->s;
   const ReuseParams* rp = cn->rp;
-  float3 sum = make_float3(0.0f, 0.0f, 0.0f);
   const int mis = rp->mis_threshold > 0.0f;
   for (uint c = 0u; c < rp->paths_per_pixel; ++c) {
     const uint slot = connector_slot(cn, c);
@@ -351,11 +387,11 @@ PR_INLINE float3 strategy_light_vertices(Connector* cn, const EyePoint* x, int h
         cn->n.clamped += clamped;
         history_offer(cn, &cn->hr, value, ray, slot, k);
       } else {
-        sum += connection(cn, value, clamped, ray, PR_STRATEGY_L);
+        connection(cn, value, clamped, ray, PR_STRATEGY_L);
       }
     }
   }
-  return sum;
+  connect_close(cn);
 }
 
 // The connection history at the first eye vertex x, that of EyeVertex e (--connection-history).
@@ -368,10 +404,9 @@ PR_INLINE float3 strategy_light_vertices(Connector* cn, const EyePoint* x, int h
 // lies on an instance that moved, whose target cannot be evaluated as it was. Strategy E's
 // connections at x (from this frame's BSDF sample, which the next frame cannot evaluate) have a
 // reservoir of their own; one of the two is chosen in proportion to its weight, and one shadow
-// ray traced. Returns the estimate of the connections at x.
-PR_INLINE float3 history_resolve(Connector* cn, const EyeVertex* e,
-                                 __global ConnectionHistory* hist, __global const uint* changed,
-                                 uint frame) {
+// ray traced: the estimate of the connections at x, one term.
+PR_INLINE void history_resolve(Connector* cn, const EyeVertex* e, __global ConnectionHistory* hist,
+                               __global const uint* changed, uint frame) {
   const float mc = (float)cn->rp->paths_per_pixel;
   // x as connect built it (rebuilt, rather than kept through the path's later vertices).
   const EyePoint x0 =
@@ -436,34 +471,29 @@ PR_INLINE float3 history_resolve(Connector* cn, const EyeVertex* e,
   }
   *hist = next;
   // One shadow ray, to L's vertex or E's connection: resampled between the two.
-  float3 out = make_float3(0.0f, 0.0f, 0.0f);
   const float both = total + w_e;
   if (both > 0.0f) {
     const int take_e = rng_next(&cn->rr) * both < w_e;
     const float3 c = take_e ? cn->he.c : c_l;
     ++cn->n.rays;
     cn->n.mis_rays += take_e;
-    if (!trace_occluded(cn->s, take_e ? cn->he.ray : ray_l)) {
-      ++cn->n.unoccluded;
-      out = c * (both / luminance(c));
-    }
+    const Ray ray = take_e ? cn->he.ray : ray_l;
+    connect_term(cn, c * (both / luminance(c)), &ray, PR_REC_ADD | PR_REC_COUNTED);
   }
   hr->slot = cn->he.slot = PR_INVALID_INDEX;
   hr->p_sum = cn->he.p_sum = 0.0f;
-  return out;
 }
 
 // Strategy E: connections from Y, the non-delta first hit of the BSDF sample taken at the eye
 // vertex at xp with solid-angle pdf pdf_x, to the vertices k >= 0 of the sample's light paths,
-// each weighted by its share of the MIS.
-PR_INLINE float3 strategy_sampled_vertex(Connector* cn, float3 xp, float pdf_x, const EyePoint* y,
-                                         int history) {
+// each weighted by its share of the MIS: one partial sum.
+PR_INLINE void strategy_sampled_vertex(Connector* cn, float3 xp, float pdf_x, const EyePoint* y,
+                                       int history) {
   const SceneData* s = cn->s;
   const ReuseParams* rp = cn->rp;
-  float3 sum = make_float3(0.0f, 0.0f, 0.0f);
   const float3 dxy = y->h.p - xp;
   const float dxy2 = dot(dxy, dxy);
-  if (!(dxy2 > 0.0f) || !(pdf_x > 0.0f)) return sum;
+  if (!(dxy2 > 0.0f) || !(pdf_x > 0.0f)) return;
   const float p_e = solid_angle_to_area_pdf(pdf_x, fabs(dot(y->f.ng, dxy)) / sqrt(dxy2), dxy2);
   for (uint c = 0u; c < rp->paths_per_pixel; ++c) {
     const uint slot = connector_slot(cn, c);
@@ -511,35 +541,63 @@ PR_INLINE float3 strategy_sampled_vertex(Connector* cn, float3 xp, float pdf_x, 
         cn->n.clamped += clamped;
         history_offer(cn, &cn->he, value, r, slot, k);
       } else {
-        sum += connection(cn, value, clamped, r, PR_STRATEGY_E);
+        connection(cn, value, clamped, r, PR_STRATEGY_E);
       }
     }
   }
-  return sum;
+  connect_close(cn);
 }
 
 // Next-event estimation at x, weighted against the BSDF sample's emitter hit where x can
-// still take one (its draws are skipped otherwise, to keep the stream's layout).
-PR_INLINE float3 strategy_next_event(const Connector* cn, const EyePoint* x, Rng* rng,
-                                     uint* shadow_rays) {
+// still take one (its draws are skipped otherwise, to keep the stream's layout). One term.
+PR_INLINE void strategy_next_event(Connector* cn, const EyePoint* x, Rng* rng, uint* shadow_rays) {
   if (x->depth + 1u > cn->rp->max_depth) {
     rng_skip(rng, PR_NEXT_EVENT_DRAWS);
-    return make_float3(0.0f, 0.0f, 0.0f);
+    return;
   }
   Ray shadow;
   float3 c;
   if (!next_event(cn->s, &x->h, &x->f, x->wo, x->depth + 1u < cn->rp->max_depth, rng, &shadow, &c,
                   0))
-    return make_float3(0.0f, 0.0f, 0.0f);
+    return;
   ++*shadow_rays;
-  if (trace_occluded(cn->s, shadow)) return make_float3(0.0f, 0.0f, 0.0f);
-  return x->tp * c;
+  connect_term(cn, x->tp * c, &shadow, PR_REC_ADD);
+}
+
+// A Connector's reservoirs, counts and terms, all empty.
+PR_INLINE void connector_empty(Connector* cn) {
+  cn->res.w_sum = 0.0f;
+  cn->res.candidates = 0u;
+  cn->n.candidates = cn->n.rays = cn->n.mis_rays = cn->n.unoccluded = cn->n.clamped = 0u;
+  cn->n.history_kept = cn->n.history_dropped = 0u;
+  cn->hr.slot = cn->he.slot = PR_INVALID_INDEX;
+  cn->hr.k = cn->he.k = 0u;
+  cn->hr.p_sum = cn->he.p_sum = 0.0f;
+  cn->n_rec = cn->overflow = cn->members = 0u;
+  cn->L = cn->g = make_float3(0.0f, 0.0f, 0.0f);
+}
+
+// Adds an eye sample's counts to the frame's counters.
+PR_INLINE void connect_count(const ConnectCounts* n, uint shadow_rays, uint bounce_rays,
+                             __global uint* counters) {
+  if (shadow_rays) atomic_add(counters + PR_C_SHADOW_RAYS, shadow_rays);
+  if (n->rays) atomic_add(counters + PR_C_CONNECT_RAYS, n->rays);
+  if (bounce_rays) atomic_add(counters + PR_C_BOUNCE_RAYS, bounce_rays);
+  if (n->mis_rays) atomic_add(counters + PR_C_MIS_RAYS, n->mis_rays);
+  if (n->clamped) atomic_add(counters + PR_C_CLAMPED, n->clamped);
+  if (n->candidates) atomic_add(counters + PR_C_CANDIDATES, n->candidates);
+  if (n->unoccluded) atomic_add(counters + PR_C_CONNECTED, n->unoccluded);
+  if (n->history_kept) atomic_add(counters + PR_C_HISTORY_KEPT, n->history_kept);
+  if (n->history_dropped) atomic_add(counters + PR_C_HISTORY_DROPPED, n->history_dropped);
 }
 
 PR_KERNEL void connect(PR_PARAMS(PR_ARGS_CONNECT)) {
   const uint i = (uint)get_global_id(0);
-  if (i >= rp.pixel_count) return;
+  if (i >= rp.pixel_count || i >= record_end) return;
   const EyeVertex e = eye[i];
+#if PR_CONNECT_DEFERRED
+  record_counts[i - record_first] = 0u;  // until the terms are written
+#endif
   if (e.prim == PR_INVALID_INDEX) return;
   const SceneData s = PR_SCENE();
   // Its own stream, apart from eye_hit's.
@@ -551,20 +609,15 @@ PR_KERNEL void connect(PR_PARAMS(PR_ARGS_CONNECT)) {
   cn.vertices = vertices;
   cn.j = i * rp.spp + sample;
   cn.inv_c = 1.0f / (float)rp.paths_per_pixel;
-  cn.res.w_sum = 0.0f;
-  cn.res.candidates = 0u;
   cn.rr = rng_make(rp.seed, PR_RNG_RESAMPLE, rp.frame, i, sample);
-  cn.n.candidates = cn.n.rays = cn.n.mis_rays = cn.n.unoccluded = cn.n.clamped = 0u;
-  cn.n.history_kept = cn.n.history_dropped = 0u;
   cn.history_cap = history_cap;
   cn.ratios = ratios;
   cn.slot_offset = slot_offset;  // 0 without a history (PathReuse::renderFrame)
-  cn.hr.slot = cn.he.slot = PR_INVALID_INDEX;
-  cn.hr.k = cn.he.k = 0u;
-  cn.hr.p_sum = cn.he.p_sum = 0.0f;
+  cn.rec = records + (size_t)(i - record_first) * record_cap;
+  cn.cap = record_cap;
+  connector_empty(&cn);
   EyePoint x = eye_point_at(&s, e.prim, e.inst, e.b1, e.b2, make_float3(e.wx, e.wy, e.wz),
                             make_float3(e.tp_r, e.tp_g, e.tp_b), e.depth);
-  float3 L = make_float3(0.0f, 0.0f, 0.0f);
   uint shadow_rays = 0u, bounce_rays = 0u;
   // The first eye vertex's connections go to the history, where there is one.
   int history_open = history_cap > 0u;
@@ -573,11 +626,12 @@ PR_KERNEL void connect(PR_PARAMS(PR_ARGS_CONNECT)) {
     // The history holds the first eye vertex's connections alone (resolved after the loop).
     if (vertex > 0u) history_open = 0;
     // The previous eye vertex's kept connections (each vertex of a delta chain has its own).
-    L += reservoir_resolve(&cn);
+    reservoir_resolve(&cn);
     // With --eye-paths, the path tracer's eye paths make everything but L's connections at x.
-    if (!rp.eye_paths) L += strategy_next_event(&cn, &x, &rng, &shadow_rays);
-    L += strategy_light_vertices(&cn, &x, history_open);
-    if (rp.eye_paths) break;
+    const int eye_paths = PR_CONNECT_DEFERRED || rp.eye_paths;
+    if (!eye_paths) strategy_next_event(&cn, &x, &rng, &shadow_rays);
+    strategy_light_vertices(&cn, &x, history_open);
+    if (eye_paths) break;
     // The completeness extension: one BSDF direction, kept only through delta surfaces.
     const float u0 = rng_next(&rng);
     const float2 u12 = rng_next2(&rng);
@@ -598,8 +652,11 @@ PR_KERNEL void connect(PR_PARAMS(PR_ARGS_CONNECT)) {
         // The environment: the sample from x shares it with next-event estimation at x.
         const float3 le = environment_radiance(&s, d);
         if (max3(le) > 0.0f)
-          L += t2 * le *
-               (chain == 0u ? power_heuristic(pdf, environment_pdf(&s, x.h.p, x.f.n, d)) : 1.0f);
+          connect_term(
+              &cn,
+              t2 * le *
+                  (chain == 0u ? power_heuristic(pdf, environment_pdf(&s, x.h.p, x.f.n, d)) : 1.0f),
+              0, PR_REC_ADD);
         break;
       }
       const SurfaceHit h = surface_at(&s.sd, hit.prim, hit.inst, hit.u, hit.v);
@@ -608,19 +665,21 @@ PR_KERNEL void connect(PR_PARAMS(PR_ARGS_CONNECT)) {
       const int is_delta = bsdf_is_delta(&y.f.bsdf);
       // An emitter met by the sample from x: its MIS share against next-event estimation at x.
       if (chain == 0u && (s.sd.materials[h.material].flags & PR_MAT_EMISSIVE))
-        L +=
-            t2 * surface_emission(&s, &h) * power_heuristic(pdf, emitter_pdf(&s, &h, x.h.p, x.f.n));
+        connect_term(
+            &cn,
+            t2 * surface_emission(&s, &h) * power_heuristic(pdf, emitter_pdf(&s, &h, x.h.p, x.f.n)),
+            0, PR_REC_ADD);
       if (chain == 0u && !is_delta) {
         // Strategy L at x counts these paths, apart from E's share.
         if (rp.mis_threshold > 0.0f && !delta)
-          L += strategy_sampled_vertex(&cn, x.h.p, pdf, &y, history_open);
+          strategy_sampled_vertex(&cn, x.h.p, pdf, &y, history_open);
         break;
       }
       ++depth;
       // Emission behind at least one delta bounce (the first delta surface's own emission is
       // next-event estimation's at x).
       if (chain > 0u && (s.sd.materials[h.material].flags & PR_MAT_EMISSIVE))
-        L += t2 * surface_emission(&s, &h);
+        connect_term(&cn, t2 * surface_emission(&s, &h), 0, PR_REC_ADD);
       if (!is_delta) {
         x = y;
         found = 1;
@@ -637,16 +696,13 @@ PR_KERNEL void connect(PR_PARAMS(PR_ARGS_CONNECT)) {
     }
     if (!found || !(max3(x.tp) < PR_INF_F)) break;
   }
-  if (history_cap > 0u) L += history_resolve(&cn, &e, hist, changed, frame_stamp);
-  L += reservoir_resolve(&cn);
-  radiance[i] += (float4)(L.x, L.y, L.z, 0.0f);
-  if (shadow_rays) atomic_add(counters + PR_C_SHADOW_RAYS, shadow_rays);
-  if (cn.n.rays) atomic_add(counters + PR_C_CONNECT_RAYS, cn.n.rays);
-  if (bounce_rays) atomic_add(counters + PR_C_BOUNCE_RAYS, bounce_rays);
-  if (cn.n.mis_rays) atomic_add(counters + PR_C_MIS_RAYS, cn.n.mis_rays);
-  if (cn.n.clamped) atomic_add(counters + PR_C_CLAMPED, cn.n.clamped);
-  if (cn.n.candidates) atomic_add(counters + PR_C_CANDIDATES, cn.n.candidates);
-  if (cn.n.unoccluded) atomic_add(counters + PR_C_CONNECTED, cn.n.unoccluded);
-  if (cn.n.history_kept) atomic_add(counters + PR_C_HISTORY_KEPT, cn.n.history_kept);
-  if (cn.n.history_dropped) atomic_add(counters + PR_C_HISTORY_DROPPED, cn.n.history_dropped);
+  if (history_cap > 0u) history_resolve(&cn, &e, hist, changed, frame_stamp);
+  reservoir_resolve(&cn);
+#if PR_CONNECT_DEFERRED
+  record_counts[i - record_first] = cn.n_rec;
+  if (cn.overflow) atomic_inc(counters + PR_C_RECORD_OVERFLOW);
+#else
+  radiance[i] += (float4)(cn.L.x, cn.L.y, cn.L.z, 0.0f);
+#endif
+  connect_count(&cn.n, shadow_rays, bounce_rays, counters);
 }

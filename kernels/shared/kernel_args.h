@@ -93,7 +93,23 @@
   X(FRAME, VAL, uint, frame_stamp)          \
   X(FRAME, IN, uint, changed)               \
   X(FRAME, OUT, ConnectionHistory, history) \
-  X(FRAME, IN, EyePathRatio, ratios)
+  X(FRAME, IN, EyePathRatio, ratios)        \
+  PR_ARGS_CONNECT_RECORDS(X, OUT)
+
+// The pixel samples [record_first, record_end) of one launch of connect and connect_shadow, and
+// their terms, record_cap per sample (--eye-paths; shared/reuse.h, ConnectRecord).
+#define PR_ARGS_CONNECT_RECORDS(X, kind) \
+  X(FRAME, kind, ConnectRecord, records) \
+  X(FRAME, kind, uint, record_counts)    \
+  X(FRAME, VAL, uint, record_cap)        \
+  X(PASS, VAL, uint, record_first)       \
+  X(PASS, VAL, uint, record_end)
+
+#define PR_ARGS_CONNECT_SHADOW(X) \
+  PR_ARGS_SCENE(X)                \
+  PR_ARGS_CONNECT_RECORDS(X, IN)  \
+  X(FRAME, OUT, float4, radiance) \
+  X(FRAME, OUT, uint, counters)
 
 // ---- The wavefront path tracer (kernels/pathtrace/) ----
 // Paths are indexed by pixel; each bounce's stages run over queues of path indices (`queue`,
@@ -159,15 +175,16 @@
   X(FRAME, VAL, uint, pixel_count)
 
 // Every kernel with a table: K(kernel name, the host's argument struct, its table).
-#define PR_KERNEL_TABLES(K)                           \
-  K(invalidate, InvalidateArgs, PR_ARGS_INVALIDATE)   \
-  K(light_trace, LightTraceArgs, PR_ARGS_LIGHT_TRACE) \
-  K(eye_hit, EyeHitArgs, PR_ARGS_EYE_HIT)             \
-  K(connect, ConnectArgs, PR_ARGS_CONNECT)            \
-  K(pt_generate, PtGenerateArgs, PR_ARGS_PT_GENERATE) \
-  K(pt_extend, PtExtendArgs, PR_ARGS_PT_EXTEND)       \
-  K(pt_shade, PtShadeArgs, PR_ARGS_PT_SHADE)          \
-  K(pt_shadow, PtShadowArgs, PR_ARGS_PT_SHADOW)       \
+#define PR_KERNEL_TABLES(K)                                    \
+  K(invalidate, InvalidateArgs, PR_ARGS_INVALIDATE)            \
+  K(light_trace, LightTraceArgs, PR_ARGS_LIGHT_TRACE)          \
+  K(eye_hit, EyeHitArgs, PR_ARGS_EYE_HIT)                      \
+  K(connect, ConnectArgs, PR_ARGS_CONNECT)                     \
+  K(connect_shadow, ConnectShadowArgs, PR_ARGS_CONNECT_SHADOW) \
+  K(pt_generate, PtGenerateArgs, PR_ARGS_PT_GENERATE)          \
+  K(pt_extend, PtExtendArgs, PR_ARGS_PT_EXTEND)                \
+  K(pt_shade, PtShadeArgs, PR_ARGS_PT_SHADE)                   \
+  K(pt_shadow, PtShadowArgs, PR_ARGS_PT_SHADOW)                \
   K(accumulate, AccumulateArgs, PR_ARGS_ACCUMULATE)
 
 // A parameter's name: scene entries carry their group's prefix (geometry and shading both have

@@ -33,6 +33,7 @@
   S(EyeVertex)               \
   S(EyePathRatio)            \
   S(ConnectionHistory)       \
+  S(ConnectRecord)           \
   S(ReuseParams)
 
 #define PR_SHARED_FIELDS(F)           \
@@ -135,6 +136,8 @@
   F(ConnectionHistory, tp_r)          \
   F(ConnectionHistory, slot)          \
   F(ConnectionHistory, frame)         \
+  F(ConnectRecord, c_r)               \
+  F(ConnectRecord, op)                \
   F(Light, moved)                     \
   F(Light, leaf)                      \
   F(ReuseParams, clamp)               \

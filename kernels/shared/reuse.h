@@ -32,6 +32,38 @@ typedef struct {
 // Most resampled connections per eye vertex (ReuseParams.resample; reservoir slots in connect).
 #define PR_MAX_CONNECTIONS 4
 
+// What connect leaves for connect_shadow (docs/design.md section 5, "Connections, then their
+// shadow rays"): per pixel sample, in the order connect found them, the terms of its estimate,
+// each a value added where its ray (if any) is unoccluded. The estimate is L, summed as connect
+// used to sum it: PR_REC_ADD adds the value to L, PR_REC_GROUP to a partial sum g, and
+// PR_REC_CLOSE adds g to L and starts g again at 0, so that the floating-point sums, and the
+// frames, are those of one kernel tracing as it goes. 48 bytes.
+typedef struct {
+  Ray ray;  // traced where op has PR_REC_RAY (else never read)
+  float c_r, c_g, c_b;
+  u32 op;  // PR_REC_ADD, _GROUP or _CLOSE, with the flags below
+} ConnectRecord;
+
+#define PR_REC_ADD 0u
+#define PR_REC_GROUP 1u
+#define PR_REC_CLOSE 2u
+#define PR_REC_SUM_MASK 3u
+#define PR_REC_RAY 4u      // a shadow ray to trace
+#define PR_REC_COUNTED 8u  // counted in connections_unoccluded where unoccluded
+
+// L and g after one more term of value v (where unoccluded).
+PR_INLINE void connect_record_apply(float3* L, float3* g, float3 v, u32 op) {
+  const u32 sum = op & PR_REC_SUM_MASK;
+  if (sum == PR_REC_ADD) {
+    *L += v;
+  } else if (sum == PR_REC_GROUP) {
+    *g += v;
+  } else {
+    *L += *g;
+    *g = make_float3(0.0f, 0.0f, 0.0f);
+  }
+}
+
 // Counters the kernels add to (one atomic add per work-item and counter), and where `--stats`
 // reports each: X(NAME, group, "key") adds counter PR_C_NAME, reported as rays.key or
 // counters.key (group rays / counters), or not at all (internal).
@@ -50,7 +82,8 @@ typedef struct {
   X(CANDIDATES, counters, "connection_candidates") /* each a ray without resampling */ \
   X(CONNECTED, counters, "connections_unoccluded")                                     \
   X(HISTORY_KEPT, counters, "history_kept")       /* carried vertices chosen again */  \
-  X(HISTORY_DROPPED, counters, "history_dropped") /* carried, their slot re-traced */
+  X(HISTORY_DROPPED, counters, "history_dropped") /* carried, their slot re-traced */  \
+  X(RECORD_OVERFLOW, internal, "")                /* connect records past the cap: 0 */
 
 #define PR_C_ENUM(name, group, key) PR_C_##name,
 enum { PR_REUSE_COUNTERS(PR_C_ENUM) PR_C_COUNT };
@@ -110,3 +143,4 @@ PR_NAMESPACE_END
 
 PR_STATIC_ASSERT(sizeof(pr::dev::ReuseParams) == 80, "ReuseParams layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::ReuseParams, clamp) == 32, "ReuseParams layout");
+PR_STATIC_ASSERT(sizeof(pr::dev::ConnectRecord) == 48, "ConnectRecord layout");

@@ -1,0 +1,24 @@
+// connect_shadow: one work-item per pixel sample of connect's launch (--eye-paths, where connect
+// traces no ray). Traces the shadow rays of the sample's ConnectRecords in the order connect wrote
+// them and adds the estimate they make, summed as the records say (shared/reuse.h), to the
+// sample's radiance; counts the unoccluded connections.
+#include "shared/reuse.h"
+
+PR_KERNEL void connect_shadow(PR_PARAMS(PR_ARGS_CONNECT_SHADOW)) {
+  const uint i = (uint)get_global_id(0);
+  if (i >= record_end) return;
+  const uint n = record_counts[i - record_first];
+  if (n == 0u) return;
+  const SceneData s = PR_SCENE();
+  __global const ConnectRecord* r = records + (size_t)(i - record_first) * record_cap;
+  float3 L = make_float3(0.0f, 0.0f, 0.0f), g = L;
+  uint unoccluded = 0u;
+  for (uint k = 0u; k < n; ++k) {
+    const u32 op = r[k].op;
+    if ((op & PR_REC_RAY) && trace_occluded(&s, r[k].ray)) continue;
+    if (op & PR_REC_COUNTED) ++unoccluded;
+    connect_record_apply(&L, &g, make_float3(r[k].c_r, r[k].c_g, r[k].c_b), op);
+  }
+  radiance[i] += (float4)(L.x, L.y, L.z, 0.0f);
+  if (unoccluded) atomic_add(counters + PR_C_CONNECTED, unoccluded);
+}
