@@ -12,7 +12,9 @@
 //   write it (single-scattering GGX, fresnel_mix at V.H, the clearcoat's Fresnel at N.V, the
 //   sheen's albedo scaling), kept for conformance comparisons.
 //
-// A delta mirror and a delta dielectric stand for smooth metals and transmission in both.
+// Both are one mixture of lobes (coat, sheen, GGX, diffuse) listed once in PR_BSDF_LOBES below,
+// each lobe a function set; a delta mirror and a delta dielectric stand for smooth metals and
+// transmission in both.
 // wo points towards the previous vertex (camera side on eye paths), wi towards the next. The
 // layered models are not reciprocal (a layer's albedo is taken at the view direction), so
 // evaluation takes the transport mode: radiance (wo is the view) or importance (light paths:
@@ -234,15 +236,184 @@ PR_INLINE BsdfLayers bsdf_layers(const BsdfParams* m, float3 w) {
   return l;
 }
 
-// ---- Lobe choice: probabilities of the coat, the sheen, the base's GGX lobe and the diffuse
-// lobe, a function of (material, wo) only. The sheen is sampled uniformly over the hemisphere:
-// its lobe peaks at grazing directions, which cosine-weighted samples reach too rarely.
+// ---- The lobe table. A microfacet material is a mixture of lobes, each with one function set:
+//
+//   float  lobe_<name>_weight(m, wo, l)        its weight for lobe choice at wo (the model's:
+//                                              PR_MODEL_ENERGY its share of the albedo,
+//                                              unnormalized; PR_MODEL_GLTF its share of what the
+//                                              lobes above it leave, the last lobe's 1)
+//   float  lobe_<name>_choice(m, wo, p, rest)  PR_MODEL_GLTF's chance of taking it once the lobes
+//                                              above were passed over (rest: what they leave)
+//   float3 lobe_<name>_sample(m, wo, u1, u2)   a direction (z <= 0: none)
+//   float  lobe_<name>_pdf(m, wo, wi, h)       that sampling's solid-angle pdf
+//   float3 lobe_<name>_eval(m, e, below)       f of this layer over `below`, the lobes under it
+//
+// The table lists them top layer first: X(NAME, name, feature), feature the PR_HAS_ flag that
+// compiles the lobe in (1: always). The last lobe is the opaque base: it takes what u0 leaves.
+// The mixture (bsdf_lobes, bsdf_choose_lobe, bsdf_mixture_pdf, bsdf_value) expands the table;
+// adding a lobe is its function set here, an entry below and one in PR_BSDF_LOBE_SUM_ORDER.
+#define PR_BSDF_LOBES(X)        \
+  X(COAT, coat, PR_HAS_COAT)    \
+  X(SHEEN, sheen, PR_HAS_SHEEN) \
+  X(SPEC, spec, 1)              \
+  X(DIFFUSE, diffuse, 1)
+
+// The order in which the mixture pdf adds the lobes and the energy model's u0 walks them (the
+// GGX lobe before the sheen, which came later): floats do not add associatively, so frames
+// depend on it. A new lobe goes last.
+#define PR_BSDF_LOBE_SUM_ORDER(X) X(COAT, coat) X(SPEC, spec) X(SHEEN, sheen) X(DIFFUSE, diffuse)
+
+#define PR_LOBE_ENUM(N, n, on) PR_LOBE_##N,
+#define PR_LOBE_ON(N, n, on) PR_LOBE_##N##_ON = (on),
+#define PR_LOBE_BIT(N, n, on) | (1 << PR_LOBE_##N)
+#define PR_LOBE_SUM_BIT(N, n) | (1 << PR_LOBE_##N)
+#define PR_LOBE_SUM_ONE(N, n) +1
+enum { PR_BSDF_LOBES(PR_LOBE_ENUM) PR_LOBE_COUNT };
+enum { PR_BSDF_LOBES(PR_LOBE_ON) };
+PR_STATIC_ASSERT((0 PR_BSDF_LOBES(PR_LOBE_BIT)) == (0 PR_BSDF_LOBE_SUM_ORDER(PR_LOBE_SUM_BIT)) &&
+                     (0 PR_BSDF_LOBE_SUM_ORDER(PR_LOBE_SUM_ONE)) == PR_LOBE_COUNT,
+                 "PR_BSDF_LOBE_SUM_ORDER must list every lobe of PR_BSDF_LOBES once");
+#undef PR_LOBE_ENUM
+#undef PR_LOBE_ON
+#undef PR_LOBE_BIT
+#undef PR_LOBE_SUM_BIT
+#undef PR_LOBE_SUM_ONE
+
+// One number per lobe (its weight or probability), a function of (material, wo) only.
+#define PR_LOBE_FIELD(N, n, on) float n;
 typedef struct {
-  float coat, sheen, spec, diffuse;
+  PR_BSDF_LOBES(PR_LOBE_FIELD)
 } BsdfLobes;
+#undef PR_LOBE_FIELD
+
+// What evaluation shares between the lobes.
+typedef struct {
+  float3 wo, wi, h;
+  float3 fd;  // the dielectric layer's Fresnel at wo.h (Schlick, f0 to f90)
+  float w5;   // Schlick's weight at wo.h
+  int mode;
+  BsdfLayers lo, li;  // the layers of wo and wi
+} BsdfEval;
+
+// The view's layers: wo's for radiance, wi's for importance.
+PR_INLINE const BsdfLayers* bsdf_view(const BsdfEval* e) {
+  return e->mode == PR_RADIANCE ? &e->lo : &e->li;
+}
+
+// What the coat and the sheen leave to the base at the view (PR_MODEL_ENERGY).
+PR_INLINE float bsdf_below_sheen(const BsdfLayers* l) {
+  return (1.0f - l->coat_albedo) * (1.0f - l->sheen_albedo);
+}
+
+// PR_MODEL_GLTF's usual choice: a lobe's probability over what the lobes above leave.
+PR_INLINE float bsdf_share_of_rest(float p, float rest) {
+  return rest > 0.0f ? p / rest : 0.0f;
+}
+
+// ---- Coat: GGX about the coat's normal, Fresnel of ior 1.5 (KHR_materials_clearcoat).
+
+PR_INLINE float bsdf_coat_probability(const BsdfParams* m, float cos_o) {
+  if (!bsdf_has_coat(m)) return 0.0f;
+  return clamp(2.0f * m->coat * coat_fresnel(schlick_weight(cos_o)), 0.05f, 0.5f);
+}
+
+PR_INLINE float lobe_coat_weight(const BsdfParams* m, float3 wo, const BsdfLayers* l) {
+  return bsdf_gltf(m) ? bsdf_coat_probability(m, dot(wo, m->coat_n)) : l->coat_albedo;
+}
+
+PR_INLINE float lobe_coat_choice(const BsdfParams* m, float3 wo, const BsdfLobes* p, float rest) {
+  (void)m;
+  (void)wo;
+  return bsdf_share_of_rest(p->coat, rest);
+}
+
+// Visible normals about the coat's own normal.
+PR_INLINE float3 lobe_coat_sample(const BsdfParams* m, float3 wo, float u1, float u2) {
+  if (m->coat_n.z >= 1.0f) {
+    const float3 h = ggx_sample_vndf(wo, m->coat_alpha, m->coat_alpha, u1, u2);
+    return h * (2.0f * dot(wo, h)) - wo;
+  }
+  float3 t, b;
+  orthonormal_basis(m->coat_n, &t, &b);
+  const float3 wc = to_local(wo, t, b, m->coat_n);
+  if (!(wc.z > 0.0f)) return make_float3(0.0f, 0.0f, -1.0f);
+  const float3 h =
+      to_world(ggx_sample_vndf(wc, m->coat_alpha, m->coat_alpha, u1, u2), t, b, m->coat_n);
+  return h * (2.0f * dot(wo, h)) - wo;
+}
+
+PR_INLINE float lobe_coat_pdf(const BsdfParams* m, float3 wo, float3 wi, float3 h) {
+  const float co = dot(wo, m->coat_n), ci = dot(wi, m->coat_n);
+  if (!(co > 0.0f) || !(ci > 0.0f)) return 0.0f;
+  const float a2 = m->coat_alpha * m->coat_alpha;
+  return ggx_d(dot(h, m->coat_n), a2) / ((1.0f + ggx_lambda(co, a2)) * 4.0f * co);
+}
+
+// The coat's reflection over what it leaves of `below`.
+PR_INLINE float3 lobe_coat_eval(const BsdfParams* m, const BsdfEval* e, float3 below) {
+  if (!bsdf_has_coat(m)) return below;
+  const BsdfLayers* lv = bsdf_view(e);
+  const float co = dot(e->wo, m->coat_n), ci = dot(e->wi, m->coat_n);
+  float coat_spec = 0.0f;
+  if (co > 0.0f && ci > 0.0f) {
+    float unused;
+    coat_spec =
+        ggx_reflection(co, ci, dot(e->h, m->coat_n), m->coat_alpha * m->coat_alpha, &unused);
+    // glTF: the coat's lobe weighted by its Fresnel at N.V; energy: the microfacet's Fresnel
+    // with the multiple-scattering factor.
+    coat_spec *= bsdf_gltf(m) ? lv->coat_albedo : m->coat * coat_fresnel(e->w5) * lv->coat_ms;
+    // The caller weights by the cosine to the shading normal; a tilted coat reflects by the
+    // cosine to its own, on the light's side (wi, or wo for importance).
+    if (m->coat_n.z < 1.0f) coat_spec *= e->mode == PR_RADIANCE ? ci / e->wi.z : co / e->wo.z;
+  }
+  return below * fmax(1.0f - lv->coat_albedo, 0.0f) + make_float3(coat_spec, coat_spec, coat_spec);
+}
+
+// ---- Sheen: the Charlie lobe (KHR_materials_sheen), sampled uniformly over the hemisphere:
+// it peaks at grazing directions, which cosine-weighted samples reach too rarely.
+
+PR_INLINE float lobe_sheen_weight(const BsdfParams* m, float3 wo, const BsdfLayers* l) {
+  (void)wo;
+  if (bsdf_gltf(m)) return l->sheen_albedo > 0.0f ? clamp(l->sheen_albedo, 0.05f, 0.5f) : 0.0f;
+  return (1.0f - l->coat_albedo) * l->sheen_albedo;
+}
+
+PR_INLINE float lobe_sheen_choice(const BsdfParams* m, float3 wo, const BsdfLobes* p, float rest) {
+  (void)m;
+  (void)wo;
+  return bsdf_share_of_rest(p->sheen, rest);
+}
+
+PR_INLINE float3 lobe_sheen_sample(const BsdfParams* m, float3 wo, float u1, float u2) {
+  (void)m;
+  (void)wo;
+  return sample_uniform_hemisphere(u1, u2);
+}
+
+PR_INLINE float lobe_sheen_pdf(const BsdfParams* m, float3 wo, float3 wi, float3 h) {
+  (void)m;
+  (void)wo;
+  (void)wi;
+  (void)h;
+  return 0.5f * PR_INV_PI;
+}
+
+PR_INLINE float3 lobe_sheen_eval(const BsdfParams* m, const BsdfEval* e, float3 below) {
+  if (!bsdf_has_sheen(m)) return below;
+  const BsdfLayers* lv = bsdf_view(e);
+  const float s = sheen_lobe(e->wo.z, e->wi.z, e->h.z, m->sheen_alpha);
+  // The glTF model's scaling is the smaller of both directions' (reciprocal); the energy
+  // model's is the view's.
+  const float keep = bsdf_gltf(m) ? fmin(1.0f - e->lo.sheen_albedo, 1.0f - e->li.sheen_albedo)
+                                  : 1.0f - lv->sheen_albedo;
+  return m->sheen * (s * lv->sheen_scale) + below * fmax(keep, 0.0f);
+}
+
+// ---- Spec: the base's GGX lobe, a conductor (metallic) and a dielectric specular layer over
+// the diffuse.
 
 // The glTF model's choice of its specular lobe over the diffuse one (luminance of the
-// fresnel_mix weights at N.V), and of the coat (its weight x Fresnel, bounded).
+// fresnel_mix weights at N.V).
 PR_INLINE float bsdf_spec_probability(const BsdfParams* m, float cos_o) {
   const float w5 = schlick_weight(cos_o);
   // (A grey F0, as most materials have, by its one value: luminance would round it.)
@@ -257,128 +428,190 @@ PR_INLINE float bsdf_spec_probability(const BsdfParams* m, float cos_o) {
   return clamp(ws / (ws + wd), 0.1f, 0.9f);
 }
 
-PR_INLINE float bsdf_coat_probability(const BsdfParams* m, float cos_o) {
-  if (!bsdf_has_coat(m)) return 0.0f;
-  return clamp(2.0f * m->coat * coat_fresnel(schlick_weight(cos_o)), 0.05f, 0.5f);
+PR_INLINE float lobe_spec_weight(const BsdfParams* m, float3 wo, const BsdfLayers* l) {
+  if (bsdf_gltf(m)) return bsdf_spec_probability(m, wo.z);
+  return bsdf_below_sheen(l) * (m->metallic * luminance(l->metal_albedo) +
+                                (1.0f - m->metallic) * luminance(l->spec_albedo));
 }
 
+// Its weight again: p->spec / rest would round otherwise than the glTF model always has.
+PR_INLINE float lobe_spec_choice(const BsdfParams* m, float3 wo, const BsdfLobes* p, float rest) {
+  (void)p;
+  (void)rest;
+  return bsdf_spec_probability(m, wo.z);
+}
+
+PR_INLINE float3 lobe_spec_sample(const BsdfParams* m, float3 wo, float u1, float u2) {
+  const float3 h = ggx_sample_vndf(wo, m->alpha_x, m->alpha_y, u1, u2);
+  return h * (2.0f * dot(wo, h)) - wo;
+}
+
+PR_INLINE float lobe_spec_pdf(const BsdfParams* m, float3 wo, float3 wi, float3 h) {
+  (void)wi;
+  return ggx_d_xy(h, m->alpha_x, m->alpha_y) /
+         ((1.0f + ggx_lambda_xy(wo, m->alpha_x, m->alpha_y)) * 4.0f * wo.z);
+}
+
+// The conductor, plus the dielectric layer over `below` (the diffuse, its Fresnel applied).
+PR_INLINE float3 lobe_spec_eval(const BsdfParams* m, const BsdfEval* e, float3 below) {
+  const BsdfLayers* lv = bsdf_view(e);
+  // The GGX lobe without Fresnel (symmetric in wo and wi).
+  const float ax = m->alpha_x, ay = m->alpha_y;
+  const float d = ggx_d_xy(e->h, ax, ay);
+  const float g2 = 1.0f / (1.0f + ggx_lambda_xy(e->wo, ax, ay) + ggx_lambda_xy(e->wi, ax, ay));
+  const float spec = d * g2 / (4.0f * e->wo.z * e->wi.z);
+  const float3 fm = m->base + (make_float3(1.0f, 1.0f, 1.0f) - m->base) * e->w5;
+  // fresnel_mix with a coloured F: specular where reflected, diffuse where not.
+  if (bsdf_gltf(m))
+    return (e->fd * spec + below) * (1.0f - m->metallic) + fm * (spec * m->metallic);
+  float3 f = make_float3(0.0f, 0.0f, 0.0f);
+  if (m->metallic > 0.0f) f = fm * lv->metal_ms * (spec * m->metallic);
+  if (m->metallic < 1.0f) f += (e->fd * lv->spec_ms * spec + below) * (1.0f - m->metallic);
+  return f;
+}
+
+// ---- Diffuse: Lambert, under the dielectric layer (its Fresnel here, so that the products
+// keep their grouping).
+
+PR_INLINE float lobe_diffuse_weight(const BsdfParams* m, float3 wo, const BsdfLayers* l) {
+  (void)wo;
+  if (bsdf_gltf(m)) return 1.0f;  // the rest
+  return bsdf_below_sheen(l) * (1.0f - m->metallic) *
+         luminance(m->base * (make_float3(1.0f, 1.0f, 1.0f) - l->spec_albedo));
+}
+
+PR_INLINE float lobe_diffuse_choice(const BsdfParams* m, float3 wo, const BsdfLobes* p,
+                                    float rest) {
+  (void)m;
+  (void)wo;
+  return bsdf_share_of_rest(p->diffuse, rest);
+}
+
+PR_INLINE float3 lobe_diffuse_sample(const BsdfParams* m, float3 wo, float u1, float u2) {
+  (void)m;
+  (void)wo;
+  return sample_cosine_hemisphere(u1, u2);
+}
+
+PR_INLINE float lobe_diffuse_pdf(const BsdfParams* m, float3 wo, float3 wi, float3 h) {
+  (void)m;
+  (void)wo;
+  (void)h;
+  return wi.z * PR_INV_PI;
+}
+
+// Opaque: nothing below it shows.
+PR_INLINE float3 lobe_diffuse_eval(const BsdfParams* m, const BsdfEval* e, float3 below) {
+  (void)below;
+  const float3 one = make_float3(1.0f, 1.0f, 1.0f);
+  if (bsdf_gltf(m)) return m->base * ((one - e->fd) * PR_INV_PI);
+  return m->base *
+         (fmax(one - bsdf_view(e)->spec_albedo, make_float3(0.0f, 0.0f, 0.0f)) * PR_INV_PI);
+}
+
+// ---- The mixture, from the table
+
+// The lobes' probabilities at wo. glTF: each lobe its weight's share of what the lobes above
+// leave. Energy: in proportion to the weights, then a tenth spread evenly over the lobes that
+// reflect anything, so a poor estimate (a textured base) cannot starve one.
 PR_INLINE BsdfLobes bsdf_lobes(const BsdfParams* m, float3 wo, const BsdfLayers* l) {
-  BsdfLobes p;
+  BsdfLobes p, w;
+#define PR_LOBE_ZERO(N, n, on) p.n = 0.0f;
+  PR_BSDF_LOBES(PR_LOBE_ZERO)
+#undef PR_LOBE_ZERO
   if (bsdf_gltf(m)) {
-    const float pc = bsdf_coat_probability(m, dot(wo, m->coat_n));
-    const float psh = l->sheen_albedo > 0.0f ? clamp(l->sheen_albedo, 0.05f, 0.5f) : 0.0f;
-    const float ps = bsdf_spec_probability(m, wo.z);
-    const float rest = (1.0f - pc) * (1.0f - psh);
-    p.coat = pc;
-    p.sheen = (1.0f - pc) * psh;
-    p.spec = rest * ps;
-    p.diffuse = rest * (1.0f - ps);
+    float rest = 1.0f;
+#define PR_LOBE_SHARE(N, n, on)                  \
+  if (on) {                                      \
+    const float s = lobe_##n##_weight(m, wo, l); \
+    p.n = rest * s;                              \
+    rest *= 1.0f - s;                            \
+  }
+    PR_BSDF_LOBES(PR_LOBE_SHARE)
+#undef PR_LOBE_SHARE
     return p;
   }
-  // In proportion to each layer's share of the albedo, then a tenth spread evenly over the
-  // lobes that reflect anything, so a poor estimate (a textured base) cannot starve one.
-  const float below_coat = 1.0f - l->coat_albedo;
-  const float below_sheen = below_coat * (1.0f - l->sheen_albedo);
-  float wc = l->coat_albedo, wsh = below_coat * l->sheen_albedo;
-  float ws = below_sheen * (m->metallic * luminance(l->metal_albedo) +
-                            (1.0f - m->metallic) * luminance(l->spec_albedo));
-  float wd = below_sheen * (1.0f - m->metallic) *
-             luminance(m->base * (make_float3(1.0f, 1.0f, 1.0f) - l->spec_albedo));
-  wc = fmax(wc, 0.0f);
-  wsh = fmax(wsh, 0.0f);
-  ws = fmax(ws, 0.0f);
-  wd = fmax(wd, 0.0f);
-  const float n = (float)((wc > 0.0f) + (wsh > 0.0f) + (ws > 0.0f) + (wd > 0.0f));
-  const float sum = wc + wsh + ws + wd;
+  int n = 0;
+  float sum = 0.0f;
+#define PR_LOBE_WEIGHT(N, name, on)                                \
+  w.name = on ? fmax(lobe_##name##_weight(m, wo, l), 0.0f) : 0.0f; \
+  n += w.name > 0.0f;                                              \
+  sum += w.name;
+  PR_BSDF_LOBES(PR_LOBE_WEIGHT)
+#undef PR_LOBE_WEIGHT
   if (!(sum > 0.0f)) {
-    // Nothing reflects (a black base): sample the GGX lobe.
-    p.coat = 0.0f;
-    p.sheen = 0.0f;
-    p.spec = 1.0f;
-    p.diffuse = 0.0f;
+    p.spec = 1.0f;  // nothing reflects (a black base): sample the GGX lobe
     return p;
   }
-  const float k = 0.9f / sum, floor_share = 0.1f / n;
-  p.coat = wc > 0.0f ? wc * k + floor_share : 0.0f;
-  p.sheen = wsh > 0.0f ? wsh * k + floor_share : 0.0f;
-  p.spec = ws > 0.0f ? ws * k + floor_share : 0.0f;
-  p.diffuse = wd > 0.0f ? wd * k + floor_share : 0.0f;
+  const float k = 0.9f / sum, floor_share = 0.1f / (float)n;
+#define PR_LOBE_FLOOR(N, n, on) p.n = w.n > 0.0f ? w.n * k + floor_share : 0.0f;
+  PR_BSDF_LOBES(PR_LOBE_FLOOR)
+#undef PR_LOBE_FLOOR
   return p;
 }
 
-// The coat's visible-normal pdf of wi from wo (about the coat's normal).
-PR_INLINE float coat_pdf(const BsdfParams* m, float3 wo, float3 wi, float3 h) {
-  const float co = dot(wo, m->coat_n), ci = dot(wi, m->coat_n);
-  if (!(co > 0.0f) || !(ci > 0.0f)) return 0.0f;
-  const float a2 = m->coat_alpha * m->coat_alpha;
-  return ggx_d(dot(h, m->coat_n), a2) / ((1.0f + ggx_lambda(co, a2)) * 4.0f * co);
+// The lobe u0 takes (PR_LOBE_*). glTF: down the layers, each taking its chance of what u0
+// leaves, u0 rescaled after each (the order of the glTF model's images); energy: u0 against
+// the lobes' running sum in PR_BSDF_LOBE_SUM_ORDER.
+PR_INLINE int bsdf_choose_lobe(const BsdfParams* m, float3 wo, const BsdfLobes* p, float u0) {
+  int lobe = -1;
+  if (bsdf_gltf(m)) {
+    float rest = 1.0f;
+#define PR_LOBE_CHOOSE_GLTF(N, n, on)                  \
+  if (on && lobe < 0) {                                \
+    const float q = lobe_##n##_choice(m, wo, p, rest); \
+    if (u0 < q) {                                      \
+      lobe = PR_LOBE_##N;                              \
+    } else {                                           \
+      if (q > 0.0f) u0 = (u0 - q) / (1.0f - q);        \
+      rest *= 1.0f - q;                                \
+    }                                                  \
+  }
+    PR_BSDF_LOBES(PR_LOBE_CHOOSE_GLTF)
+#undef PR_LOBE_CHOOSE_GLTF
+  } else {
+    float c = 0.0f;
+#define PR_LOBE_CHOOSE_SUM(N, n)                \
+  if (PR_LOBE_##N##_ON) {                       \
+    c += p->n;                                  \
+    if (lobe < 0 && u0 < c) lobe = PR_LOBE_##N; \
+  }
+    PR_BSDF_LOBE_SUM_ORDER(PR_LOBE_CHOOSE_SUM)
+#undef PR_LOBE_CHOOSE_SUM
+  }
+  return lobe < 0 ? PR_LOBE_COUNT - 1 : lobe;
 }
 
-// The mixture's pdf of sampling wi from wo with lobe probabilities p (h: their half vector).
+// A direction from lobe `lobe`.
+PR_INLINE float3 bsdf_lobe_sample(const BsdfParams* m, int lobe, float3 wo, float u1, float u2) {
+#define PR_LOBE_SAMPLE(N, n, on) \
+  if (on && lobe == PR_LOBE_##N) return lobe_##n##_sample(m, wo, u1, u2);
+  PR_BSDF_LOBES(PR_LOBE_SAMPLE)
+#undef PR_LOBE_SAMPLE
+  return make_float3(0.0f, 0.0f, -1.0f);
+}
+
+// The mixture's pdf of sampling wi from wo with lobe probabilities p (h: their half vector):
+// sum of p x lobe pdf in PR_BSDF_LOBE_SUM_ORDER.
 PR_INLINE float bsdf_mixture_pdf(const BsdfParams* m, const BsdfLobes* p, float3 wo, float3 wi,
                                  float3 h) {
   float pdf = 0.0f;
-  if (PR_HAS_COAT && p->coat > 0.0f) pdf += p->coat * coat_pdf(m, wo, wi, h);
-  if (p->spec > 0.0f) {
-    const float pdf_spec = ggx_d_xy(h, m->alpha_x, m->alpha_y) /
-                           ((1.0f + ggx_lambda_xy(wo, m->alpha_x, m->alpha_y)) * 4.0f * wo.z);
-    pdf += p->spec * pdf_spec;
-  }
-  if (PR_HAS_SHEEN && p->sheen > 0.0f) pdf += p->sheen * (0.5f * PR_INV_PI);
-  return pdf + p->diffuse * (wi.z * PR_INV_PI);
+#define PR_LOBE_PDF(N, n) \
+  if (PR_LOBE_##N##_ON && p->n > 0.0f) pdf += p->n * lobe_##n##_pdf(m, wo, wi, h);
+  PR_BSDF_LOBE_SUM_ORDER(PR_LOBE_PDF)
+#undef PR_LOBE_PDF
+  return pdf;
 }
 
-// f with view v = (mode radiance ? wo : wi); lv and li are the layers of wo and wi.
-PR_INLINE float3 bsdf_value(const BsdfParams* m, float3 wo, float3 wi, float3 h, int mode,
-                            const BsdfLayers* lo, const BsdfLayers* li) {
-  const BsdfLayers* lv = mode == PR_RADIANCE ? lo : li;
-  const float3 one = make_float3(1.0f, 1.0f, 1.0f);
-  // The GGX lobe without Fresnel (symmetric in wo and wi).
-  const float ax = m->alpha_x, ay = m->alpha_y;
-  const float d = ggx_d_xy(h, ax, ay);
-  const float g2 = 1.0f / (1.0f + ggx_lambda_xy(wo, ax, ay) + ggx_lambda_xy(wi, ax, ay));
-  const float spec = d * g2 / (4.0f * wo.z * wi.z);
-  const float w5 = schlick_weight(fmax(dot(wo, h), 0.0f));
-  const float3 fd = m->f0 + (make_float3(m->f90, m->f90, m->f90) - m->f0) * w5;
-  const float3 fm = m->base + (one - m->base) * w5;
-  float3 f;
-  if (bsdf_gltf(m)) {
-    // fresnel_mix with a coloured F: specular where reflected, diffuse where not.
-    const float3 dielectric = fd * spec + m->base * ((one - fd) * PR_INV_PI);
-    f = dielectric * (1.0f - m->metallic) + fm * (spec * m->metallic);
-  } else {
-    f = make_float3(0.0f, 0.0f, 0.0f);
-    if (m->metallic > 0.0f) f = fm * lv->metal_ms * (spec * m->metallic);
-    if (m->metallic < 1.0f)
-      f += (fd * lv->spec_ms * spec +
-            m->base * (fmax(one - lv->spec_albedo, make_float3(0.0f, 0.0f, 0.0f)) * PR_INV_PI)) *
-           (1.0f - m->metallic);
-  }
-  if (bsdf_has_sheen(m)) {
-    const float a = m->sheen_alpha;
-    const float s = sheen_lobe(wo.z, wi.z, h.z, a);
-    // The glTF model's scaling is the smaller of both directions' (reciprocal); the energy
-    // model's is the view's.
-    const float keep = bsdf_gltf(m) ? fmin(1.0f - lo->sheen_albedo, 1.0f - li->sheen_albedo)
-                                    : 1.0f - lv->sheen_albedo;
-    f = m->sheen * (s * lv->sheen_scale) + f * fmax(keep, 0.0f);
-  }
-  if (bsdf_has_coat(m)) {
-    const float co = dot(wo, m->coat_n), ci = dot(wi, m->coat_n);
-    float coat_spec = 0.0f;
-    if (co > 0.0f && ci > 0.0f) {
-      float unused;
-      coat_spec = ggx_reflection(co, ci, dot(h, m->coat_n), m->coat_alpha * m->coat_alpha, &unused);
-      // glTF: the coat's lobe weighted by its Fresnel at N.V; energy: the microfacet's Fresnel
-      // with the multiple-scattering factor.
-      coat_spec *= bsdf_gltf(m) ? lv->coat_albedo : m->coat * coat_fresnel(w5) * lv->coat_ms;
-      // The caller weights by the cosine to the shading normal; a tilted coat reflects by the
-      // cosine to its own, on the light's side (wi, or wo for importance).
-      if (m->coat_n.z < 1.0f) coat_spec *= mode == PR_RADIANCE ? ci / wi.z : co / wo.z;
-    }
-    f = f * fmax(1.0f - lv->coat_albedo, 0.0f) + make_float3(coat_spec, coat_spec, coat_spec);
-  }
-  return f;
+// f: each layer over the ones below it, from the base up (the expansion nests the calls as
+// coat(sheen(spec(diffuse(0))))).
+PR_INLINE float3 bsdf_value(const BsdfParams* m, const BsdfEval* e) {
+#define PR_LOBE_EVAL_OPEN(N, n, on) lobe_##n##_eval(m, e,
+#define PR_LOBE_EVAL_CLOSE(N, n, on) )
+  return PR_BSDF_LOBES(PR_LOBE_EVAL_OPEN) make_float3(0.0f, 0.0f, 0.0f)
+      PR_BSDF_LOBES(PR_LOBE_EVAL_CLOSE);
+#undef PR_LOBE_EVAL_OPEN
+#undef PR_LOBE_EVAL_CLOSE
 }
 
 // bsdf_eval_mode's body.
@@ -392,38 +625,29 @@ PR_INLINE float3 bsdf_eval_impl(const BsdfParams* m, float3 wo, float3 wi, int m
     *pdf_rev = wo.z * PR_INV_PI;
     return m->base * PR_INV_PI;
   }
-  float3 h = wo + wi;
-  const float hl = length(h);
+  BsdfEval e;
+  e.wo = wo;
+  e.wi = wi;
+  e.h = wo + wi;
+  const float hl = length(e.h);
   if (hl <= 0.0f) return make_float3(0.0f, 0.0f, 0.0f);
-  h = h / hl;
+  e.h = e.h / hl;
+  e.w5 = schlick_weight(fmax(dot(wo, e.h), 0.0f));
+  e.fd = m->f0 + (make_float3(m->f90, m->f90, m->f90) - m->f0) * e.w5;
+  e.mode = mode;
   // wi's layers where the value (seen from wi, or the glTF sheen's scaling) or pdf_rev needs
   // them.
-  const BsdfLayers lo = bsdf_layers(m, wo);
+  e.lo = bsdf_layers(m, wo);
   const int need_li = want_rev || mode == PR_IMPORTANCE || (bsdf_gltf(m) && bsdf_has_sheen(m));
-  const BsdfLayers li = need_li ? bsdf_layers(m, wi) : lo;
-  const float3 f = bsdf_value(m, wo, wi, h, mode, &lo, &li);
-  const BsdfLobes po = bsdf_lobes(m, wo, &lo);
-  *pdf = bsdf_mixture_pdf(m, &po, wo, wi, h);
+  e.li = need_li ? bsdf_layers(m, wi) : e.lo;
+  const float3 f = bsdf_value(m, &e);
+  const BsdfLobes po = bsdf_lobes(m, wo, &e.lo);
+  *pdf = bsdf_mixture_pdf(m, &po, wo, wi, e.h);
   if (want_rev) {
-    const BsdfLobes pi = bsdf_lobes(m, wi, &li);
-    *pdf_rev = bsdf_mixture_pdf(m, &pi, wi, wo, h);
+    const BsdfLobes pi = bsdf_lobes(m, wi, &e.li);
+    *pdf_rev = bsdf_mixture_pdf(m, &pi, wi, wo, e.h);
   }
   return f;
-}
-
-// A direction from the coat's visible normals, about its own normal.
-PR_INLINE float3 coat_sample(const BsdfParams* m, float3 wo, float u1, float u2) {
-  if (m->coat_n.z >= 1.0f) {
-    const float3 h = ggx_sample_vndf(wo, m->coat_alpha, m->coat_alpha, u1, u2);
-    return h * (2.0f * dot(wo, h)) - wo;
-  }
-  float3 t, b;
-  orthonormal_basis(m->coat_n, &t, &b);
-  const float3 wc = to_local(wo, t, b, m->coat_n);
-  if (!(wc.z > 0.0f)) return make_float3(0.0f, 0.0f, -1.0f);
-  const float3 h =
-      to_world(ggx_sample_vndf(wc, m->coat_alpha, m->coat_alpha, u1, u2), t, b, m->coat_n);
-  return h * (2.0f * dot(wo, h)) - wo;
 }
 
 // bsdf_sample's body.
@@ -472,40 +696,7 @@ PR_INLINE int bsdf_sample_impl(const BsdfParams* m, float3 wo, float u0, float u
   }
   const BsdfLayers lo = bsdf_layers(m, wo);
   const BsdfLobes p = bsdf_lobes(m, wo, &lo);
-  float3 dir;
-  if (bsdf_gltf(m)) {
-    // The random number's rest after each choice makes the next (the order of the glTF model's
-    // images before the sheen was added).
-    float ub = u0;
-    if (ub < p.coat) {
-      dir = coat_sample(m, wo, u1, u2);
-    } else {
-      if (p.coat > 0.0f) ub = (ub - p.coat) / (1.0f - p.coat);
-      const float rest = 1.0f - p.coat;
-      const float psh = rest > 0.0f ? p.sheen / rest : 0.0f;
-      if (ub < psh) {
-        dir = sample_uniform_hemisphere(u1, u2);
-      } else {
-        if (psh > 0.0f) ub = (ub - psh) / (1.0f - psh);
-        const float ps = bsdf_spec_probability(m, wo.z);
-        if (ub < ps) {
-          const float3 h = ggx_sample_vndf(wo, m->alpha_x, m->alpha_y, u1, u2);
-          dir = h * (2.0f * dot(wo, h)) - wo;
-        } else {
-          dir = sample_cosine_hemisphere(u1, u2);
-        }
-      }
-    }
-  } else if (u0 < p.coat) {
-    dir = coat_sample(m, wo, u1, u2);
-  } else if (u0 < p.coat + p.spec) {
-    const float3 h = ggx_sample_vndf(wo, m->alpha_x, m->alpha_y, u1, u2);
-    dir = h * (2.0f * dot(wo, h)) - wo;
-  } else if (u0 < p.coat + p.spec + p.sheen) {
-    dir = sample_uniform_hemisphere(u1, u2);
-  } else {
-    dir = sample_cosine_hemisphere(u1, u2);
-  }
+  const float3 dir = bsdf_lobe_sample(m, bsdf_choose_lobe(m, wo, &p, u0), wo, u1, u2);
   if (dir.z <= 0.0f) return 0;
   float p_fwd = 0.0f, p_rev;
   const float3 f = bsdf_eval_impl(m, wo, dir, mode, 0, &p_fwd, &p_rev);
