@@ -3,7 +3,8 @@
 // ray for next-event estimation, samples the BSDF for the next ray and applies Russian roulette.
 // With light_paths = C > 0 (--eye-paths), the eye path's ends on a light are weighted against
 // the reuse connections that make the same paths too (shared/eye_paths.h): the path keeps the
-// ratio of the two ways' densities of its vertices beyond x_1 as it goes.
+// ratio of the two ways' densities of its vertices beyond x_1 as it goes (mis_ratio_*, and every
+// weight here from shared/mis.h).
 // With light_paths > 0, x_1 (the first non-delta vertex) is written to the sample's EyeVertex for
 // connect. Writes the PathState, the radiance and the ShadowRay of the same index, and appends
 // the path to next_queue if it goes on and to shadow_queue if it has a shadow ray (their order
@@ -23,6 +24,13 @@ PR_INLINE float eye_paths_light_side(const Light* l, float3 n_tri, float start, 
   const float d2 = dot(d, d);
   return (float)light_paths * start *
          eye_paths_emit_density(l, n_tri, d * (1.0f / sqrt(d2)), cos_x, d2) * rev * eye_ratio;
+}
+
+// The light tracer's density of x_{t-1} (the vertex `p.ray` left, at squared distance dist2)
+// sampled from a non-delta x_t in frame f, arriving from wi and leaving towards wo.
+PR_INLINE float pt_light_density(const ShadingFrame* f, const PathState* p, float3 wi, float3 wo,
+                                 float dist2) {
+  return solid_angle_to_area_pdf(eye_paths_bsdf_pdf(f, wi, wo), p->seg_cos, dist2);
 }
 
 // Escaped: the environment's light, MIS-weighted against next-event estimation, into *add;
@@ -62,7 +70,7 @@ PR_INLINE float pt_emission_weight(const SceneData* s, const PathState* p, const
     const float dens_l = eye_paths_light_side(&l, n_tri, start, light_paths, p->eye_ratio, h->p,
                                               prev, p->seg_cos, 1.0f);
     const float dens_n = spec ? 0.0f : start;
-    if (dens_l > 0.0f) w *= 1.0f - eye_path_share(dens_n / dens_l, dens_h / dens_l);
+    if (dens_l > 0.0f) w *= 1.0f - mis_power_share(dens_n / dens_l, dens_h / dens_l);
   }
   return w;
 }
@@ -88,7 +96,7 @@ PR_INLINE float pt_next_event_weight(const SceneData* s, const PathState* p, con
     const float rev = has_rev ? solid_angle_to_area_pdf(ch->pdf_bsdf_rev, p->seg_cos, dist2) : 1.0f;
     const float dens_l = eye_paths_light_side(&l, n_tri, dens_n, light_paths, p->eye_ratio, ch->pos,
                                               h->p, fabs(dot(f->ng, wi)), rev);
-    if (dens_l > 0.0f) w *= 1.0f - eye_path_share(dens_n / dens_l, dens_h / dens_l);
+    if (dens_l > 0.0f) w *= 1.0f - mis_power_share(dens_n / dens_l, dens_h / dens_l);
   }
   return w;
 }
@@ -142,8 +150,9 @@ PR_KERNEL void pt_shade(PR_PARAMS(PR_ARGS_PT_SHADE)) {
     } else {
       if (p.depth == p.x1_depth + 1u) p.eye_flags = delta_here ? 0u : PR_EYE_JOINABLE;
       // This vertex's eye density (x_t, t >= 2): 1 when sampled from a delta vertex.
-      if (!(p.flags & PR_PATH_SPECULAR))
-        p.eye_ratio /= solid_angle_to_area_pdf(p.last_pdf, fabs(dot(h.ng, d)), dist2);
+      p.eye_ratio = mis_ratio_arrive(p.eye_ratio,
+                                     solid_angle_to_area_pdf(p.last_pdf, fabs(dot(h.ng, d)), dist2),
+                                     (p.flags & PR_PATH_SPECULAR) != 0u);
     }
   }
   // x_t with t >= 3: the light tracer's density of x_{t-1}, reached from this vertex.
@@ -184,9 +193,10 @@ PR_KERNEL void pt_shade(PR_PARAMS(PR_ARGS_PT_SHADE)) {
       // From the third vertex on (the camera's throughput starts at 1).
       const float rr = rng_next(&rng);
       if (p.depth >= 3u && !russian_roulette(max3(tp), rr, &tp)) p.alive = 0u;
-      if (has_rev && !delta_here)
-        p.eye_ratio *=
-            solid_angle_to_area_pdf(eye_paths_bsdf_pdf(&f, step.wi, wo), p.seg_cos, dist2);
+      if (has_rev)  // x_{t-1}'s light-tracing density from here (1 where this is delta)
+        p.eye_ratio = mis_ratio_leave(
+            p.eye_ratio, delta_here ? 1.0f : pt_light_density(&f, &p, step.wi, wo, dist2),
+            delta_here);
       p.seg_cos = fabs(dot(f.ng, step.wi));
       p.ray = surface_ray(&s, &h, step.wi, PR_INF_F);
       p.prev_x = h.p.x;

@@ -9,9 +9,9 @@
 // Reads the EyeVertex, the arena and the scene; adds to the sample's radiance and the counters.
 //
 // Each strategy is one function over a Connector (what every connection of the eye sample
-// shares) and the eye point it starts from; the connection MIS weights come from
-// connection_mis_weight (shared/connection_mis.h, unit-tested on the host), next-event
-// estimation's from the path tracer's power heuristic.
+// shares) and the eye point it starts from. Every weight, the connection MIS
+// (mis_connection_weight), next-event estimation's power heuristic, the reservoirs' and the
+// history's resampling weights, comes from shared/mis.h (unit-tested on the host).
 //
 // Resampled connections (rp.resample = K, 1 to PR_MAX_CONNECTIONS). Every connection of both
 // strategies, to all the light vertices of the C paths, is a candidate with an unshadowed
@@ -37,9 +37,9 @@
 #ifndef PR_CONNECT_DEFERRED
 #define PR_CONNECT_DEFERRED 0
 #endif
-// After reuse.h: its FP_CONTRACT OFF (shared/bvh.h) holds for these weights too.
-#include "shared/connection_mis.h"
+// After reuse.h: its FP_CONTRACT OFF (shared/bvh.h) holds here too.
 #include "shared/eye_paths.h"
+#include "shared/mis.h"
 
 // The connections kept so far among an eye vertex's candidates: rp.resample of them, each
 // chosen independently among all (with replacement), sharing the sum of the weights.
@@ -216,7 +216,7 @@ PR_INLINE void connection_trace_or_keep(Connector* cn, float3 c, Ray ray, u32 st
       ++res->candidates;
       for (u32 k = 0u; k < cn->rp->resample; ++k) {
         // The first candidate is kept by every slot (u * w < w).
-        if (rng_next(&cn->rr) * res->w_sum < w) {
+        if (ris_accept(rng_next(&cn->rr), res->w_sum, w)) {
           res->ray[k] = ray;
           res->c[3 * k] = c.x, res->c[3 * k + 1] = c.y, res->c[3 * k + 2] = c.z;
           res->w[k] = w;
@@ -261,7 +261,7 @@ PR_INLINE void reservoir_resolve(Connector* cn) {
       ++cn->n.rays;
       cn->n.mis_rays += res->strategy[k] == PR_STRATEGY_E;
       const float3 c = make_float3(res->c[3 * k], res->c[3 * k + 1], res->c[3 * k + 2]) *
-                       (res->w_sum / (res->w[k] * (float)cn->rp->resample));
+                       ris_contribution_weight(res->w_sum, res->w[k], (float)cn->rp->resample);
       connect_term(cn, c, &res->ray[k], PR_REC_GROUP | PR_REC_COUNTED);
     }
     connect_close(cn);
@@ -304,7 +304,7 @@ PR_INLINE float3 light_vertex_value(const Connector* cn, const EyePoint* x, cons
   const float mis = cn->rp->eye_paths
                         ? eye_path_weight(cn->ratios[vk - cn->vertices], k, pdf_x,
                                           fabs(dot(y->h.ng, dir)), dist2, pdf_rev, cn->inv_c)
-                        : connection_mis_weight(PR_STRATEGY_L, p_l, p_e, cn->rp->mis_threshold);
+                        : mis_connection_weight(PR_STRATEGY_L, p_l, p_e, cn->rp->mis_threshold);
   const float3 tpy = make_float3(vk->tp_r, vk->tp_g, vk->tp_b);
   *ray = surface_segment(cn->s, &x->h, &y->h);
   return connection_value(cn, x->tp, f_x, fabs(dot(x->f.n, dir)), tpy, f_y, cos_y, dist2, corr, mis,
@@ -346,7 +346,7 @@ PR_INLINE void history_offer(Connector* cn, HistoryReservoir* hr, float3 c, Ray 
   const float p = luminance(c);
   if (!(p > 0.0f)) return;
   hr->p_sum += p;
-  if (rng_next(&cn->rr) * hr->p_sum < p) {
+  if (ris_accept(rng_next(&cn->rr), hr->p_sum, p)) {
     hr->slot = slot;
     hr->k = k;
     hr->c = c;
@@ -430,8 +430,7 @@ PR_INLINE void history_resolve(Connector* cn, const EyeVertex* e, __global Conne
     if (prev_kept) {
       c_prev = light_vertex_value_at(cn, x, prev.slot, prev_k, &ray_prev);
       const float p_cur = luminance(c_prev);
-      const float den = m_prev * prev.p + mc * p_cur;
-      if (den > 0.0f && p_cur > 0.0f) w_prev = m_prev * prev.p / den * p_cur * prev.w;
+      if (p_cur > 0.0f) w_prev = gris_weight(mis_balance(m_prev, prev.p, mc, p_cur), p_cur, prev.w);
     }
     if (hr->slot != PR_INVALID_INDEX && changed[hr->slot] <= prev.frame) {
       const EyePoint xp = eye_point_at(
@@ -440,7 +439,7 @@ PR_INLINE void history_resolve(Connector* cn, const EyeVertex* e, __global Conne
       Ray unused;
       const float p_old = luminance(light_vertex_value_at(cn, &xp, hr->slot, hr->k, &unused));
       const float p_cur = luminance(hr->c);
-      w_cur *= mc * p_cur / (m_prev * p_old + mc * p_cur);
+      w_cur *= mis_balance(mc, p_cur, m_prev, p_old);
     }
   }
   const float total = w_cur + w_prev;
@@ -460,25 +459,26 @@ PR_INLINE void history_resolve(Connector* cn, const EyeVertex* e, __global Conne
   float3 c_l = make_float3(0.0f, 0.0f, 0.0f);
   Ray ray_l;
   if (total > 0.0f) {
-    const int take_prev = rng_next(&cn->rr) * total < w_prev;
+    const int take_prev = ris_accept(rng_next(&cn->rr), total, w_prev);
     c_l = take_prev ? c_prev : hr->c;
     ray_l = take_prev ? ray_prev : hr->ray;
     next.slot = take_prev ? prev.slot : hr->slot;
     next.depth_k |= (take_prev ? prev_k : hr->k) << 16;
     next.p = luminance(c_l);
-    next.w = total / next.p;
+    next.w = ris_contribution_weight(total, next.p, 1.0f);
     cn->n.history_kept += take_prev;
   }
   *hist = next;
   // One shadow ray, to L's vertex or E's connection: resampled between the two.
   const float both = total + w_e;
   if (both > 0.0f) {
-    const int take_e = rng_next(&cn->rr) * both < w_e;
+    const int take_e = ris_accept(rng_next(&cn->rr), both, w_e);
     const float3 c = take_e ? cn->he.c : c_l;
     ++cn->n.rays;
     cn->n.mis_rays += take_e;
     const Ray ray = take_e ? cn->he.ray : ray_l;
-    connect_term(cn, c * (both / luminance(c)), &ray, PR_REC_ADD | PR_REC_COUNTED);
+    connect_term(cn, c * ris_contribution_weight(both, luminance(c), 1.0f), &ray,
+                 PR_REC_ADD | PR_REC_COUNTED);
   }
   hr->slot = cn->he.slot = PR_INVALID_INDEX;
   hr->p_sum = cn->he.p_sum = 0.0f;
@@ -526,7 +526,7 @@ PR_INLINE void strategy_sampled_vertex(Connector* cn, float3 xp, float pdf_x, co
         zng = z.f.ng;
       }
       const float p_l = solid_angle_to_area_pdf(pdf_l, fabs(dot(y->f.ng, dir)), dist2);
-      const float w = connection_mis_weight(PR_STRATEGY_E, p_l, p_e, rp->mis_threshold);
+      const float w = mis_connection_weight(PR_STRATEGY_E, p_l, p_e, rp->mis_threshold);
       if (!(w > 0.0f)) continue;
       float pdf_unused;
       const float3 f_y = eye_point_eval(y, dir, &pdf_unused);

@@ -4,7 +4,8 @@
 // generation; writes the slot's PathHeader and LightVertex records (with --eye-paths, their
 // EyePathRatio records too) and adds to the counters.
 #include "shared/reuse.h"
-// After reuse.h: its FP_CONTRACT OFF (shared/bvh.h) holds for the ratios too.
+// After reuse.h: its FP_CONTRACT OFF (shared/bvh.h) holds for the ratios too (shared/mis.h keeps
+// them safe without it).
 #include "shared/eye_paths.h"
 
 // A light sub-path's first vertex: its point on light L (chosen with probability pmf), the

@@ -1,19 +1,20 @@
 // --eye-paths (docs/design.md section 5, "Eye paths"): the path tracer's eye paths and the
 // reuse connections make the same paths. L (the first non-delta eye vertex x_1 joined to the
-// stored light vertex z_k) takes the share eye_path_share gives it against N (the eye path's
-// next-event estimation) and H (its BSDF sample meets the emitter), and the eye path the rest,
-// split between N and H by the path tracer's own power heuristic. Each strategy's density of a
-// path is the product of the densities (per unit area) of the vertices it samples beyond x_1,
+// stored light vertex z_k) takes its power-heuristic share (mis_power_share) against N (the eye
+// path's next-event estimation) and H (its BSDF sample meets the emitter), and the eye path the
+// rest, split between N and H by the path tracer's own power heuristic. Each strategy's density of
+// a path is the product of the densities (per unit area) of the vertices it samples beyond x_1,
 // with C light paths per camera sample counted in L's; a density sampled from a delta vertex
 // counts as 1 on both sides. N's choice of z_0 is counted as the light tracer's (its power
 // table, uniform on the triangle), and Russian roulette is left out: any share that both sides
 // compute alike keeps the estimate unbiased, and this one needs no light-tree walk in connect.
-// These helpers are what connect (kernels/reuse) and pt_shade (kernels/pathtrace) share.
+// These helpers are what connect (kernels/reuse) and pt_shade (kernels/pathtrace) share; the
+// densities are gathered and weighed by the functions of shared/mis.h.
 #pragma once
 
 #include "shared/arena.h"
-#include "shared/connection_mis.h"
 #include "shared/integrator.h"
+#include "shared/mis.h"
 
 PR_NAMESPACE_BEGIN
 
@@ -62,8 +63,7 @@ typedef struct {
   Light light;
   int tri;          // a triangle light (H can reach z_0)
   float inv_start;  // 1 / the light tracer's density of z_0
-  float rest;       // its densities of z_1 .. z_k
-  float eye;        // the eye's densities of z_1 .. z_{k-2}, each sampled from the next vertex
+  MisChain chain;   // fwd: its densities of z_1 .. z_k; rev: the eye's of z_1 .. z_{k-2}
   float hit;        // the eye's density of z_0 sampled from z_1 arriving from z_2 (1: z_1 delta)
   float pdf_next;   // solid-angle pdf of the light tracer's step from z_k
   float g;          // |cos| at z_{k-1} over the squared distance to z_k (z_0: the triangle's)
@@ -79,7 +79,8 @@ PR_INLINE EyePathWalk eye_path_walk_start(const Light* l, u32 li, float3 n_tri,
   w.light = *l;
   w.tri = l->type == PR_LIGHT_TRIANGLE;
   w.inv_start = 1.0f / eye_paths_start_density(l, li, trace_cdf, trace_total);
-  w.rest = w.eye = w.hit = 1.0f;
+  w.chain = mis_chain_start();
+  w.hit = 1.0f;
   w.pdf_next = w.g = 0.0f;
   w.z1_delta = w.delta_k = 0;
   w.n_tri = w.ng_prev = n_tri;
@@ -90,18 +91,18 @@ PR_INLINE EyePathWalk eye_path_walk_start(const Light* l, u32 li, float3 n_tri,
 // kept for it.
 PR_INLINE EyePathRatio eye_path_walk_arrive(EyePathWalk* w, u32 k, float3 dir, float t, float3 ng) {
   const float t2 = t * t, cos_k = fabs(dot(ng, dir));
-  if (k == 1u)
-    w->rest = eye_paths_emit_density(&w->light, w->n_tri, dir, cos_k, t2);
-  else if (!w->delta_k)  // a density sampled from a delta vertex counts as 1
-    w->rest *= solid_angle_to_area_pdf(w->pdf_next, cos_k, t2);
+  // z_k's density: from the light (z_0 is never delta), else the step from z_{k-1}.
+  const float fwd = k == 1u ? eye_paths_emit_density(&w->light, w->n_tri, dir, cos_k, t2)
+                            : solid_angle_to_area_pdf(w->pdf_next, cos_k, t2);
+  mis_chain_arrive(&w->chain, fwd, w->delta_k);
   w->g = (k > 1u || w->tri) ? fabs(dot(w->ng_prev, dir)) / t2 : 0.0f;
   w->ng_prev = ng;
   EyePathRatio r;
   if (k == 1u) {
-    r.n = 1.0f / w->rest;
-    r.h = w->g * w->inv_start / w->rest;
+    r.n = 1.0f / w->chain.fwd;
+    r.h = w->g * w->inv_start / w->chain.fwd;
   } else {
-    const float a = w->g * w->eye / w->rest;
+    const float a = w->g * w->chain.rev / w->chain.fwd;
     r.n = w->z1_delta ? 0.0f : a;  // no next-event estimation from a delta z_1
     r.h = a * w->hit * w->inv_start;
   }
@@ -111,11 +112,13 @@ PR_INLINE EyePathRatio eye_path_walk_arrive(EyePathWalk* w, u32 k, float3 dir, f
 // Leaving z_k (delta or not) by the light tracer's step, whose pdf was pdf_fwd and that of the
 // reverse step (towards z_{k-1}) pdf_rev.
 PR_INLINE void eye_path_walk_leave(EyePathWalk* w, u32 k, int delta, float pdf_fwd, float pdf_rev) {
+  // The eye's density of z_{k-1} sampled from z_k (g is 0 where z_0 is not a triangle).
+  const float rev = area_pdf_g(pdf_rev, w->g);
   if (k == 1u) {
     w->z1_delta = delta;
-    w->hit = delta ? 1.0f : pdf_rev * w->g;  // g is 0 where z_0 is not a triangle
-  } else if (!delta) {
-    w->eye *= pdf_rev * w->g;
+    w->hit = mis_sampled(rev, delta);
+  } else {
+    mis_chain_leave(&w->chain, rev, delta);
   }
   w->pdf_next = delta ? 0.0f : pdf_fwd;
   w->delta_k = delta;
@@ -127,7 +130,7 @@ PR_INLINE void eye_path_walk_leave(EyePathWalk* w, u32 k, int delta, float pdf_f
 PR_INLINE float eye_path_weight(EyePathRatio r, u32 k, float pdf_x, float cos_z, float dist2,
                                 float pdf_rev, float inv_c) {
   const float e = solid_angle_to_area_pdf(pdf_x, cos_z, dist2) * inv_c;
-  return eye_path_share(e * (k == 1u ? 1.0f : pdf_rev) * r.n, e * pdf_rev * r.h);
+  return mis_power_share(e * (k == 1u ? 1.0f : pdf_rev) * r.n, e * pdf_rev * r.h);
 }
 
 PR_NAMESPACE_END

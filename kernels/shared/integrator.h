@@ -5,6 +5,7 @@
 #include "shared/bvh.h"
 #include "shared/environment.h"
 #include "shared/lights.h"
+#include "shared/mis.h"
 #include "shared/rng.h"
 #include "shared/shading.h"
 
@@ -353,7 +354,7 @@ PR_INLINE int next_event(const SceneData* s, const SurfaceHit* h, const ShadingF
   const float3 wol = to_local(wo, f->t, f->b, f->n), wil = to_local(ls.wi, f->t, f->b, f->n);
   const float3 fr = bsdf_eval_both(&f->bsdf, wol, wil, &bsdf_pdf, &bsdf_pdf_rev);
   const float cos_i = fabs(wil.z);
-  // MIS from the pmf that BSDF-sampled emitter hits see (light_choice_pmf).
+  // MIS from the pmf that BSDF-sampled emitter hits see (light_choice_pmf; shared/mis.h).
   const float w =
       (ls.delta || !use_mis) ? 1.0f : power_heuristic(ls.pdf * (mis_pmf / pmf), bsdf_pdf);
   *contribution = fr * le * (cos_i * w / ls.pdf);

@@ -1,8 +1,9 @@
-// Sampling routines shared by kernels and host tests: directions, points on triangles,
-// the power heuristic for multiple importance sampling.
+// Sampling routines shared by kernels and host tests: directions, points on triangles. The
+// MIS weights, power_heuristic among them, are in shared/mis.h (included here for its users).
 #pragma once
 
 #include "shared/math.h"
+#include "shared/mis.h"
 
 PR_NAMESPACE_BEGIN
 
@@ -84,12 +85,6 @@ PR_INLINE float3 to_world(float3 v, float3 t, float3 b, float3 n) {
 }
 PR_INLINE float3 to_local(float3 v, float3 t, float3 b, float3 n) {
   return make_float3(dot(v, t), dot(v, b), dot(v, n));
-}
-
-// Power heuristic with beta = 2 (Veach 1997, eq. 9.13) for one sample of each strategy.
-PR_INLINE float power_heuristic(float pdf_a, float pdf_b) {
-  const float a = pdf_a * pdf_a, b = pdf_b * pdf_b;
-  return a + b > 0.0f ? a / (a + b) : 0.0f;
 }
 
 PR_NAMESPACE_END
