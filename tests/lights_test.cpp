@@ -1,12 +1,17 @@
 // Emitter sampling (kernels/shared/lights.h) on the CPU reference: the solid angle a triangle
 // subtends, chi-square tests of the points light_sample draws against the density it claims
 // (uniform in solid angle where it samples by solid angle, uniform in area elsewhere), and the
-// pdf of a given point (what MIS uses) equal to the pdf of drawing it.
+// pdf of a given point (what MIS uses) equal to the pdf of drawing it. The light-type table:
+// each type's flags, its dispatch reaching its own function set, and per type the pdfs of its
+// samples and the receiver importance.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <vector>
 
+#include "scene/environment.h"
 #include "shared/lights.h"
 #include "shared/rng.h"
 #include "shared/types.h"
@@ -221,6 +226,219 @@ TEST(SphericalTriangle, PdfOfAPointEqualsThePdfOfDrawingIt) {
         ASSERT_NEAR(pdf, ls.pdf, 2e-3f * ls.pdf) << "sample " << s << " from y " << p.y;
       }
     }
+}
+
+// The light-type table (PR_LIGHT_TYPES): what each type says of itself.
+TEST(LightTable, EveryTypeHasItsFlags) {
+  EXPECT_EQ(PR_LIGHT_TYPE_COUNT, 5);
+  const struct {
+    uint32_t type, flags;
+  } want[] = {
+      {PR_LIGHT_TRIANGLE, PR_LIGHT_ON_TRIANGLE | PR_LIGHT_JOINS_VERTEX0 | PR_LIGHT_EYE_PATHS},
+      {PR_LIGHT_POINT, PR_LIGHT_DELTA_POSITION | PR_LIGHT_JOINS_VERTEX0 | PR_LIGHT_EYE_PATHS},
+      {PR_LIGHT_SPOT, PR_LIGHT_DELTA_POSITION},
+      {PR_LIGHT_DIRECTIONAL, PR_LIGHT_DELTA_DIRECTION | PR_LIGHT_AT_INFINITY},
+      {PR_LIGHT_ENV, PR_LIGHT_AT_INFINITY},
+  };
+  for (const auto& w : want) EXPECT_EQ(dev::light_type_flags(w.type), w.flags) << w.type;
+  EXPECT_EQ(dev::light_type_flags(PR_LIGHT_TYPE_COUNT), 0u);
+  // What the callers rely on, for any type added later.
+  for (uint32_t t = 0; t < PR_LIGHT_TYPE_COUNT; ++t) {
+    EXPECT_FALSE(dev::light_is_triangle(t) && dev::light_is_delta(t)) << t;
+    EXPECT_FALSE(dev::light_is_triangle(t) && dev::light_at_infinity(t)) << t;
+    EXPECT_FALSE(dev::light_joins_vertex0(t) && dev::light_at_infinity(t)) << t;
+    EXPECT_TRUE(!dev::light_in_eye_paths(t) || dev::light_joins_vertex0(t)) << t;
+    const uint32_t f = dev::light_type_flags(t);
+    EXPECT_FALSE((f & PR_LIGHT_DELTA_POSITION) && (f & PR_LIGHT_DELTA_DIRECTION)) << t;
+  }
+}
+
+// One light of each type, and the environment's data buffer.
+struct LightsOfEveryType {
+  std::vector<dev::Light> lights;
+  std::vector<float> env;
+  LightsOfEveryType() {
+    lights.push_back(triangleLight(kBig));
+    lights.back().le_r = 2.0f, lights.back().le_b = 0.5f;
+    dev::Light point{};
+    point.type = PR_LIGHT_POINT;
+    point.p0x = 0.3f, point.p0y = 2.0f, point.p0z = -0.2f;
+    point.le_r = 3.0f, point.le_g = 2.0f, point.le_b = 1.0f;
+    lights.push_back(point);
+    dev::Light spot = point;
+    spot.type = PR_LIGHT_SPOT;
+    const float3 axis = dev::normalize(make_float3(0.2f, -1.0f, 0.1f));
+    spot.e1x = axis.x, spot.e1y = axis.y, spot.e1z = axis.z;
+    spot.cos_inner = std::cos(0.3f), spot.cos_outer = std::cos(0.7f);
+    lights.push_back(spot);
+    dev::Light sun = spot;
+    sun.type = PR_LIGHT_DIRECTIONAL;
+    lights.push_back(sun);
+    Environment e;
+    e.width = 8, e.height = 4;
+    e.rgb.resize(3 * 8 * 4);
+    for (size_t i = 0; i < e.rgb.size(); ++i) e.rgb[i] = 0.1f + float(i % 7);
+    float mean = 0.0f;
+    env = environmentTables(e, &mean);
+    dev::Light sky{};
+    sky.type = PR_LIGHT_ENV;
+    sky.inst = 8, sky.prim = 4;
+    sky.p0x = std::cos(0.4f), sky.p0y = std::sin(0.4f);
+    sky.le_r = sky.le_g = sky.le_b = 1.5f;
+    sky.area = mean;
+    lights.push_back(sky);
+  }
+};
+
+bool sameBits(float a, float b) {
+  return std::memcmp(&a, &b, sizeof a) == 0;
+}
+bool sameBits(float3 a, float3 b) {
+  return sameBits(a.x, b.x) && sameBits(a.y, b.y) && sameBits(a.z, b.z);
+}
+
+// Each type's functions, named here rather than from the table: a row that names the wrong set
+// (or a dispatcher that forgets a type) fails.
+struct FunctionSet {
+  uint32_t type;
+  int (*sample)(const dev::Light*, const float*, float, float3, float3, float, float,
+                dev::LightSample*, float*, float*);
+  float (*pdf)(const dev::Light*, const float*, float, float3, float3, float3, float3);
+  float (*sampleEmit)(const dev::Light*, const float*, float3, float, float, float3*, float3*);
+  float (*pdfEmit)(const dev::Light*, float3, float3);
+  float (*falloff)(const dev::Light*, float3);
+  float (*power)(const dev::Light*, float);
+  float (*importance)(const dev::Light*, float3, float3);
+};
+#define PR_TEST_SET(T, fn)                                                              \
+  {                                                                                     \
+    T, dev::light_##fn##_sample, dev::light_##fn##_pdf, dev::light_##fn##_sample_emit,  \
+        dev::light_##fn##_pdf_emit, dev::light_##fn##_falloff, dev::light_##fn##_power, \
+        dev::light_##fn##_importance                                                    \
+  }
+const FunctionSet kSets[] = {
+    PR_TEST_SET(PR_LIGHT_TRIANGLE, triangle), PR_TEST_SET(PR_LIGHT_POINT, point),
+    PR_TEST_SET(PR_LIGHT_SPOT, spot),         PR_TEST_SET(PR_LIGHT_DIRECTIONAL, directional),
+    PR_TEST_SET(PR_LIGHT_ENV, env),
+};
+#undef PR_TEST_SET
+
+TEST(LightTable, DispatchReachesEachTypesOwnFunctions) {
+  const LightsOfEveryType all;
+  ASSERT_EQ(sizeof kSets / sizeof kSets[0], size_t(PR_LIGHT_TYPE_COUNT));
+  dev::Rng rng = dev::rng_make(21u, PR_RNG_TEST, 0u, 3u, 0u);
+  for (const FunctionSet& set : kSets) {
+    const dev::Light& l = all.lights[set.type];
+    ASSERT_EQ(l.type, set.type);
+    const float* data = all.env.data();
+    for (int k = 0; k < 200; ++k) {
+      float r[8];
+      for (float& v : r) v = dev::rng_next(&rng);
+      const float3 ref = make_float3(2 * r[0] - 1, r[1], 2 * r[2] - 1);
+      const float3 n = dev::normalize(make_float3(r[3] - 0.5f, 1.0f, r[4] - 0.5f));
+      dev::LightSample a{}, b{};
+      float a1 = 0, a2 = 0, b1 = 0, b2 = 0;
+      const int got = dev::light_sample_towards(&l, data, 0.5f, ref, n, r[5], r[6], &a, &a1, &a2);
+      ASSERT_EQ(got, set.sample(&l, data, 0.5f, ref, n, r[5], r[6], &b, &b1, &b2)) << set.type;
+      EXPECT_EQ(a.delta, dev::light_is_delta(set.type));
+      if (got) {
+        EXPECT_TRUE(sameBits(a.pos, b.pos) && sameBits(a.wi, b.wi) && sameBits(a.le, b.le));
+        EXPECT_TRUE(sameBits(a.pdf, b.pdf) && sameBits(a.dist, b.dist)) << set.type;
+        EXPECT_TRUE(sameBits(dev::light_pdf_towards(&l, data, 0.5f, ref, n, a.pos, a.wi),
+                             set.pdf(&l, data, 0.5f, ref, n, a.pos, a.wi)));
+      }
+      float3 da, db, la, lb;
+      const float pa = dev::light_sample_emit(&l, data, n, r[5], r[6], &da, &la);
+      EXPECT_TRUE(sameBits(pa, set.sampleEmit(&l, data, n, r[5], r[6], &db, &lb)));
+      EXPECT_TRUE(sameBits(da, db) && sameBits(la, lb)) << set.type;
+      EXPECT_TRUE(sameBits(dev::light_pdf_emit_dir(&l, n, da), set.pdfEmit(&l, n, da)));
+      EXPECT_TRUE(sameBits(dev::light_falloff(&l, da), set.falloff(&l, da)));
+      EXPECT_TRUE(sameBits(dev::light_receiver_importance(&l, ref, n), set.importance(&l, ref, n)));
+    }
+    EXPECT_TRUE(sameBits(dev::light_power(&l, 3.0f), set.power(&l, 3.0f))) << set.type;
+    EXPECT_GT(dev::light_power(&l, 3.0f), 0.0f) << set.type;
+  }
+}
+
+// MIS and the light tracer need each type's pdfs to be those of its samples: the pdf of the
+// point a sample drew (0 for delta lights, whose sample pdf is the pmf alone), and the pdf of
+// the direction a light path leaves in where eye vertices join vertex 0 (0 elsewhere).
+TEST(LightTable, EachTypesPdfsAreThoseOfItsSamples) {
+  const LightsOfEveryType all;
+  const float* data = all.env.data();
+  dev::Rng rng = dev::rng_make(22u, PR_RNG_TEST, 0u, 4u, 0u);
+  for (const dev::Light& l : all.lights) {
+    int drawn = 0, apart = 0;
+    for (int k = 0; k < 2000; ++k) {
+      float r[6];
+      for (float& v : r) v = dev::rng_next(&rng);
+      const float3 ref = make_float3(2 * r[0] - 1, 0.2f * r[1], 2 * r[2] - 1);
+      const float3 n = make_float3(0, 1, 0);
+      dev::LightSample s;
+      float b1, b2;
+      if (dev::light_sample_towards(&l, data, 0.25f, ref, n, r[3], r[4], &s, &b1, &b2)) {
+        ++drawn;
+        EXPECT_NEAR(dev::length(s.wi), 1.0f, 1e-5f);
+        const float pdf = dev::light_pdf_towards(&l, data, 0.25f, ref, n, s.pos, s.wi);
+        if (s.delta) {
+          EXPECT_EQ(s.pdf, 0.25f) << l.type;
+          EXPECT_EQ(pdf, 0.0f) << l.type;
+        } else if (std::fabs(pdf - s.pdf) > 2e-3f * s.pdf) {
+          // A direction on an environment texel's edge may look up its neighbour: rare.
+          ++apart;
+          EXPECT_FALSE(dev::light_is_triangle(l.type)) << pdf << " drawn with " << s.pdf;
+        }
+        EXPECT_EQ(s.dist == PR_INF_F, dev::light_at_infinity(l.type) != 0) << l.type;
+      }
+      const float3 n0 = dev::normalize(make_float3(l.e1x + l.e2x, 1.0f, l.e1z)) * -1.0f;
+      float3 dir, le;
+      const float pe = dev::light_sample_emit(&l, data, n0, r[3], r[4], &dir, &le);
+      if (!(pe > 0.0f)) continue;
+      EXPECT_NEAR(dev::length(dir), 1.0f, 1e-5f);
+      const float back = dev::light_pdf_emit_dir(&l, n0, dir);
+      if (dev::light_joins_vertex0(l.type))
+        ASSERT_NEAR(back, pe, 1e-4f * pe) << l.type;
+      else
+        EXPECT_EQ(back, 0.0f) << l.type;
+      // Nothing leaves a light where its falloff is 0 (outside a spot's cone).
+      EXPECT_GT(dev::light_falloff(&l, dir), 0.0f) << l.type;
+    }
+    EXPECT_GT(drawn, 1000) << l.type;
+    EXPECT_LT(apart, drawn / 100) << l.type;
+  }
+}
+
+// Receiver importance is what light sampling sees: for point and spot lights exactly the
+// irradiance a sample brings (its falloff included) times the receiver's cosine; 0 for lights
+// at infinity, which no receiver-aware sampler weighs.
+TEST(LightTable, ReceiverImportanceIsTheSampledIrradiance) {
+  const LightsOfEveryType all;
+  dev::Rng rng = dev::rng_make(23u, PR_RNG_TEST, 0u, 5u, 0u);
+  for (const dev::Light& l : all.lights) {
+    for (int k = 0; k < 500; ++k) {
+      const float3 ref =
+          make_float3(2 * dev::rng_next(&rng) - 1, 0.0f, 2 * dev::rng_next(&rng) - 1);
+      const float3 n = dev::normalize(make_float3(dev::rng_next(&rng) - 0.5f, 1.0f, 0.0f));
+      const float importance = dev::light_receiver_importance(&l, ref, n);
+      if (dev::light_at_infinity(l.type)) {
+        EXPECT_EQ(importance, 0.0f);
+        continue;
+      }
+      if (!dev::light_is_delta(l.type)) continue;
+      dev::LightSample s;
+      float b1, b2;
+      if (!dev::light_sample_towards(&l, all.env.data(), 1.0f, ref, n, 0.5f, 0.5f, &s, &b1, &b2)) {
+        EXPECT_EQ(importance, 0.0f);
+        continue;
+      }
+      // Near a spot's cone the falloff is steep: tolerances relative to the unattenuated value.
+      const float full = dev::luminance(make_float3(l.le_r, l.le_g, l.le_b)) / (s.dist * s.dist);
+      const float want = dev::luminance(s.le) * std::max(dev::dot(n, s.wi), 0.0f);
+      EXPECT_NEAR(importance, want, 1e-5f * full) << l.type;
+      // The falloff as the light tracer sees it: along -wi, leaving the light.
+      EXPECT_NEAR(dev::luminance(s.le), full * dev::light_falloff(&l, -1.0f * s.wi), 1e-5f * full);
+    }
+  }
 }
 
 }  // namespace

@@ -403,8 +403,11 @@ std::string GpuScene::buildOptions() const {
   if (!options_.shadowTerminator) o += "-DPR_TERMINATOR_OFFSET=0 ";
   if (options_.materialModel == MaterialModel::Gltf)
     o += "-DPR_HAS_GLTF_MODEL=1 -DPR_HAS_ENERGY_MODEL=0 ";
-  if (lightChoice_ == LightSampler::Power) o += "-DPR_LIGHT_SAMPLER_POWER=1 ";
-  if (lightChoice_ == LightSampler::Exhaustive) o += "-DPR_LIGHT_SAMPLER_EXHAUSTIVE=1 ";
+  // One value picks the receivers' light sampler; the kernels compile all three (shared/lights.h).
+  const int sampler = lightChoice_ == LightSampler::Power        ? PR_LIGHT_SAMPLER_POWER
+                      : lightChoice_ == LightSampler::Exhaustive ? PR_LIGHT_SAMPLER_EXHAUSTIVE
+                                                                 : PR_LIGHT_SAMPLER_BVH;
+  o += "-DPR_LIGHT_SAMPLER=" + std::to_string(sampler) + " ";
   if (!o.empty()) o.pop_back();
   return o;
 }

@@ -85,12 +85,12 @@ PR_INLINE float pt_next_event_weight(const SceneData* s, const PathState* p, con
   float w = ch->delta ? 1.0f : power_heuristic(ch->pdf_light, ch->pdf_bsdf);
   if (eye_paths_light(&l)) {
     const float3 n_tri =
-        l.type == PR_LIGHT_TRIANGLE ? eye_paths_light_normal(s, &l) : make_float3(0.0f, 0.0f, 1.0f);
+        light_is_triangle(l.type) ? eye_paths_light_normal(s, &l) : make_float3(0.0f, 0.0f, 1.0f);
     const float3 dz = ch->pos - h->p;
     const float dz2 = dot(dz, dz);
     const float3 wi = dz * (1.0f / sqrt(dz2));
     const float dens_n = eye_paths_start_density(&l, ch->light, trace_cdf, trace_total);
-    const float dens_h = l.type == PR_LIGHT_TRIANGLE
+    const float dens_h = light_is_triangle(l.type)
                              ? solid_angle_to_area_pdf(ch->pdf_bsdf, fabs(dot(n_tri, wi)), dz2)
                              : 0.0f;
     const float rev = has_rev ? solid_angle_to_area_pdf(ch->pdf_bsdf_rev, p->seg_cos, dist2) : 1.0f;

@@ -511,11 +511,11 @@ PR_INLINE void strategy_sampled_vertex(Connector* cn, float3 xp, float pdf_x, co
       if (k == 0u) {
         // Vertex 0: the point on the light; f_z * tpz is its emission over the position pdf.
         const u32 type = s->lights.lights[cn->headers[slot].light].type;
-        if (type != PR_LIGHT_TRIANGLE && type != PR_LIGHT_POINT) continue;
+        if (!light_joins_vertex0(type)) continue;
         zng = oct_decode(v[0].ng_oct);
         pdf_l = light_emit_pdf(s, cn->headers[slot].light, v, dir);
         // The stored throughput is emission over (position pdf times pdf_l / cos).
-        const int tri = type == PR_LIGHT_TRIANGLE;
+        const int tri = light_is_triangle(type);
         cos_z = tri ? fabs(dot(zng, dir)) : 1.0f;
         f_z = make_float3(1.0f, 1.0f, 1.0f) * (tri ? 0.5f * PR_INV_PI : 0.25f * PR_INV_PI);
       } else {

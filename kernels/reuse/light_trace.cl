@@ -23,7 +23,7 @@ PR_INLINE LightEmission light_emit(const SceneData* s, const Light* L, const Reu
   e.tp = make_float3(0.0f, 0.0f, 0.0f);
   e.prim = e.inst = PR_INVALID_INDEX;
   e.b1 = e.b2 = 0.0f;
-  if (L->type == PR_LIGHT_TRIANGLE) {
+  if (light_is_triangle(L->type)) {
     const float2 b = sample_triangle(u1, u2);
     e.b1 = b.x;
     e.b2 = b.y;
@@ -38,19 +38,12 @@ PR_INLINE LightEmission light_emit(const SceneData* s, const Light* L, const Reu
                           : make_float3(0.0f, 0.0f, 0.0f);
     e.prim = L->prim;
     e.inst = L->inst;
-  } else if (L->type == PR_LIGHT_DIRECTIONAL || L->type == PR_LIGHT_ENV) {
+  } else if (light_at_infinity(L->type)) {
     // Parallel rays from a disk that covers the scene's bounding sphere; the environment's
     // direction from its importance map (Le / pdf of the direction).
-    float3 le = make_float3(L->le_r, L->le_g, L->le_b);
-    if (L->type == PR_LIGHT_ENV) {
-      float3 wi = make_float3(0.0f, 1.0f, 0.0f);
-      float pdf_w;
-      if (!env_sample(L, s->lights.env, u4, u5, &wi, &pdf_w, &le)) pdf_w = 0.0f;
-      e.dir = -wi;
-      le = pdf_w > 0.0f ? le / pdf_w : make_float3(0.0f, 0.0f, 0.0f);
-    } else {
-      light_sample_emit_dir(L, e.n, u4, u5, &e.dir);
-    }
+    float3 le;
+    const float pdf_w = light_sample_emit(L, s->lights.env, e.n, u4, u5, &e.dir, &le);
+    le = pdf_w > 0.0f ? le / pdf_w : make_float3(0.0f, 0.0f, 0.0f);  // a directional's pdf: 1
     float3 t, bt;
     orthonormal_basis(e.dir, &t, &bt);
     const float3 d = sample_cosine_hemisphere(u1, u2);  // its xy is uniform on the unit disk
@@ -60,10 +53,7 @@ PR_INLINE LightEmission light_emit(const SceneData* s, const Light* L, const Reu
   } else {
     e.p = make_float3(L->p0x, L->p0y, L->p0z);
     const float pdf_dir = light_sample_emit_dir(L, e.n, u4, u5, &e.dir);
-    const float att = L->type == PR_LIGHT_SPOT
-                          ? spot_attenuation(dot(e.dir, make_float3(L->e1x, L->e1y, L->e1z)),
-                                             L->cos_inner, L->cos_outer)
-                          : 1.0f;
+    const float att = light_falloff(L, e.dir);
     e.tp = make_float3(L->le_r, L->le_g, L->le_b) * (att / (pmf * pdf_dir));
   }
   return e;
@@ -140,10 +130,10 @@ PR_KERNEL void light_trace(PR_PARAMS(PR_ARGS_LIGHT_TRACE)) {
   const int walk_on = rp.eye_paths && eye_paths_light(&L);
   EyePathWalk walk;
   if (walk_on)
-    walk = eye_path_walk_start(&L, li,
-                               L.type == PR_LIGHT_TRIANGLE ? eye_paths_light_normal(&s, &L)
-                                                           : make_float3(0.0f, 0.0f, 1.0f),
-                               trace_cdf, rp.trace_total);
+    walk = eye_path_walk_start(
+        &L, li,
+        light_is_triangle(L.type) ? eye_paths_light_normal(&s, &L) : make_float3(0.0f, 0.0f, 1.0f),
+        trace_cdf, rp.trace_total);
   __global EyePathRatio* ratio_out = ratios + (size_t)slot * rp.stride;
   const float tp0 = max3(tp);  // Russian roulette weighs the throughput against this
 

@@ -3,7 +3,8 @@
 // over its texels (marginal over rows, conditional within each). Shared by the kernels and the
 // host's tests.
 //
-// Its Light (type PR_LIGHT_ENV, always the last in the table) holds: inst = map width W,
+// Its Light (type PR_LIGHT_ENV, always the last in the table; its function set light_env_* is
+// at the end) holds: inst = map width W,
 // prim = height H, (p0x, p0y) = cos and sin of the turn, le = the scale (strength times
 // colour), area = the map's mean luminance over the sphere (for its power). Its data buffer:
 // the texels (3 floats each, top row first: +Y), then per row W + 1 conditional cumulative
@@ -105,6 +106,63 @@ PR_INLINE int env_sample(const Light* l, PR_GLOBAL const float* env, float u1, f
   *le = make_float3(env[3u * t], env[3u * t + 1u], env[3u * t + 2u]) *
         make_float3(l->le_r, l->le_g, l->le_b);
   return *pdf > 0.0f;
+}
+
+// The environment's light function set (shared/lights.h, PR_LIGHT_TYPES); data is its buffer
+// above (none: it emits nothing).
+PR_INLINE int light_env_sample(const Light* l, PR_GLOBAL const float* data, float pmf, float3 ref,
+                               float3 n_ref, float u1, float u2, LightSample* s, float* b1,
+                               float* b2) {
+  (void)n_ref, (void)b1, (void)b2;
+  float pdf_w;
+  if (!data || !env_sample(l, data, u1, u2, &s->wi, &pdf_w, &s->le)) return 0;
+  s->pdf = pmf * pdf_w;
+  s->dist = PR_INF_F;
+  s->pos = ref + s->wi * 1e7f;
+  s->normal = make_float3(0.0f, 0.0f, 0.0f);
+  return 1;
+}
+
+PR_INLINE float light_env_pdf(const Light* l, PR_GLOBAL const float* data, float pmf, float3 ref,
+                              float3 n_ref, float3 pos, float3 wi) {
+  (void)ref, (void)n_ref, (void)pos;
+  if (!data || !(pmf > 0.0f)) return 0.0f;
+  return pmf * env_pdf(l, data, wi);
+}
+
+// Towards -wi for a direction wi sampled from the map; *le its radiance.
+PR_INLINE float light_env_sample_emit(const Light* l, PR_GLOBAL const float* data, float3 n0,
+                                      float u1, float u2, float3* dir, float3* le) {
+  (void)n0;
+  float3 wi = make_float3(0.0f, 1.0f, 0.0f);
+  float pdf_w;
+  *le = make_float3(0.0f, 0.0f, 0.0f);
+  if (!data || !env_sample(l, data, u1, u2, &wi, &pdf_w, le)) pdf_w = 0.0f;
+  *dir = -wi;
+  return pdf_w;
+}
+
+// 0: no strategy joins the environment's vertex 0.
+PR_INLINE float light_env_pdf_emit(const Light* l, float3 n0, float3 dir) {
+  (void)l, (void)n0, (void)dir;
+  return 0.0f;
+}
+
+PR_INLINE float light_env_falloff(const Light* l, float3 dir) {
+  (void)l, (void)dir;
+  return 1.0f;
+}
+
+// Radiance over all directions through the scene's disk.
+PR_INLINE float light_env_power(const Light* l, float scene_radius) {
+  const float lum = luminance(make_float3(l->le_r, l->le_g, l->le_b));
+  return 4.0f * PR_PI * PR_PI * scene_radius * scene_radius * lum * l->area;
+}
+
+// 0: chosen by power, outside the light BVH.
+PR_INLINE float light_env_importance(PR_GLOBAL const Light* l, float3 p, float3 n) {
+  (void)l, (void)p, (void)n;
+  return 0.0f;
 }
 
 PR_NAMESPACE_END

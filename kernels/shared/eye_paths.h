@@ -21,7 +21,7 @@ PR_NAMESPACE_BEGIN
 // The lights whose stored paths take part: emissive triangles and point lights. The others'
 // paths are the path tracer's alone.
 PR_INLINE int eye_paths_light(const Light* l) {
-  return l->type == PR_LIGHT_TRIANGLE || l->type == PR_LIGHT_POINT;
+  return light_in_eye_paths(l->type);
 }
 
 // The unit normal of an emissive triangle light, from the light table.
@@ -37,7 +37,7 @@ PR_INLINE float eye_paths_start_density(const Light* l, u32 li, PR_GLOBAL const 
                                         float trace_total) {
   if (!(trace_total > 0.0f)) return 0.0f;
   const float pmf = (trace_cdf[li] - (li > 0u ? trace_cdf[li - 1u] : 0.0f)) / trace_total;
-  return l->type == PR_LIGHT_TRIANGLE ? pmf / l->area : pmf;
+  return light_is_triangle(l->type) ? pmf / l->area : pmf;
 }
 
 // The density at a point (|cos| cos_x of its geometric normal with the segment, squared
@@ -77,7 +77,7 @@ PR_INLINE EyePathWalk eye_path_walk_start(const Light* l, u32 li, float3 n_tri,
                                           PR_GLOBAL const float* trace_cdf, float trace_total) {
   EyePathWalk w;
   w.light = *l;
-  w.tri = l->type == PR_LIGHT_TRIANGLE;
+  w.tri = light_is_triangle(l->type);
   w.inv_start = 1.0f / eye_paths_start_density(l, li, trace_cdf, trace_total);
   w.chain = mis_chain_start();
   w.hit = 1.0f;

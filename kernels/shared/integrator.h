@@ -334,19 +334,11 @@ PR_INLINE int next_event(const SceneData* s, const SurfaceHit* h, const ShadingF
   const Light l = s->lights.lights[idx];
   LightSample ls;
   float b1, b2;
-  if (l.type == PR_LIGHT_ENV) {
-    float pdf_w;
-    if (!env_sample(&l, s->lights.env, u1, u2, &ls.wi, &pdf_w, &ls.le)) return 0;
-    ls.pdf = pmf * pdf_w;
-    ls.delta = 0;
-    ls.dist = PR_INF_F;
-  } else if (!light_sample(&l, pmf, h->p, f->n, u1, u2, &ls, &b1, &b2)) {
-    return 0;
-  }
+  if (!light_sample_towards(&l, s->lights.env, pmf, h->p, f->n, u1, u2, &ls, &b1, &b2)) return 0;
   // Below the geometric surface: only from a lifted point (shading_frame).
   if (dot(ls.wi, f->ng) <= 0.0f && !surface_lifted(s, h, f)) return 0;
   float3 le = ls.le;
-  if (l.type == PR_LIGHT_TRIANGLE) {
+  if (light_is_triangle(l.type)) {
     const SurfaceHit e = surface_interp(&s->sd, l.prim, l.inst, b1, b2, 0);
     le = material_emission(&s->sd, &e);
   }
@@ -367,7 +359,7 @@ PR_INLINE int next_event(const SceneData* s, const SurfaceHit* h, const ShadingF
     choice->pdf_bsdf = bsdf_pdf;
     choice->pdf_bsdf_rev = bsdf_pdf_rev;
   }
-  if (l.type == PR_LIGHT_TRIANGLE) {
+  if (light_is_triangle(l.type)) {
     *shadow = surface_ray_to(s, h, ls.pos, ls.normal);
   } else {
     *shadow = surface_ray(s, h, ls.wi, ls.dist < PR_INF_F ? ls.dist * (1.0f - 1e-4f) : PR_INF_F);

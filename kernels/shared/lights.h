@@ -1,21 +1,57 @@
-// Lights: emissive triangles (world space, rebuilt by the host whenever a dynamic emitter moves)
-// and KHR_lights_punctual lights. A receiving point chooses a light with the light BVH
-// (shared/light_bvh.h), by weighing every light from the point with PR_LIGHT_SAMPLER_EXHAUSTIVE,
-// or by power alone with PR_LIGHT_SAMPLER_POWER; light paths, whose origin knows no receiver,
-// choose by power (docs/design.md section 6).
+// Lights: emissive triangles (world space, rebuilt by the host whenever a dynamic emitter moves),
+// KHR_lights_punctual lights and the environment. Every light type is one entry of
+// PR_LIGHT_TYPES and one set of functions (below; the environment's in shared/environment.h);
+// the dispatchers (light_sample_towards, light_power, ...) and the queries on a type's flags
+// (light_is_triangle, ...) are generated from the table, so no other file tests a light's type.
+// A receiving point chooses a light with the light BVH (shared/light_bvh.h), by weighing every
+// light from the point, or by power alone: PR_LIGHT_SAMPLER; light paths, whose origin knows no
+// receiver, choose by power (docs/design.md section 6).
 #pragma once
 
 #include "shared/light_bvh.h"
 #include "shared/math.h"
 #include "shared/sampling.h"
 
-PR_NAMESPACE_BEGIN
+// What callers may ask of a light type, instead of testing the type itself (light_is_triangle
+// and the other queries below).
+// An emissive triangle of the scene (prim, inst): BSDF rays hit it, its emission is its material's.
+#define PR_LIGHT_ON_TRIANGLE 1u
+// Delta in position (a point) or in direction: no MIS, light_sample's pdf is the pmf alone.
+#define PR_LIGHT_DELTA_POSITION 2u
+#define PR_LIGHT_DELTA_DIRECTION 4u
+// Outside the scene: after the light BVH's lights in the table; light paths start on a disk.
+#define PR_LIGHT_AT_INFINITY 8u
+// Eye vertices join its light paths' vertex 0 (strategy E): light_pdf_emit_dir is not 0.
+#define PR_LIGHT_JOINS_VERTEX0 16u
+// Its light paths take part in --eye-paths (shared/eye_paths.h).
+#define PR_LIGHT_EYE_PATHS 32u
 
-#define PR_LIGHT_TRIANGLE 0u
-#define PR_LIGHT_POINT 1u
-#define PR_LIGHT_SPOT 2u
-#define PR_LIGHT_DIRECTIONAL 3u
-#define PR_LIGHT_ENV 4u  // the environment (shared/environment.h): last in the table
+// The light types: X(NAME, fn, flags). NAME gives PR_LIGHT_NAME (Light::type, in table order),
+// fn the prefix of its function set light_<fn>_* (PR_LIGHT_DECLARE lists it). Adding a type is
+// one row here and one function set; the host builds its Light (host/render/light_table.cpp).
+#define PR_LIGHT_TYPES(X)                                                                   \
+  X(TRIANGLE, triangle, PR_LIGHT_ON_TRIANGLE | PR_LIGHT_JOINS_VERTEX0 | PR_LIGHT_EYE_PATHS) \
+  X(POINT, point, PR_LIGHT_DELTA_POSITION | PR_LIGHT_JOINS_VERTEX0 | PR_LIGHT_EYE_PATHS)    \
+  X(SPOT, spot, PR_LIGHT_DELTA_POSITION)                                                    \
+  X(DIRECTIONAL, directional, PR_LIGHT_DELTA_DIRECTION | PR_LIGHT_AT_INFINITY)              \
+  X(ENV, env, PR_LIGHT_AT_INFINITY) /* shared/environment.h; the last light of the table */
+
+// Outside the namespace, as the macros it replaced: host code names PR_LIGHT_POINT unqualified.
+#define PR_LIGHT_ENUM_ENTRY(name, fn, flags) PR_LIGHT_##name,
+enum { PR_LIGHT_TYPES(PR_LIGHT_ENUM_ENTRY) PR_LIGHT_TYPE_COUNT };
+#undef PR_LIGHT_ENUM_ENTRY
+
+// The light sampler for receivers, one compile-time value (-DPR_LIGHT_SAMPLER=n from the host's
+// GpuScene::buildOptions): every sampler is compiled and type-checked in every build, and the
+// compiler drops the others' branches.
+#define PR_LIGHT_SAMPLER_BVH 0         // the light BVH, resampled (light_tree_resample)
+#define PR_LIGHT_SAMPLER_EXHAUSTIVE 1  // every light weighed from the receiver
+#define PR_LIGHT_SAMPLER_POWER 2       // by power alone
+#ifndef PR_LIGHT_SAMPLER
+#define PR_LIGHT_SAMPLER PR_LIGHT_SAMPLER_BVH
+#endif
+
+PR_NAMESPACE_BEGIN
 
 // 96 bytes.
 typedef struct {
@@ -189,122 +225,6 @@ PR_INLINE float2 triangle_barycentrics_along(float3 p, float3 w, float3 v0, floa
   return make_float2(b1, b2);
 }
 
-// Samples a point on light `l` (selected with probability `pmf`) as seen from `ref`, whose
-// shading normal is n_ref (zero: none, no cosine warp). Emissive triangles emit on both faces,
-// as in Blender and Cycles. Returns 0 when the sample carries no light. For triangles,
-// (*b1, *b2) are the barycentrics of the point, for emission textures.
-PR_INLINE int light_sample(const Light* l, float pmf, float3 ref, float3 n_ref, float u1, float u2,
-                           LightSample* s, float* b1, float* b2) {
-  s->delta = l->type != PR_LIGHT_TRIANGLE;
-  s->le = make_float3(l->le_r, l->le_g, l->le_b);
-  *b1 = 0.0f;
-  *b2 = 0.0f;
-  if (l->type == PR_LIGHT_TRIANGLE) {
-    const float3 v0 = make_float3(l->p0x, l->p0y, l->p0z);
-    const float3 e1 = make_float3(l->e1x, l->e1y, l->e1z), e2 = make_float3(l->e2x, l->e2y, l->e2z);
-    const float3 cr = cross(e1, e2);
-    const float cl = length(cr);
-    if (cl <= 0.0f) return 0;
-    s->normal = cr / cl;
-    SphericalTriangle st;
-    const float omega = spherical_triangle(ref, v0, e1, e2, &st);
-    const int solid = use_solid_angle(omega);
-    float warp_pdf = 1.0f;
-    if (solid && has_normal(n_ref)) {
-      const CosineWarp cw = cosine_warp(&st, n_ref);
-      const float2 uw = sample_bilinear(u1, u2, cw.w00, cw.w10, cw.w01, cw.w11);
-      warp_pdf = bilinear_pdf(uw, cw.w00, cw.w10, cw.w01, cw.w11);
-      u1 = uw.x;
-      u2 = uw.y;
-    }
-    const float2 b = solid ? triangle_barycentrics_along(
-                                 ref, sample_spherical_triangle(&st, omega, u1, u2), v0, e1, e2)
-                           : sample_triangle(u1, u2);
-    s->pos = v0 + e1 * b.x + e2 * b.y;
-    const float3 d = s->pos - ref;
-    const float d2 = dot(d, d);
-    if (d2 <= 0.0f) return 0;
-    s->dist = sqrt(d2);
-    s->wi = d / s->dist;
-    const float cos_l = fabs(dot(s->wi, s->normal));
-    if (cos_l <= 1e-7f) return 0;
-    s->pdf = solid ? pmf * warp_pdf / omega : pmf * d2 / (cos_l * l->area);
-    *b1 = b.x;
-    *b2 = b.y;
-    return 1;
-  }
-  s->normal = make_float3(0.0f, 0.0f, 0.0f);
-  s->pdf = pmf;
-  if (l->type == PR_LIGHT_DIRECTIONAL) {
-    // e1 is the direction the light travels.
-    s->wi = -make_float3(l->e1x, l->e1y, l->e1z);
-    s->dist = PR_INF_F;
-    s->pos = ref + s->wi * 1e7f;
-    return 1;
-  }
-  s->pos = make_float3(l->p0x, l->p0y, l->p0z);
-  const float3 d = s->pos - ref;
-  const float d2 = dot(d, d);
-  if (d2 <= 0.0f) return 0;
-  s->dist = sqrt(d2);
-  s->wi = d / s->dist;
-  float att = 1.0f / d2;
-  if (l->type == PR_LIGHT_SPOT)
-    att *= spot_attenuation(dot(-s->wi, make_float3(l->e1x, l->e1y, l->e1z)), l->cos_inner,
-                            l->cos_outer);
-  s->le = s->le * att;  // intensity / r^2 = irradiance at ref, normal to wi
-  return att > 0.0f;
-}
-
-// The selection weight of a light by power: the luminance of the flux it emits (a directional
-// light's through the disk of radius scene_radius that covers the scene). The host builds the
-// power tables and the light BVH from it.
-PR_INLINE float light_power(const Light* l, float scene_radius) {
-  const float lum = luminance(make_float3(l->le_r, l->le_g, l->le_b));
-  if (l->type == PR_LIGHT_TRIANGLE) return lum * PR_PI * l->area;
-  if (l->type == PR_LIGHT_POINT) return 4.0f * PR_PI * lum;
-  if (l->type == PR_LIGHT_SPOT)
-    return 2.0f * PR_PI * (1.0f - 0.5f * (l->cos_inner + l->cos_outer)) * lum;
-  if (l->type == PR_LIGHT_ENV)  // radiance over all directions through the scene's disk
-    return 4.0f * PR_PI * PR_PI * scene_radius * scene_radius * lum * l->area;
-  return PR_PI * scene_radius * scene_radius * lum;
-}
-
-// The direction in which a light path leaves vertex 0 of light l, and its solid-angle pdf:
-// triangles cosine-weighted about the face n0 already chosen (each face with probability 1/2:
-// pdf cos / (2 pi)); point lights uniform on the sphere; spot lights uniform in the outer cone;
-// directional lights along their direction (a delta: pdf 1).
-PR_INLINE float light_sample_emit_dir(const Light* l, float3 n0, float u1, float u2, float3* dir) {
-  const float3 axis = make_float3(l->e1x, l->e1y, l->e1z);
-  float3 t, b;
-  if (l->type == PR_LIGHT_TRIANGLE) {
-    orthonormal_basis(n0, &t, &b);
-    const float3 wl = sample_cosine_hemisphere(u1, u2);
-    *dir = normalize(to_world(wl, t, b, n0));
-    return wl.z * (0.5f * PR_INV_PI);
-  }
-  if (l->type == PR_LIGHT_POINT) {
-    *dir = sample_uniform_sphere(u1, u2);
-    return 0.25f * PR_INV_PI;
-  }
-  if (l->type == PR_LIGHT_SPOT) {
-    orthonormal_basis(axis, &t, &b);
-    *dir = normalize(to_world(sample_uniform_cone(u1, u2, l->cos_outer), t, b, axis));
-    return 1.0f / (2.0f * PR_PI * (1.0f - l->cos_outer));
-  }
-  *dir = axis;
-  return 1.0f;
-}
-
-// The solid-angle pdf with which a light path leaves vertex 0 of a triangle or point light along
-// dir, whichever face of the triangle (normal n0 or -n0) it chose. Spot and directional lights:
-// 0, no other strategy reaches their vertex 0.
-PR_INLINE float light_pdf_emit_dir(const Light* l, float3 n0, float3 dir) {
-  if (l->type == PR_LIGHT_TRIANGLE) return fabs(dot(n0, dir)) * (0.5f * PR_INV_PI);
-  if (l->type == PR_LIGHT_POINT) return 0.25f * PR_INV_PI;
-  return 0.0f;
-}
-
 // Solid-angle pdf with which light sampling from `ref` (shading normal n_ref) would pick the
 // point `pos` of the emissive triangle (v0, v0 + e1, v0 + e2), chosen with probability pmf: the
 // same choices (solid angle or area, cosine warp) as light_sample makes.
@@ -327,58 +247,460 @@ PR_INLINE float light_pdf_triangle(float pmf, float3 ref, float3 n_ref, float3 p
   return pmf * bilinear_pdf(u, cw.w00, cw.w10, cw.w01, cw.w11) / omega;
 }
 
-// What a receiver at p with shading normal n (zero: none) can expect from light l were nothing
-// in between, as the luminance of its irradiance. For a triangle, the radiance times the solid
-// angle it subtends times the receiver's cosine: near it (the squared distance to its centroid
-// under twice the sum of two edges' squares), the exact solid angle times the cosine averaged
-// over its corners and centroid; farther, its area projected from the centroid, which is close
-// to the solid angle there and costs a fraction of it. For a point or spot light, the intensity
-// (spot falloff included) times the cosine over the squared distance. Exact for punctual lights and
-// close for triangles. Zero only where l sends p nothing: behind the receiver's normal (every
-// non-delta BSDF only reflects) or in the triangle's plane.
-PR_INLINE float light_receiver_importance(PR_GLOBAL const Light* l, float3 p, float3 n) {
+// Each type's function set; `data` is the light table's data buffer (LightData::env: the
+// environment's map), which the other types ignore.
+//  sample:      a point on the light as seen from ref (shading normal n_ref, zero: none), chosen
+//               with probability pmf: LightSample's pos, wi, dist, le, pdf, normal (the
+//               dispatcher sets delta, *b1, *b2). 0 where the sample carries no light.
+//  pdf:         the solid-angle pdf (times pmf) with which sample gives the point pos in
+//               direction wi; 0 for delta lights, which no other strategy reaches.
+//  sample_emit: the direction in which a light path leaves vertex 0 (n0: the face chosen on a
+//               triangle), its solid-angle pdf (1: a delta direction) and, in *le, the emission
+//               along it before the falloff: radiance factor, intensity or irradiance.
+//  pdf_emit:    sample_emit's pdf of dir where strategy E joins vertex 0
+//               (PR_LIGHT_JOINS_VERTEX0), else 0.
+//  falloff:     the share of the emission sent along dir leaving the light (a spot's cone).
+//  power:       the luminance of the flux it emits (through the scene's disk, at infinity).
+//  importance:  the luminance of the irradiance a receiver (p, n) can expect from it.
+#define PR_LIGHT_DECLARE(name, fn, flags)                                                          \
+  PR_INLINE int light_##fn##_sample(const Light* l, PR_GLOBAL const float* data, float pmf,        \
+                                    float3 ref, float3 n_ref, float u1, float u2, LightSample* s,  \
+                                    float* b1, float* b2);                                         \
+  PR_INLINE float light_##fn##_pdf(const Light* l, PR_GLOBAL const float* data, float pmf,         \
+                                   float3 ref, float3 n_ref, float3 pos, float3 wi);               \
+  PR_INLINE float light_##fn##_sample_emit(const Light* l, PR_GLOBAL const float* data, float3 n0, \
+                                           float u1, float u2, float3* dir, float3* le);           \
+  PR_INLINE float light_##fn##_pdf_emit(const Light* l, float3 n0, float3 dir);                    \
+  PR_INLINE float light_##fn##_falloff(const Light* l, float3 dir);                                \
+  PR_INLINE float light_##fn##_power(const Light* l, float scene_radius);                          \
+  PR_INLINE float light_##fn##_importance(PR_GLOBAL const Light* l, float3 p, float3 n);
+PR_LIGHT_TYPES(PR_LIGHT_DECLARE)
+#undef PR_LIGHT_DECLARE
+
+// A type's flags (PR_LIGHT_ON_TRIANGLE ...), and the queries callers make of them.
+#define PR_LIGHT_FLAGS_CASE(name, fn, flags) \
+  case PR_LIGHT_##name:                      \
+    return flags;
+PR_INLINE u32 light_type_flags(u32 type) {
+  switch (type) { PR_LIGHT_TYPES(PR_LIGHT_FLAGS_CASE) }
+  return 0u;
+}
+#undef PR_LIGHT_FLAGS_CASE
+
+// An emissive triangle of the scene: its points, normal and emission come from the triangle.
+PR_INLINE int light_is_triangle(u32 type) {
+  return (light_type_flags(type) & PR_LIGHT_ON_TRIANGLE) != 0u;
+}
+// Delta in position or direction: BSDF-sampled rays never reach it, so no MIS.
+PR_INLINE int light_is_delta(u32 type) {
+  return (light_type_flags(type) & (PR_LIGHT_DELTA_POSITION | PR_LIGHT_DELTA_DIRECTION)) != 0u;
+}
+PR_INLINE int light_at_infinity(u32 type) {
+  return (light_type_flags(type) & PR_LIGHT_AT_INFINITY) != 0u;
+}
+PR_INLINE int light_joins_vertex0(u32 type) {
+  return (light_type_flags(type) & PR_LIGHT_JOINS_VERTEX0) != 0u;
+}
+PR_INLINE int light_in_eye_paths(u32 type) {
+  return (light_type_flags(type) & PR_LIGHT_EYE_PATHS) != 0u;
+}
+
+// Emissive triangles, sampled by solid angle or area (use_solid_angle) and emitting on both
+// faces, as in Blender and Cycles. (*b1, *b2): the barycentrics of the point, for emission
+// textures.
+PR_INLINE int light_triangle_sample(const Light* l, PR_GLOBAL const float* data, float pmf,
+                                    float3 ref, float3 n_ref, float u1, float u2, LightSample* s,
+                                    float* b1, float* b2) {
+  (void)data;
+  s->le = make_float3(l->le_r, l->le_g, l->le_b);
+  const float3 v0 = make_float3(l->p0x, l->p0y, l->p0z);
+  const float3 e1 = make_float3(l->e1x, l->e1y, l->e1z), e2 = make_float3(l->e2x, l->e2y, l->e2z);
+  const float3 cr = cross(e1, e2);
+  const float cl = length(cr);
+  if (cl <= 0.0f) return 0;
+  s->normal = cr / cl;
+  SphericalTriangle st;
+  const float omega = spherical_triangle(ref, v0, e1, e2, &st);
+  const int solid = use_solid_angle(omega);
+  float warp_pdf = 1.0f;
+  if (solid && has_normal(n_ref)) {
+    const CosineWarp cw = cosine_warp(&st, n_ref);
+    const float2 uw = sample_bilinear(u1, u2, cw.w00, cw.w10, cw.w01, cw.w11);
+    warp_pdf = bilinear_pdf(uw, cw.w00, cw.w10, cw.w01, cw.w11);
+    u1 = uw.x;
+    u2 = uw.y;
+  }
+  const float2 b = solid ? triangle_barycentrics_along(
+                               ref, sample_spherical_triangle(&st, omega, u1, u2), v0, e1, e2)
+                         : sample_triangle(u1, u2);
+  s->pos = v0 + e1 * b.x + e2 * b.y;
+  const float3 d = s->pos - ref;
+  const float d2 = dot(d, d);
+  if (d2 <= 0.0f) return 0;
+  s->dist = sqrt(d2);
+  s->wi = d / s->dist;
+  const float cos_l = fabs(dot(s->wi, s->normal));
+  if (cos_l <= 1e-7f) return 0;
+  s->pdf = solid ? pmf * warp_pdf / omega : pmf * d2 / (cos_l * l->area);
+  *b1 = b.x;
+  *b2 = b.y;
+  return 1;
+}
+
+PR_INLINE float light_triangle_pdf(const Light* l, PR_GLOBAL const float* data, float pmf,
+                                   float3 ref, float3 n_ref, float3 pos, float3 wi) {
+  (void)data;
+  (void)wi;
+  return light_pdf_triangle(pmf, ref, n_ref, pos, make_float3(l->p0x, l->p0y, l->p0z),
+                            make_float3(l->e1x, l->e1y, l->e1z),
+                            make_float3(l->e2x, l->e2y, l->e2z));
+}
+
+// Cosine-weighted about the face n0 already chosen (each face with probability 1/2: pdf
+// cos / (2 pi)).
+PR_INLINE float light_triangle_sample_emit(const Light* l, PR_GLOBAL const float* data, float3 n0,
+                                           float u1, float u2, float3* dir, float3* le) {
+  (void)data;
+  float3 t, b;
+  orthonormal_basis(n0, &t, &b);
+  const float3 wl = sample_cosine_hemisphere(u1, u2);
+  *dir = normalize(to_world(wl, t, b, n0));
+  *le = make_float3(l->le_r, l->le_g, l->le_b);
+  return wl.z * (0.5f * PR_INV_PI);
+}
+
+// Whichever face (n0 or -n0) the path chose.
+PR_INLINE float light_triangle_pdf_emit(const Light* l, float3 n0, float3 dir) {
+  (void)l;
+  return fabs(dot(n0, dir)) * (0.5f * PR_INV_PI);
+}
+
+PR_INLINE float light_triangle_falloff(const Light* l, float3 dir) {
+  (void)l;
+  (void)dir;
+  return 1.0f;
+}
+
+PR_INLINE float light_triangle_power(const Light* l, float scene_radius) {
+  (void)scene_radius;
+  return luminance(make_float3(l->le_r, l->le_g, l->le_b)) * PR_PI * l->area;
+}
+
+// The radiance times the solid angle the triangle subtends times the receiver's cosine: near
+// it (the squared distance to its centroid under twice the sum of two edges' squares), the
+// exact solid angle times the cosine averaged over its corners and centroid; farther, its area
+// projected from the centroid, which is close to the solid angle there and costs a fraction of
+// it. Zero only behind the receiver's normal or in the triangle's plane.
+PR_INLINE float light_triangle_importance(PR_GLOBAL const Light* l, float3 p, float3 n) {
   const float lum = luminance(make_float3(l->le_r, l->le_g, l->le_b));
   const int normal = has_normal(n);
   const float3 v0 = make_float3(l->p0x, l->p0y, l->p0z);
-  if (l->type == PR_LIGHT_TRIANGLE) {
-    const float3 e1 = make_float3(l->e1x, l->e1y, l->e1z), e2 = make_float3(l->e2x, l->e2y, l->e2z);
-    const float3 d = v0 + (e1 + e2) * (1.0f / 3.0f) - p;  // to the centroid
-    const float d2 = dot(d, d);
-    if (!(d2 > 0.0f)) return 0.0f;
-    if (normal) {  // the whole triangle below n (its points are blends of its corners)
-      const float h0 = dot(n, v0 - p);
-      if (!(fmax(h0, fmax(h0 + dot(n, e1), h0 + dot(n, e2))) > 0.0f)) return 0.0f;
-    }
-    float omega = 0.0f, cos_r = 1.0f;
-    if (d2 < 2.0f * (dot(e1, e1) + dot(e2, e2))) {
-      SphericalTriangle st;
-      omega = spherical_triangle(p, v0, e1, e2, &st);
-      if (omega > 0.0f && normal)
-        cos_r = 0.25f * (fmax(dot(n, st.a), 0.0f) + fmax(dot(n, st.b), 0.0f) +
-                         fmax(dot(n, st.c), 0.0f) + fmax(dot(n, d) * rsqrt(d2), 0.0f));
-    }
-    if (!(omega > 0.0f)) {
-      omega = 0.5f * fabs(dot(cross(e1, e2), d)) / (d2 * sqrt(d2));
-      // A corner above n where the centroid is not: a small cosine keeps the light possible.
-      if (normal) {
-        const float c = dot(n, d) * rsqrt(d2);
-        cos_r = c > 0.0f ? c : 0.01f;
-      }
-    }
-    return omega > 0.0f && isfinite_f(omega) ? fmax(lum * omega * cos_r, 0.0f) : 0.0f;
+  const float3 e1 = make_float3(l->e1x, l->e1y, l->e1z), e2 = make_float3(l->e2x, l->e2y, l->e2z);
+  const float3 d = v0 + (e1 + e2) * (1.0f / 3.0f) - p;  // to the centroid
+  const float d2 = dot(d, d);
+  if (!(d2 > 0.0f)) return 0.0f;
+  if (normal) {  // the whole triangle below n (its points are blends of its corners)
+    const float h0 = dot(n, v0 - p);
+    if (!(fmax(h0, fmax(h0 + dot(n, e1), h0 + dot(n, e2))) > 0.0f)) return 0.0f;
   }
-  if (l->type != PR_LIGHT_POINT && l->type != PR_LIGHT_SPOT) return 0.0f;
+  float omega = 0.0f, cos_r = 1.0f;
+  if (d2 < 2.0f * (dot(e1, e1) + dot(e2, e2))) {
+    SphericalTriangle st;
+    omega = spherical_triangle(p, v0, e1, e2, &st);
+    if (omega > 0.0f && normal)
+      cos_r = 0.25f * (fmax(dot(n, st.a), 0.0f) + fmax(dot(n, st.b), 0.0f) +
+                       fmax(dot(n, st.c), 0.0f) + fmax(dot(n, d) * rsqrt(d2), 0.0f));
+  }
+  if (!(omega > 0.0f)) {
+    omega = 0.5f * fabs(dot(cross(e1, e2), d)) / (d2 * sqrt(d2));
+    // A corner above n where the centroid is not: a small cosine keeps the light possible.
+    if (normal) {
+      const float c = dot(n, d) * rsqrt(d2);
+      cos_r = c > 0.0f ? c : 0.01f;
+    }
+  }
+  return omega > 0.0f && isfinite_f(omega) ? fmax(lum * omega * cos_r, 0.0f) : 0.0f;
+}
+
+// Point and spot lights: the light's position as seen from ref, and the intensity unattenuated.
+// Returns the squared distance (s->dist and s->wi set where it is > 0).
+PR_INLINE float light_position_sample(const Light* l, float pmf, float3 ref, LightSample* s) {
+  s->le = make_float3(l->le_r, l->le_g, l->le_b);
+  s->normal = make_float3(0.0f, 0.0f, 0.0f);
+  s->pdf = pmf;
+  s->pos = make_float3(l->p0x, l->p0y, l->p0z);
+  const float3 d = s->pos - ref;
+  const float d2 = dot(d, d);
+  if (d2 <= 0.0f) return d2;
+  s->dist = sqrt(d2);
+  s->wi = d / s->dist;
+  return d2;
+}
+
+// The intensity (spot falloff included) times the receiver's cosine over the squared distance:
+// exact for point and spot lights.
+PR_INLINE float light_position_importance(PR_GLOBAL const Light* l, float3 p, float3 n, int spot) {
+  const float lum = luminance(make_float3(l->le_r, l->le_g, l->le_b));
+  const int normal = has_normal(n);
+  const float3 v0 = make_float3(l->p0x, l->p0y, l->p0z);
   const float3 d = v0 - p;
   const float d2 = dot(d, d);
   if (!(d2 > 0.0f)) return 0.0f;
   const float3 wi = d * rsqrt(d2);
   float importance = lum / d2;
-  if (l->type == PR_LIGHT_SPOT)
+  if (spot)
     importance *=
         spot_attenuation(dot(-wi, make_float3(l->e1x, l->e1y, l->e1z)), l->cos_inner, l->cos_outer);
   if (normal) importance *= fmax(dot(n, wi), 0.0f);
   return isfinite_f(importance) ? importance : 0.0f;
 }
+
+// Point lights: isotropic intensity le.
+PR_INLINE int light_point_sample(const Light* l, PR_GLOBAL const float* data, float pmf, float3 ref,
+                                 float3 n_ref, float u1, float u2, LightSample* s, float* b1,
+                                 float* b2) {
+  (void)data, (void)n_ref, (void)u1, (void)u2, (void)b1, (void)b2;
+  const float d2 = light_position_sample(l, pmf, ref, s);
+  if (d2 <= 0.0f) return 0;
+  const float att = 1.0f / d2;
+  s->le = s->le * att;  // intensity / r^2 = irradiance at ref, normal to wi
+  return att > 0.0f;
+}
+
+PR_INLINE float light_point_pdf(const Light* l, PR_GLOBAL const float* data, float pmf, float3 ref,
+                                float3 n_ref, float3 pos, float3 wi) {
+  (void)l, (void)data, (void)pmf, (void)ref, (void)n_ref, (void)pos, (void)wi;
+  return 0.0f;
+}
+
+// Uniform on the sphere.
+PR_INLINE float light_point_sample_emit(const Light* l, PR_GLOBAL const float* data, float3 n0,
+                                        float u1, float u2, float3* dir, float3* le) {
+  (void)data, (void)n0;
+  *dir = sample_uniform_sphere(u1, u2);
+  *le = make_float3(l->le_r, l->le_g, l->le_b);
+  return 0.25f * PR_INV_PI;
+}
+
+PR_INLINE float light_point_pdf_emit(const Light* l, float3 n0, float3 dir) {
+  (void)l, (void)n0, (void)dir;
+  return 0.25f * PR_INV_PI;
+}
+
+PR_INLINE float light_point_falloff(const Light* l, float3 dir) {
+  (void)l, (void)dir;
+  return 1.0f;
+}
+
+PR_INLINE float light_point_power(const Light* l, float scene_radius) {
+  (void)scene_radius;
+  return 4.0f * PR_PI * luminance(make_float3(l->le_r, l->le_g, l->le_b));
+}
+
+PR_INLINE float light_point_importance(PR_GLOBAL const Light* l, float3 p, float3 n) {
+  return light_position_importance(l, p, n, 0);
+}
+
+// Spot lights: intensity le about the axis e1, with KHR_lights_punctual's falloff between the
+// outer and inner cone.
+PR_INLINE int light_spot_sample(const Light* l, PR_GLOBAL const float* data, float pmf, float3 ref,
+                                float3 n_ref, float u1, float u2, LightSample* s, float* b1,
+                                float* b2) {
+  (void)data, (void)n_ref, (void)u1, (void)u2, (void)b1, (void)b2;
+  const float d2 = light_position_sample(l, pmf, ref, s);
+  if (d2 <= 0.0f) return 0;
+  float att = 1.0f / d2;
+  att *= spot_attenuation(dot(-s->wi, make_float3(l->e1x, l->e1y, l->e1z)), l->cos_inner,
+                          l->cos_outer);
+  s->le = s->le * att;
+  return att > 0.0f;
+}
+
+PR_INLINE float light_spot_pdf(const Light* l, PR_GLOBAL const float* data, float pmf, float3 ref,
+                               float3 n_ref, float3 pos, float3 wi) {
+  (void)l, (void)data, (void)pmf, (void)ref, (void)n_ref, (void)pos, (void)wi;
+  return 0.0f;
+}
+
+// Uniform in the outer cone.
+PR_INLINE float light_spot_sample_emit(const Light* l, PR_GLOBAL const float* data, float3 n0,
+                                       float u1, float u2, float3* dir, float3* le) {
+  (void)data, (void)n0;
+  const float3 axis = make_float3(l->e1x, l->e1y, l->e1z);
+  float3 t, b;
+  orthonormal_basis(axis, &t, &b);
+  *dir = normalize(to_world(sample_uniform_cone(u1, u2, l->cos_outer), t, b, axis));
+  *le = make_float3(l->le_r, l->le_g, l->le_b);
+  return 1.0f / (2.0f * PR_PI * (1.0f - l->cos_outer));
+}
+
+// 0: no strategy joins a spot light's vertex 0.
+PR_INLINE float light_spot_pdf_emit(const Light* l, float3 n0, float3 dir) {
+  (void)l, (void)n0, (void)dir;
+  return 0.0f;
+}
+
+PR_INLINE float light_spot_falloff(const Light* l, float3 dir) {
+  return spot_attenuation(dot(dir, make_float3(l->e1x, l->e1y, l->e1z)), l->cos_inner,
+                          l->cos_outer);
+}
+
+PR_INLINE float light_spot_power(const Light* l, float scene_radius) {
+  (void)scene_radius;
+  const float lum = luminance(make_float3(l->le_r, l->le_g, l->le_b));
+  return 2.0f * PR_PI * (1.0f - 0.5f * (l->cos_inner + l->cos_outer)) * lum;
+}
+
+PR_INLINE float light_spot_importance(PR_GLOBAL const Light* l, float3 p, float3 n) {
+  return light_position_importance(l, p, n, 1);
+}
+
+// Directional lights: irradiance le travelling along e1, from far away.
+PR_INLINE int light_directional_sample(const Light* l, PR_GLOBAL const float* data, float pmf,
+                                       float3 ref, float3 n_ref, float u1, float u2, LightSample* s,
+                                       float* b1, float* b2) {
+  (void)data, (void)n_ref, (void)u1, (void)u2, (void)b1, (void)b2;
+  s->le = make_float3(l->le_r, l->le_g, l->le_b);
+  s->normal = make_float3(0.0f, 0.0f, 0.0f);
+  s->pdf = pmf;
+  s->wi = -make_float3(l->e1x, l->e1y, l->e1z);
+  s->dist = PR_INF_F;
+  s->pos = ref + s->wi * 1e7f;
+  return 1;
+}
+
+PR_INLINE float light_directional_pdf(const Light* l, PR_GLOBAL const float* data, float pmf,
+                                      float3 ref, float3 n_ref, float3 pos, float3 wi) {
+  (void)l, (void)data, (void)pmf, (void)ref, (void)n_ref, (void)pos, (void)wi;
+  return 0.0f;
+}
+
+// Along its direction: a delta, pdf 1.
+PR_INLINE float light_directional_sample_emit(const Light* l, PR_GLOBAL const float* data,
+                                              float3 n0, float u1, float u2, float3* dir,
+                                              float3* le) {
+  (void)data, (void)n0, (void)u1, (void)u2;
+  *dir = make_float3(l->e1x, l->e1y, l->e1z);
+  *le = make_float3(l->le_r, l->le_g, l->le_b);
+  return 1.0f;
+}
+
+PR_INLINE float light_directional_pdf_emit(const Light* l, float3 n0, float3 dir) {
+  (void)l, (void)n0, (void)dir;
+  return 0.0f;
+}
+
+PR_INLINE float light_directional_falloff(const Light* l, float3 dir) {
+  (void)l, (void)dir;
+  return 1.0f;
+}
+
+// Through the disk of radius scene_radius that covers the scene.
+PR_INLINE float light_directional_power(const Light* l, float scene_radius) {
+  const float lum = luminance(make_float3(l->le_r, l->le_g, l->le_b));
+  return PR_PI * scene_radius * scene_radius * lum;
+}
+
+// 0: directional lights are chosen by power, outside the light BVH.
+PR_INLINE float light_directional_importance(PR_GLOBAL const Light* l, float3 p, float3 n) {
+  (void)l, (void)p, (void)n;
+  return 0.0f;
+}
+
+// The dispatchers: one switch over PR_LIGHT_TYPES each, calling PR_LIGHT_CALL(fn) for the type.
+#define PR_LIGHT_CASE(name, fn, flags) \
+  case PR_LIGHT_##name:                \
+    return PR_LIGHT_CALL(fn);
+
+// Samples a point on light l (chosen with probability pmf) as seen from ref, whose shading
+// normal is n_ref (zero: none, no cosine warp). Returns 0 when the sample carries no light. For
+// triangles, (*b1, *b2) are the barycentrics of the point, for emission textures.
+PR_INLINE int light_sample_towards(const Light* l, PR_GLOBAL const float* data, float pmf,
+                                   float3 ref, float3 n_ref, float u1, float u2, LightSample* s,
+                                   float* b1, float* b2) {
+  s->delta = light_is_delta(l->type);
+  *b1 = 0.0f;
+  *b2 = 0.0f;
+#define PR_LIGHT_CALL(fn) light_##fn##_sample(l, data, pmf, ref, n_ref, u1, u2, s, b1, b2)
+  switch (l->type) { PR_LIGHT_TYPES(PR_LIGHT_CASE) }
+#undef PR_LIGHT_CALL
+  return 0;
+}
+
+// light_sample_towards for a light that needs no data buffer (all but the environment).
+PR_INLINE int light_sample(const Light* l, float pmf, float3 ref, float3 n_ref, float u1, float u2,
+                           LightSample* s, float* b1, float* b2) {
+  return light_sample_towards(l, (PR_GLOBAL const float*)0, pmf, ref, n_ref, u1, u2, s, b1, b2);
+}
+
+// The solid-angle pdf with which light_sample_towards from ref (shading normal n_ref) gives the
+// point pos of l, in unit direction wi from ref; 0 for delta lights.
+PR_INLINE float light_pdf_towards(const Light* l, PR_GLOBAL const float* data, float pmf,
+                                  float3 ref, float3 n_ref, float3 pos, float3 wi) {
+#define PR_LIGHT_CALL(fn) light_##fn##_pdf(l, data, pmf, ref, n_ref, pos, wi)
+  switch (l->type) { PR_LIGHT_TYPES(PR_LIGHT_CASE) }
+#undef PR_LIGHT_CALL
+  return 0.0f;
+}
+
+// The direction in which a light path leaves vertex 0 of l (n0: the face chosen on a
+// triangle), its solid-angle pdf (1: a delta direction), and in *le the emission along it
+// before light_falloff.
+PR_INLINE float light_sample_emit(const Light* l, PR_GLOBAL const float* data, float3 n0, float u1,
+                                  float u2, float3* dir, float3* le) {
+#define PR_LIGHT_CALL(fn) light_##fn##_sample_emit(l, data, n0, u1, u2, dir, le)
+  switch (l->type) { PR_LIGHT_TYPES(PR_LIGHT_CASE) }
+#undef PR_LIGHT_CALL
+  *dir = make_float3(0.0f, 0.0f, 1.0f);
+  *le = make_float3(0.0f, 0.0f, 0.0f);
+  return 0.0f;
+}
+
+// light_sample_emit's direction and pdf, for a light that needs no data buffer.
+PR_INLINE float light_sample_emit_dir(const Light* l, float3 n0, float u1, float u2, float3* dir) {
+  float3 le;
+  return light_sample_emit(l, (PR_GLOBAL const float*)0, n0, u1, u2, dir, &le);
+}
+
+// The solid-angle pdf with which a light path leaves vertex 0 of l along dir where strategy E
+// joins that vertex (light_joins_vertex0), whichever face of a triangle (n0 or -n0) it chose;
+// 0 for the other lights.
+PR_INLINE float light_pdf_emit_dir(const Light* l, float3 n0, float3 dir) {
+#define PR_LIGHT_CALL(fn) light_##fn##_pdf_emit(l, n0, dir)
+  switch (l->type) { PR_LIGHT_TYPES(PR_LIGHT_CASE) }
+#undef PR_LIGHT_CALL
+  return 0.0f;
+}
+
+// The share of its emission that l sends along dir, leaving it: a spot's cone; 1 elsewhere.
+PR_INLINE float light_falloff(const Light* l, float3 dir) {
+#define PR_LIGHT_CALL(fn) light_##fn##_falloff(l, dir)
+  switch (l->type) { PR_LIGHT_TYPES(PR_LIGHT_CASE) }
+#undef PR_LIGHT_CALL
+  return 0.0f;
+}
+
+// The selection weight of a light by power: the luminance of the flux it emits (a directional
+// light's or the environment's through the disk of radius scene_radius that covers the scene).
+// The host builds the power tables and the light BVH from it.
+PR_INLINE float light_power(const Light* l, float scene_radius) {
+#define PR_LIGHT_CALL(fn) light_##fn##_power(l, scene_radius)
+  switch (l->type) { PR_LIGHT_TYPES(PR_LIGHT_CASE) }
+#undef PR_LIGHT_CALL
+  return 0.0f;
+}
+
+// What a receiver at p with shading normal n (zero: none) can expect from light l were nothing
+// in between, as the luminance of its irradiance: exact for punctual lights and close for
+// triangles; 0 for lights outside the light BVH. Zero only where l sends p nothing: behind the
+// receiver's normal (every non-delta BSDF only reflects) or in a triangle's plane.
+PR_INLINE float light_receiver_importance(PR_GLOBAL const Light* l, float3 p, float3 n) {
+#define PR_LIGHT_CALL(fn) light_##fn##_importance(l, p, n)
+  switch (l->type) { PR_LIGHT_TYPES(PR_LIGHT_CASE) }
+#undef PR_LIGHT_CALL
+  return 0.0f;
+}
+#undef PR_LIGHT_CASE
 
 // One step of weighted reservoir sampling driven by a single uniform *u: adds w (> 0) to *w_sum
 // and says whether this item replaces the kept one (probability w / *w_sum), rescaling *u so
@@ -480,43 +802,46 @@ typedef struct {
   u32 env_light;  // the environment's index, or PR_INVALID_INDEX
 } LightData;
 
+// The receiver-aware choice among lights [0, tree_count) with ut (and ur, the tree's
+// resampling), by PR_LIGHT_SAMPLER: *choice divides the light's contribution, *tree_pmf is the
+// pmf for MIS weights (light_choose).
+PR_INLINE u32 light_choose_in_tree(const LightData* d, float3 p, float3 n, float ut, float ur,
+                                   float* choice, float* tree_pmf) {
+  if (PR_LIGHT_SAMPLER == PR_LIGHT_SAMPLER_EXHAUSTIVE) {
+    const u32 j = light_exhaustive_sample(d->lights, d->tree_count, p, n, ut, choice);
+    *tree_pmf = *choice;
+    return j;
+  }
+  return light_tree_resample(d->nodes, d->lights, p, n, ut, ur, choice, tree_pmf);
+}
+
 // Chooses a light for the receiver at p with shading normal n (zero: none) with u (and ur, for
 // the tree's resampling). *pmf divides the light's contribution: the probability of the choice,
 // or through the tree the inverse contribution weight of its resampling. *mis_pmf is what
 // light_choice_pmf gives the light, for MIS weights against BSDF sampling (any pmf that both
-// sides use keeps the weights adding to 1). A directional light is chosen by its share of the
-// power, the tree (or the exhaustive choice) as a whole by the share of the others.
-// PR_INVALID_INDEX where no light can reach p.
+// sides use keeps the weights adding to 1). A light at infinity is chosen by its share of the
+// power, the tree (or the exhaustive choice) as a whole by the share of the others; by power
+// alone, every light by its share. PR_INVALID_INDEX where no light can reach p.
 PR_INLINE u32 light_choose(const LightData* d, float3 p, float3 n, float u, float ur, float* pmf,
                            float* mis_pmf) {
   *pmf = 0.0f;
   *mis_pmf = 0.0f;
   if (d->count == 0u || !(d->total_power > 0.0f)) return PR_INVALID_INDEX;
-#ifndef PR_LIGHT_SAMPLER_POWER
-  const float share = d->tree_count > 0u ? d->cdf[d->tree_count - 1u] / d->total_power : 0.0f;
+  const int by_receiver = PR_LIGHT_SAMPLER != PR_LIGHT_SAMPLER_POWER;
+  const float share =
+      by_receiver && d->tree_count > 0u ? d->cdf[d->tree_count - 1u] / d->total_power : 0.0f;
   if (u < share) {
     const float ut = fmin(u / share, PR_ONE_MINUS_EPSILON);
     float choice, tree_pmf;
-#ifdef PR_LIGHT_SAMPLER_EXHAUSTIVE
-    (void)ur;
-    const u32 j = light_exhaustive_sample(d->lights, d->tree_count, p, n, ut, &choice);
-    tree_pmf = choice;
-#else
-    const u32 j = light_tree_resample(d->nodes, d->lights, p, n, ut, ur, &choice, &tree_pmf);
-#endif
+    const u32 j = light_choose_in_tree(d, p, n, ut, ur, &choice, &tree_pmf);
     *pmf = share * choice;
     *mis_pmf = share * tree_pmf;
     return j;
   }
-  // A directional light (the rounding of u * total at the boundary aside).
+  // By power: with a receiver-aware sampler, a light at infinity (the rounding of u * total at
+  // the boundary aside).
   const u32 found = light_select(d->cdf, d->count, u);
-  const u32 i = found < d->tree_count ? d->tree_count : found;
-#else
-  (void)p;
-  (void)n;
-  (void)ur;
-  const u32 i = light_select(d->cdf, d->count, u);
-#endif
+  const u32 i = by_receiver && found < d->tree_count ? d->tree_count : found;
   *pmf = *mis_pmf = d->lights[i].power / d->total_power;
   return i;
 }
@@ -524,19 +849,12 @@ PR_INLINE u32 light_choose(const LightData* d, float3 p, float3 n, float u, floa
 // The probability that light_choose picks `light` for the receiver (p, n).
 PR_INLINE float light_choice_pmf(const LightData* d, u32 light, float3 p, float3 n) {
   if (light >= d->count || !(d->total_power > 0.0f)) return 0.0f;
-#ifndef PR_LIGHT_SAMPLER_POWER
-  if (light < d->tree_count) {
+  if (PR_LIGHT_SAMPLER != PR_LIGHT_SAMPLER_POWER && light < d->tree_count) {
     const float share = d->cdf[d->tree_count - 1u] / d->total_power;
-#ifdef PR_LIGHT_SAMPLER_EXHAUSTIVE
-    return share * light_exhaustive_pmf(d->lights, d->tree_count, light, p, n);
-#else
+    if (PR_LIGHT_SAMPLER == PR_LIGHT_SAMPLER_EXHAUSTIVE)
+      return share * light_exhaustive_pmf(d->lights, d->tree_count, light, p, n);
     return share * light_bvh_pmf(d->nodes, d->lights[light].leaf, p, n);
-#endif
   }
-#else
-  (void)p;
-  (void)n;
-#endif
   return d->lights[light].power / d->total_power;
 }
 
@@ -549,3 +867,7 @@ PR_ARG_GATHER(LightData, pr_light_data, PR_ARGS_LIGHTS)
 PR_STATIC_ASSERT(sizeof(pr::dev::Light) == 96, "Light layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::Light, le_r) == 48, "Light layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::Light, material) == 76, "Light layout");
+
+// The environment's function set, declared above from PR_LIGHT_TYPES (its header includes this
+// one: either may come first).
+#include "shared/environment.h"
