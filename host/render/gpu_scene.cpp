@@ -334,8 +334,7 @@ void GpuScene::buildLights(double t) {
   // refitted and uploaded again only when a light moved. Its size never changes.
   if (!lightBvhBuilt_) {
     treeLights_ = 0;
-    while (treeLights_ < lights_.size() && lights_[treeLights_].type != PR_LIGHT_DIRECTIONAL &&
-           lights_[treeLights_].type != PR_LIGHT_ENV)
+    while (treeLights_ < lights_.size() && !dev::light_at_infinity(lights_[treeLights_].type))
       ++treeLights_;
     lightBvh_.build(&lights_, lightChoice_ == LightSampler::Bvh ? treeLights_ : 0u);
     lightBvhBuilt_ = true;
