@@ -159,6 +159,38 @@ TEST(Reuse, ArenaEqualsAFullRetraceSlotBySlot) {
   EXPECT_GT(reusedSlots, 0u);
 }
 
+// With eye paths connect leaves its terms to connect_shadow, for as many pixel samples a launch
+// as the records' memory holds: launches of 37 pixels (not a divisor of the image's) give the
+// frames of one launch, float for float.
+TEST(Reuse, ConnectRecordsInSmallLaunchesGiveTheSameFrames) {
+  const Scene scene = loadScene(sweepScene());
+  Context& ctx = test::testContext();
+  GpuScene gpu(ctx, scene);
+  Film one(ctx, 16, 12), many(ctx, 16, 12);
+  PathReuseSettings rs;
+  rs.spp = 2;
+  rs.resample = 1;  // the reservoir's terms too
+  PathReuse a(ctx, gpu, one, rs);
+  ASSERT_EQ(a.connectLaunchPixels(), one.pixels());
+  rs.connectRecordBytes = 37 * uint64_t(a.connectRecordCap()) * sizeof(dev::ConnectRecord);
+  PathReuse b(ctx, gpu, many, rs);
+  ASSERT_EQ(b.connectLaunchPixels(), 37u);
+  uint64_t connected = 0;
+  for (int f = 0; f < 3; ++f) {
+    const double t = f / 8.0;
+    gpu.setTime(t);
+    const auto cam = gpu.camera(0, t, 16, 12);
+    one.clear();
+    many.clear();
+    FrameStats st;
+    a.renderFrame(f, cam, &st);
+    b.renderFrame(f, cam, nullptr);
+    connected += st.counters["connections_unoccluded"];
+    EXPECT_EQ(one.read().rgba, many.read().rgba) << "frame " << f;
+  }
+  EXPECT_GT(connected, 0u) << "the connections should reach some light vertices";
+}
+
 TEST(Reuse, CameraMotionAloneInvalidatesNothing) {
   test::GltfBuilder b;
   const int white = b.addMaterial({glm::vec4(0.7f, 0.7f, 0.7f, 1), 0, 1});

@@ -14,10 +14,6 @@ namespace pr {
 
 namespace {
 
-// The most device memory that connect's records (--eye-paths) take: the pixel samples of one
-// launch are as many as fit.
-constexpr uint64_t kConnectRecordBudget = uint64_t(128) << 20;
-
 // A counter of the light paths (the same on every device that holds them).
 void setLightPathCounter(FrameStats* stats, const char* key, uint64_t value) {
   stats->counters[key] = value;
@@ -82,7 +78,7 @@ PathReuse::PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseS
     recordCap_ = settings_.pathsPerPixel * (stride_ - 1) + 1 + 1 + settings_.resample + 1;
     const uint64_t perSample = uint64_t(recordCap_) * sizeof(dev::ConnectRecord);
     recordPixels_ = static_cast<uint32_t>(
-        std::clamp<uint64_t>(kConnectRecordBudget / perSample, 1, film.pixels()));
+        std::clamp<uint64_t>(settings_.connectRecordBytes / perSample, 1, film.pixels()));
   }
   records_ =
       alloc("connection records", std::max<uint64_t>(uint64_t(recordPixels_) * recordCap_, 1) *

@@ -32,8 +32,11 @@ struct PathReuseSettings {
   uint32_t historyCap = 0;     // connection history (connect.cl): carried candidates per C; 0: off
   uint32_t historyPeriod = 1;  // frames between moves of the history's light-path offset (>= 1)
   bool eyePaths = true;        // connections weighted against the path tracer's eye paths
-  bool retraceAll = false;     // --mode retrace
-  bool fixedNoise = false;     // camera samples keyed by frame 0 on every frame
+  // Device memory for connect's terms (eye paths): each launch of connect and connect_shadow
+  // takes as many pixel samples as fit.
+  uint64_t connectRecordBytes = uint64_t(128) << 20;
+  bool retraceAll = false;  // --mode retrace
+  bool fixedNoise = false;  // camera samples keyed by frame 0 on every frame
 };
 
 class PathReuse : public Integrator {
@@ -42,6 +45,9 @@ class PathReuse : public Integrator {
   void renderFrame(int frame, const dev::CameraParams& camera, FrameStats* stats) override;
   uint64_t deviceBytes() const override { return bytes_; }
 
+  // connect's terms per pixel sample, and the pixel samples of one launch (eye paths).
+  uint32_t connectRecordCap() const { return recordCap_; }
+  uint32_t connectLaunchPixels() const { return recordPixels_; }
   uint32_t slots() const { return slots_; }
   uint32_t stride() const { return stride_; }
   uint64_t arenaBytes() const {
