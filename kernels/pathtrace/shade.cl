@@ -101,12 +101,29 @@ PR_INLINE float pt_next_event_weight(const SceneData* s, const PathState* p, con
   return w;
 }
 
-PR_KERNEL void pt_shade(PR_PARAMS(PR_ARGS_PT_SHADE)) {
-  const uint j = (uint)get_global_id(0);
-  if (j >= count) return;
-  const uint i = queue[j];
+#define PR_SHADE_LIVE 1u    // the path goes on
+#define PR_SHADE_SHADOW 2u  // it wrote a shadow ray
+
+// Appends `item` to `queue` where `take`, with one global atomic per work-group (its items land
+// together: in work-item order where a device runs them in order, as PoCL does). Every
+// work-item of the group must call it.
+PR_INLINE void queue_append(__global uint* queue, __global uint* size, int take, uint item,
+                            __local uint* group_count, __local uint* group_base) {
+  if (get_local_id(0) == 0u) *group_count = 0u;
+  barrier(CLK_LOCAL_MEM_FENCE);
+  const uint slot = take ? atomic_inc(group_count) : 0u;
+  barrier(CLK_LOCAL_MEM_FENCE);
+  if (get_local_id(0) == 0u) *group_base = *group_count ? atomic_add(size, *group_count) : 0u;
+  barrier(CLK_LOCAL_MEM_FENCE);
+  if (take) queue[*group_base + slot] = item;
+  barrier(CLK_LOCAL_MEM_FENCE);  // before the next call resets the counts
+}
+
+// One live path i: PR_SHADE_* of what it goes on with.
+PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
   const SceneData s = PR_SCENE();
   PathState p = states[i];
+  uint out = 0u;
 
   const Hit hit = hits[i];
   if (hit.prim == PR_INVALID_INDEX) {
@@ -114,7 +131,7 @@ PR_KERNEL void pt_shade(PR_PARAMS(PR_ARGS_PT_SHADE)) {
     if (pt_escaped(&s, &p, &add)) radiance[i] += (float4)(add.x, add.y, add.z, 0.0f);
     p.alive = 0u;
     states[i] = p;
-    return;
+    return 0u;
   }
   Rng rng = rng_make(seed, PR_RNG_CAMERA, frame, p.pixel, sample);
   rng.dim = p.rng_dim;
@@ -178,7 +195,7 @@ PR_KERNEL void pt_shade(PR_PARAMS(PR_ARGS_PT_SHADE)) {
         shadows[i].c_r = c.x;
         shadows[i].c_g = c.y;
         shadows[i].c_b = c.z;
-        shadow_queue[atomic_inc(queue_sizes + PR_QUEUE_SHADOW)] = i;
+        out = PR_SHADE_SHADOW;
       }
     } else {
       rng_skip(&rng, PR_NEXT_EVENT_DRAWS);  // the same dimensions whatever the material
@@ -215,5 +232,16 @@ PR_KERNEL void pt_shade(PR_PARAMS(PR_ARGS_PT_SHADE)) {
   p.tp_b = tp.z;
   p.rng_dim = rng.dim;
   states[i] = p;
-  if (p.alive) next_queue[atomic_inc(queue_sizes + PR_QUEUE_LIVE)] = i;
+  return out | (p.alive ? PR_SHADE_LIVE : 0u);
+}
+
+PR_KERNEL void pt_shade(PR_PARAMS(PR_ARGS_PT_SHADE)) {
+  __local uint group_count, group_base;
+  const uint j = (uint)get_global_id(0);
+  const uint i = j < count ? queue[j] : 0u;
+  const uint out = j < count ? pt_shade_path(PR_ARG_VALUES(PR_ARGS_PT_SHADE), i) : 0u;
+  queue_append(next_queue, queue_sizes + PR_QUEUE_LIVE, out & PR_SHADE_LIVE, i, &group_count,
+               &group_base);
+  queue_append(shadow_queue, queue_sizes + PR_QUEUE_SHADOW, out & PR_SHADE_SHADOW, i, &group_count,
+               &group_base);
 }
