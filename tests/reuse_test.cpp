@@ -172,7 +172,7 @@ TEST(Reuse, ConnectRecordsInSmallLaunchesGiveTheSameFrames) {
   rs.resample = 1;  // the reservoir's terms too
   PathReuse a(ctx, gpu, one, rs);
   ASSERT_EQ(a.connectLaunchPixels(), one.pixels());
-  rs.connectRecordBytes = 37 * uint64_t(a.connectRecordCap()) * sizeof(dev::ConnectRecord);
+  rs.connectRecordBytes = 37 * uint64_t(a.connectRecordCap()) * sizeof(dev::ShadowRay);
   PathReuse b(ctx, gpu, many, rs);
   ASSERT_EQ(b.connectLaunchPixels(), 37u);
   uint64_t connected = 0;

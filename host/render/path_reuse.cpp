@@ -76,13 +76,13 @@ PathReuse::PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseS
     // Per pixel sample: L's connections at x, each a term (at most C per stored vertex k >= 1)
     // and their sum's end, the history's one term, a reservoir's terms and their sum's end.
     recordCap_ = settings_.pathsPerPixel * (stride_ - 1) + 1 + 1 + settings_.resample + 1;
-    const uint64_t perSample = uint64_t(recordCap_) * sizeof(dev::ConnectRecord);
+    const uint64_t perSample = uint64_t(recordCap_) * sizeof(dev::ShadowRay);
     recordPixels_ = static_cast<uint32_t>(
         std::clamp<uint64_t>(settings_.connectRecordBytes / perSample, 1, film.pixels()));
   }
   records_ =
-      alloc("connection records", std::max<uint64_t>(uint64_t(recordPixels_) * recordCap_, 1) *
-                                      sizeof(dev::ConnectRecord));
+      alloc("connection records",
+            std::max<uint64_t>(uint64_t(recordPixels_) * recordCap_, 1) * sizeof(dev::ShadowRay));
   recordCounts_ = alloc("connection record counts", uint64_t(recordPixels_) * 4);
   if (settings_.eyePaths) {
     PathTracerSettings pt{settings_.spp, settings_.maxDepth, settings_.seed, settings_.fixedNoise};

@@ -33,7 +33,7 @@
 #include "shared/reuse.h"
 
 // Built with 1 for --eye-paths (PathReuse): connect then traces no ray, and leaves the estimate's
-// terms, shadow rays with what each adds, to connect_shadow (shared/reuse.h, ConnectRecord).
+// terms, shadow rays with what each adds, to connect_shadow (ShadowRay records, shared/reuse.h).
 #ifndef PR_CONNECT_DEFERRED
 #define PR_CONNECT_DEFERRED 0
 #endif
@@ -83,9 +83,9 @@ typedef struct {
   HistoryReservoir hr;  // strategy L's connections at the first eye vertex, carried
   HistoryReservoir he;  // strategy E's there, this frame's alone
   __global const EyePathRatio* ratios;  // --eye-paths: beside the vertices (light_trace)
-  // The estimate's terms (ConnectRecord, shared/reuse.h): with PR_CONNECT_DEFERRED written to
+  // The estimate's terms (ShadowRay records, shared/reuse.h): with PR_CONNECT_DEFERRED written to
   // rec for connect_shadow (at most cap of them), else traced and summed into L and g here.
-  __global ConnectRecord* rec;
+  __global ShadowRay* rec;
   uint n_rec, cap, overflow;
   uint members;  // terms in the partial sum g since it was last closed
   float3 L, g;
@@ -99,7 +99,7 @@ PR_INLINE void connect_term(Connector* cn, float3 v, const Ray* ray, u32 op) {
     cn->overflow = 1u;
     return;
   }
-  __global ConnectRecord* r = cn->rec + cn->n_rec++;
+  __global ShadowRay* r = cn->rec + cn->n_rec++;
   if (ray) r->ray = *ray;
   r->c_r = v.x;
   r->c_g = v.y;

@@ -1,5 +1,5 @@
 // connect_shadow: one work-item per pixel sample of connect's launch (--eye-paths, where connect
-// traces no ray). Traces the shadow rays of the sample's ConnectRecords in the order connect wrote
+// traces no ray). Traces the shadow rays of the sample's records in the order connect wrote
 // them and adds the estimate they make, summed as the records say (shared/reuse.h), to the
 // sample's radiance; counts the unoccluded connections.
 #include "shared/reuse.h"
@@ -10,7 +10,7 @@ PR_KERNEL void connect_shadow(PR_PARAMS(PR_ARGS_CONNECT_SHADOW)) {
   const uint n = record_counts[i - record_first];
   if (n == 0u) return;
   const SceneData s = PR_SCENE();
-  __global const ConnectRecord* r = records + (size_t)(i - record_first) * record_cap;
+  __global const ShadowRay* r = records + (size_t)(i - record_first) * record_cap;
   float3 L = make_float3(0.0f, 0.0f, 0.0f), g = L;
   uint unoccluded = 0u;
   for (uint k = 0u; k < n; ++k) {

@@ -97,9 +97,9 @@
   PR_ARGS_CONNECT_RECORDS(X, OUT)
 
 // The pixel samples [record_first, record_end) of one launch of connect and connect_shadow, and
-// their terms, record_cap per sample (--eye-paths; shared/reuse.h, ConnectRecord).
+// their terms, record_cap per sample (--eye-paths; ShadowRay with op, shared/reuse.h).
 #define PR_ARGS_CONNECT_RECORDS(X, kind) \
-  X(FRAME, kind, ConnectRecord, records) \
+  X(FRAME, kind, ShadowRay, records)     \
   X(FRAME, kind, uint, record_counts)    \
   X(FRAME, VAL, uint, record_cap)        \
   X(PASS, VAL, uint, record_first)       \

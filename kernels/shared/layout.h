@@ -33,7 +33,6 @@
   S(EyeVertex)               \
   S(EyePathRatio)            \
   S(ConnectionHistory)       \
-  S(ConnectRecord)           \
   S(ReuseParams)
 
 #define PR_SHARED_FIELDS(F)           \
@@ -118,7 +117,7 @@
   F(LightNode, r2)                    \
   F(LightNode, parent)                \
   F(ShadowRay, c_r)                   \
-  F(ShadowRay, pad)                   \
+  F(ShadowRay, op)                    \
   F(PathHeader, end)                  \
   F(PathHeader, valid)                \
   F(PathHeader, escape_z)             \
@@ -136,8 +135,6 @@
   F(ConnectionHistory, tp_r)          \
   F(ConnectionHistory, slot)          \
   F(ConnectionHistory, frame)         \
-  F(ConnectRecord, c_r)               \
-  F(ConnectRecord, op)                \
   F(Light, moved)                     \
   F(Light, leaf)                      \
   F(ReuseParams, clamp)               \

@@ -41,12 +41,13 @@ typedef struct {
 #define PR_PATH_SPECULAR 1u  // the last bounce was delta (or the ray is the camera ray)
 #define PR_EYE_JOINABLE 1u   // x_2 is non-delta: stored light paths can make this path's ends
 
-// A shadow ray with the contribution it carries if unoccluded (traced where the path is in the
-// bounce's shadow queue). 48 bytes.
+// A shadow ray with the contribution it carries if unoccluded: the path tracer's next-event
+// estimation (traced where the path is in the bounce's shadow queue) and connect's terms for
+// connect_shadow (shared/reuse.h). 48 bytes.
 typedef struct {
   Ray ray;
   float c_r, c_g, c_b;
-  u32 pad;
+  u32 op;  // connect's terms: how they sum, PR_REC_* (shared/reuse.h); unused by the path tracer
 } ShadowRay;
 
 PR_NAMESPACE_END

@@ -5,6 +5,7 @@
 
 #include "shared/arena.h"
 #include "shared/integrator.h"
+#include "shared/path_state.h"
 
 PR_NAMESPACE_BEGIN
 
@@ -34,16 +35,11 @@ typedef struct {
 
 // What connect leaves for connect_shadow (docs/design.md section 5, "Connections, then their
 // shadow rays"): per pixel sample, in the order connect found them, the terms of its estimate,
-// each a value added where its ray (if any) is unoccluded. The estimate is L, summed as connect
-// used to sum it: PR_REC_ADD adds the value to L, PR_REC_GROUP to a partial sum g, and
-// PR_REC_CLOSE adds g to L and starts g again at 0, so that the floating-point sums, and the
-// frames, are those of one kernel tracing as it goes. 48 bytes.
-typedef struct {
-  Ray ray;  // traced where op has PR_REC_RAY (else never read)
-  float c_r, c_g, c_b;
-  u32 op;  // PR_REC_ADD, _GROUP or _CLOSE, with the flags below
-} ConnectRecord;
-
+// each a ShadowRay whose value is added where its ray (if any) is unoccluded. The estimate is L,
+// summed as connect used to sum it: op PR_REC_ADD adds the value to L, PR_REC_GROUP to a partial
+// sum g, and PR_REC_CLOSE adds g to L and starts g again at 0, so that the floating-point sums,
+// and the frames, are those of one kernel tracing as it goes. The ray is read only where op has
+// PR_REC_RAY.
 #define PR_REC_ADD 0u
 #define PR_REC_GROUP 1u
 #define PR_REC_CLOSE 2u
@@ -143,4 +139,3 @@ PR_NAMESPACE_END
 
 PR_STATIC_ASSERT(sizeof(pr::dev::ReuseParams) == 80, "ReuseParams layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::ReuseParams, clamp) == 32, "ReuseParams layout");
-PR_STATIC_ASSERT(sizeof(pr::dev::ConnectRecord) == 48, "ConnectRecord layout");
