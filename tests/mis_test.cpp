@@ -6,6 +6,7 @@
 // forward / reverse density would miss.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -411,6 +412,88 @@ TEST(Gris, MergedReservoirsAreUnbiased) {
   }
   const double mean = sum / n, se = std::sqrt((sum2 / n - mean * mean) / n);
   EXPECT_NEAR(mean, exact, 4.5 * se) << "standard error " << se;
+}
+
+// Pairwise MIS (path resampling across pixels): for any targets and confidences, the canonical
+// weight and the k neighbours' weights at a sample add to 1, zero targets included; a neighbour
+// whose target is 0 gets 0; equal targets and confidences give the canonical side more than a
+// neighbour (it takes part in every pair).
+TEST(Pairwise, WeightsAddToOne) {
+  std::mt19937 gen(11);
+  std::uniform_real_distribution<float> logu(-10.0f, 10.0f);
+  std::uniform_int_distribution<int> zero(0, 3);
+  for (int k = 1; k <= 6; ++k) {
+    for (int trial = 0; trial < 2000; ++trial) {
+      const float kf = float(k);
+      const float pc = zero(gen) == 0 ? 0.0f : std::exp(logu(gen));
+      const float cc = std::exp(0.2f * logu(gen));
+      double sum = 0.0, terms = 0.0;
+      for (int i = 0; i < k; ++i) {
+        const float pi = zero(gen) == 0 ? 0.0f : std::exp(logu(gen));
+        const float ci = std::exp(0.2f * logu(gen));
+        const float m = mis_pairwise_neighbor(ci, pi, cc, pc, kf);
+        EXPECT_GE(m, 0.0f);
+        if (pi == 0.0f) {
+          EXPECT_EQ(m, 0.0f);
+        }
+        sum += m;
+        terms += mis_pairwise_canonical_term(ci, pi, cc, pc, kf);
+      }
+      sum += mis_pairwise_canonical(float(terms), kf);
+      ASSERT_NEAR(sum, 1.0, 1e-5) << "k " << k << " trial " << trial;
+    }
+  }
+  const float c = mis_pairwise_canonical(3 * mis_pairwise_canonical_term(1, 1, 1, 1, 3), 3);
+  EXPECT_NEAR(c, 7.0f / 16.0f, 1e-6f);
+  EXPECT_NEAR(mis_pairwise_neighbor(1, 1, 1, 1, 3), 3.0f / 16.0f, 1e-6f);
+}
+
+// The reconnection shift's Jacobian: x_2 kept, x_1 moved to x_1'. A small patch around x_2 seen
+// from x_1 and from x_1' subtends solid angles whose ratio is |J| = g(x_1') / g(x_1), with g =
+// |cos at x_2| / d^2 (measured here in double precision from the patch's corners); and the
+// shifts there and back multiply to 1.
+TEST(Reconnection, JacobianIsTheRatioOfSolidAngles) {
+  using V = std::array<double, 3>;
+  auto sub = [](V a, V b) { return V{a[0] - b[0], a[1] - b[1], a[2] - b[2]}; };
+  auto dot3 = [](V a, V b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; };
+  auto norm = [&](V a) {
+    const double l = std::sqrt(dot3(a, a));
+    return V{a[0] / l, a[1] / l, a[2] / l};
+  };
+  auto cross3 = [](V a, V b) {
+    return V{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+  };
+  // The solid angle of the small triangle (a, b, c) seen from o.
+  auto solidAngle = [&](V o, V a, V b, V c) {
+    const V da = norm(sub(a, o)), db = norm(sub(b, o)), dc = norm(sub(c, o));
+    const double num = std::fabs(dot3(da, cross3(db, dc)));
+    const double den = 1.0 + dot3(da, db) + dot3(db, dc) + dot3(dc, da);
+    return 2.0 * std::atan2(num, den);
+  };
+  std::mt19937 gen(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 200; ++trial) {
+    const V x2{u(gen), u(gen), u(gen)};
+    const V n2 = norm(V{u(gen), u(gen), 2.0 + u(gen)});  // x_2's normal, facing +z roughly
+    const V t1 = norm(cross3(n2, V{1, 0, 0})), t2 = cross3(n2, t1);
+    const V x1{x2[0] + 2 * u(gen), x2[1] + 2 * u(gen), x2[2] + 1.5 + u(gen)};
+    const V x1b{x2[0] + 2 * u(gen), x2[1] + 2 * u(gen), x2[2] + 1.5 + u(gen)};
+    if (dot3(sub(x1, x2), n2) <= 0.1 || dot3(sub(x1b, x2), n2) <= 0.1) continue;
+    const double e = 1e-4;
+    const V a = x2;
+    const V b{x2[0] + e * t1[0], x2[1] + e * t1[1], x2[2] + e * t1[2]};
+    const V c{x2[0] + e * t2[0], x2[1] + e * t2[1], x2[2] + e * t2[2]};
+    const double measured = solidAngle(x1b, a, b, c) / solidAngle(x1, a, b, c);
+    auto g = [&](V x) {
+      const V d = sub(x, x2);
+      const double d2 = dot3(d, d);
+      return float(std::fabs(dot3(n2, d)) / std::sqrt(d2) / d2);
+    };
+    const float jac = reconnection_jacobian(g(x1b), g(x1));
+    EXPECT_NEAR(jac, measured, 1e-3 * measured) << "trial " << trial;
+    EXPECT_NEAR(jac * reconnection_jacobian(g(x1), g(x1b)), 1.0f, 1e-5f);
+  }
+  EXPECT_EQ(reconnection_jacobian(1.0f, 0.0f), 0.0f);
 }
 
 }  // namespace

@@ -17,6 +17,8 @@ PathTracer::PathTracer(Context& ctx, GpuScene& scene, Film& film,
   extend_ = kargs::kernel<kargs::PtExtendArgs>(ctx, "pathtrace/extend.cl", opts);
   shade_ = kargs::kernel<kargs::PtShadeArgs>(ctx, "pathtrace/shade.cl", opts);
   shadow_ = kargs::kernel<kargs::PtShadowArgs>(ctx, "pathtrace/shadow.cl", opts);
+  if (settings.resample)
+    resample_ = kargs::kernel<kargs::PtResampleArgs>(ctx, "pathtrace/resample.cl", opts);
   const uint64_t n = film.pixels();
   auto alloc = [&](const char* name, uint64_t bytes) {
     bytes_ += bytes;
@@ -33,6 +35,24 @@ PathTracer::PathTracer(Context& ctx, GpuScene& scene, Film& film,
   queueSizes_ = alloc("queue sizes", dev::PR_QUEUE_COUNT * 4);
   rays_ = alloc("ray counters", dev::PR_PT_COUNT * 4);
   noEye_ = alloc("no eye vertices", 64);
+  const uint64_t rsPixels = settings.resample ? n : 1;
+  rsTrack_ = alloc("path tracks", rsPixels * sizeof(dev::PathTrack));
+  rsRes_ = alloc("path reservoirs", rsPixels * sizeof(dev::PathReservoir));
+  rsPending_ = alloc("path candidates", rsPixels * sizeof(dev::PathReservoir));
+  if (settings.resample) rsEye_ = alloc("eye vertices", n * sizeof(dev::EyeVertex));
+}
+
+dev::ResampleParams PathTracer::resampleParams() const {
+  dev::ResampleParams p{};
+  p.enabled = settings_.resample ? 1u : 0u;
+  p.neighbors = cl_uint(settings_.resampleNeighbors);
+  p.radius = settings_.resampleRadius;
+  const float r = settings_.resampleRoughness;
+  p.min_alpha = r * r;  // GGX alpha = roughness^2, as the materials map it
+  p.min_dist2 = settings_.resampleDistance * settings_.resampleDistance;
+  p.width = film_.width();
+  p.height = film_.height();
+  return p;
 }
 
 void PathTracer::beginFrame(int frame, const dev::CameraParams& camera,
@@ -42,6 +62,9 @@ void PathTracer::beginFrame(int frame, const dev::CameraParams& camera,
   const cl_uint n = film_.end();
   const cl_uint rngFrame = settings_.fixedNoise ? 0 : cl_uint(frame);
   ctx_.zero(rays_, dev::PR_PT_COUNT * 4);
+  const dev::ResampleParams rsp = resampleParams();
+  // Resampling needs every sample's x_1, which the path tracer alone does not keep.
+  const cl::Buffer& eyeOut = settings_.resample && settings_.lightPaths == 0 ? rsEye_ : eye;
   kargs::setScene(&extendArgs_, sceneArgs);
   extendArgs_.states = states_;
   extendArgs_.hits = hits_;
@@ -60,22 +83,46 @@ void PathTracer::beginFrame(int frame, const dev::CameraParams& camera,
   shadeArgs_.light_paths = cl_uint(settings_.lightPaths);
   shadeArgs_.trace_cdf = scene_.traceCdf();
   shadeArgs_.trace_total = scene_.traceTotalPower();
-  shadeArgs_.eye = eye;
+  shadeArgs_.eye = eyeOut;
+  shadeArgs_.rsp = rsp;
+  shadeArgs_.rs_track = rsTrack_;
+  shadeArgs_.rs_res = rsRes_;
+  shadeArgs_.rs_pending = rsPending_;
   shadeArgs_.set(shade_, kargs::kScene | kargs::kFrame);
   kargs::setScene(&shadowArgs_, sceneArgs);
   shadowArgs_.radiance = radiance;
   shadowArgs_.shadows = shadows_;
   shadowArgs_.rays = rays_;
   shadowArgs_.shadow_queue = shadowQueue_;
+  shadowArgs_.seed = settings_.seed;
+  shadowArgs_.frame = rngFrame;
+  shadowArgs_.resample = rsp.enabled;
+  shadowArgs_.rs_res = rsRes_;
+  shadowArgs_.rs_pending = rsPending_;
   shadowArgs_.set(shadow_, kargs::kScene | kargs::kFrame);
+  if (settings_.resample) {
+    kargs::setScene(&resampleArgs_, sceneArgs);
+    resampleArgs_.rsp = rsp;
+    resampleArgs_.eye = eyeOut;
+    resampleArgs_.rs_res = rsRes_;
+    resampleArgs_.radiance = radiance;
+    resampleArgs_.seed = settings_.seed;
+    resampleArgs_.frame = rngFrame;
+    resampleArgs_.first = film_.first();
+    resampleArgs_.end = n;
+    resampleArgs_.rays = rays_;
+    resampleArgs_.set(resample_, kargs::kScene | kargs::kFrame);
+  }
   generateArgs_.cam = camera;
   generateArgs_.seed = settings_.seed;
   generateArgs_.frame = rngFrame;
   generateArgs_.states = states_;
   generateArgs_.radiance = radiance;
   generateArgs_.count = n;
-  generateArgs_.eye = eye;
-  generateArgs_.write_eye = settings_.lightPaths > 0 ? 1 : 0;
+  generateArgs_.eye = eyeOut;
+  generateArgs_.write_eye = settings_.lightPaths > 0 || settings_.resample ? 1 : 0;
+  generateArgs_.resample = rsp.enabled;
+  generateArgs_.rs_res = rsRes_;
   generateArgs_.queue = queues_[0];
   generateArgs_.first = film_.first();
   generateArgs_.set(generate_);
@@ -83,7 +130,7 @@ void PathTracer::beginFrame(int frame, const dev::CameraParams& camera,
 
 void PathTracer::tracePass(int sample, StageTimer* timer) {
   const cl_uint first = film_.first(), n = film_.end();
-  generateArgs_.sample = shadeArgs_.sample = cl_uint(sample);
+  generateArgs_.sample = shadeArgs_.sample = shadowArgs_.sample = cl_uint(sample);
   generateArgs_.set(generate_, kargs::kPass);
   ctx_.launch1D(generate_, first, n, "generate", timer);
   // Each bounce runs over the paths still live (a queue pt_shade compacts), and traces the shadow
@@ -110,6 +157,11 @@ void PathTracer::tracePass(int sample, StageTimer* timer) {
     shadowArgs_.set(shadow_, kargs::kPass);
     ctx_.launch1D(shadow_, 0, sizes[dev::PR_QUEUE_SHADOW], "shadow", timer);
     live = sizes[dev::PR_QUEUE_LIVE];
+  }
+  if (settings_.resample) {
+    resampleArgs_.sample = cl_uint(sample);
+    resampleArgs_.set(resample_, kargs::kPass);
+    ctx_.launch1D(resample_, 0, n - first, "resample", timer);
   }
 }
 

@@ -21,6 +21,12 @@ struct PathTracerSettings {
   // vertex; the ends of eye paths on lights are weighted against those connections
   // (kernels/shared/eye_paths.h). 0: the path tracer alone.
   uint32_t lightPaths = 0;
+  // --resample (kernels/shared/resample.h): neighbours 0 resamples each pixel's own paths.
+  bool resample = false;
+  int resampleNeighbors = 3;
+  float resampleRadius = 10.0f;
+  float resampleRoughness = 0.2f;
+  float resampleDistance = 0.01f;  // scene units
 };
 
 class PathTracer : public Integrator {
@@ -40,21 +46,27 @@ class PathTracer : public Integrator {
   void reportRays(FrameStats* stats);
 
  private:
+  dev::ResampleParams resampleParams() const;
+
   Context& ctx_;
   GpuScene& scene_;
   Film& film_;
   PathTracerSettings settings_;
-  cl::Kernel generate_, extend_, shade_, shadow_;
+  cl::Kernel generate_, extend_, shade_, shadow_, resample_;
   // Kept between beginFrame and the passes, which change the sample index and the queues.
   kargs::PtGenerateArgs generateArgs_;
   kargs::PtExtendArgs extendArgs_;
   kargs::PtShadeArgs shadeArgs_;
   kargs::PtShadowArgs shadowArgs_;
+  kargs::PtResampleArgs resampleArgs_;
   cl::Buffer states_, hits_, radiance_, shadows_, rays_;
   cl::Buffer queues_[2];    // the live paths' indices, at this bounce and the next
   cl::Buffer shadowQueue_;  // the paths with a shadow ray at this bounce
   cl::Buffer queueSizes_;   // PR_QUEUE_* (kernels/shared/path_state.h)
   cl::Buffer noEye_;        // the eye-vertex argument when nothing is written there
+  // --resample: each path's candidates as it goes, its sample's reservoir, next-event
+  // estimation's candidate until pt_shadow, and x_1 (when the caller gives no eye buffer).
+  cl::Buffer rsTrack_, rsRes_, rsPending_, rsEye_;
   uint64_t bytes_ = 0;
 };
 

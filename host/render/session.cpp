@@ -115,9 +115,17 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
   gpu_ = std::make_unique<GpuScene>(ctx_, scene, sceneOptions);
   film_ = std::make_unique<Film>(ctx_, width_, height_);
   const RenderOptions& o = options_;
+  if (o.resample && o.mode != RenderMode::PathTrace)
+    throw InputError("--resample: works with --mode pathtrace only for now");
   if (o.mode == RenderMode::PathTrace) {
-    integrator_ = std::make_unique<PathTracer>(
-        ctx_, *gpu_, *film_, PathTracerSettings{o.spp, o.maxDepth, o.seed, o.fixedNoise});
+    PathTracerSettings p{o.spp, o.maxDepth, o.seed, o.fixedNoise};
+    p.resample = o.resample;
+    p.resampleNeighbors = o.resampleNeighbors;
+    p.resampleRadius = o.resampleRadius;
+    p.resampleRoughness = o.resampleRoughness;
+    p.resampleDistance =
+        o.resampleDistance > 0.0f ? o.resampleDistance : 0.01f * gpu_->sceneRadius();
+    integrator_ = std::make_unique<PathTracer>(ctx_, *gpu_, *film_, p);
   } else {
     PathReuseSettings r;
     r.spp = o.spp;

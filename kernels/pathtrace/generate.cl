@@ -1,6 +1,7 @@
 // pt_generate: one work-item per pixel. Reads the camera; writes a fresh PathState with the
 // camera ray through a jittered point of the pixel (random dimensions 0 and 1), and zero radiance;
-// with write_eye (--eye-paths), marks the sample's EyeVertex empty. Every path is live: the first
+// with write_eye (--eye-paths, --resample), marks the sample's EyeVertex empty, and with
+// resample its reservoir. Every path is live: the first
 // bounce's queue lists them all (pixel `first` on, in order).
 #include "shared/arena.h"
 #include "shared/bvh.h"
@@ -33,5 +34,9 @@ PR_KERNEL void pt_generate(PR_PARAMS(PR_ARGS_PT_GENERATE)) {
   states[i] = s;
   radiance[i] = (float4)(0.0f, 0.0f, 0.0f, 0.0f);
   if (write_eye) eye[i].prim = PR_INVALID_INDEX;  // until pt_shade meets x_1
+  if (resample) {                                 // an empty reservoir (shared/resample.h)
+    rs_res[i].prim = PR_INVALID_INDEX;
+    rs_res[i].w_sum = 0.0f;
+  }
   queue[i - first] = i;
 }

@@ -13,6 +13,7 @@
 #include "shared/eye_paths.h"
 #include "shared/reuse.h"
 #include "shared/path_state.h"
+#include "shared/resample.h"
 
 // L's density of the path over that of the eye path's vertices beyond x_1 (eye_ratio holds
 // the rest), for a path ending at x_t on light l (normal n_tri, start density `start`) at z0,
@@ -101,6 +102,154 @@ PR_INLINE float pt_next_event_weight(const SceneData* s, const PathState* p, con
   return w;
 }
 
+// --resample: the random number that offers the candidate found at vertex `vertex` of a path
+// (2 vertex: its BSDF's emitter hit; 2 vertex + 1: next-event estimation, in pt_shadow).
+#define PR_RS_DIM(vertex, nee) (2u * (vertex) + (nee))
+
+// --resample, at a hit `rel` vertices beyond x_1 (2 and on: x_3 ...) or, escaped, from the
+// vertex `rel` - 1 beyond it: the path's end on an emitter (le, weighted w by the path tracer,
+// pdf_light its light pdf) offered to the pixel's reservoir.
+PR_INLINE void rs_offer_emission(PR_GLOBAL const PathTrack* t, PR_GLOBAL PathReservoir* r,
+                                 const PathState* p, uint rel, float3 le, float w, float pdf_light,
+                                 Rng* rr) {
+  const int t2 = rel == 2u && !(p->flags & PR_PATH_SPECULAR);
+  const float3 rest = make_float3(t->rest_r, t->rest_g, t->rest_b) * le * (t2 ? 1.0f : w);
+  const PathReservoir c =
+      rs_candidate(t, make_float3(t->f2_r, t->f2_g, t->f2_b), make_float3(t->wx, t->wy, t->wz),
+                   t->g_src, rest, t->pdf, t2 ? PR_RS_HIT2 : PR_RS_DEEP, pdf_light, p->last_pdf);
+  rr->dim = PR_RS_DIM(p->depth + 1u, 0u);
+  rs_offer(r, &c, rng_next(rr));
+}
+
+// --resample, after the BSDF step at vertex `rel` beyond x_1 (0: x_1; 1: x_2, surface h in frame
+// f, reached along -wo at squared distance dist2): the tracked path goes on along `step`; q the
+// roulette's survival probability (1: none).
+PR_INLINE void rs_track_step(PR_GLOBAL PathTrack* t, const ResampleParams* rsp, uint rel,
+                             const SurfaceHit* h, const ShadingFrame* f, float3 wo, float dist2,
+                             const PathStep* step, float q) {
+  const float pdf = step->delta ? 1.0f : step->pdf;
+  const float3 fc = step->weight * pdf;
+  if (rel == 0u) {
+    t->x1_ok = rs_rough(&f->bsdf, rsp->min_alpha) && dot(step->wi, f->ng) > 0.0f;
+    t->f1_r = fc.x;
+    t->f1_g = fc.y;
+    t->f1_b = fc.z;
+    t->pdf = pdf * q;
+    return;
+  }
+  if (rel == 1u) {
+    t->f2_r = fc.x;
+    t->f2_g = fc.y;
+    t->f2_b = fc.z;
+    t->pdf2 = step->delta ? 0.0f : step->pdf;
+    t->wx = step->wi.x;
+    t->wy = step->wi.y;
+    t->wz = step->wi.z;
+    t->rest_r = t->rest_g = t->rest_b = 1.0f;
+    t->g_src = !step->delta && rs_reconnectable(t->x1_ok, h, f, wo, dist2, step->wi, rsp)
+                   ? fabs(dot(h->ng, wo)) / dist2
+                   : 0.0f;
+  } else {
+    t->rest_r *= fc.x;
+    t->rest_g *= fc.y;
+    t->rest_b *= fc.z;
+  }
+  t->pdf *= pdf * q;
+}
+
+// --resample: next-event estimation's path at vertex `rel` >= 1 beyond x_1, the candidate for
+// pt_shadow to offer if its shadow ray is unoccluded.
+PR_INLINE PathReservoir rs_next_event(PR_GLOBAL const PathTrack* t, const ResampleParams* rsp,
+                                      uint rel, const SurfaceHit* h, const ShadingFrame* f,
+                                      float3 wo, float dist2, const NextEventChoice* ch) {
+  if (rel == 1u) {
+    const float g = rs_reconnectable(t->x1_ok, h, f, wo, dist2, ch->wi, rsp)
+                        ? fabs(dot(h->ng, wo)) / dist2
+                        : 0.0f;
+    return rs_candidate(t, ch->fr_cos, ch->wi, g, ch->le, t->pdf * ch->pdf,
+                        ch->delta ? PR_RS_DEEP : PR_RS_NEE2, ch->pdf_light, ch->pdf_bsdf);
+  }
+  const float w = ch->delta ? 1.0f : power_heuristic(ch->pdf_light, ch->pdf_bsdf);
+  const float3 rest = make_float3(t->rest_r, t->rest_g, t->rest_b) * ch->fr_cos * ch->le * w;
+  return rs_candidate(t, make_float3(t->f2_r, t->f2_g, t->f2_b), make_float3(t->wx, t->wy, t->wz),
+                      t->g_src, rest, t->pdf * ch->pdf, PR_RS_DEEP, 0.0f, 0.0f);
+}
+
+// A contribution as the radiance buffer holds it.
+PR_INLINE float4 pt_rgb(float3 c) {
+  return (float4)(c.x, c.y, c.z, 0.0f);
+}
+
+// The path escaped: the environment's light into the sample's radiance, or with --resample from
+// x_2 on (rel >= 2), to its reservoir.
+PR_INLINE void pt_escape(const SceneData* s, const PathState* p, uint rel,
+                         __global const PathTrack* track, __global PathReservoir* res, Rng* rr,
+                         __global float4* radiance) {
+  float3 add;
+  if (!pt_escaped(s, p, &add)) return;
+  if (rel < 2u) {
+    *radiance += pt_rgb(add);
+    return;
+  }
+  const float3 d = make_float3(p->ray.dx, p->ray.dy, p->ray.dz);
+  const float3 prev = make_float3(p->prev_x, p->prev_y, p->prev_z);
+  const float3 prev_n = make_float3(p->prev_nx, p->prev_ny, p->prev_nz);
+  const float pdf_light = environment_pdf(s, prev, prev_n, d);
+  const float w = (p->flags & PR_PATH_SPECULAR) ? 1.0f : power_heuristic(p->last_pdf, pdf_light);
+  rs_offer_emission(track, res, p, rel, environment_radiance(s, d), w, pdf_light, rr);
+}
+
+// Emission at h, weighted w by the path tracer, into the sample's radiance, or with --resample
+// from x_3 on (rel >= 2) to its reservoir.
+PR_INLINE void pt_emission(const SceneData* s, const PathState* p, const SurfaceHit* h, uint rel,
+                           float w, float3 tp, __global const PathTrack* track,
+                           __global PathReservoir* res, Rng* rr, __global float4* radiance) {
+  const float3 le = surface_emission(s, h);
+  if (rel < 2u) {
+    *radiance += pt_rgb(tp * le * w);
+    return;
+  }
+  const float pdf_light = emitter_pdf(s, h, make_float3(p->prev_x, p->prev_y, p->prev_z),
+                                      make_float3(p->prev_nx, p->prev_ny, p->prev_nz));
+  rs_offer_emission(track, res, p, rel, le, w, pdf_light, rr);
+}
+
+// --resample: the hit `rel` >= 1 vertices beyond x_1 joins the tracked path, with the
+// transmittance tr of the segment to it.
+PR_INLINE void rs_track_hit(__global PathTrack* t, uint rel, const Hit* hit, float3 tr) {
+  if (rel == 1u) {  // x_2
+    t->prim = hit->prim;
+    t->inst = hit->inst;
+    t->b1 = hit->u;
+    t->b2 = hit->v;
+    t->f1_r *= tr.x;
+    t->f1_g *= tr.y;
+    t->f1_b *= tr.z;
+  } else {
+    t->rest_r *= tr.x;
+    t->rest_g *= tr.y;
+    t->rest_b *= tr.z;
+  }
+}
+
+// --eye-paths: the eye path's density of this vertex x_t (t >= 2; 1 when sampled from a delta
+// vertex) into its running ratio, and whether x_2 is joinable.
+PR_INLINE void pt_eye_arrive(PathState* p, const SurfaceHit* h, float3 d, float dist2,
+                             int delta_here) {
+  if (p->depth == p->x1_depth + 1u) p->eye_flags = delta_here ? 0u : PR_EYE_JOINABLE;
+  p->eye_ratio = mis_ratio_arrive(p->eye_ratio,
+                                  solid_angle_to_area_pdf(p->last_pdf, fabs(dot(h->ng, d)), dist2),
+                                  (p->flags & PR_PATH_SPECULAR) != 0u);
+}
+
+PR_INLINE void pt_shadow_set(__global ShadowRay* r, Ray ray, float3 c, uint op) {
+  r->ray = ray;
+  r->c_r = c.x;
+  r->c_g = c.y;
+  r->c_b = c.z;
+  r->op = op;
+}
+
 #define PR_SHADE_LIVE 1u    // the path goes on
 #define PR_SHADE_SHADOW 2u  // it wrote a shadow ray
 
@@ -125,10 +274,14 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
   PathState p = states[i];
   uint out = 0u;
 
+  // --resample: the vertex this hit is, counted from x_1 (0: x_1 not met yet); the paths that
+  // reach an emitter from x_2 on go to the pixel's reservoir instead of its radiance.
+  const uint rel = rsp.enabled && p.x1_depth ? p.depth + 1u - p.x1_depth : 0u;
+  PR_GLOBAL PathTrack* track = rs_track + i;
+  Rng rr = rng_make(seed, PR_RNG_PATH_RESAMPLE, frame, p.pixel, sample);
   const Hit hit = hits[i];
   if (hit.prim == PR_INVALID_INDEX) {
-    float3 add;
-    if (pt_escaped(&s, &p, &add)) radiance[i] += (float4)(add.x, add.y, add.z, 0.0f);
+    pt_escape(&s, &p, rel, track, rs_res + i, &rr, radiance + i);
     p.alive = 0u;
     states[i] = p;
     return 0u;
@@ -138,38 +291,34 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
   const float3 d = make_float3(p.ray.dx, p.ray.dy, p.ray.dz);
   const float3 wo = -d;
   const SurfaceHit h = surface_at(&s.sd, hit.prim, hit.inst, hit.u, hit.v);
-  float3 tp = make_float3(p.tp_r, p.tp_g, p.tp_b) * volume_transmittance(&s, &h, d, hit.t);
+  const float3 tr = volume_transmittance(&s, &h, d, hit.t);
+  float3 tp = make_float3(p.tp_r, p.tp_g, p.tp_b) * tr;
   const float dist2 = hit.t * hit.t;
+  if (rel) rs_track_hit(track, rel, &hit, tr);
   // Connections can make the paths that end after x_t, t >= 2 (x_t: the vertex `ray` left).
   const int joinable =
       light_paths > 0u && (p.eye_flags & PR_EYE_JOINABLE) && p.depth >= p.x1_depth + 1u;
 
-  PR_GLOBAL const Material* mat = s.sd.materials + h.material;
-  if (mat->flags & PR_MAT_EMISSIVE) {
-    const float3 le = surface_emission(&s, &h);
+  if (s.sd.materials[h.material].flags & PR_MAT_EMISSIVE) {
     const float w =
         pt_emission_weight(&s, &p, &h, d, dist2, joinable, light_paths, trace_cdf, trace_total);
-    const float3 add = tp * le * w;
-    radiance[i] += (float4)(add.x, add.y, add.z, 0.0f);
+    pt_emission(&s, &p, &h, rel, w, tp, track, rs_res + i, &rr, radiance + i);
   }
   p.depth += 1u;
   const ShadingFrame f = shading_frame(&s, &h, wo);
   const int delta_here = bsdf_is_delta(&f.bsdf);
-  if (light_paths > 0u) {
+  if (light_paths > 0u || rsp.enabled) {
     if (p.x1_depth == 0u) {
       if (!delta_here && p.depth < max_depth) {
-        // x_1: the eye vertex that connect joins to the stored light paths.
+        // x_1: the eye vertex that connect joins to the stored light paths (and, resampling, the
+        // vertex that pt_resample reconnects from).
         p.x1_depth = p.depth;
         EyeVertex e;
         eye_vertex_set(&e, &h, &hit, wo, tp, p.depth);
         eye[p.pixel] = e;
       }
-    } else {
-      if (p.depth == p.x1_depth + 1u) p.eye_flags = delta_here ? 0u : PR_EYE_JOINABLE;
-      // This vertex's eye density (x_t, t >= 2): 1 when sampled from a delta vertex.
-      p.eye_ratio = mis_ratio_arrive(p.eye_ratio,
-                                     solid_angle_to_area_pdf(p.last_pdf, fabs(dot(h.ng, d)), dist2),
-                                     (p.flags & PR_PATH_SPECULAR) != 0u);
+    } else if (light_paths > 0u) {
+      pt_eye_arrive(&p, &h, d, dist2, delta_here);
     }
   }
   // x_t with t >= 3: the light tracer's density of x_{t-1}, reached from this vertex.
@@ -190,11 +339,13 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
           c = c * pt_next_event_weight(&s, &p, &h, &f, &ch, has_rev, dist2, light_paths, trace_cdf,
                                        trace_total);
         }
-        c = tp * c;
-        shadows[i].ray = shadow;
-        shadows[i].c_r = c.x;
-        shadows[i].c_g = c.y;
-        shadows[i].c_b = c.z;
+        uint op = 0u;
+        const uint rel_here = rsp.enabled && p.x1_depth ? p.depth - p.x1_depth : 0u;
+        if (rel_here >= 1u) {  // to the reservoir, once pt_shadow finds it unoccluded
+          rs_pending[i] = rs_next_event(track, &rsp, rel_here, &h, &f, wo, dist2, &ch);
+          op = PR_RS_DIM(p.depth, 1u) + 1u;
+        }
+        pt_shadow_set(shadows + i, shadow, tp * c, op);
         out = PR_SHADE_SHADOW;
       }
     } else {
@@ -209,7 +360,10 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
       tp = tp * step.weight;
       // From the third vertex on (the camera's throughput starts at 1).
       const float rr = rng_next(&rng);
+      const float q = p.depth >= 3u ? fmin(max3(tp), 1.0f) : 1.0f;
       if (p.depth >= 3u && !russian_roulette(max3(tp), rr, &tp)) p.alive = 0u;
+      if (rsp.enabled && p.x1_depth && p.alive)
+        rs_track_step(track, &rsp, p.depth - p.x1_depth, &h, &f, wo, dist2, &step, q);
       if (has_rev)  // x_{t-1}'s light-tracing density from here (1 where this is delta)
         p.eye_ratio = mis_ratio_leave(
             p.eye_ratio, delta_here ? 1.0f : pt_light_density(&f, &p, step.wi, wo, dist2),

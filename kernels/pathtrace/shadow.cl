@@ -1,7 +1,10 @@
 // pt_shadow: one work-item per path that pt_shade gave a shadow ray (shadow_queue). If the ray is
-// unoccluded, adds its contribution to the sample's radiance. Counts it in rays[PR_PT_SHADOW].
+// unoccluded, adds its contribution to the sample's radiance, or with --resample, where pt_shade
+// marked it (op: 1 + the random dimension that offers it), offers the path it ends to the
+// sample's reservoir. Counts it in rays[PR_PT_SHADOW].
 #include "shared/integrator.h"
 #include "shared/path_state.h"
+#include "shared/resample.h"
 
 PR_KERNEL void pt_shadow(PR_PARAMS(PR_ARGS_PT_SHADOW)) {
   const uint j = (uint)get_global_id(0);
@@ -11,5 +14,12 @@ PR_KERNEL void pt_shadow(PR_PARAMS(PR_ARGS_PT_SHADOW)) {
   const SceneData s = PR_SCENE();
   atomic_inc(rays + PR_PT_SHADOW);
   if (trace_occluded(&s, r.ray)) return;
+  if (resample && r.op) {
+    Rng rr = rng_make(seed, PR_RNG_PATH_RESAMPLE, frame, i, sample);
+    rr.dim = r.op - 1u;
+    const PathReservoir c = rs_pending[i];
+    rs_offer(rs_res + i, &c, rng_next(&rr));
+    return;
+  }
   radiance[i] += (float4)(r.c_r, r.c_g, r.c_b, 0.0f);
 }

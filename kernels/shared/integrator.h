@@ -320,6 +320,9 @@ typedef struct {
   int delta;
   float3 pos;
   float pdf_light, pdf_bsdf, pdf_bsdf_rev;
+  float3 fr_cos, le;  // the BSDF times the cosine, and the light's radiance (--resample)
+  float3 wi;          // the direction towards the light
+  float pdf;          // the density it was sampled with
 } NextEventChoice;
 
 PR_INLINE int next_event(const SceneData* s, const SurfaceHit* h, const ShadingFrame* f, float3 wo,
@@ -358,6 +361,10 @@ PR_INLINE int next_event(const SceneData* s, const SurfaceHit* h, const ShadingF
     choice->pdf_light = ls.pdf * (mis_pmf / pmf);
     choice->pdf_bsdf = bsdf_pdf;
     choice->pdf_bsdf_rev = bsdf_pdf_rev;
+    choice->fr_cos = fr * cos_i;
+    choice->le = le;
+    choice->wi = ls.wi;
+    choice->pdf = ls.pdf;
   }
   if (light_is_triangle(l.type)) {
     *shadow = surface_ray_to(s, h, ls.pos, ls.normal);

@@ -127,7 +127,9 @@
   X(FRAME, OUT, EyeVertex, eye)    \
   X(FRAME, VAL, uint, write_eye)   \
   X(FRAME, OUT, uint, queue)       \
-  X(FRAME, VAL, uint, first)
+  X(FRAME, VAL, uint, first)       \
+  X(FRAME, VAL, uint, resample)    \
+  X(FRAME, OUT, PathReservoir, rs_res)
 
 #define PR_ARGS_PT_EXTEND(X)      \
   PR_ARGS_SCENE(X)                \
@@ -155,15 +157,45 @@
   X(FRAME, VAL, uint, light_paths)  \
   X(FRAME, IN, float, trace_cdf)    \
   X(FRAME, VAL, float, trace_total) \
-  X(FRAME, OUT, EyeVertex, eye)
+  X(FRAME, OUT, EyeVertex, eye)     \
+  PR_ARGS_PT_RESAMPLE(X)
 
-#define PR_ARGS_PT_SHADOW(X)       \
-  PR_ARGS_SCENE(X)                 \
-  X(FRAME, OUT, float4, radiance)  \
-  X(FRAME, IN, ShadowRay, shadows) \
-  X(FRAME, OUT, uint, rays)        \
-  X(FRAME, IN, uint, shadow_queue) \
-  X(PASS, VAL, uint, count)
+// --resample: the paths' candidates, offered by pt_shade and pt_shadow to their pixel's
+// reservoir (shared/resample.h).
+#define PR_ARGS_PT_RESAMPLE(X)         \
+  X(FRAME, VAL, ResampleParams, rsp)   \
+  X(FRAME, OUT, PathTrack, rs_track)   \
+  X(FRAME, OUT, PathReservoir, rs_res) \
+  X(FRAME, OUT, PathReservoir, rs_pending)
+
+#define PR_ARGS_PT_SHADOW(X)           \
+  PR_ARGS_SCENE(X)                     \
+  X(FRAME, OUT, float4, radiance)      \
+  X(FRAME, IN, ShadowRay, shadows)     \
+  X(FRAME, OUT, uint, rays)            \
+  X(FRAME, IN, uint, shadow_queue)     \
+  X(PASS, VAL, uint, count)            \
+  X(FRAME, VAL, uint, seed)            \
+  X(FRAME, VAL, uint, frame)           \
+  X(PASS, VAL, uint, sample)           \
+  X(FRAME, VAL, uint, resample)        \
+  X(FRAME, OUT, PathReservoir, rs_res) \
+  X(FRAME, IN, PathReservoir, rs_pending)
+
+// pt_resample: each pixel sample's reservoir with its neighbours' by reconnection, into its
+// radiance (one pass over the film's pixels [first, end)).
+#define PR_ARGS_PT_RESAMPLE_SPATIAL(X) \
+  PR_ARGS_SCENE(X)                     \
+  X(FRAME, VAL, ResampleParams, rsp)   \
+  X(FRAME, IN, EyeVertex, eye)         \
+  X(FRAME, IN, PathReservoir, rs_res)  \
+  X(FRAME, OUT, float4, radiance)      \
+  X(FRAME, VAL, uint, seed)            \
+  X(FRAME, VAL, uint, frame)           \
+  X(PASS, VAL, uint, sample)           \
+  X(FRAME, VAL, uint, first)           \
+  X(FRAME, VAL, uint, end)             \
+  X(FRAME, OUT, uint, rays)
 
 // ---- The film (kernels/accumulate.cl) ----
 
@@ -185,6 +217,7 @@
   K(pt_extend, PtExtendArgs, PR_ARGS_PT_EXTEND)                \
   K(pt_shade, PtShadeArgs, PR_ARGS_PT_SHADE)                   \
   K(pt_shadow, PtShadowArgs, PR_ARGS_PT_SHADOW)                \
+  K(pt_resample, PtResampleArgs, PR_ARGS_PT_RESAMPLE_SPATIAL)  \
   K(accumulate, AccumulateArgs, PR_ARGS_ACCUMULATE)
 
 // A parameter's name: scene entries carry their group's prefix (geometry and shading both have

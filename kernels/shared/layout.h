@@ -28,6 +28,9 @@
   S(ShadingInstance)         \
   S(PathState)               \
   S(ShadowRay)               \
+  S(PathReservoir)           \
+  S(PathTrack)               \
+  S(ResampleParams)          \
   S(PathHeader)              \
   S(LightVertex)             \
   S(EyeVertex)               \
@@ -118,6 +121,13 @@
   F(LightNode, parent)                \
   F(ShadowRay, c_r)                   \
   F(ShadowRay, op)                    \
+  F(PathReservoir, g_src)             \
+  F(PathReservoir, f_r)               \
+  F(PathReservoir, w_sum)             \
+  F(PathTrack, x1_ok)                 \
+  F(PathTrack, pdf)                   \
+  F(PathTrack, pdf2)                  \
+  F(ResampleParams, min_dist2)        \
   F(PathHeader, end)                  \
   F(PathHeader, valid)                \
   F(PathHeader, escape_z)             \

@@ -10,7 +10,8 @@ PR_NAMESPACE_BEGIN
 #define PR_PT_COUNTERS(X) \
   X(CAMERA, "camera")     \
   X(BOUNCE, "bounce")     \
-  X(SHADOW, "shadow")
+  X(SHADOW, "shadow")     \
+  X(RECONNECT, "reconnect")
 #define PR_PT_ENUM(name, key) PR_PT_##name,
 enum { PR_PT_COUNTERS(PR_PT_ENUM) PR_PT_COUNT };
 #undef PR_PT_ENUM
@@ -50,9 +51,65 @@ typedef struct {
   u32 op;  // connect's terms: how they sum, PR_REC_* (shared/reuse.h); unused by the path tracer
 } ShadowRay;
 
+// --- Path resampling across pixels (--resample; kernels/shared/resample.h) ---------------------
+
+// A pixel sample's resampled path and its reservoir: one of the paths beyond the first
+// non-delta vertex x_1 that reach a light after at least one more scattering vertex x_2 (the
+// terms of the eye path from next-event estimation at x_2 on and from emitters it hits after
+// x_2), kept so that a neighbouring pixel can take it by reconnecting its own x_1 to x_2. The
+// path's contribution is f = f_1 f_2 rest w in the measure (solid angle at x_1, at x_2, ...):
+// x_1's BSDF and cosine along omega_1 (f_1), x_2's along omega_2 (f_2), what lies beyond x_2
+// (`rest`) and its MIS weight w (in `rest` but at t = 2, where it depends on x_1's direction).
+// 80 bytes.
+typedef struct {
+  u32 prim, inst;    // x_2 (prim PR_INVALID_INDEX: no path kept)
+  float b1, b2;      //
+  float wx, wy, wz;  // omega_2: the direction the path leaves x_2 along
+  float g_src;       // |cos at x_2| / d^2 of x_1 x_2; 0 where the path may not be reconnected
+  float rest_r, rest_g, rest_b;
+  float pdf_light;      // PR_RS_NEE2 and PR_RS_HIT2: the light's solid-angle pdf of omega_2 at x_2
+  float f_r, f_g, f_b;  // f at its own pixel
+  u32 kind;             // PR_RS_*
+  float p_hat;          // the target at its own pixel: luminance(f)
+  float w_sum;          // the reservoir's sum of resampling weights (a candidate's own weight)
+  float pad0, pad1;
+} PathReservoir;
+
+#define PR_RS_DEEP 0u  // the weight is in `rest` (t >= 3, or a delta light)
+#define PR_RS_NEE2 1u  // next-event estimation at x_2: w = power heuristic (light, x_2's BSDF)
+#define PR_RS_HIT2 2u  // x_2's BSDF sample met an emitter or escaped: w = (x_2's BSDF, light)
+
+// Where a path's candidates stand as pt_shade follows it (one per pixel). 80 bytes.
+typedef struct {
+  u32 prim, inst;  // x_2
+  float b1, b2;
+  float f1_r, f1_g, f1_b;  // f_1 (and the transmittance before x_2)
+  u32 x1_ok;               // x_1 is rough and omega_1 leaves it above its surface
+  float f2_r, f2_g, f2_b;  // f_2 of the path's own omega_2
+  float pdf;               // the path's density from x_1 on (BSDF pdfs, roulette)
+  float rest_r, rest_g, rest_b;
+  float g_src;  // of the path's own omega_2 (0: not reconnectable)
+  float wx, wy, wz;
+  float pdf2;  // x_2's BSDF pdf of omega_2
+} PathTrack;
+
+// What the resampling kernels are told. 32 bytes.
+typedef struct {
+  u32 enabled;      // 0: the path tracer alone
+  u32 neighbors;    // k of pairwise MIS (0: the pixel's own paths, resampled)
+  float radius;     // in pixels
+  float min_alpha;  // GGX alpha below which a vertex is too smooth to reconnect at
+  float min_dist2;  // squared distance below which x_1 x_2 is too short to reconnect
+  u32 width, height;
+  u32 pad;
+} ResampleParams;
+
 PR_NAMESPACE_END
 
 PR_STATIC_ASSERT(sizeof(pr::dev::PathState) == 112, "PathState layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::PathState, depth) == 48, "PathState layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::PathState, flags) == 64, "PathState layout");
 PR_STATIC_ASSERT(sizeof(pr::dev::ShadowRay) == 48, "ShadowRay layout");
+PR_STATIC_ASSERT(sizeof(pr::dev::PathReservoir) == 80, "PathReservoir layout");
+PR_STATIC_ASSERT(sizeof(pr::dev::PathTrack) == 80, "PathTrack layout");
+PR_STATIC_ASSERT(sizeof(pr::dev::ResampleParams) == 32, "ResampleParams layout");

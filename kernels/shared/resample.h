@@ -1,0 +1,138 @@
+// Path resampling across pixels (--resample): the reconnection shift and the reservoirs' updates,
+// shared by pt_shade and pt_shadow (which offer a path's candidates to its pixel's reservoir) and
+// pt_resample (which takes the neighbours' paths by reconnection, with pairwise MIS).
+//
+// A path x_1 x_2 ... of pixel i moves to pixel j by keeping x_2 and everything beyond it and
+// joining j's own x_1 to x_2 (ReSTIR GI, Ouyang et al. 2021; the reconnection shift of Lin et al.
+// 2022). It may only where both ends of the new segment are rough and it is not too short, the
+// same rule for the path and its image, so that a shift fails in one direction exactly where it
+// fails in the other (rs_reconnectable). Its Jacobian in solid angle at x_1 is
+// reconnection_jacobian (shared/mis.h).
+#pragma once
+
+#include "shared/arena.h"
+#include "shared/integrator.h"
+#include "shared/mis.h"
+#include "shared/path_state.h"
+
+PR_NAMESPACE_BEGIN
+
+// Rough enough to reconnect at: no delta lobe and every GGX lobe's alpha at least min_alpha.
+PR_INLINE int rs_rough(const BsdfParams* b, float min_alpha) {
+  if (bsdf_is_delta(b)) return 0;
+  if (!(fmin(b->alpha_x, b->alpha_y) >= min_alpha)) return 0;
+  return !(b->coat > 0.0f) || b->coat_alpha >= min_alpha;
+}
+
+// wo is above h's shading normal's horizon on its own side by PR_MIN_VIEW_COS, so that the
+// shading frame there does not depend on wo (shading_frame turns it otherwise).
+PR_INLINE int rs_unbent(const SurfaceHit* h, float3 wo) {
+  const float3 ns = dot(wo, h->ng) < 0.0f ? -h->ns : h->ns;
+  return dot(wo, ns) >= PR_MIN_VIEW_COS;
+}
+
+// Whether x_2 (surface h2 in frame f2, the segment from x_1 arriving along -wo2 with squared
+// length d2) can be a reconnection vertex for a path leaving it along w2, x_1's side being
+// x1_ok (rough, and the segment leaves it above its geometric surface).
+PR_INLINE int rs_reconnectable(int x1_ok, const SurfaceHit* h2, const ShadingFrame* f2, float3 wo2,
+                               float d2, float3 w2, const ResampleParams* rp) {
+  return x1_ok && d2 >= rp->min_dist2 && rs_rough(&f2->bsdf, rp->min_alpha) && rs_unbent(h2, wo2) &&
+         dot(w2, f2->ng) > 0.0f && dot(wo2, f2->ng) > 0.0f;
+}
+
+// The MIS weight of a t = 2 path at x_2 against the other way of sampling its last segment.
+PR_INLINE float rs_weight2(u32 kind, float pdf_light, float pdf_bsdf) {
+  if (kind == PR_RS_NEE2) return power_heuristic(pdf_light, pdf_bsdf);
+  if (kind == PR_RS_HIT2) return power_heuristic(pdf_bsdf, pdf_light);
+  return 1.0f;
+}
+
+// A pixel sample's x_1, rebuilt from its EyeVertex; ok: rough enough to reconnect from.
+typedef struct {
+  SurfaceHit h;
+  ShadingFrame f;
+  float3 wo, wol, tp;
+  int ok;
+} RsPrimary;
+
+PR_INLINE RsPrimary rs_primary(const SceneData* s, const EyeVertex* e, const ResampleParams* rp) {
+  RsPrimary x;
+  x.h = surface_at(&s->sd, e->prim, e->inst, e->b1, e->b2);
+  x.wo = make_float3(e->wx, e->wy, e->wz);
+  x.f = shading_frame(s, &x.h, x.wo);
+  x.wol = to_local(x.wo, x.f.t, x.f.b, x.f.n);
+  x.tp = make_float3(e->tp_r, e->tp_g, e->tp_b);
+  x.ok = rs_rough(&x.f.bsdf, rp->min_alpha);
+  return x;
+}
+
+// Path r moved to x_1 = x by reconnection: its contribution f there (0 where the shift fails),
+// *g_dst of the new segment and *seg its shadow ray (traced by the caller).
+PR_INLINE float3 rs_shift(const SceneData* s, const RsPrimary* x, PR_GLOBAL const PathReservoir* r,
+                          const ResampleParams* rp, float* g_dst, Ray* seg) {
+  const float3 zero = make_float3(0.0f, 0.0f, 0.0f);
+  *g_dst = 0.0f;
+  if (r->prim == PR_INVALID_INDEX || !(r->g_src > 0.0f) || !x->ok) return zero;
+  const SurfaceHit h2 = surface_at(&s->sd, r->prim, r->inst, r->b1, r->b2);
+  const float3 d = h2.p - x->h.p;
+  const float d2 = dot(d, d);
+  if (!(d2 > 0.0f)) return zero;
+  const float3 w1 = d * (1.0f / sqrt(d2));
+  if (!(dot(w1, x->f.ng) > 0.0f)) return zero;  // x_1's side: above its surface
+  const float3 wo2 = -w1;
+  const ShadingFrame f2 = shading_frame(s, &h2, wo2);
+  const float3 w2 = make_float3(r->wx, r->wy, r->wz);
+  if (!rs_reconnectable(1, &h2, &f2, wo2, d2, w2, rp)) return zero;
+  float pdf1, pdf2;
+  const float3 w1l = to_local(w1, x->f.t, x->f.b, x->f.n);
+  const float3 f1 = bsdf_eval(&x->f.bsdf, x->wol, w1l, &pdf1) * fabs(w1l.z);
+  const float3 w2l = to_local(w2, f2.t, f2.b, f2.n);
+  const float3 fx2 = bsdf_eval(&f2.bsdf, to_local(wo2, f2.t, f2.b, f2.n), w2l, &pdf2) * fabs(w2l.z);
+  const float w = rs_weight2(r->kind, r->pdf_light, pdf2);
+  *g_dst = fabs(dot(h2.ng, w1)) / d2;
+  *seg = surface_segment(s, &x->h, &h2);
+  return f1 * fx2 * make_float3(r->rest_r, r->rest_g, r->rest_b) * w;
+}
+
+// Offers candidate c (its resampling weight in c->w_sum) to reservoir r, with u uniform.
+PR_INLINE void rs_offer(PR_GLOBAL PathReservoir* r, const PathReservoir* c, float u) {
+  const float w = c->w_sum;
+  if (!(w > 0.0f) || !(w < PR_INF_F)) return;
+  const float sum = r->w_sum + w;
+  if (ris_accept(u, sum, w)) *r = *c;
+  r->w_sum = sum;
+}
+
+// A candidate of the path tracked in t: x_2's factor f2 along w2 (g its segment's g_src), the
+// rest beyond, the path's density pdf from x_1 on; at t = 2 the light's and x_2's BSDF's pdfs of
+// w2 for its weight.
+PR_INLINE PathReservoir rs_candidate(PR_GLOBAL const PathTrack* t, float3 f2, float3 w2, float g,
+                                     float3 rest, float pdf, u32 kind, float pdf_light,
+                                     float pdf_bsdf) {
+  PathReservoir c;
+  c.prim = t->prim;
+  c.inst = t->inst;
+  c.b1 = t->b1;
+  c.b2 = t->b2;
+  c.wx = w2.x;
+  c.wy = w2.y;
+  c.wz = w2.z;
+  c.g_src = g;
+  c.rest_r = rest.x;
+  c.rest_g = rest.y;
+  c.rest_b = rest.z;
+  c.pdf_light = pdf_light;
+  // The weight of a t = 2 path is in its f, not in rest.
+  const float w = rs_weight2(kind, pdf_light, pdf_bsdf);
+  const float3 f = make_float3(t->f1_r, t->f1_g, t->f1_b) * f2 * rest * w;
+  c.f_r = f.x;
+  c.f_g = f.y;
+  c.f_b = f.z;
+  c.kind = kind;
+  c.p_hat = luminance(f);
+  c.w_sum = pdf > 0.0f ? c.p_hat / pdf : 0.0f;
+  c.pad0 = c.pad1 = 0.0f;
+  return c;
+}
+
+PR_NAMESPACE_END
