@@ -38,13 +38,13 @@ TEST(Resample, WhiteFurnaceConvergesToLeOverOneMinusAlbedo) {
   b.addNode(b.addBox(glm::vec3(-1), glm::vec3(1), mat, true));
   b.addCamera(glm::vec3(0.1f, 0.2f, 0.3f), glm::vec3(1, 0.5f, -1), 1.2f, 1.0f);
   const std::string scene = b.write(test::tempDir("rs-furnace"), "furnace");
-  const int spp = 1024;
+  const int spp = 512;
   const Image img =
       render(scene,
-             "--width 32 --height 32 --max-depth 30 --force-diffuse --resample --spp " +
+             "--width 32 --height 32 --max-depth 16 --force-diffuse --resample --spp " +
                  std::to_string(spp),
              "rs-furnace-out");
-  const double expected = le / (1.0 - albedo);
+  const double expected = le / (1.0 - albedo);  // depth 16 leaves out albedo^16 of it
   for (int c = 0; c < 3; ++c) {
     const Moments m = regionMean(img, 0, 0, 32, 32, c);
     // Neighbours share paths, so pixels are not independent: a wider margin than 5 errors.
@@ -53,13 +53,13 @@ TEST(Resample, WhiteFurnaceConvergesToLeOverOneMinusAlbedo) {
 }
 
 // The demo scene (glossy and diffuse, an area light): resampled with neighbours, each 12 x 12
-// region's mean agrees with the path tracer's within 4% (the noise leaves under 2% here; the
+// region's mean agrees with the path tracer's within 5% (the noise leaves under 3% here; the
 // pixels' spread within a region is mostly the image's own detail, so no standard error is used).
-// Without the reconnection Jacobian three regions are 7-19% off.
+// Without the reconnection Jacobian regions are up to 19% off.
 TEST(Resample, ConvergesToThePathTracerRegionByRegion) {
   const std::string size = "--width 96 --height 72 ";
-  const Image ref = render(demoScene(), size + "--spp 2048 --seed 1", "rs-demo-ref");
-  const Image img = render(demoScene(), size + "--spp 1024 --seed 2 --resample", "rs-demo");
+  const Image ref = render(demoScene(), size + "--spp 1024 --seed 1", "rs-demo-ref");
+  const Image img = render(demoScene(), size + "--spp 512 --seed 2 --resample", "rs-demo");
   int regions = 0;
   for (int y = 0; y < 72; y += 12) {
     for (int x = 0; x < 96; x += 12) {
@@ -70,7 +70,7 @@ TEST(Resample, ConvergesToThePathTracerRegionByRegion) {
       }
       if (r < 0.03) continue;  // the black outside of the box
       ++regions;
-      EXPECT_NEAR(a, r, 0.04 * r) << "region at " << x << ", " << y;
+      EXPECT_NEAR(a, r, 0.05 * r) << "region at " << x << ", " << y;
     }
   }
   EXPECT_GT(regions, 30);
