@@ -28,6 +28,25 @@ Image render(const std::string& scene, const std::string& args, const std::strin
   return test::frameImage(test::renderFrames(scene, "0", "--mode pathtrace " + args, tag), 0);
 }
 
+// Each 12 x 12 region of a 96 x 72 image that is not dark (the sum of its channels' means at
+// least 0.03 in ref) has the mean of ref's within tol of it; more than 30 such regions.
+void expectRegionsAgree(const Image& img, const Image& ref, double tol) {
+  int regions = 0;
+  for (int y = 0; y < 72; y += 12) {
+    for (int x = 0; x < 96; x += 12) {
+      double a = 0, r = 0;
+      for (int c = 0; c < 3; ++c) {
+        a += regionMean(img, x, y, x + 12, y + 12, c).mean;
+        r += regionMean(ref, x, y, x + 12, y + 12, c).mean;
+      }
+      if (r < 0.03) continue;
+      ++regions;
+      EXPECT_NEAR(a, r, tol * r) << "region at " << x << ", " << y;
+    }
+  }
+  EXPECT_GT(regions, 30);
+}
+
 // Every surface emits le and reflects albedo (diffuse): every pixel sees le / (1 - albedo); the
 // resampled paths carry all but the first two vertices' light, so a wrong weight or Jacobian
 // moves the answer.
@@ -60,20 +79,7 @@ TEST(Resample, ConvergesToThePathTracerRegionByRegion) {
   const std::string size = "--width 96 --height 72 ";
   const Image ref = render(demoScene(), size + "--spp 1024 --seed 1", "rs-demo-ref");
   const Image img = render(demoScene(), size + "--spp 512 --seed 2 --resample", "rs-demo");
-  int regions = 0;
-  for (int y = 0; y < 72; y += 12) {
-    for (int x = 0; x < 96; x += 12) {
-      double a = 0, r = 0;
-      for (int c = 0; c < 3; ++c) {
-        a += regionMean(img, x, y, x + 12, y + 12, c).mean;
-        r += regionMean(ref, x, y, x + 12, y + 12, c).mean;
-      }
-      if (r < 0.03) continue;  // the black outside of the box
-      ++regions;
-      EXPECT_NEAR(a, r, 0.05 * r) << "region at " << x << ", " << y;
-    }
-  }
-  EXPECT_GT(regions, 30);
+  expectRegionsAgree(img, ref, 0.05);
 }
 
 // Slats on a lit floor: a pixel's neighbours' x_2 often lie behind a slat from its x_1, which
@@ -95,20 +101,7 @@ TEST(Resample, SlatsHideNeighboursPaths) {
   const Image ref = render(scene, size + "--spp 2048 --seed 1", "rs-slats-ref");
   const Image img =
       render(scene, size + "--spp 1024 --seed 2 --resample --resample-radius 16", "rs-slats");
-  int regions = 0;
-  for (int y = 0; y < 72; y += 12) {
-    for (int x = 0; x < 96; x += 12) {
-      double a = 0, r = 0;
-      for (int c = 0; c < 3; ++c) {
-        a += regionMean(img, x, y, x + 12, y + 12, c).mean;
-        r += regionMean(ref, x, y, x + 12, y + 12, c).mean;
-      }
-      if (r < 0.03) continue;
-      ++regions;
-      EXPECT_NEAR(a, r, 0.04 * r) << "region at " << x << ", " << y;
-    }
-  }
-  EXPECT_GT(regions, 30);
+  expectRegionsAgree(img, ref, 0.04);
 }
 
 // Three neighbours' paths at each pixel: less error than the pixel's own paths alone at the same
