@@ -173,27 +173,27 @@ void addSamplingOptions(CLI::App* render, RenderArgs& a) {
                    "at most 4, power between)")
       ->check(CLI::IsMember({"auto", "bvh", "exhaustive", "power"}))
       ->capture_default_str();
-  render->add_flag("--resample", ro.resample,
+  render->add_flag("--resample", ro.resample.enabled,
                    "Resample the paths beyond each first surface with those of neighbouring "
                    "pixels, reconnected there and weighed by pairwise MIS (unbiased; --mode "
                    "pathtrace only for now)");
   render
-      ->add_option("--resample-neighbors", ro.resampleNeighbors,
+      ->add_option("--resample-neighbors", ro.resample.neighbors,
                    "Pixels whose paths each pixel takes (--resample; 0: its own alone)")
       ->check(CLI::Range(0, 16))
       ->capture_default_str();
   render
-      ->add_option("--resample-radius", ro.resampleRadius,
+      ->add_option("--resample-radius", ro.resample.radius,
                    "Radius in pixels within which the neighbours are drawn (--resample)")
       ->check(finiteIn(1, 256))
       ->capture_default_str();
   render
-      ->add_option("--resample-roughness", ro.resampleRoughness,
+      ->add_option("--resample-roughness", ro.resample.roughness,
                    "GGX roughness below which a surface is too smooth to reconnect at (--resample)")
       ->check(finiteIn(0, 1))
       ->capture_default_str();
   render
-      ->add_option("--resample-distance", ro.resampleDistance,
+      ->add_option("--resample-distance", ro.resample.distance,
                    "Shortest segment reconnected, in scene units (--resample; 0: 1% of the "
                    "scene's radius)")
       ->check(finiteIn(0, 1e30))

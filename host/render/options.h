@@ -30,6 +30,16 @@ const char* renderModeName(RenderMode m);
 enum class MaterialModel { Energy, Gltf };
 const char* materialModelName(MaterialModel m);
 
+// Path resampling across pixels (--resample; docs/design.md section 5): the path tracer's
+// paths beyond x_1 resampled with those of `neighbors` pixels within `radius` pixels.
+struct ResampleSettings {
+  bool enabled = false;
+  int neighbors = 3;
+  float radius = 10.0f;    // pixels
+  float roughness = 0.2f;  // GGX roughness below which a vertex is not reconnected
+  float distance = 0.0f;   // shortest reconnected segment; 0: 1% of the scene's radius
+};
+
 struct FrameRange {
   int first = 0;
   int last = -1;  // -1: up to the end of the animation
@@ -75,13 +85,7 @@ struct RenderOptions {
   int connectionHistory = 0;   // cap on a pixel sample's carried reservoir, per C; 0 = off
   int connectionHistoryPeriod = 1;  // frames between moves of the history's light-path offset
   bool eyePaths = true;  // full eye paths, weighted against the connections over whole paths
-  // Path resampling across pixels (--resample; docs/design.md section 5): the path tracer's
-  // paths beyond x_1 resampled with those of `resampleNeighbors` pixels within resampleRadius.
-  bool resample = false;
-  int resampleNeighbors = 3;
-  float resampleRadius = 10.0f;    // pixels
-  float resampleRoughness = 0.2f;  // GGX roughness below which a vertex is not reconnected
-  float resampleDistance = 0.0f;   // shortest reconnected segment; 0: 1% of the scene's radius
+  ResampleSettings resample;
   // The environment light (scene/environment.h): a map file, "none", or "" (a uniform one of
   // envColor where --env-color is given, else white where the scene has no lights, else none).
   std::string env;

@@ -17,7 +17,7 @@ PathTracer::PathTracer(Context& ctx, GpuScene& scene, Film& film,
   extend_ = kargs::kernel<kargs::PtExtendArgs>(ctx, "pathtrace/extend.cl", opts);
   shade_ = kargs::kernel<kargs::PtShadeArgs>(ctx, "pathtrace/shade.cl", opts);
   shadow_ = kargs::kernel<kargs::PtShadowArgs>(ctx, "pathtrace/shadow.cl", opts);
-  if (settings.resample)
+  if (settings.resample.enabled)
     resample_ = kargs::kernel<kargs::PtResampleArgs>(ctx, "pathtrace/resample.cl", opts);
   const uint64_t n = film.pixels();
   auto alloc = [&](const char* name, uint64_t bytes) {
@@ -35,21 +35,21 @@ PathTracer::PathTracer(Context& ctx, GpuScene& scene, Film& film,
   queueSizes_ = alloc("queue sizes", dev::PR_QUEUE_COUNT * 4);
   rays_ = alloc("ray counters", dev::PR_PT_COUNT * 4);
   noEye_ = alloc("no eye vertices", 64);
-  const uint64_t rsPixels = settings.resample ? n : 1;
+  const uint64_t rsPixels = settings.resample.enabled ? n : 1;
   rsTrack_ = alloc("path tracks", rsPixels * sizeof(dev::PathTrack));
   rsRes_ = alloc("path reservoirs", rsPixels * sizeof(dev::PathReservoir));
   rsPending_ = alloc("path candidates", rsPixels * sizeof(dev::PathReservoir));
-  if (settings.resample) rsEye_ = alloc("eye vertices", n * sizeof(dev::EyeVertex));
+  if (settings.resample.enabled) rsEye_ = alloc("eye vertices", n * sizeof(dev::EyeVertex));
 }
 
 dev::ResampleParams PathTracer::resampleParams() const {
   dev::ResampleParams p{};
-  p.enabled = settings_.resample ? 1u : 0u;
-  p.neighbors = cl_uint(settings_.resampleNeighbors);
-  p.radius = settings_.resampleRadius;
-  const float r = settings_.resampleRoughness;
-  p.min_alpha = r * r;  // GGX alpha = roughness^2, as the materials map it
-  p.min_dist2 = settings_.resampleDistance * settings_.resampleDistance;
+  const ResampleSettings& r = settings_.resample;
+  p.enabled = r.enabled ? 1u : 0u;
+  p.neighbors = cl_uint(r.neighbors);
+  p.radius = r.radius;
+  p.min_alpha = r.roughness * r.roughness;  // GGX alpha = roughness^2, as the materials map it
+  p.min_dist2 = r.distance * r.distance;
   p.width = film_.width();
   p.height = film_.height();
   return p;
@@ -64,7 +64,7 @@ void PathTracer::beginFrame(int frame, const dev::CameraParams& camera,
   ctx_.zero(rays_, dev::PR_PT_COUNT * 4);
   const dev::ResampleParams rsp = resampleParams();
   // Resampling needs every sample's x_1, which the path tracer alone does not keep.
-  const cl::Buffer& eyeOut = settings_.resample && settings_.lightPaths == 0 ? rsEye_ : eye;
+  const cl::Buffer& eyeOut = settings_.resample.enabled && settings_.lightPaths == 0 ? rsEye_ : eye;
   kargs::setScene(&extendArgs_, sceneArgs);
   extendArgs_.states = states_;
   extendArgs_.hits = hits_;
@@ -100,7 +100,7 @@ void PathTracer::beginFrame(int frame, const dev::CameraParams& camera,
   shadowArgs_.rs_res = rsRes_;
   shadowArgs_.rs_pending = rsPending_;
   shadowArgs_.set(shadow_, kargs::kScene | kargs::kFrame);
-  if (settings_.resample) {
+  if (settings_.resample.enabled) {
     kargs::setScene(&resampleArgs_, sceneArgs);
     resampleArgs_.rsp = rsp;
     resampleArgs_.eye = eyeOut;
@@ -120,7 +120,7 @@ void PathTracer::beginFrame(int frame, const dev::CameraParams& camera,
   generateArgs_.radiance = radiance;
   generateArgs_.count = n;
   generateArgs_.eye = eyeOut;
-  generateArgs_.write_eye = settings_.lightPaths > 0 || settings_.resample ? 1 : 0;
+  generateArgs_.write_eye = settings_.lightPaths > 0 || settings_.resample.enabled ? 1 : 0;
   generateArgs_.resample = rsp.enabled;
   generateArgs_.rs_res = rsRes_;
   generateArgs_.queue = queues_[0];
@@ -158,7 +158,7 @@ void PathTracer::tracePass(int sample, StageTimer* timer) {
     ctx_.launch1D(shadow_, 0, sizes[dev::PR_QUEUE_SHADOW], "shadow", timer);
     live = sizes[dev::PR_QUEUE_LIVE];
   }
-  if (settings_.resample) {
+  if (settings_.resample.enabled) {
     resampleArgs_.sample = cl_uint(sample);
     resampleArgs_.set(resample_, kargs::kPass);
     ctx_.launch1D(resample_, 0, n - first, "resample", timer);

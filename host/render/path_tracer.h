@@ -9,6 +9,7 @@
 #include "render/film.h"
 #include "render/gpu_scene.h"
 #include "render/integrator.h"
+#include "render/options.h"
 
 namespace pr {
 
@@ -21,12 +22,8 @@ struct PathTracerSettings {
   // vertex; the ends of eye paths on lights are weighted against those connections
   // (kernels/shared/eye_paths.h). 0: the path tracer alone.
   uint32_t lightPaths = 0;
-  // --resample (kernels/shared/resample.h): neighbours 0 resamples each pixel's own paths.
-  bool resample = false;
-  int resampleNeighbors = 3;
-  float resampleRadius = 10.0f;
-  float resampleRoughness = 0.2f;
-  float resampleDistance = 0.01f;  // scene units
+  // --resample (kernels/shared/resample.h), its distance resolved (> 0, scene units).
+  ResampleSettings resample;
 };
 
 class PathTracer : public Integrator {

@@ -115,16 +115,16 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
   gpu_ = std::make_unique<GpuScene>(ctx_, scene, sceneOptions);
   film_ = std::make_unique<Film>(ctx_, width_, height_);
   const RenderOptions& o = options_;
-  if (o.resample && o.mode != RenderMode::PathTrace)
+  if (o.resample.enabled && o.mode != RenderMode::PathTrace)
     throw InputError("--resample: works with --mode pathtrace only for now");
   if (o.mode == RenderMode::PathTrace) {
-    PathTracerSettings p{o.spp, o.maxDepth, o.seed, o.fixedNoise};
+    PathTracerSettings p;
+    p.spp = o.spp;
+    p.maxDepth = o.maxDepth;
+    p.seed = o.seed;
+    p.fixedNoise = o.fixedNoise;
     p.resample = o.resample;
-    p.resampleNeighbors = o.resampleNeighbors;
-    p.resampleRadius = o.resampleRadius;
-    p.resampleRoughness = o.resampleRoughness;
-    p.resampleDistance =
-        o.resampleDistance > 0.0f ? o.resampleDistance : 0.01f * gpu_->sceneRadius();
+    if (!(p.resample.distance > 0.0f)) p.resample.distance = 0.01f * gpu_->sceneRadius();
     integrator_ = std::make_unique<PathTracer>(ctx_, *gpu_, *film_, p);
   } else {
     PathReuseSettings r;

@@ -53,7 +53,7 @@ PR_KERNEL void pt_resample(PR_PARAMS(PR_ARGS_PT_RESAMPLE_SPATIAL)) {
   const float k = (float)rsp.neighbors;
   const int has_c = rc->prim != PR_INVALID_INDEX && rc->w_sum > 0.0f && rc->p_hat > 0.0f;
   Rng rng = rng_make(seed, PR_RNG_PATH_RESAMPLE, frame, j, sample);
-  rng.dim = 0x10000u;  // apart from the paths' offers (pt_shade's PR_RS_DIM)
+  rng.dim = 0x10000u;  // apart from the paths' offers (PR_RS_DIM)
   float w_sum = 0.0f, canon_terms = 0.0f;
   float3 f_kept = make_float3(0.0f, 0.0f, 0.0f);
   float p_kept = 0.0f;
@@ -66,7 +66,6 @@ PR_KERNEL void pt_resample(PR_PARAMS(PR_ARGS_PT_RESAMPLE_SPATIAL)) {
       canon_terms += 1.0f;  // a pixel without x_1 makes no path here
       continue;
     }
-    const RsPrimary xi = rs_primary(&s, &ei, &rsp);
     __global const PathReservoir* ri = rs_res + i;
     // The neighbour's path, here.
     if (ri->prim != PR_INVALID_INDEX && ri->w_sum > 0.0f && ri->p_hat > 0.0f) {
@@ -88,6 +87,7 @@ PR_KERNEL void pt_resample(PR_PARAMS(PR_ARGS_PT_RESAMPLE_SPATIAL)) {
     // The canonical path at the neighbour, for its own weight.
     float p_back = 0.0f;
     if (has_c) {
+      const RsPrimary xi = rs_primary(&s, &ei, &rsp);
       float3 f;
       float jac;
       const float p = rs_target_at(&s, &xi, rc, &rsp, &f, &jac, &traced);

@@ -102,23 +102,18 @@ PR_INLINE float pt_next_event_weight(const SceneData* s, const PathState* p, con
   return w;
 }
 
-// --resample: the random number that offers the candidate found at vertex `vertex` of a path
-// (2 vertex: its BSDF's emitter hit; 2 vertex + 1: next-event estimation, in pt_shadow).
-#define PR_RS_DIM(vertex, nee) (2u * (vertex) + (nee))
-
 // --resample, at a hit `rel` vertices beyond x_1 (2 and on: x_3 ...) or, escaped, from the
 // vertex `rel` - 1 beyond it: the path's end on an emitter (le, weighted w by the path tracer,
 // pdf_light its light pdf) offered to the pixel's reservoir.
 PR_INLINE void rs_offer_emission(PR_GLOBAL const PathTrack* t, PR_GLOBAL PathReservoir* r,
                                  const PathState* p, uint rel, float3 le, float w, float pdf_light,
-                                 Rng* rr) {
+                                 const RsKey* key) {
   const int t2 = rel == 2u && !(p->flags & PR_PATH_SPECULAR);
   const float3 rest = make_float3(t->rest_r, t->rest_g, t->rest_b) * le * (t2 ? 1.0f : w);
   const PathReservoir c =
       rs_candidate(t, make_float3(t->f2_r, t->f2_g, t->f2_b), make_float3(t->wx, t->wy, t->wz),
                    t->g_src, rest, t->pdf, t2 ? PR_RS_HIT2 : PR_RS_DEEP, pdf_light, p->last_pdf);
-  rr->dim = PR_RS_DIM(p->depth + 1u, 0u);
-  rs_offer(r, &c, rng_next(rr));
+  rs_offer_keyed(r, &c, key, PR_RS_DIM(p->depth + 1u, 0u));
 }
 
 // --resample, after the BSDF step at vertex `rel` beyond x_1 (0: x_1; 1: x_2, surface h in frame
@@ -141,7 +136,6 @@ PR_INLINE void rs_track_step(PR_GLOBAL PathTrack* t, const ResampleParams* rsp, 
     t->f2_r = fc.x;
     t->f2_g = fc.y;
     t->f2_b = fc.z;
-    t->pdf2 = step->delta ? 0.0f : step->pdf;
     t->wx = step->wi.x;
     t->wy = step->wi.y;
     t->wz = step->wi.z;
@@ -183,8 +177,8 @@ PR_INLINE float4 pt_rgb(float3 c) {
 // The path escaped: the environment's light into the sample's radiance, or with --resample from
 // x_2 on (rel >= 2), to its reservoir.
 PR_INLINE void pt_escape(const SceneData* s, const PathState* p, uint rel,
-                         __global const PathTrack* track, __global PathReservoir* res, Rng* rr,
-                         __global float4* radiance) {
+                         __global const PathTrack* track, __global PathReservoir* res,
+                         const RsKey* key, __global float4* radiance) {
   float3 add;
   if (!pt_escaped(s, p, &add)) return;
   if (rel < 2u) {
@@ -196,14 +190,15 @@ PR_INLINE void pt_escape(const SceneData* s, const PathState* p, uint rel,
   const float3 prev_n = make_float3(p->prev_nx, p->prev_ny, p->prev_nz);
   const float pdf_light = environment_pdf(s, prev, prev_n, d);
   const float w = (p->flags & PR_PATH_SPECULAR) ? 1.0f : power_heuristic(p->last_pdf, pdf_light);
-  rs_offer_emission(track, res, p, rel, environment_radiance(s, d), w, pdf_light, rr);
+  rs_offer_emission(track, res, p, rel, environment_radiance(s, d), w, pdf_light, key);
 }
 
 // Emission at h, weighted w by the path tracer, into the sample's radiance, or with --resample
 // from x_3 on (rel >= 2) to its reservoir.
 PR_INLINE void pt_emission(const SceneData* s, const PathState* p, const SurfaceHit* h, uint rel,
                            float w, float3 tp, __global const PathTrack* track,
-                           __global PathReservoir* res, Rng* rr, __global float4* radiance) {
+                           __global PathReservoir* res, const RsKey* key,
+                           __global float4* radiance) {
   const float3 le = surface_emission(s, h);
   if (rel < 2u) {
     *radiance += pt_rgb(tp * le * w);
@@ -211,7 +206,7 @@ PR_INLINE void pt_emission(const SceneData* s, const PathState* p, const Surface
   }
   const float pdf_light = emitter_pdf(s, h, make_float3(p->prev_x, p->prev_y, p->prev_z),
                                       make_float3(p->prev_nx, p->prev_ny, p->prev_nz));
-  rs_offer_emission(track, res, p, rel, le, w, pdf_light, rr);
+  rs_offer_emission(track, res, p, rel, le, w, pdf_light, key);
 }
 
 // --resample: the hit `rel` >= 1 vertices beyond x_1 joins the tracked path, with the
@@ -278,10 +273,10 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
   // reach an emitter from x_2 on go to the pixel's reservoir instead of its radiance.
   const uint rel = rsp.enabled && p.x1_depth ? p.depth + 1u - p.x1_depth : 0u;
   PR_GLOBAL PathTrack* track = rs_track + i;
-  Rng rr = rng_make(seed, PR_RNG_PATH_RESAMPLE, frame, p.pixel, sample);
+  const RsKey key = {seed, frame, p.pixel, sample};
   const Hit hit = hits[i];
   if (hit.prim == PR_INVALID_INDEX) {
-    pt_escape(&s, &p, rel, track, rs_res + i, &rr, radiance + i);
+    pt_escape(&s, &p, rel, track, rs_res + i, &key, radiance + i);
     p.alive = 0u;
     states[i] = p;
     return 0u;
@@ -302,7 +297,7 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
   if (s.sd.materials[h.material].flags & PR_MAT_EMISSIVE) {
     const float w =
         pt_emission_weight(&s, &p, &h, d, dist2, joinable, light_paths, trace_cdf, trace_total);
-    pt_emission(&s, &p, &h, rel, w, tp, track, rs_res + i, &rr, radiance + i);
+    pt_emission(&s, &p, &h, rel, w, tp, track, rs_res + i, &key, radiance + i);
   }
   p.depth += 1u;
   const ShadingFrame f = shading_frame(&s, &h, wo);

@@ -15,10 +15,9 @@ PR_KERNEL void pt_shadow(PR_PARAMS(PR_ARGS_PT_SHADOW)) {
   atomic_inc(rays + PR_PT_SHADOW);
   if (trace_occluded(&s, r.ray)) return;
   if (resample && r.op) {
-    Rng rr = rng_make(seed, PR_RNG_PATH_RESAMPLE, frame, i, sample);
-    rr.dim = r.op - 1u;
+    const RsKey key = {seed, frame, i, sample};
     const PathReservoir c = rs_pending[i];
-    rs_offer(rs_res + i, &c, rng_next(&rr));
+    rs_offer_keyed(rs_res + i, &c, &key, r.op - 1u);
     return;
   }
   radiance[i] += (float4)(r.c_r, r.c_g, r.c_b, 0.0f);

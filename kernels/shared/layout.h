@@ -126,7 +126,7 @@
   F(PathReservoir, w_sum)             \
   F(PathTrack, x1_ok)                 \
   F(PathTrack, pdf)                   \
-  F(PathTrack, pdf2)                  \
+  F(PathTrack, g_src)                 \
   F(ResampleParams, min_dist2)        \
   F(PathHeader, end)                  \
   F(PathHeader, valid)                \

@@ -62,8 +62,8 @@ typedef struct {
 // (`rest`) and its MIS weight w (in `rest` but at t = 2, where it depends on x_1's direction).
 // 80 bytes.
 typedef struct {
-  u32 prim, inst;    // x_2 (prim PR_INVALID_INDEX: no path kept)
-  float b1, b2;      //
+  u32 prim, inst;  // x_2 (prim PR_INVALID_INDEX: no path kept)
+  float b1, b2;
   float wx, wy, wz;  // omega_2: the direction the path leaves x_2 along
   float g_src;       // |cos at x_2| / d^2 of x_1 x_2; 0 where the path may not be reconnected
   float rest_r, rest_g, rest_b;
@@ -90,7 +90,7 @@ typedef struct {
   float rest_r, rest_g, rest_b;
   float g_src;  // of the path's own omega_2 (0: not reconnectable)
   float wx, wy, wz;
-  float pdf2;  // x_2's BSDF pdf of omega_2
+  u32 pad;
 } PathTrack;
 
 // What the resampling kernels are told. 32 bytes.

@@ -94,6 +94,16 @@ PR_INLINE float3 rs_shift(const SceneData* s, const RsPrimary* x, PR_GLOBAL cons
   return f1 * fx2 * make_float3(r->rest_r, r->rest_g, r->rest_b) * w;
 }
 
+// What keys the random numbers that offer a pixel sample's candidates to its reservoir
+// (stream PR_RNG_PATH_RESAMPLE): dimension PR_RS_DIM(vertex, nee) for the candidate found at
+// that vertex of the path (its BSDF's emitter hit in pt_shade; next-event estimation in
+// pt_shadow), 0x10000 on for pt_resample.
+typedef struct {
+  u32 seed, frame, pixel, sample;
+} RsKey;
+
+#define PR_RS_DIM(vertex, nee) (2u * (vertex) + (nee))
+
 // Offers candidate c (its resampling weight in c->w_sum) to reservoir r, with u uniform.
 PR_INLINE void rs_offer(PR_GLOBAL PathReservoir* r, const PathReservoir* c, float u) {
   const float w = c->w_sum;
@@ -101,6 +111,14 @@ PR_INLINE void rs_offer(PR_GLOBAL PathReservoir* r, const PathReservoir* c, floa
   const float sum = r->w_sum + w;
   if (ris_accept(u, sum, w)) *r = *c;
   r->w_sum = sum;
+}
+
+// The same with u drawn from dimension dim of key k.
+PR_INLINE void rs_offer_keyed(PR_GLOBAL PathReservoir* r, const PathReservoir* c, const RsKey* k,
+                              u32 dim) {
+  Rng rr = rng_make(k->seed, PR_RNG_PATH_RESAMPLE, k->frame, k->pixel, k->sample);
+  rr.dim = dim;
+  rs_offer(r, c, rng_next(&rr));
 }
 
 // A candidate of the path tracked in t: x_2's factor f2 along w2 (g its segment's g_src), the
