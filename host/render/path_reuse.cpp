@@ -85,7 +85,11 @@ PathReuse::PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseS
             std::max<uint64_t>(uint64_t(recordPixels_) * recordCap_, 1) * sizeof(dev::ShadowRay));
   recordCounts_ = alloc("connection record counts", uint64_t(recordPixels_) * 4);
   if (settings_.eyePaths) {
-    PathTracerSettings pt{settings_.spp, settings_.maxDepth, settings_.seed, settings_.fixedNoise};
+    PathTracerSettings pt;
+    pt.spp = settings_.spp;
+    pt.maxDepth = settings_.maxDepth;
+    pt.seed = settings_.seed;
+    pt.fixedNoise = settings_.fixedNoise;
     pt.lightPaths = settings_.pathsPerPixel;
     eyePaths_ = std::make_unique<PathTracer>(ctx, scene, film, pt);
     bytes_ += eyePaths_->deviceBytes();

@@ -19,8 +19,10 @@ both run in the same binary on the same machine in the same run; --baseline-buil
 build's pathreuse instead (e.g. of an older commit whose device structs differ). Standard
 library only.
 
---reuse adds a row rendered with --mode reuse and its defaults (eye paths and connections), a
-single frame, so its light paths are all traced in that frame's time.
+--resample adds a row rendered with --mode pathtrace --resample and its defaults (paths
+resampled with neighbouring pixels'). --reuse adds a row rendered with --mode reuse and its
+defaults (eye paths and connections), a single frame, so its light paths are all traced in that
+frame's time.
 
 --cycles adds, for the cases whose light transport Blender can match (--force-diffuse scenes
 without punctual lights: cases 1-3), a row rendered by Blender Cycles (Debian's `blender`,
@@ -155,6 +157,8 @@ def main():
     ap.add_argument("--cache", default="/tmp/pathreuse-bench-sampling")
     ap.add_argument("--python", default="/usr/bin/python3", help="python for gen_atrium.py")
     ap.add_argument("--cycles", action="store_true", help="add Blender Cycles rows (cases 1-3)")
+    ap.add_argument("--resample", action="store_true",
+                    help="add a row of --mode pathtrace --resample with its defaults")
     ap.add_argument("--reuse", action="store_true",
                     help="add a row of --mode reuse with its defaults (one frame: every light path traced)")
     args = ap.parse_args()
@@ -197,6 +201,8 @@ def main():
                 continue
             shutil.move(str(tmp / "ref_0000.exr"), str(ref))   # only a finished one is cached
         rows = [(label, vlabel, kd, vopts) for vlabel, vopts in variants for label, kd in configs]
+        if args.resample:
+            rows.append(("pathtrace --resample (its defaults)", None, None, ["--resample"]))
         if args.reuse:
             rows.append(("reuse (its defaults)", None, None, ["--mode", "reuse"]))
         if args.cycles and ci in CYCLES_CASES:
