@@ -28,6 +28,11 @@ Image render(const std::string& scene, const std::string& args, const std::strin
   return test::frameImage(test::renderFrames(scene, "0", "--mode pathtrace " + args, tag), 0);
 }
 
+// The path tracer's demo at 96 x 72 and 1024 spp.
+Image demoReference() {
+  return render(demoScene(), "--width 96 --height 72 --spp 1024 --seed 1", "rs-demo-ref");
+}
+
 // Each 12 x 12 region of a 96 x 72 image that is not dark (the sum of its channels' means at
 // least 0.03 in ref) has the mean of ref's within tol of it; more than 30 such regions.
 void expectRegionsAgree(const Image& img, const Image& ref, double tol) {
@@ -77,7 +82,7 @@ TEST(Resample, WhiteFurnaceConvergesToLeOverOneMinusAlbedo) {
 // Without the reconnection Jacobian regions are up to 19% off.
 TEST(Resample, ConvergesToThePathTracerRegionByRegion) {
   const std::string size = "--width 96 --height 72 ";
-  const Image ref = render(demoScene(), size + "--spp 1024 --seed 1", "rs-demo-ref");
+  const Image ref = demoReference();
   const Image img = render(demoScene(), size + "--spp 512 --seed 2 --resample", "rs-demo");
   expectRegionsAgree(img, ref, 0.05);
 }
@@ -97,7 +102,7 @@ TEST(Resample, SlatsHideNeighboursPaths) {
                       {2.0f, 2.5f, 0.5f}, lamp));
   b.addCamera(glm::vec3(-0.3f, 2.5f, 2.5f), glm::vec3(0.0f, 0.0f, 0.0f), 0.9f, 4.0f / 3.0f);
   const std::string scene = b.write(test::tempDir("rs-slats"), "slats");
-  const std::string size = "--width 96 --height 72 --force-diffuse ";
+  const std::string size = "--width 96 --height 72 --force-diffuse --max-depth 5 ";
   const Image ref = render(scene, size + "--spp 2048 --seed 1", "rs-slats-ref");
   const Image img =
       render(scene, size + "--spp 1024 --seed 2 --resample --resample-radius 16", "rs-slats");
@@ -108,7 +113,7 @@ TEST(Resample, SlatsHideNeighboursPaths) {
 // samples, against a reference of the path tracer.
 TEST(Resample, NeighboursLowerTheError) {
   const std::string size = "--width 96 --height 72 ";
-  const Image ref = render(demoScene(), size + "--spp 1024 --seed 1", "rs-gain-ref");
+  const Image ref = demoReference();
   const Image own =
       render(demoScene(), size + "--spp 8 --seed 2 --resample --resample-neighbors 0", "rs-own");
   const Image shared = render(demoScene(), size + "--spp 8 --seed 2 --resample", "rs-shared");
