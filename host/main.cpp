@@ -175,8 +175,8 @@ void addSamplingOptions(CLI::App* render, RenderArgs& a) {
       ->capture_default_str();
   render->add_flag("--resample", ro.resample.enabled,
                    "Resample the paths beyond each first surface with those of neighbouring "
-                   "pixels, reconnected there and weighed by pairwise MIS (unbiased; --mode "
-                   "pathtrace only for now)");
+                   "pixels and of the previous frame, reconnected there and weighed by pairwise "
+                   "MIS (unbiased; --mode pathtrace only for now)");
   render
       ->add_option("--resample-neighbors", ro.resample.neighbors,
                    "Pixels whose paths each pixel takes (--resample; 0: its own alone)")
@@ -197,6 +197,12 @@ void addSamplingOptions(CLI::App* render, RenderArgs& a) {
                    "Shortest segment reconnected, in scene units (--resample; 0: 1% of the "
                    "scene's radius)")
       ->check(finiteIn(0, 1e30))
+      ->capture_default_str();
+  render
+      ->add_option("--resample-history", ro.resample.history,
+                   "Confidence the previous frame's paths count at most, in samples (--resample; "
+                   "0: no reuse between frames)")
+      ->check(CLI::Range(0, 1000))
       ->capture_default_str();
 }
 

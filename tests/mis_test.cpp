@@ -427,25 +427,33 @@ TEST(Pairwise, WeightsAddToOne) {
       const float kf = float(k);
       const float pc = zero(gen) == 0 ? 0.0f : std::exp(logu(gen));
       const float cc = std::exp(0.2f * logu(gen));
+      std::vector<float> pi(k), ci(k);
+      float total = cc;
+      for (int i = 0; i < k; ++i) {
+        pi[i] = zero(gen) == 0 ? 0.0f : std::exp(logu(gen));
+        ci[i] = std::exp(0.2f * logu(gen));
+        total += ci[i];
+      }
       double sum = 0.0, terms = 0.0;
       for (int i = 0; i < k; ++i) {
-        const float pi = zero(gen) == 0 ? 0.0f : std::exp(logu(gen));
-        const float ci = std::exp(0.2f * logu(gen));
-        const float m = mis_pairwise_neighbor(ci, pi, cc, pc, kf);
+        const float m = mis_pairwise_neighbor(ci[i], pi[i], cc, pc, kf, total);
         EXPECT_GE(m, 0.0f);
-        if (pi == 0.0f) {
+        if (pi[i] == 0.0f) {
           EXPECT_EQ(m, 0.0f);
         }
         sum += m;
-        terms += mis_pairwise_canonical_term(ci, pi, cc, pc, kf);
+        terms += mis_pairwise_canonical_term(ci[i], pi[i], cc, pc, kf, total);
       }
-      sum += mis_pairwise_canonical(float(terms), kf);
+      sum += mis_pairwise_canonical(float(terms), cc, total);
       ASSERT_NEAR(sum, 1.0, 1e-5) << "k " << k << " trial " << trial;
     }
   }
-  const float c = mis_pairwise_canonical(3 * mis_pairwise_canonical_term(1, 1, 1, 1, 3), 3);
+  const float c = mis_pairwise_canonical(3 * mis_pairwise_canonical_term(1, 1, 1, 1, 3, 4), 1, 4);
   EXPECT_NEAR(c, 7.0f / 16.0f, 1e-6f);
-  EXPECT_NEAR(mis_pairwise_neighbor(1, 1, 1, 1, 3), 3.0f / 16.0f, 1e-6f);
+  EXPECT_NEAR(mis_pairwise_neighbor(1, 1, 1, 1, 3, 4), 3.0f / 16.0f, 1e-6f);
+  // A neighbour standing for 20 samples (the previous frame's reservoir) takes most of a sample
+  // both targets agree on.
+  EXPECT_GT(mis_pairwise_neighbor(20, 1, 1, 1, 1, 21), 0.85f);
 }
 
 // The reconnection shift's Jacobian: x_2 kept, x_1 moved to x_1'. A small patch around x_2 seen

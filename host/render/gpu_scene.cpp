@@ -247,8 +247,12 @@ void GpuScene::setTime(double t) {
     lastTransforms_[i] = m;
   }
   if (anyMoved_) {
+    const std::vector<accel::Aabb> before = dsg_.instanceBounds();
     dsg_.setInstances(inputs);
     deviceAccel_.uploadFrame(ctx_, dsg_);
+    collectMovedBoxes(before);
+  } else {
+    movedBoxes_.clear();
   }
   // The moved flags change even when no transform does (all back to 0), so always upload.
   const uint64_t bytes = std::max<size_t>(n, 1) * sizeof(dev::ShadingInstance);
@@ -271,6 +275,28 @@ void GpuScene::setTime(double t) {
                                              lights_.size() * sizeof(dev::Light), lights_.data()));
   }
   firstFrame_ = false;
+}
+
+void GpuScene::collectMovedBoxes(const std::vector<accel::Aabb>& before) {
+  movedBoxes_.clear();
+  const std::vector<accel::Aabb>& after = dsg_.instanceBounds();
+  // Enlarged by a little of the scene's size, so that rounding in the kernels' segment tests
+  // cannot miss a surface on a box's face.
+  const float pad = 1e-4f * sceneRadius_;
+  auto add = [&](const accel::Aabb& b) {
+    if (b.empty()) return;
+    for (int a = 0; a < 3; ++a) movedBoxes_.push_back(b.lo[a] - pad - 1e-4f * std::fabs(b.lo[a]));
+    for (int a = 0; a < 3; ++a) movedBoxes_.push_back(b.hi[a] + pad + 1e-4f * std::fabs(b.hi[a]));
+  };
+  for (size_t i = 0; i < instances_.size(); ++i) {
+    if (!instances_[i].moved) continue;
+    if (i < before.size()) add(before[i]);
+    if (i < after.size()) add(after[i]);
+  }
+}
+
+bool GpuScene::anyLightMoved() const {
+  return std::any_of(lights_.begin(), lights_.end(), [](const dev::Light& l) { return l.moved; });
 }
 
 std::vector<dev::Light> GpuScene::lightsAt(double t) const {

@@ -67,6 +67,12 @@ class GpuScene {
   const std::vector<dev::Light>& lights() const { return lights_; }
   const std::vector<dev::ShadingInstance>& instances() const { return instances_; }
   bool anyInstanceMoved() const { return anyMoved_; }
+  // Whether the last setTime changed a light (the light table, and so every light pdf).
+  bool anyLightMoved() const;
+  // Boxes (lo xyz, hi xyz; 6 floats each) that hold every instance the last setTime moved or
+  // reshaped, where it was before and where it is now, a little enlarged: where this frame's
+  // scene may differ from the previous one's (path resampling's temporal reuse).
+  const std::vector<float>& movedBoxes() const { return movedBoxes_; }
   // Host seconds the last setTime spent deforming meshes and rebuilding their BVHs.
   double lastDeformSeconds() const { return deformSeconds_; }
   bool hasAlphaMaterials() const { return hasAlpha_; }
@@ -82,6 +88,8 @@ class GpuScene {
   // shape changed (*changed, per dynamic mesh). Returns whether any did.
   bool deformMeshes(double t, std::vector<bool>* changed);
   void buildLights(double t);
+  // movedBoxes_ from the instances' bounds before this frame's setInstances and after.
+  void collectMovedBoxes(const std::vector<accel::Aabb>& before);
   std::vector<dev::Light> lightsAt(double t) const;
   cl::Buffer upload(const char* name, const void* data, uint64_t bytes, uint64_t* counter);
 
@@ -102,6 +110,7 @@ class GpuScene {
   double deformedAt_ = std::nan("");  // the time deformed_ holds (NaN: none yet)
   std::vector<dev::ShadingInstance> instances_;
   std::vector<glm::mat4> lastTransforms_;
+  std::vector<float> movedBoxes_;
   bool firstFrame_ = true;
   bool anyMoved_ = true;
   bool hasAlpha_ = false;

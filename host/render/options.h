@@ -30,14 +30,18 @@ const char* renderModeName(RenderMode m);
 enum class MaterialModel { Energy, Gltf };
 const char* materialModelName(MaterialModel m);
 
-// Path resampling across pixels (--resample; docs/design.md section 5): the path tracer's
-// paths beyond x_1 resampled with those of `neighbors` pixels within `radius` pixels.
+// Path resampling across pixels and frames (--resample; docs/design.md section 5): the path
+// tracer's paths beyond x_1 resampled with those of `neighbors` pixels within `radius` pixels
+// and with the previous frame's.
 struct ResampleSettings {
   bool enabled = false;
   int neighbors = 3;
   float radius = 10.0f;    // pixels
   float roughness = 0.2f;  // GGX roughness below which a vertex is not reconnected
   float distance = 0.0f;   // shortest reconnected segment; 0: 1% of the scene's radius
+  // Temporal reuse: the confidence the previous frame's reservoir counts at most (ReSTIR's M
+  // cap); 0: none, each frame alone.
+  int history = 20;
 };
 
 struct FrameRange {

@@ -1,5 +1,6 @@
 #include "render/path_tracer.h"
 
+#include <algorithm>
 #include <chrono>
 
 #include "cl/kernel_args.h"
@@ -39,7 +40,16 @@ PathTracer::PathTracer(Context& ctx, GpuScene& scene, Film& film,
   rsTrack_ = alloc("path tracks", rsPixels * sizeof(dev::PathTrack));
   rsRes_ = alloc("path reservoirs", rsPixels * sizeof(dev::PathReservoir));
   rsPending_ = alloc("path candidates", rsPixels * sizeof(dev::PathReservoir));
-  if (settings.resample.enabled) rsEye_ = alloc("eye vertices", n * sizeof(dev::EyeVertex));
+  if (settings.resample.enabled) {
+    rsEye_ = alloc("eye vertices", n * sizeof(dev::EyeVertex));
+    historyOut_ = alloc("path history", n * sizeof(dev::PathHistory));
+    // One chain per pass, within 1 GiB.
+    const uint64_t perChain = n * sizeof(dev::PathHistory);
+    const uint64_t fit = std::max<uint64_t>(1, (uint64_t(1) << 30) / perChain);
+    chains_ =
+        settings.resample.history > 0 ? int(std::min<uint64_t>(uint64_t(settings.spp), fit)) : 0;
+    for (int c = 0; c < chains_; ++c) history_.push_back(alloc("path history", perChain));
+  }
 }
 
 dev::ResampleParams PathTracer::resampleParams() const {
@@ -52,6 +62,7 @@ dev::ResampleParams PathTracer::resampleParams() const {
   p.min_dist2 = r.distance * r.distance;
   p.width = film_.width();
   p.height = film_.height();
+  p.max_m = float(r.history);
   return p;
 }
 
@@ -62,7 +73,29 @@ void PathTracer::beginFrame(int frame, const dev::CameraParams& camera,
   const cl_uint n = film_.end();
   const cl_uint rngFrame = settings_.fixedNoise ? 0 : cl_uint(frame);
   ctx_.zero(rays_, dev::PR_PT_COUNT * 4);
-  const dev::ResampleParams rsp = resampleParams();
+  dev::ResampleParams rsp = resampleParams();
+  // The previous frame's reservoirs are taken where every chain was kept, the frame follows it
+  // and no light changed (a light pdf in a kept path would differ).
+  temporal_ = chains_ > 0 && written_ >= chains_ && frame == frame_ + 1 && !scene_.anyLightMoved();
+  const dev::CameraParams prevCamera = temporal_ ? camera_ : camera;
+  frame_ = frame;
+  camera_ = camera;
+  written_ = 0;
+  if (settings_.resample.enabled) {
+    const std::vector<float>& boxes = scene_.movedBoxes();
+    const uint64_t bytes = std::max<uint64_t>(boxes.size() * 4, 24);
+    if (bytes > movedBytes_) {
+      if (movedBytes_) ctx_.release(movedBytes_);
+      bytes_ += bytes - movedBytes_;
+      moved_ = ctx_.allocate("moved boxes", bytes, CL_MEM_READ_ONLY);
+      ctx_.zero(moved_, bytes);
+      movedBytes_ = bytes;
+    }
+    if (!boxes.empty())
+      CL_CHECK(
+          ctx_.queue().enqueueWriteBuffer(moved_, CL_FALSE, 0, boxes.size() * 4, boxes.data()));
+    rsp.moved_count = cl_uint(boxes.size() / 6);
+  }
   // Resampling needs every sample's x_1, which the path tracer alone does not keep.
   const cl::Buffer& eyeOut = settings_.resample.enabled && settings_.lightPaths == 0 ? rsEye_ : eye;
   kargs::setScene(&extendArgs_, sceneArgs);
@@ -111,6 +144,9 @@ void PathTracer::beginFrame(int frame, const dev::CameraParams& camera,
     resampleArgs_.first = film_.first();
     resampleArgs_.end = n;
     resampleArgs_.rays = rays_;
+    resampleArgs_.history_out = historyOut_;
+    resampleArgs_.prev_cam = prevCamera;
+    resampleArgs_.moved = moved_;
     resampleArgs_.set(resample_, kargs::kScene | kargs::kFrame);
   }
   generateArgs_.cam = camera;
@@ -159,9 +195,18 @@ void PathTracer::tracePass(int sample, StageTimer* timer) {
     live = sizes[dev::PR_QUEUE_LIVE];
   }
   if (settings_.resample.enabled) {
+    const bool chained = sample < chains_;
     resampleArgs_.sample = cl_uint(sample);
+    resampleArgs_.temporal = temporal_ && chained ? 1u : 0u;
+    resampleArgs_.history = chained ? history_[size_t(sample)] : historyOut_;
     resampleArgs_.set(resample_, kargs::kPass);
     ctx_.launch1D(resample_, 0, n - first, "resample", timer);
+    if (chained) {
+      const size_t rec = sizeof(dev::PathHistory);
+      CL_CHECK(ctx_.queue().enqueueCopyBuffer(historyOut_, history_[size_t(sample)], first * rec,
+                                              first * rec, (n - first) * rec));
+      written_ = std::max(written_, sample + 1);
+    }
   }
 }
 

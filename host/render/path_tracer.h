@@ -4,6 +4,8 @@
 // with MIS, Russian roulette.
 #pragma once
 
+#include <vector>
+
 #include "cl/context.h"
 #include "cl/kernel_args.h"
 #include "render/film.h"
@@ -64,6 +66,17 @@ class PathTracer : public Integrator {
   // --resample: each path's candidates as it goes, its sample's reservoir, next-event
   // estimation's candidate until pt_shadow, and x_1 (when the caller gives no eye buffer).
   cl::Buffer rsTrack_, rsRes_, rsPending_, rsEye_;
+  // Temporal reuse: pass s < chains_ keeps its final reservoirs in history_[s] for pass s of the
+  // next frame (pt_resample writes historyOut_, copied there): chains_ = spp as far as 1 GiB
+  // allows; later passes resample within the frame alone.
+  std::vector<cl::Buffer> history_;
+  cl::Buffer historyOut_, moved_;
+  uint64_t movedBytes_ = 0;
+  int chains_ = 0;
+  int written_ = 0;             // passes of the frame since beginFrame whose history is kept
+  int frame_ = -2;              // the frame of the last beginFrame
+  dev::CameraParams camera_{};  // and its camera
+  bool temporal_ = false;       // this frame resamples with the previous frame's history
   uint64_t bytes_ = 0;
 };
 

@@ -102,17 +102,18 @@ PR_INLINE float pt_next_event_weight(const SceneData* s, const PathState* p, con
   return w;
 }
 
-// --resample, at a hit `rel` vertices beyond x_1 (2 and on: x_3 ...) or, escaped, from the
-// vertex `rel` - 1 beyond it: the path's end on an emitter (le, weighted w by the path tracer,
-// pdf_light its light pdf) offered to the pixel's reservoir.
+// --resample, at a hit `rel` vertices beyond x_1 (2 and on: x_3 ...) or, escaped along d
+// (escaped), from the vertex `rel` - 1 beyond it: the path's end on an emitter (le, weighted w
+// by the path tracer, pdf_light its light pdf) offered to the pixel's reservoir.
 PR_INLINE void rs_offer_emission(PR_GLOBAL const PathTrack* t, PR_GLOBAL PathReservoir* r,
                                  const PathState* p, uint rel, float3 le, float w, float pdf_light,
-                                 const RsKey* key) {
+                                 int escaped, float3 d, const RsKey* key) {
   const int t2 = rel == 2u && !(p->flags & PR_PATH_SPECULAR);
   const float3 rest = make_float3(t->rest_r, t->rest_g, t->rest_b) * le * (t2 ? 1.0f : w);
-  const PathReservoir c =
+  PathReservoir c =
       rs_candidate(t, make_float3(t->f2_r, t->f2_g, t->f2_b), make_float3(t->wx, t->wy, t->wz),
                    t->g_src, rest, t->pdf, t2 ? PR_RS_HIT2 : PR_RS_DEEP, pdf_light, p->last_pdf);
+  if (escaped) rs_suffix_push(&c.suffix, c.sp, d, 1);
   rs_offer_keyed(r, &c, key, PR_RS_DIM(p->depth + 1u, 0u));
 }
 
@@ -153,20 +154,26 @@ PR_INLINE void rs_track_step(PR_GLOBAL PathTrack* t, const ResampleParams* rsp, 
 
 // --resample: next-event estimation's path at vertex `rel` >= 1 beyond x_1, the candidate for
 // pt_shadow to offer if its shadow ray is unoccluded.
+// The light's point (at_infinity: its direction) ends the path's suffix.
 PR_INLINE PathReservoir rs_next_event(PR_GLOBAL const PathTrack* t, const ResampleParams* rsp,
                                       uint rel, const SurfaceHit* h, const ShadingFrame* f,
-                                      float3 wo, float dist2, const NextEventChoice* ch) {
+                                      float3 wo, float dist2, const NextEventChoice* ch,
+                                      int at_infinity) {
+  PathReservoir c;
   if (rel == 1u) {
     const float g = rs_reconnectable(t->x1_ok, h, f, wo, dist2, ch->wi, rsp)
                         ? fabs(dot(h->ng, wo)) / dist2
                         : 0.0f;
-    return rs_candidate(t, ch->fr_cos, ch->wi, g, ch->le, t->pdf * ch->pdf,
-                        ch->delta ? PR_RS_DEEP : PR_RS_NEE2, ch->pdf_light, ch->pdf_bsdf);
+    c = rs_candidate(t, ch->fr_cos, ch->wi, g, ch->le, t->pdf * ch->pdf,
+                     ch->delta ? PR_RS_DEEP : PR_RS_NEE2, ch->pdf_light, ch->pdf_bsdf);
+  } else {
+    const float w = ch->delta ? 1.0f : power_heuristic(ch->pdf_light, ch->pdf_bsdf);
+    const float3 rest = make_float3(t->rest_r, t->rest_g, t->rest_b) * ch->fr_cos * ch->le * w;
+    c = rs_candidate(t, make_float3(t->f2_r, t->f2_g, t->f2_b), make_float3(t->wx, t->wy, t->wz),
+                     t->g_src, rest, t->pdf * ch->pdf, PR_RS_DEEP, 0.0f, 0.0f);
   }
-  const float w = ch->delta ? 1.0f : power_heuristic(ch->pdf_light, ch->pdf_bsdf);
-  const float3 rest = make_float3(t->rest_r, t->rest_g, t->rest_b) * ch->fr_cos * ch->le * w;
-  return rs_candidate(t, make_float3(t->f2_r, t->f2_g, t->f2_b), make_float3(t->wx, t->wy, t->wz),
-                      t->g_src, rest, t->pdf * ch->pdf, PR_RS_DEEP, 0.0f, 0.0f);
+  rs_suffix_push(&c.suffix, c.sp, at_infinity ? ch->wi : ch->pos, at_infinity);
+  return c;
 }
 
 // A contribution as the radiance buffer holds it.
@@ -190,7 +197,7 @@ PR_INLINE void pt_escape(const SceneData* s, const PathState* p, uint rel,
   const float3 prev_n = make_float3(p->prev_nx, p->prev_ny, p->prev_nz);
   const float pdf_light = environment_pdf(s, prev, prev_n, d);
   const float w = (p->flags & PR_PATH_SPECULAR) ? 1.0f : power_heuristic(p->last_pdf, pdf_light);
-  rs_offer_emission(track, res, p, rel, environment_radiance(s, d), w, pdf_light, key);
+  rs_offer_emission(track, res, p, rel, environment_radiance(s, d), w, pdf_light, 1, d, key);
 }
 
 // Emission at h, weighted w by the path tracer, into the sample's radiance, or with --resample
@@ -206,12 +213,12 @@ PR_INLINE void pt_emission(const SceneData* s, const PathState* p, const Surface
   }
   const float pdf_light = emitter_pdf(s, h, make_float3(p->prev_x, p->prev_y, p->prev_z),
                                       make_float3(p->prev_nx, p->prev_ny, p->prev_nz));
-  rs_offer_emission(track, res, p, rel, le, w, pdf_light, key);
+  rs_offer_emission(track, res, p, rel, le, w, pdf_light, 0, h->p, key);
 }
 
-// --resample: the hit `rel` >= 1 vertices beyond x_1 joins the tracked path, with the
+// --resample: the hit `rel` >= 1 vertices beyond x_1 (at p) joins the tracked path, with the
 // transmittance tr of the segment to it.
-PR_INLINE void rs_track_hit(__global PathTrack* t, uint rel, const Hit* hit, float3 tr) {
+PR_INLINE void rs_track_hit(__global PathTrack* t, uint rel, const Hit* hit, float3 p, float3 tr) {
   if (rel == 1u) {  // x_2
     t->prim = hit->prim;
     t->inst = hit->inst;
@@ -220,10 +227,12 @@ PR_INLINE void rs_track_hit(__global PathTrack* t, uint rel, const Hit* hit, flo
     t->f1_r *= tr.x;
     t->f1_g *= tr.y;
     t->f1_b *= tr.z;
+    t->suffix = 0u;
   } else {
     t->rest_r *= tr.x;
     t->rest_g *= tr.y;
     t->rest_b *= tr.z;
+    rs_track_push(t, p);
   }
 }
 
@@ -289,7 +298,7 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
   const float3 tr = volume_transmittance(&s, &h, d, hit.t);
   float3 tp = make_float3(p.tp_r, p.tp_g, p.tp_b) * tr;
   const float dist2 = hit.t * hit.t;
-  if (rel) rs_track_hit(track, rel, &hit, tr);
+  if (rel) rs_track_hit(track, rel, &hit, h.p, tr);
   // Connections can make the paths that end after x_t, t >= 2 (x_t: the vertex `ray` left).
   const int joinable =
       light_paths > 0u && (p.eye_flags & PR_EYE_JOINABLE) && p.depth >= p.x1_depth + 1u;
@@ -337,7 +346,8 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
         uint op = 0u;
         const uint rel_here = rsp.enabled && p.x1_depth ? p.depth - p.x1_depth : 0u;
         if (rel_here >= 1u) {  // to the reservoir, once pt_shadow finds it unoccluded
-          rs_pending[i] = rs_next_event(track, &rsp, rel_here, &h, &f, wo, dist2, &ch);
+          rs_pending[i] = rs_next_event(track, &rsp, rel_here, &h, &f, wo, dist2, &ch,
+                                        light_at_infinity(s.lights.lights[ch.light].type));
           op = PR_RS_DIM(p.depth, 1u) + 1u;
         }
         pt_shadow_set(shadows + i, shadow, tp * c, op);

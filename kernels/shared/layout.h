@@ -30,6 +30,7 @@
   S(ShadowRay)               \
   S(PathReservoir)           \
   S(PathTrack)               \
+  S(PathHistory)             \
   S(ResampleParams)          \
   S(PathHeader)              \
   S(LightVertex)             \
@@ -124,10 +125,13 @@
   F(PathReservoir, g_src)             \
   F(PathReservoir, f_r)               \
   F(PathReservoir, w_sum)             \
+  F(PathReservoir, sp)                \
+  F(PathHistory, prim)                \
   F(PathTrack, x1_ok)                 \
   F(PathTrack, pdf)                   \
   F(PathTrack, g_src)                 \
   F(ResampleParams, min_dist2)        \
+  F(ResampleParams, moved_count)      \
   F(PathHeader, end)                  \
   F(PathHeader, valid)                \
   F(PathHeader, escape_z)             \

@@ -196,29 +196,33 @@ PR_INLINE int ris_accept(float u, float w_sum, float w) {
 // Pairwise MIS (Bitterli 2022) over a canonical reservoir c and k neighbours, each compared with
 // the canonical one alone: O(k) where the balance heuristic is O(k^2). p_i is neighbour i's
 // target pulled back to the sample (p_i(T(y)) |J|), p_c the canonical target at it, c_* the
-// confidences. A neighbour's sample gets
-//   m_i(y) = 1/(k+1) c_i p_i / (c_i p_i + c_c p_c / k),
-// and the canonical sample 1/(k+1) (1 + sum_i of (c_c p_c / k) / (c_i p_i + c_c p_c / k)): for
-// every y the k + 1 weights add to 1. A pair where both targets are 0 counts 1 to the canonical
-// side and 0 to the neighbour's.
-PR_INLINE float mis_pairwise_neighbor(float c_i, float p_i, float c_c, float p_c, float k) {
+// confidences (how many samples' domains a reservoir stands for) and C = c_c + sum_i c_i. A
+// neighbour's sample gets
+//   m_i(y) = c_i / C * c_i p_i / (c_i p_i + c_c p_c / k),
+// and the canonical sample c_c / C + sum_i c_i / C * (c_c p_c / k) / (c_i p_i + c_c p_c / k):
+// for every y the k + 1 weights add to 1, and a domain's share grows with its confidence. With
+// every confidence 1 the shares are 1 / (k + 1). A pair where both targets are 0 counts wholly
+// to the canonical side.
+PR_INLINE float mis_pairwise_neighbor(float c_i, float p_i, float c_c, float p_c, float k,
+                                      float total) {
   const float a = c_i * p_i;
   const float b = c_c * p_c / k;
   const float den = a + b;
-  return den > 0.0f ? a / (den * (k + 1.0f)) : 0.0f;
+  return den > 0.0f ? c_i / total * (a / den) : 0.0f;
 }
 
-// The canonical side's term of one pair, (c_c p_c / k) / (c_i p_i + c_c p_c / k); the canonical
-// weight is (1 + the sum of these over the k pairs) / (k + 1) (mis_pairwise_canonical).
-PR_INLINE float mis_pairwise_canonical_term(float c_i, float p_i, float c_c, float p_c, float k) {
+// The canonical side's share of one pair, c_i / C (c_c p_c / k) / (c_i p_i + c_c p_c / k); the
+// canonical weight is c_c / C plus the sum of these over the k pairs (mis_pairwise_canonical).
+PR_INLINE float mis_pairwise_canonical_term(float c_i, float p_i, float c_c, float p_c, float k,
+                                            float total) {
   const float a = c_i * p_i;
   const float b = c_c * p_c / k;
   const float den = a + b;
-  return den > 0.0f ? b / den : 1.0f;
+  return c_i / total * (den > 0.0f ? b / den : 1.0f);
 }
 
-PR_INLINE float mis_pairwise_canonical(float term_sum, float k) {
-  return (1.0f + term_sum) / (k + 1.0f);
+PR_INLINE float mis_pairwise_canonical(float term_sum, float c_c, float total) {
+  return c_c / total + term_sum;
 }
 
 // The Jacobian of the reconnection shift (ReSTIR GI; Lin et al. 2022): a path whose vertex x_2

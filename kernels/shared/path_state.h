@@ -60,7 +60,10 @@ typedef struct {
 // path's contribution is f = f_1 f_2 rest w in the measure (solid angle at x_1, at x_2, ...):
 // x_1's BSDF and cosine along omega_1 (f_1), x_2's along omega_2 (f_2), what lies beyond x_2
 // (`rest`) and its MIS weight w (in `rest` but at t = 2, where it depends on x_1's direction).
-// 80 bytes.
+// The points after x_2 (its suffix) are kept for temporal reuse, which takes a path into the
+// next frame only where nothing that moved comes near them (shared/resample.h). 160 bytes.
+#define PR_RS_SUFFIX 6  // suffix points kept; a longer path is not reused in the next frame
+
 typedef struct {
   u32 prim, inst;  // x_2 (prim PR_INVALID_INDEX: no path kept)
   float b1, b2;
@@ -72,14 +75,31 @@ typedef struct {
   u32 kind;             // PR_RS_*
   float p_hat;          // the target at its own pixel: luminance(f)
   float w_sum;          // the reservoir's sum of resampling weights (a candidate's own weight)
+  float m;              // its confidence: how many pixel samples' domains it has resampled
+  u32 suffix;           // the points in sp (PR_RS_SUFFIX at most) | PR_RS_ESCAPES | PR_RS_LONG
+  float sp[3 * PR_RS_SUFFIX];  // x_3, x_4, ... and the light's point, in world space
   float pad0, pad1;
 } PathReservoir;
+
+#define PR_RS_COUNT_MASK 0xffu
+#define PR_RS_ESCAPES 0x100u  // the last point of sp is a direction: the path ends at infinity
+#define PR_RS_LONG 0x200u     // more points than sp holds
+
+// A pixel sample's resampled path as the next frame's temporal reuse finds it: the reservoir
+// and the x_1 it is a path of (surface and the direction it was seen from). 192 bytes.
+typedef struct {
+  PathReservoir r;
+  u32 prim, inst;  // x_1 (prim PR_INVALID_INDEX: none)
+  float b1, b2;
+  float wx, wy, wz;
+  u32 pad;
+} PathHistory;
 
 #define PR_RS_DEEP 0u  // the weight is in `rest` (t >= 3, or a delta light)
 #define PR_RS_NEE2 1u  // next-event estimation at x_2: w = power heuristic (light, x_2's BSDF)
 #define PR_RS_HIT2 2u  // x_2's BSDF sample met an emitter or escaped: w = (x_2's BSDF, light)
 
-// Where a path's candidates stand as pt_shade follows it (one per pixel). 80 bytes.
+// Where a path's candidates stand as pt_shade follows it (one per pixel). 160 bytes.
 typedef struct {
   u32 prim, inst;  // x_2
   float b1, b2;
@@ -90,10 +110,12 @@ typedef struct {
   float rest_r, rest_g, rest_b;
   float g_src;  // of the path's own omega_2 (0: not reconnectable)
   float wx, wy, wz;
-  u32 pad;
+  u32 suffix;                  // as PathReservoir's: the points met after x_2
+  float sp[3 * PR_RS_SUFFIX];  // their positions
+  float pad0, pad1;
 } PathTrack;
 
-// What the resampling kernels are told. 32 bytes.
+// What the resampling kernels are told. 48 bytes.
 typedef struct {
   u32 enabled;      // 0: the path tracer alone
   u32 neighbors;    // k of pairwise MIS (0: the pixel's own paths, resampled)
@@ -101,7 +123,9 @@ typedef struct {
   float min_alpha;  // GGX alpha below which a vertex is too smooth to reconnect at
   float min_dist2;  // squared distance below which x_1 x_2 is too short to reconnect
   u32 width, height;
-  u32 pad;
+  float max_m;      // the confidence a reservoir of the previous frame counts at most
+  u32 moved_count;  // boxes in `moved` (pt_resample): where the scene changed since then
+  u32 pad0, pad1, pad2;
 } ResampleParams;
 
 PR_NAMESPACE_END
@@ -110,6 +134,7 @@ PR_STATIC_ASSERT(sizeof(pr::dev::PathState) == 112, "PathState layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::PathState, depth) == 48, "PathState layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::PathState, flags) == 64, "PathState layout");
 PR_STATIC_ASSERT(sizeof(pr::dev::ShadowRay) == 48, "ShadowRay layout");
-PR_STATIC_ASSERT(sizeof(pr::dev::PathReservoir) == 80, "PathReservoir layout");
-PR_STATIC_ASSERT(sizeof(pr::dev::PathTrack) == 80, "PathTrack layout");
-PR_STATIC_ASSERT(sizeof(pr::dev::ResampleParams) == 32, "ResampleParams layout");
+PR_STATIC_ASSERT(sizeof(pr::dev::PathReservoir) == 160, "PathReservoir layout");
+PR_STATIC_ASSERT(sizeof(pr::dev::PathHistory) == 192, "PathHistory layout");
+PR_STATIC_ASSERT(sizeof(pr::dev::PathTrack) == 160, "PathTrack layout");
+PR_STATIC_ASSERT(sizeof(pr::dev::ResampleParams) == 48, "ResampleParams layout");

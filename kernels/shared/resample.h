@@ -11,6 +11,7 @@
 #pragma once
 
 #include "shared/arena.h"
+#include "shared/camera.h"
 #include "shared/integrator.h"
 #include "shared/mis.h"
 #include "shared/path_state.h"
@@ -149,8 +150,109 @@ PR_INLINE PathReservoir rs_candidate(PR_GLOBAL const PathTrack* t, float3 f2, fl
   c.kind = kind;
   c.p_hat = luminance(f);
   c.w_sum = pdf > 0.0f ? c.p_hat / pdf : 0.0f;
+  c.m = 1.0f;
+  c.suffix = t->suffix;
+  for (int k = 0; k < 3 * PR_RS_SUFFIX; ++k) c.sp[k] = t->sp[k];
   c.pad0 = c.pad1 = 0.0f;
   return c;
+}
+
+// --- Temporal reuse ----------------------------------------------------------------------------
+//
+// A path of the previous frame is a path of this one where nothing that moved between the two
+// frames comes near it: then its vertices, the visibility of its segments, its BSDFs and its
+// lights are the same in both scenes (lights that move turn temporal reuse off for the frame).
+// `moved` lists boxes (lo xyz, hi xyz) that hold every instance that moved or changed shape, where
+// it was and where it is; a path is reused only where its suffix, and both reconnection segments
+// (from the previous frame's x_1 and from this one's), meet none of them. The test is one
+// function of the path and the two x_1, so the shift and its inverse are defined on the same
+// paths, and the previous frame's target at a path is this frame's, which pt_resample evaluates.
+// This is the arena's exact invalidation (reuse/invalidate.cl) for eye paths: a stored path that
+// a moving object disturbs is never reused.
+
+// Appends point p (direction: a direction, the path's end at infinity) to a suffix.
+PR_INLINE void rs_suffix_push(u32* suffix, float* sp, float3 p, int direction) {
+  const u32 n = *suffix & PR_RS_COUNT_MASK;
+  if (n >= PR_RS_SUFFIX) {
+    *suffix |= PR_RS_LONG;
+    return;
+  }
+  sp[3u * n] = p.x;
+  sp[3u * n + 1u] = p.y;
+  sp[3u * n + 2u] = p.z;
+  *suffix += 1u;
+  if (direction) *suffix |= PR_RS_ESCAPES;
+}
+
+// The same for the path pt_shade follows: point p, met after x_2.
+PR_INLINE void rs_track_push(PR_GLOBAL PathTrack* t, float3 p) {
+  const u32 n = t->suffix & PR_RS_COUNT_MASK;
+  if (n >= PR_RS_SUFFIX) {
+    t->suffix |= PR_RS_LONG;
+    return;
+  }
+  t->sp[3u * n] = p.x;
+  t->sp[3u * n + 1u] = p.y;
+  t->sp[3u * n + 2u] = p.z;
+  t->suffix += 1u;
+}
+
+// Whether the ray o + t d, 0 <= t <= tmax, meets box b (6 floats).
+PR_INLINE int rs_box_hit(PR_GLOBAL const float* b, float3 o, float3 d, float tmax) {
+  float t0 = 0.0f, t1 = tmax;
+  const float oo[3] = {o.x, o.y, o.z}, dd[3] = {d.x, d.y, d.z};
+  for (int a = 0; a < 3; ++a) {
+    if (fabs(dd[a]) < 1e-30f) {
+      if (oo[a] < b[a] || oo[a] > b[3 + a]) return 0;
+      continue;
+    }
+    const float ta = (b[a] - oo[a]) / dd[a], tb = (b[3 + a] - oo[a]) / dd[a];
+    t0 = fmax(t0, fmin(ta, tb));
+    t1 = fmin(t1, fmax(ta, tb));
+    if (t0 > t1) return 0;
+  }
+  return 1;
+}
+
+// Whether the ray (segment: tmax 1 and d the far end minus o) meets none of the moved boxes.
+PR_INLINE int rs_clear(PR_GLOBAL const float* moved, u32 count, float3 o, float3 d, float tmax) {
+  for (u32 k = 0u; k < count; ++k)
+    if (rs_box_hit(moved + 6u * k, o, d, tmax)) return 0;
+  return 1;
+}
+
+// Whether path r can be taken between frames, reconnected to x_1 at xa in one and at xb in the
+// other: its suffix kept whole and no segment near what moved.
+PR_INLINE int rs_temporal_ok(const SceneData* s, PR_GLOBAL const float* moved, u32 count,
+                             PR_GLOBAL const PathReservoir* r, float3 xa, float3 xb) {
+  if (r->prim == PR_INVALID_INDEX || (r->suffix & PR_RS_LONG)) return 0;
+  const u32 n = r->suffix & PR_RS_COUNT_MASK;
+  if (n == 0u) return 0;
+  const float3 x2 = surface_at(&s->sd, r->prim, r->inst, r->b1, r->b2).p;
+  if (!rs_clear(moved, count, xa, x2 - xa, 1.0f) || !rs_clear(moved, count, xb, x2 - xb, 1.0f))
+    return 0;
+  float3 a = x2;
+  for (u32 k = 0u; k < n; ++k) {
+    const float3 p = make_float3(r->sp[3u * k], r->sp[3u * k + 1u], r->sp[3u * k + 2u]);
+    if (k + 1u == n && (r->suffix & PR_RS_ESCAPES)) return rs_clear(moved, count, a, p, PR_INF_F);
+    if (!rs_clear(moved, count, a, p - a, 1.0f)) return 0;
+    a = p;
+  }
+  return 1;
+}
+
+// The pixel of camera c that sees world point p (PR_INVALID_INDEX: behind it or outside).
+PR_INLINE u32 rs_project(const CameraParams* c, float3 p) {
+  const float3 v = p - make_float3(c->px, c->py, c->pz);
+  const float z = dot(v, make_float3(c->fx, c->fy, c->fz));
+  if (!(z > 0.0f)) return PR_INVALID_INDEX;
+  const float nx = dot(v, make_float3(c->rx, c->ry, c->rz)) / (z * c->tan_half_fov * c->aspect);
+  const float ny = dot(v, make_float3(c->ux, c->uy, c->uz)) / (z * c->tan_half_fov);
+  const float sx = 0.5f * (nx + 1.0f) * (float)c->width;
+  const float sy = 0.5f * (1.0f - ny) * (float)c->height;
+  if (!(sx >= 0.0f && sy >= 0.0f && sx < (float)c->width && sy < (float)c->height))
+    return PR_INVALID_INDEX;
+  return (u32)sy * c->width + (u32)sx;
 }
 
 PR_NAMESPACE_END
