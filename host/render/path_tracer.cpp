@@ -81,6 +81,7 @@ void PathTracer::beginFrame(int frame, const dev::CameraParams& camera,
   frame_ = frame;
   camera_ = camera;
   written_ = 0;
+  ++stamp_;
   if (settings_.resample.enabled) {
     const std::vector<float>& boxes = scene_.movedBoxes();
     const uint64_t bytes = std::max<uint64_t>(boxes.size() * 4, 24);
@@ -147,6 +148,7 @@ void PathTracer::beginFrame(int frame, const dev::CameraParams& camera,
     resampleArgs_.history_out = historyOut_;
     resampleArgs_.prev_cam = prevCamera;
     resampleArgs_.moved = moved_;
+    resampleArgs_.stamp = stamp_;
     resampleArgs_.set(resample_, kargs::kScene | kargs::kFrame);
   }
   generateArgs_.cam = camera;

@@ -77,6 +77,8 @@ class PathTracer : public Integrator {
   int frame_ = -2;              // the frame of the last beginFrame
   dev::CameraParams camera_{};  // and its camera
   bool temporal_ = false;       // this frame resamples with the previous frame's history
+  // Counts beginFrame calls: the history's stamp (zeroed records' 0 never precedes one).
+  cl_uint stamp_ = 1;
   uint64_t bytes_ = 0;
 };
 

@@ -8,8 +8,10 @@
 // (one more). The previous frame's paths are taken only where nothing that moved comes near
 // them (rs_temporal_ok), the same test both ways. The kept path's f W, times the camera's weight
 // of x_1, goes into the sample's radiance, and the reservoir, with x_1, to history_out for the
-// next frame. Neighbours outside [first, end) or without an x_1 are domains that make no paths
-// here and are left out, which keeps the weights a partition of unity.
+// next frame, stamped with `stamp` (the previous frame's record counts only if its stamp is one
+// less: a device's rows move between frames). Neighbours outside [first, end) or without an x_1
+// are domains that make no paths here and are left out, which keeps the weights a partition of
+// unity.
 #include "shared/path_state.h"
 #include "shared/resample.h"
 
@@ -79,6 +81,7 @@ PR_KERNEL void pt_resample(PR_PARAMS(PR_ARGS_PT_RESAMPLE_SPATIAL)) {
   out->wx = e.wx;
   out->wy = e.wy;
   out->wz = e.wz;
+  out->stamp = stamp;
   out->r.prim = PR_INVALID_INDEX;
   out->r.w_sum = 0.0f;
   out->r.m = 0.0f;
@@ -107,7 +110,8 @@ PR_KERNEL void pt_resample(PR_PARAMS(PR_ARGS_PT_RESAMPLE_SPATIAL)) {
   float c_t = 0.0f;
   if (temporal) {
     q = rs_project(&prev_cam, x.h.p);
-    if (q != PR_INVALID_INDEX && (q < first || q >= end || history[q].prim == PR_INVALID_INDEX))
+    if (q != PR_INVALID_INDEX && (q < first || q >= end || history[q].stamp + 1u != stamp ||
+                                  history[q].prim == PR_INVALID_INDEX))
       q = PR_INVALID_INDEX;
     if (q != PR_INVALID_INDEX) c_t = fmin(history[q].r.m, rsp.max_m);
     if (!(c_t > 0.0f)) q = PR_INVALID_INDEX;

@@ -202,7 +202,8 @@
   X(PASS, IN, PathHistory, history)       \
   X(FRAME, OUT, PathHistory, history_out) \
   X(FRAME, VAL, CameraParams, prev_cam)   \
-  X(FRAME, IN, float, moved)
+  X(FRAME, IN, float, moved)              \
+  X(FRAME, VAL, uint, stamp)
 
 // ---- The film (kernels/accumulate.cl) ----
 

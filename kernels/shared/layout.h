@@ -127,6 +127,7 @@
   F(PathReservoir, w_sum)             \
   F(PathReservoir, sp)                \
   F(PathHistory, prim)                \
+  F(PathHistory, stamp)               \
   F(PathTrack, x1_ok)                 \
   F(PathTrack, pdf)                   \
   F(PathTrack, g_src)                 \

@@ -92,7 +92,7 @@ typedef struct {
   u32 prim, inst;  // x_1 (prim PR_INVALID_INDEX: none)
   float b1, b2;
   float wx, wy, wz;
-  u32 pad;
+  u32 stamp;  // the frame that wrote it, counted by its PathTracer (rows move between devices)
 } PathHistory;
 
 #define PR_RS_DEEP 0u  // the weight is in `rest` (t >= 3, or a delta light)

@@ -52,10 +52,13 @@ run "cornell-dynamic-pathtrace-lightbvh" scenes/cornell-dynamic.gltf --frames 0-
   --light-sampler bvh
 run "cornell-dynamic-pathtrace-power" scenes/cornell-dynamic.gltf --frames 0-1 --mode pathtrace \
   --light-sampler power
-# Path resampling across pixels: the paths' candidates in pt_shade and pt_shadow, pt_resample's
-# reconnections (an environment too, for the escaped paths' candidates).
-run "cornell-orbit-pathtrace-resample" scenes/cornell-orbit.gltf --frames 0 --mode pathtrace \
+# Path resampling across pixels and frames: the paths' candidates in pt_shade and pt_shadow,
+# pt_resample's reconnections (an environment too, for the escaped paths' candidates), and on the
+# second frame the previous frame's reservoirs: through a moving camera, and past moving objects.
+run "cornell-orbit-pathtrace-resample" scenes/cornell-orbit.gltf --frames 0-1 --mode pathtrace \
   --resample --env-color 0.4,0.5,0.6
+run "cornell-dynamic-pathtrace-resample" scenes/cornell-dynamic.gltf --frames 0-1 \
+  --mode pathtrace --resample
 # Resampled connections (two shadow rays per eye vertex).
 run "cornell-dynamic-reuse-ris" scenes/cornell-dynamic.gltf --frames 0-1 --mode reuse --connections 2 \
   --no-eye-paths

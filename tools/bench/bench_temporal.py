@@ -1,0 +1,143 @@
+"""Path resampling across frames, measured on animations: per frame relMSE against path-traced
+references, seconds per frame, flicker, and the equal-error speed-up over the path tracer, for
+the path tracer, `--resample` within each frame (`--resample-history 0`), `--resample` with the
+previous frames' paths (3 neighbours, the default, and 1), and `--mode reuse`.
+
+  /usr/bin/python3 -m tools.bench.bench_temporal                     # ~10-15 min on 2 cores
+  /usr/bin/python3 -m tools.bench.bench_temporal --scenes atrium --seeds 1
+
+The first --warm frames of each run are rendered and not measured: temporal reuse needs a few
+frames of history, as a user's sequence has after its start. Every figure is the median over
+seeds (each seed one process per setting and spp, settings interleaved); relMSE is exr_compare's
+and the equal-error time is interpolated in log-log over the spp sweep, as tools/bench/evaluate.py
+does. Needs numpy, hence /usr/bin/python3.
+"""
+
+import argparse
+import json
+import math
+import sys
+import tempfile
+from pathlib import Path
+
+from .benchlib import ATRIUM, REPO, median
+from .evaluation.metrics import LOWEST, flicker, interp_time
+from .evaluation.run import Runner, die, load_scenes, references, warm_up
+
+SETTINGS = {
+    "pathtrace": ("pathtrace", ()),
+    "resample, one frame": ("pathtrace", ("--resample", "--resample-history", "0")),
+    "resample": ("pathtrace", ("--resample",)),
+    "resample, 1 neighbour": ("pathtrace", ("--resample", "--resample-neighbors", "1")),
+    "reuse": ("reuse", ()),
+}
+
+
+def parse_args():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--scenes", default="atrium,cornell-dynamic,cornell-skinned")
+    ap.add_argument("--width", type=int, default=160)
+    ap.add_argument("--frames", type=int, default=12, help="frames per run, --warm included")
+    ap.add_argument("--warm", type=int, default=4, help="first frames rendered, not measured")
+    ap.add_argument("--spp", type=int, default=4, help="the path tracer's spp of the target error")
+    ap.add_argument("--sweep-spp", default="1,2,4,8")
+    ap.add_argument("--seeds", default="1,2,3")
+    ap.add_argument("--ref-spp", type=int, default=512)
+    ap.add_argument("--atrium-ref-spp", type=int, default=256)
+    ap.add_argument("--max-depth", type=int, default=8)
+    ap.add_argument("--atrium", default=str(ATRIUM), help="atrium glTF (generated if absent)")
+    ap.add_argument("--build", default="build", help="folder holding pathreuse and exr_compare")
+    ap.add_argument("--cache", default=str(REPO / "out" / "bench-temporal-cache"),
+                    help="reference frames, kept between runs")
+    ap.add_argument("--json", help="write the figures here too")
+    ap.add_argument("--quiet", action="store_true")
+    args = ap.parse_args()
+    args.sweep_spp = sorted({int(s) for s in args.sweep_spp.split(",")} | {args.spp})
+    args.seeds = [int(s) for s in args.seeds.split(",")]
+    if args.frames - args.warm < 2 or args.warm < 0:
+        die("--frames must exceed --warm by at least 2 (flicker needs frame pairs)")
+    # What load_scenes and Runner read.
+    args.atrium_frames = args.frames
+    args.timing_frames = args.atrium_timing_frames = args.frames
+    args.atrium_sweep_spp = args.sweep_spp
+    args.reuse_args = ""
+    build = Path(args.build) if Path(args.build).is_absolute() else REPO / args.build
+    args.exe, args.cmp = build / "pathreuse", build / "exr_compare"
+    for f in (args.exe, args.cmp):
+        if not f.is_file():
+            die(f"{f} not found; build first (tools/setup/build.sh)")
+    return args
+
+
+def measure(runner, sc, ref_exrs, refs, args):
+    """{setting: {spp: (relMSE, s/frame, flicker)}}, medians over seeds of the measured frames'
+    mean relMSE, median seconds and mean flicker."""
+    runs = {name: {s: [] for s in args.sweep_spp} for name in SETTINGS}
+    for seed in args.seeds:
+        for spp in args.sweep_spp:
+            for name, (mode, extra) in SETTINGS.items():
+                recs, imgs, _, diffs = runner.render(sc.path, mode, spp, seed, sc.frames[0],
+                                                     sc.frames[-1], extra=extra, refs=ref_exrs)
+                w = args.warm
+                e = sum(d["relmse"] for d in diffs[w:]) / len(diffs[w:])
+                t = median([r["wall_s"] for r in recs[w:]])
+                fl = [flicker(imgs[k - 1], imgs[k], refs[k - 1], refs[k])
+                      for k in range(w + 1, len(imgs))]
+                runs[name][spp].append((e, t, sum(fl) / len(fl)))
+    return {name: {s: tuple(median([r[i] for r in rs]) for i in range(3)) for s, rs in by.items()}
+            for name, by in runs.items()}
+
+
+def report(sc, fig, args):
+    """Markdown lines: the sweep, then the equal-error speed-up and flicker against the path
+    tracer at --spp."""
+    pt = fig["pathtrace"][args.spp]
+    target = pt[0]
+    lines = [f"### {sc.key} ({args.width} px wide, frames {args.warm}-{args.frames - 1} of "
+             f"0-{args.frames - 1} measured, seeds {','.join(map(str, args.seeds))})", "",
+             "| setting | " + " | ".join(f"spp {s}: relMSE, s/frame" for s in args.sweep_spp)
+             + f" | equal-error speed-up (target: path tracer at {args.spp} spp) "
+             f"| flicker at {args.spp} spp, / path tracer's |",
+             "|---|" + "---|" * (len(args.sweep_spp) + 2)]
+    out = {}
+    for name, by in fig.items():
+        pts = [(by[s][1], by[s][0]) for s in args.sweep_spp]
+        t, how = interp_time(pts, target)
+        sp = pt[1] / t if t else None
+        fl = by[args.spp][2] / pt[2] if pt[2] > 0 else math.nan
+        cells = [f"{by[s][0]:.4f}, {by[s][1]:.3f}" for s in args.sweep_spp]
+        sps = "not reached" if sp is None else f"{sp:.2f}x" + (" (at least)" if how == LOWEST else "")
+        lines.append(f"| {name} | " + " | ".join(cells) + f" | {sps} | {fl:.2f} |")
+        out[name] = {"points": {str(s): dict(zip(("relmse", "s_per_frame", "flicker"), by[s]))
+                                for s in args.sweep_spp},
+                     "equal_error_speedup": sp, "speedup_lower_bound": how == LOWEST,
+                     "flicker_ratio": fl}
+    return lines + [""], out
+
+
+def main():
+    args = parse_args()
+    scenes = load_scenes(args)
+    for sc in scenes:
+        if sc.key == "atrium":
+            sc.ref_spp = args.atrium_ref_spp
+    cache = Path(args.cache)
+    lines, out = [], {}
+    with tempfile.TemporaryDirectory(prefix="bench-temporal-") as tmp:
+        tmp = Path(tmp)
+        warm_up(args.exe, scenes, tmp)
+        runner = Runner(args, tmp)
+        for sc in scenes:
+            ref_exrs, refs, _ = references(runner, sc, cache)
+            fig = measure(runner, sc, ref_exrs, refs, args)
+            l, o = report(sc, fig, args)
+            lines += l
+            out[sc.key] = o
+            print("\n".join(l), flush=True)
+    if args.json:
+        Path(args.json).write_text(json.dumps(out, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
