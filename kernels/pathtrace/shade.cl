@@ -110,9 +110,9 @@ PR_INLINE void rs_offer_emission(PR_GLOBAL const PathTrack* t, PR_GLOBAL PathRes
                                  int escaped, float3 d, const RsKey* key) {
   const int t2 = rel == 2u && !(p->flags & PR_PATH_SPECULAR);
   const float3 rest = make_float3(t->rest_r, t->rest_g, t->rest_b) * le * (t2 ? 1.0f : w);
-  PathReservoir c =
-      rs_candidate(t, make_float3(t->f2_r, t->f2_g, t->f2_b), make_float3(t->wx, t->wy, t->wz),
-                   t->g_src, rest, t->pdf, t2 ? PR_RS_HIT2 : PR_RS_DEEP, pdf_light, p->last_pdf);
+  PathReservoir c;
+  rs_candidate(&c, t, make_float3(t->f2_r, t->f2_g, t->f2_b), make_float3(t->wx, t->wy, t->wz),
+               t->g_src, rest, t->pdf, t2 ? PR_RS_HIT2 : PR_RS_DEEP, pdf_light, p->last_pdf);
   if (escaped) rs_suffix_push(&c.suffix, c.sp, d, 1);
   rs_offer_keyed(r, &c, key, PR_RS_DIM(p->depth + 1u, 0u));
 }
@@ -153,27 +153,25 @@ PR_INLINE void rs_track_step(PR_GLOBAL PathTrack* t, const ResampleParams* rsp, 
 }
 
 // --resample: next-event estimation's path at vertex `rel` >= 1 beyond x_1, the candidate for
-// pt_shadow to offer if its shadow ray is unoccluded.
-// The light's point (at_infinity: its direction) ends the path's suffix.
-PR_INLINE PathReservoir rs_next_event(PR_GLOBAL const PathTrack* t, const ResampleParams* rsp,
-                                      uint rel, const SurfaceHit* h, const ShadingFrame* f,
-                                      float3 wo, float dist2, const NextEventChoice* ch,
-                                      int at_infinity) {
-  PathReservoir c;
+// pt_shadow to offer if its shadow ray is unoccluded, into *c. The light's point (at_infinity: its
+// direction) ends the path's suffix.
+PR_INLINE void rs_next_event(PathReservoir* c, PR_GLOBAL const PathTrack* t,
+                             const ResampleParams* rsp, uint rel, const SurfaceHit* h,
+                             const ShadingFrame* f, float3 wo, float dist2,
+                             const NextEventChoice* ch, int at_infinity) {
   if (rel == 1u) {
     const float g = rs_reconnectable(t->x1_ok, h, f, wo, dist2, ch->wi, rsp)
                         ? fabs(dot(h->ng, wo)) / dist2
                         : 0.0f;
-    c = rs_candidate(t, ch->fr_cos, ch->wi, g, ch->le, t->pdf * ch->pdf,
-                     ch->delta ? PR_RS_DEEP : PR_RS_NEE2, ch->pdf_light, ch->pdf_bsdf);
+    rs_candidate(c, t, ch->fr_cos, ch->wi, g, ch->le, t->pdf * ch->pdf,
+                 ch->delta ? PR_RS_DEEP : PR_RS_NEE2, ch->pdf_light, ch->pdf_bsdf);
   } else {
     const float w = ch->delta ? 1.0f : power_heuristic(ch->pdf_light, ch->pdf_bsdf);
     const float3 rest = make_float3(t->rest_r, t->rest_g, t->rest_b) * ch->fr_cos * ch->le * w;
-    c = rs_candidate(t, make_float3(t->f2_r, t->f2_g, t->f2_b), make_float3(t->wx, t->wy, t->wz),
-                     t->g_src, rest, t->pdf * ch->pdf, PR_RS_DEEP, 0.0f, 0.0f);
+    rs_candidate(c, t, make_float3(t->f2_r, t->f2_g, t->f2_b), make_float3(t->wx, t->wy, t->wz),
+                 t->g_src, rest, t->pdf * ch->pdf, PR_RS_DEEP, 0.0f, 0.0f);
   }
-  rs_suffix_push(&c.suffix, c.sp, at_infinity ? ch->wi : ch->pos, at_infinity);
-  return c;
+  rs_suffix_push(&c->suffix, c->sp, at_infinity ? ch->wi : ch->pos, at_infinity);
 }
 
 // A contribution as the radiance buffer holds it.
@@ -346,8 +344,10 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
         uint op = 0u;
         const uint rel_here = rsp.enabled && p.x1_depth ? p.depth - p.x1_depth : 0u;
         if (rel_here >= 1u) {  // to the reservoir, once pt_shadow finds it unoccluded
-          rs_pending[i] = rs_next_event(track, &rsp, rel_here, &h, &f, wo, dist2, &ch,
-                                        light_at_infinity(s.lights.lights[ch.light].type));
+          PathReservoir c_nee;
+          rs_next_event(&c_nee, track, &rsp, rel_here, &h, &f, wo, dist2, &ch,
+                        light_at_infinity(s.lights.lights[ch.light].type));
+          rs_pending[i] = c_nee;
           op = PR_RS_DIM(p.depth, 1u) + 1u;
         }
         pt_shadow_set(shadows + i, shadow, tp * c, op);

@@ -122,39 +122,38 @@ PR_INLINE void rs_offer_keyed(PR_GLOBAL PathReservoir* r, const PathReservoir* c
   rs_offer(r, c, rng_next(&rr));
 }
 
-// A candidate of the path tracked in t: x_2's factor f2 along w2 (g its segment's g_src), the
-// rest beyond, the path's density pdf from x_1 on; at t = 2 the light's and x_2's BSDF's pdfs of
-// w2 for its weight.
-PR_INLINE PathReservoir rs_candidate(PR_GLOBAL const PathTrack* t, float3 f2, float3 w2, float g,
-                                     float3 rest, float pdf, u32 kind, float pdf_light,
-                                     float pdf_bsdf) {
-  PathReservoir c;
-  c.prim = t->prim;
-  c.inst = t->inst;
-  c.b1 = t->b1;
-  c.b2 = t->b2;
-  c.wx = w2.x;
-  c.wy = w2.y;
-  c.wz = w2.z;
-  c.g_src = g;
-  c.rest_r = rest.x;
-  c.rest_g = rest.y;
-  c.rest_b = rest.z;
-  c.pdf_light = pdf_light;
+// A candidate of the path tracked in t, into *c: x_2's factor f2 along w2 (g its segment's
+// g_src), the rest beyond, the path's density pdf from x_1 on; at t = 2 the light's and x_2's
+// BSDF's pdfs of w2 for its weight. (Written through a pointer: a struct this large returned by
+// value leaves an LLVM intrinsic that Oclgrind cannot run.)
+PR_INLINE void rs_candidate(PathReservoir* c, PR_GLOBAL const PathTrack* t, float3 f2, float3 w2,
+                            float g, float3 rest, float pdf, u32 kind, float pdf_light,
+                            float pdf_bsdf) {
+  c->prim = t->prim;
+  c->inst = t->inst;
+  c->b1 = t->b1;
+  c->b2 = t->b2;
+  c->wx = w2.x;
+  c->wy = w2.y;
+  c->wz = w2.z;
+  c->g_src = g;
+  c->rest_r = rest.x;
+  c->rest_g = rest.y;
+  c->rest_b = rest.z;
+  c->pdf_light = pdf_light;
   // The weight of a t = 2 path is in its f, not in rest.
   const float w = rs_weight2(kind, pdf_light, pdf_bsdf);
   const float3 f = make_float3(t->f1_r, t->f1_g, t->f1_b) * f2 * rest * w;
-  c.f_r = f.x;
-  c.f_g = f.y;
-  c.f_b = f.z;
-  c.kind = kind;
-  c.p_hat = luminance(f);
-  c.w_sum = pdf > 0.0f ? c.p_hat / pdf : 0.0f;
-  c.m = 1.0f;
-  c.suffix = t->suffix;
-  for (int k = 0; k < 3 * PR_RS_SUFFIX; ++k) c.sp[k] = t->sp[k];
-  c.pad0 = c.pad1 = 0.0f;
-  return c;
+  c->f_r = f.x;
+  c->f_g = f.y;
+  c->f_b = f.z;
+  c->kind = kind;
+  c->p_hat = luminance(f);
+  c->w_sum = pdf > 0.0f ? c->p_hat / pdf : 0.0f;
+  c->m = 1.0f;
+  c->suffix = t->suffix;
+  for (int k = 0; k < 3 * PR_RS_SUFFIX; ++k) c->sp[k] = t->sp[k];
+  c->pad0 = c->pad1 = 0.0f;
 }
 
 // --- Temporal reuse ----------------------------------------------------------------------------
