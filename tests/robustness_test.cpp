@@ -155,6 +155,45 @@ TEST(Resume, FinishesARunBitForBitAsAnUninterruptedOne) {
   }
 }
 
+// --resample takes each frame's paths into the next: --resume keeps the last frame's beside its
+// EXR, so a run cut after frame 2 and resumed equals the uninterrupted one bit for bit. A history
+// that does not match (cut short, or of other options) is not used: the run starts afresh and
+// says so.
+TEST(Resume, GoesOnFromTheResampledPathsOfTheLastFrame) {
+  const std::string dir = test::tempDir("resume-rs");
+  const std::string base = "render '" + kScene +
+                           "' --exr-float --width 64 --height 48 --mode pathtrace --resample "
+                           "--resume";
+  const std::string common = base + " --spp 2";
+  auto r =
+      test::runPathreuse(common + " --quiet --frames 0-5 --out '" + dir + "/whole/f_%04d.exr'");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  r = test::runPathreuse(common + " --frames 0-2 --out '" + dir + "/cut/f_%04d.exr'");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  ASSERT_TRUE(fs::is_regular_file(dir + "/cut/f_0002.exr.history"));
+  EXPECT_FALSE(fs::exists(dir + "/cut/f_0001.exr.history"));  // only the last frame's is kept
+  r = test::runPathreuse(common + " --frames 0-5 --out '" + dir + "/cut/f_%04d.exr'");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.err.find("goes on from frame 2's resampled paths"), std::string::npos) << r.err;
+  char name[32];
+  for (int f = 0; f <= 5; ++f) {
+    std::snprintf(name, sizeof name, "/f_%04d.exr", f);
+    EXPECT_TRUE(samePixels(dir + "/whole" + name, dir + "/cut" + name)) << "frame " << f;
+  }
+  // Cut short: not used. Of another spp: not used either (its key differs).
+  const std::string history5 = dir + "/cut/f_0005.exr.history";
+  ASSERT_TRUE(fs::is_regular_file(history5));
+  fs::resize_file(history5, fs::file_size(history5) / 2);
+  r = test::runPathreuse(common + " --frames 0-6 --out '" + dir + "/cut/f_%04d.exr'");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.err.find("history starts afresh at frame 6"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(history5));
+  ASSERT_TRUE(fs::is_regular_file(dir + "/cut/f_0006.exr.history"));
+  r = test::runPathreuse(base + " --spp 3 --frames 0-7 --out '" + dir + "/cut/f_%04d.exr'");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.err.find("history starts afresh at frame 7"), std::string::npos) << r.err;
+}
+
 TEST(Resume, AFrameOfAnotherSizeIsRenderedAgain) {
   const std::string dir = test::tempDir("resize");
   const std::string common =

@@ -2,10 +2,14 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstring>
+#include <string>
+#include <vector>
 
 #include "cl/kernel_args.h"
 #include "shared/path_state.h"
 #include "util/check.h"
+#include "util/hash.h"
 #include "util/interrupt.h"
 
 namespace pr {
@@ -210,6 +214,72 @@ void PathTracer::tracePass(int sample, StageTimer* timer) {
       written_ = std::max(written_, sample + 1);
     }
   }
+}
+
+namespace {
+
+// The history file's header; the chains' records of the film's rows follow, then a checksum.
+struct HistoryHeader {
+  char magic[8];
+  uint64_t key;  // Hash128 of the caller's key
+  int32_t frame;
+  uint32_t stamp, chains, first, end, record;
+  dev::CameraParams camera;
+};
+
+constexpr char kHistoryMagic[8] = {'P', 'R', 'H', 'I', 'S', 'T', '1', '\0'};
+
+}  // namespace
+
+std::string PathTracer::writeHistory(const std::string& key) {
+  PR_CHECK(hasHistory());
+  HistoryHeader h{};
+  std::memcpy(h.magic, kHistoryMagic, sizeof h.magic);
+  h.key = Hash128().add(key).low();
+  h.frame = frame_;
+  h.stamp = stamp_;
+  h.chains = cl_uint(chains_);
+  h.first = film_.first();
+  h.end = film_.end();
+  h.record = sizeof(dev::PathHistory);
+  h.camera = camera_;
+  const size_t bytes = size_t(h.end - h.first) * h.record;
+  std::string out(sizeof h + bytes * history_.size() + sizeof(uint64_t), '\0');
+  std::memcpy(&out[0], &h, sizeof h);
+  Hash128 sum;
+  for (size_t c = 0; c < history_.size(); ++c) {
+    char* at = &out[sizeof h + c * bytes];
+    CL_CHECK(ctx_.queue().enqueueReadBuffer(history_[c], CL_TRUE, h.first * h.record, bytes, at));
+    sum.add(at, bytes);
+  }
+  const uint64_t check = sum.low();
+  std::memcpy(&out[out.size() - sizeof check], &check, sizeof check);
+  return out;
+}
+
+bool PathTracer::readHistory(const std::string& data, const std::string& key, int frame) {
+  HistoryHeader h{};
+  if (chains_ == 0 || data.size() < sizeof h) return false;
+  std::memcpy(&h, data.data(), sizeof h);
+  if (std::memcmp(h.magic, kHistoryMagic, sizeof h.magic) != 0 ||
+      h.key != Hash128().add(key).low() || h.frame != frame || h.chains != cl_uint(chains_) ||
+      h.first != film_.first() || h.end != film_.end() || h.record != sizeof(dev::PathHistory))
+    return false;
+  const size_t bytes = size_t(h.end - h.first) * h.record;
+  if (data.size() != sizeof h + bytes * history_.size() + sizeof(uint64_t)) return false;
+  Hash128 sum;
+  for (size_t c = 0; c < history_.size(); ++c) sum.add(data.data() + sizeof h + c * bytes, bytes);
+  uint64_t check = 0;
+  std::memcpy(&check, data.data() + data.size() - sizeof check, sizeof check);
+  if (sum.low() != check) return false;
+  for (size_t c = 0; c < history_.size(); ++c)
+    CL_CHECK(ctx_.queue().enqueueWriteBuffer(history_[c], CL_TRUE, h.first * h.record, bytes,
+                                             data.data() + sizeof h + c * bytes));
+  frame_ = h.frame;
+  stamp_ = h.stamp;
+  camera_ = h.camera;
+  written_ = chains_;
+  return true;
 }
 
 void PathTracer::reportRays(FrameStats* stats) {

@@ -4,6 +4,7 @@
 // with MIS, Russian roulette.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "cl/context.h"
@@ -43,6 +44,16 @@ class PathTracer : public Integrator {
   void tracePass(int sample, StageTimer* timer);
   // The rays the passes since beginFrame traced, into stats.
   void reportRays(FrameStats* stats);
+
+  // --resample's history between frames (docs/design.md section 5), so that a resumed run goes
+  // on as the uninterrupted one would: whether the last frame left one whole, and its bytes
+  // (a header, the chains' records of the film's rows, a checksum) or reading them back. `key`
+  // names everything else it depends on (scene, options); a history of another key, size or frame
+  // is not read (returns false). readHistory's frame is the frame that wrote it; the caller sets
+  // the scene to that frame's time before the next frame.
+  bool hasHistory() const { return chains_ > 0 && written_ >= chains_; }
+  std::string writeHistory(const std::string& key);
+  bool readHistory(const std::string& data, const std::string& key, int frame);
 
  private:
   dev::ResampleParams resampleParams() const;

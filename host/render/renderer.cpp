@@ -16,6 +16,7 @@
 
 #include "cl/context.h"
 #include "cl/device.h"
+#include "cl/kernel_sources.h"
 #include "io/image.h"
 #include "render/film.h"
 #include "render/gpu_scene.h"
@@ -211,12 +212,83 @@ void printSummary(const RenderOptions& o, const FrameRange& range, const Tally& 
               << t.badFrames << " frame(s)\n";
 }
 
+// --resume with --resample: the resampled paths' history of frame f, kept beside its EXR so that a
+// resumed run (or the next chunk of frames, where it starts after this one ended) goes on as one
+// uninterrupted run; one device only (rows move between devices).
+std::string historyPath(const RenderOptions& o, int f) {
+  return formatOutPath(o.outPattern, f) + ".history";
+}
+
+bool keepsHistory(const RenderOptions& o, const MultiDeviceSession& session) {
+  return o.resume && o.resample.enabled && o.resample.history > 0 && session.deviceCount() == 1;
+}
+
+// Everything a history depends on besides its frame and size: the scene file, the options that
+// change what a path is worth, and the kernels that made it.
+std::string historyKey(const RenderOptions& o) {
+  std::string scene;
+  readFile(o.scene, &scene);
+  const ResampleSettings& r = o.resample;
+  nlohmann::json j = {o.scene,
+                      o.spp,
+                      o.maxDepth,
+                      o.seed,
+                      o.fps,
+                      o.camera,
+                      o.forceDiffuse,
+                      int(o.materialModel),
+                      o.shadowTerminator,
+                      int(o.lightSampler),
+                      o.bvhWidth,
+                      o.fixedNoise,
+                      o.env,
+                      o.envColor,
+                      o.envStrength,
+                      o.envRotate,
+                      r.neighbors,
+                      r.radius,
+                      r.roughness,
+                      r.distance,
+                      r.history,
+                      o.allowOutsideUris};
+  return j.dump() + scene + expandKernelSource("pathtrace/shade.cl") +
+         expandKernelSource("pathtrace/resample.cl");
+}
+
+// Before a frame f whose previous frame this run did not render: the history frame f - 1 left,
+// if any.
+void readHistory(const RenderOptions& o, MultiDeviceSession& session, const std::string& key,
+                 int f) {
+  if (f == 0) return;
+  std::string data;
+  const bool read =
+      readFile(historyPath(o, f - 1), &data) && session.session(0).readHistory(data, key, f - 1);
+  if (!o.quiet)
+    std::cerr << (read ? "note: --resume: goes on from frame " + std::to_string(f - 1) +
+                             "'s resampled paths\n"
+                       : "note: --resume: the resampled paths' history starts afresh at frame " +
+                             std::to_string(f) +
+                             " (frames from here differ from an uninterrupted run's, unbiased)\n");
+}
+
+// After frame f is written: its history replaces the previous frame's.
+void writeHistory(const RenderOptions& o, MultiDeviceSession& session, const std::string& key,
+                  int f) {
+  if (session.session(0).hasHistory())
+    writeFileAtomic(historyPath(o, f), session.session(0).writeHistory(key));
+  std::error_code ec;
+  std::filesystem::remove(historyPath(o, f - 1), ec);
+}
+
 // Renders the session's frames in order, each written as soon as it is done.
 int renderFrames(const RenderOptions& o, MultiDeviceSession& session, const FrameRange& range,
                  StatsFile* stats) {
   const bool progress = !o.quiet && isatty(STDERR_FILENO);
   Tally t;
   int f = range.first;
+  const bool history = keepsHistory(o, session);
+  const std::string key = history ? historyKey(o) : std::string();
+  int lastRendered = -2;
   endLoadingPhase();  // a signal from here on finishes cleanly between launches
   for (; f <= range.last && !interrupted(); ++f) {
     const std::string exr = formatOutPath(o.outPattern, f);
@@ -228,6 +300,11 @@ int renderFrames(const RenderOptions& o, MultiDeviceSession& session, const Fram
         o.mode != RenderMode::PathTrace && !o.quiet)
       std::cerr << "note: --resume: the connection history starts afresh at frame " << f
                 << " (frames from here differ from an uninterrupted run's, unbiased)\n";
+    if (history && lastRendered != f - 1) readHistory(o, session, key, f);
+    if (!history && o.resample.enabled && o.resample.history > 0 && t.skipped > 0 &&
+        t.rendered == 0 && !o.quiet)  // several devices: not kept
+      std::cerr << "note: --resume: the resampled paths' history starts afresh at frame " << f
+                << " (frames from here differ from an uninterrupted run's, unbiased)\n";
     const auto t0 = std::chrono::steady_clock::now();
     FrameStats fs;
     std::vector<DeviceFrame> parts;
@@ -235,6 +312,8 @@ int renderFrames(const RenderOptions& o, MultiDeviceSession& session, const Fram
     if (interrupted()) break;  // the film may be partial: drop the frame
     writeExr(exr, img, o.exrFloat ? ExrPixels::Float : ExrPixels::Half);
     if (o.png) writePng(withExtension(exr, ".png"), img, o.exposure);
+    if (history) writeHistory(o, session, key, f);
+    lastRendered = f;
     ++t.rendered;
     fs.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     for (const auto& [k, v] : fs.rays) t.raysSoFar += v;
@@ -249,6 +328,11 @@ int renderFrames(const RenderOptions& o, MultiDeviceSession& session, const Fram
     if (progress) printProgress(range, t, f);
   }
   if (progress) std::fprintf(stderr, "\n");
+  // The animation's last frame has no next one to take its history.
+  if (history && f > range.last && range.last >= session.session(0).frameCount() - 1) {
+    std::error_code ec;
+    std::filesystem::remove(historyPath(o, range.last), ec);
+  }
   // A signal after the last frame changes nothing.
   if (interrupted() && f <= range.last) return reportInterrupt(o, range, f);
   if (!o.quiet) printSummary(o, range, t);

@@ -125,7 +125,9 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
     p.fixedNoise = o.fixedNoise;
     p.resample = o.resample;
     if (!(p.resample.distance > 0.0f)) p.resample.distance = 0.01f * gpu_->sceneRadius();
-    integrator_ = std::make_unique<PathTracer>(ctx_, *gpu_, *film_, p);
+    auto tracer = std::make_unique<PathTracer>(ctx_, *gpu_, *film_, p);
+    pathTracer_ = tracer.get();
+    integrator_ = std::move(tracer);
   } else {
     PathReuseSettings r;
     r.spp = o.spp;
@@ -145,6 +147,21 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
     r.fixedNoise = o.fixedNoise;
     integrator_ = std::make_unique<PathReuse>(ctx_, *gpu_, *film_, r);
   }
+}
+
+bool RenderSession::hasHistory() const {
+  return pathTracer_ && pathTracer_->hasHistory();
+}
+
+std::string RenderSession::writeHistory(const std::string& key) {
+  return pathTracer_->writeHistory(key);
+}
+
+bool RenderSession::readHistory(const std::string& data, const std::string& key, int frame) {
+  if (!pathTracer_ || !pathTracer_->readHistory(data, key, frame)) return false;
+  // What moved between that frame and the next is measured from that frame's scene.
+  gpu_->setTime(frame / options_.fps);
+  return true;
 }
 
 FrameRange RenderSession::frameRange() const {

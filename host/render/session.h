@@ -4,6 +4,7 @@
 #pragma once
 
 #include <memory>
+#include <string>
 
 #include "cl/context.h"
 #include "cl/device.h"
@@ -15,6 +16,8 @@
 #include "scene/scene.h"
 
 namespace pr {
+
+class PathTracer;
 
 // Checks the options that do not need the scene; throws InputError naming the option.
 void validateRenderOptions(const RenderOptions& o);
@@ -42,6 +45,13 @@ class RenderSession {
   // path reuse cover every slot whatever the rows (render/multi_device.h).
   void setRows(int rowBegin, int rowEnd) { film_->setRows(rowBegin, rowEnd); }
 
+  // --resample's history between frames (render/path_tracer.h): whether the last frame left
+  // one, its bytes, and reading the one frame `frame` wrote (which also sets the scene to
+  // that frame's time, so that the next frame finds what moved since, as it would have).
+  bool hasHistory() const;
+  std::string writeHistory(const std::string& key);
+  bool readHistory(const std::string& data, const std::string& key, int frame);
+
   int width() const { return width_; }
   int height() const { return height_; }
   Context& context() { return ctx_; }
@@ -60,6 +70,7 @@ class RenderSession {
   std::unique_ptr<GpuScene> gpu_;
   std::unique_ptr<Film> film_;
   std::unique_ptr<Integrator> integrator_;
+  PathTracer* pathTracer_ = nullptr;  // integrator_, where it is the path tracer
 };
 
 }  // namespace pr

@@ -48,6 +48,20 @@ PR_INLINE float rs_target_at(const SceneData* s, const RsPrimary* x,
   return p;
 }
 
+// The kept path r as this pixel's, into out: its f, target p and segment's g here, the
+// reservoir's sum of weights and confidence.
+PR_INLINE void rs_keep(__global PathReservoir* out, __global const PathReservoir* r, float3 f,
+                       float p, float g, float w_sum, float m) {
+  *out = *r;
+  out->f_r = f.x;
+  out->f_g = f.y;
+  out->f_b = f.z;
+  out->g_src = g;
+  out->p_hat = p;
+  out->w_sum = w_sum;
+  out->m = m;
+}
+
 PR_INLINE int rs_has_path(__global const PathReservoir* r) {
   return r->prim != PR_INVALID_INDEX && r->w_sum > 0.0f && r->p_hat > 0.0f;
 }
@@ -181,13 +195,5 @@ PR_KERNEL void pt_resample(PR_PARAMS(PR_ARGS_PT_RESAMPLE_SPATIAL)) {
   const float3 c = x.tp * f_kept * (w_sum / p_kept);
   if (!(max3(c) < PR_INF_F)) return;
   radiance[j] += (float4)(c.x, c.y, c.z, 0.0f);
-  // The kept path as this pixel's: its f, target and segment here, the reservoir's weights.
-  out->r = *kept;
-  out->r.f_r = f_kept.x;
-  out->r.f_g = f_kept.y;
-  out->r.f_b = f_kept.z;
-  out->r.g_src = g_kept;
-  out->r.p_hat = p_kept;
-  out->r.w_sum = w_sum;
-  out->r.m = total;
+  rs_keep(&out->r, kept, f_kept, p_kept, g_kept, w_sum, total);
 }

@@ -174,6 +174,22 @@ PR_INLINE void rs_next_event(PathReservoir* c, PR_GLOBAL const PathTrack* t,
   rs_suffix_push(&c->suffix, c->sp, at_infinity ? ch->wi : ch->pos, at_infinity);
 }
 
+// --resample: next-event estimation at vertex `rel` beyond x_1 (depth: the path's), to the
+// reservoir once pt_shadow finds it unoccluded where rel >= 1: its candidate into *pending, and
+// the shadow ray's op (1 + the random dimension that offers it; 0: into the radiance).
+PR_INLINE uint rs_next_event_pending(const SceneData* s, PR_GLOBAL const PathTrack* t,
+                                     PR_GLOBAL PathReservoir* pending, const ResampleParams* rsp,
+                                     uint rel, uint depth, const SurfaceHit* h,
+                                     const ShadingFrame* f, float3 wo, float dist2,
+                                     const NextEventChoice* ch) {
+  if (rel < 1u) return 0u;
+  PathReservoir c;
+  rs_next_event(&c, t, rsp, rel, h, f, wo, dist2, ch,
+                light_at_infinity(s->lights.lights[ch->light].type));
+  *pending = c;
+  return PR_RS_DIM(depth, 1u) + 1u;
+}
+
 // A contribution as the radiance buffer holds it.
 PR_INLINE float4 pt_rgb(float3 c) {
   return (float4)(c.x, c.y, c.z, 0.0f);
@@ -341,15 +357,9 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
           c = c * pt_next_event_weight(&s, &p, &h, &f, &ch, has_rev, dist2, light_paths, trace_cdf,
                                        trace_total);
         }
-        uint op = 0u;
         const uint rel_here = rsp.enabled && p.x1_depth ? p.depth - p.x1_depth : 0u;
-        if (rel_here >= 1u) {  // to the reservoir, once pt_shadow finds it unoccluded
-          PathReservoir c_nee;
-          rs_next_event(&c_nee, track, &rsp, rel_here, &h, &f, wo, dist2, &ch,
-                        light_at_infinity(s.lights.lights[ch.light].type));
-          rs_pending[i] = c_nee;
-          op = PR_RS_DIM(p.depth, 1u) + 1u;
-        }
+        const uint op = rs_next_event_pending(&s, track, rs_pending + i, &rsp, rel_here, p.depth,
+                                              &h, &f, wo, dist2, &ch);
         pt_shadow_set(shadows + i, shadow, tp * c, op);
         out = PR_SHADE_SHADOW;
       }
