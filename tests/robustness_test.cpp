@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -25,6 +26,8 @@
 #include "support/background.h"
 #include "support/test_env.h"
 #include "util/error.h"
+#include "util/files.h"
+#include "util/hash.h"
 
 namespace pr {
 namespace {
@@ -180,18 +183,37 @@ TEST(Resume, GoesOnFromTheResampledPathsOfTheLastFrame) {
     std::snprintf(name, sizeof name, "/f_%04d.exr", f);
     EXPECT_TRUE(samePixels(dir + "/whole" + name, dir + "/cut" + name)) << "frame " << f;
   }
-  // Cut short: not used. Of another spp: not used either (its key differs).
+  // Not used: a record naming a triangle the scene lacks (its checksum made right), a file cut
+  // short, or one of another spp (its key differs). Each time the next frame starts afresh.
+  const auto refused = [&](int f, const std::string& extra, const char* why) {
+    SCOPED_TRACE(why);
+    r = test::runPathreuse(base + extra + " --frames 0-" + std::to_string(f) + " --out '" + dir +
+                           "/cut/f_%04d.exr'");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.err.find("history starts afresh at frame " + std::to_string(f)), std::string::npos)
+        << r.err;
+  };
+  std::string bytes;
   const std::string history5 = dir + "/cut/f_0005.exr.history";
-  ASSERT_TRUE(fs::is_regular_file(history5));
-  fs::resize_file(history5, fs::file_size(history5) / 2);
-  r = test::runPathreuse(common + " --frames 0-6 --out '" + dir + "/cut/f_%04d.exr'");
-  ASSERT_EQ(r.exitCode, 0) << r.err;
-  EXPECT_NE(r.err.find("history starts afresh at frame 6"), std::string::npos) << r.err;
+  ASSERT_TRUE(readFile(history5, &bytes));
+  const size_t records = 2 * 64 * 48, record = 192;  // 2 chains (spp) of a record per pixel
+  ASSERT_GT(bytes.size(), records * record + 8);
+  const size_t head = bytes.size() - 8 - records * record;
+  size_t k = 0;
+  while (k < records && bytes.compare(head + k * record, 4, std::string(4, '\xff')) == 0) ++k;
+  ASSERT_LT(k, records) << "no record keeps a path";
+  const uint32_t bad = 0x7ffffff0u;  // r.prim: the record's first field
+  std::memcpy(&bytes[head + k * record], &bad, sizeof bad);
+  const uint64_t sum = Hash128().add(bytes.data() + head, records * record).low();
+  std::memcpy(&bytes[bytes.size() - 8], &sum, sizeof sum);
+  writeFileAtomic(history5, bytes);
+  refused(6, " --spp 2", "a triangle out of range");
+  const std::string history6 = dir + "/cut/f_0006.exr.history";
+  ASSERT_TRUE(fs::is_regular_file(history6));
   EXPECT_FALSE(fs::exists(history5));
-  ASSERT_TRUE(fs::is_regular_file(dir + "/cut/f_0006.exr.history"));
-  r = test::runPathreuse(base + " --spp 3 --frames 0-7 --out '" + dir + "/cut/f_%04d.exr'");
-  ASSERT_EQ(r.exitCode, 0) << r.err;
-  EXPECT_NE(r.err.find("history starts afresh at frame 7"), std::string::npos) << r.err;
+  fs::resize_file(history6, fs::file_size(history6) / 2);
+  refused(7, " --spp 2", "cut short");
+  refused(8, " --spp 3", "another spp");
 }
 
 TEST(Resume, AFrameOfAnotherSizeIsRenderedAgain) {

@@ -295,6 +295,15 @@ void GpuScene::collectMovedBoxes(const std::vector<accel::Aabb>& before) {
   }
 }
 
+bool GpuScene::validSurface(uint32_t prim, uint32_t inst) const {
+  if (inst == PR_INVALID_INDEX) return prim < staticTriangles_;
+  if (inst >= scene_.instances.size()) return false;
+  const uint32_t mesh = scene_.instances[inst].mesh;
+  if (mesh >= scene_.dynamicMeshes.size()) return false;
+  const uint32_t first = meshFirstTriangle_[mesh];
+  return prim >= first && prim - first < scene_.dynamicMeshes[mesh].triangleCount();
+}
+
 bool GpuScene::anyLightMoved() const {
   return std::any_of(lights_.begin(), lights_.end(), [](const dev::Light& l) { return l.moved; });
 }

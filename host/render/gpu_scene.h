@@ -63,6 +63,9 @@ class GpuScene {
   uint32_t environmentLight() const;
   glm::vec3 sceneCentre() const { return sceneCentre_; }
 
+  // Whether (prim, inst) names a triangle of this scene as hits do (inst PR_INVALID_INDEX: the
+  // SSG's; else one of that instance's mesh).
+  bool validSurface(uint32_t prim, uint32_t inst) const;
   const Scene& scene() const { return scene_; }
   const std::vector<dev::Light>& lights() const { return lights_; }
   const std::vector<dev::ShadingInstance>& instances() const { return instances_; }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -229,6 +230,21 @@ struct HistoryHeader {
 
 constexpr char kHistoryMagic[8] = {'P', 'R', 'H', 'I', 'S', 'T', '1', '\0'};
 
+// A record the kernels can read safely: its surfaces in the scene, its numbers finite.
+bool validRecord(const dev::PathHistory& h, const GpuScene& scene) {
+  const dev::PathReservoir& r = h.r;
+  const float nums[] = {h.b1,        h.b2,  h.wx,  h.wy,    h.wz,     r.b1,     r.b2,
+                        r.wx,        r.wy,  r.wz,  r.g_src, r.rest_r, r.rest_g, r.rest_b,
+                        r.pdf_light, r.f_r, r.f_g, r.f_b,   r.p_hat,  r.w_sum,  r.m};
+  for (float x : nums)
+    if (!std::isfinite(x)) return false;
+  for (float x : r.sp)
+    if (!std::isfinite(x)) return false;
+  if ((r.suffix & PR_RS_COUNT_MASK) > PR_RS_SUFFIX) return false;
+  if (h.prim != PR_INVALID_INDEX && !scene.validSurface(h.prim, h.inst)) return false;
+  return r.prim == PR_INVALID_INDEX || scene.validSurface(r.prim, r.inst);
+}
+
 }  // namespace
 
 std::string PathTracer::writeHistory(const std::string& key) {
@@ -272,6 +288,11 @@ bool PathTracer::readHistory(const std::string& data, const std::string& key, in
   uint64_t check = 0;
   std::memcpy(&check, data.data() + data.size() - sizeof check, sizeof check);
   if (sum.low() != check) return false;
+  for (size_t k = 0; k < bytes * history_.size(); k += h.record) {
+    dev::PathHistory rec;
+    std::memcpy(&rec, data.data() + sizeof h + k, sizeof rec);
+    if (!validRecord(rec, scene_)) return false;
+  }
   for (size_t c = 0; c < history_.size(); ++c)
     CL_CHECK(ctx_.queue().enqueueWriteBuffer(history_[c], CL_TRUE, h.first * h.record, bytes,
                                              data.data() + sizeof h + c * bytes));
