@@ -45,6 +45,8 @@ PathTracer::PathTracer(Context& ctx, GpuScene& scene, Film& film,
   rsTrack_ = alloc("path tracks", rsPixels * sizeof(dev::PathTrack));
   rsRes_ = alloc("path reservoirs", rsPixels * sizeof(dev::PathReservoir));
   rsPending_ = alloc("path candidates", rsPixels * sizeof(dev::PathReservoir));
+  diRes_ = alloc("direct light reservoirs", rsPixels * sizeof(dev::DirectReservoir));
+  diPending_ = alloc("direct light candidates", rsPixels * sizeof(dev::DirectReservoir));
   if (settings.resample.enabled) {
     rsEye_ = alloc("eye vertices", n * sizeof(dev::EyeVertex));
     historyOut_ = alloc("path history", n * sizeof(dev::PathHistory));
@@ -127,6 +129,8 @@ void PathTracer::beginFrame(int frame, const dev::CameraParams& camera,
   shadeArgs_.rs_track = rsTrack_;
   shadeArgs_.rs_res = rsRes_;
   shadeArgs_.rs_pending = rsPending_;
+  shadeArgs_.di_res = diRes_;
+  shadeArgs_.di_pending = diPending_;
   shadeArgs_.set(shade_, kargs::kScene | kargs::kFrame);
   kargs::setScene(&shadowArgs_, sceneArgs);
   shadowArgs_.radiance = radiance;
@@ -138,12 +142,15 @@ void PathTracer::beginFrame(int frame, const dev::CameraParams& camera,
   shadowArgs_.resample = rsp.enabled;
   shadowArgs_.rs_res = rsRes_;
   shadowArgs_.rs_pending = rsPending_;
+  shadowArgs_.di_res = diRes_;
+  shadowArgs_.di_pending = diPending_;
   shadowArgs_.set(shadow_, kargs::kScene | kargs::kFrame);
   if (settings_.resample.enabled) {
     kargs::setScene(&resampleArgs_, sceneArgs);
     resampleArgs_.rsp = rsp;
     resampleArgs_.eye = eyeOut;
     resampleArgs_.rs_res = rsRes_;
+    resampleArgs_.di_res = diRes_;
     resampleArgs_.radiance = radiance;
     resampleArgs_.seed = settings_.seed;
     resampleArgs_.frame = rngFrame;
@@ -166,6 +173,7 @@ void PathTracer::beginFrame(int frame, const dev::CameraParams& camera,
   generateArgs_.write_eye = settings_.lightPaths > 0 || settings_.resample.enabled ? 1 : 0;
   generateArgs_.resample = rsp.enabled;
   generateArgs_.rs_res = rsRes_;
+  generateArgs_.di_res = diRes_;
   generateArgs_.queue = queues_[0];
   generateArgs_.first = film_.first();
   generateArgs_.set(generate_);
@@ -232,6 +240,11 @@ constexpr char kHistoryMagic[8] = {'P', 'R', 'H', 'I', 'S', 'T', '1', '\0'};
 
 // A record the kernels can read safely: its surfaces in the scene, its numbers finite.
 bool validRecord(const dev::PathHistory& h, const GpuScene& scene) {
+  const dev::DirectReservoir& d = h.d;
+  const float direct[] = {d.b1, d.b2, d.wx, d.wy, d.wz, d.f_r, d.f_g, d.f_b, d.p_hat, d.w_sum, d.m};
+  for (float x : direct)
+    if (!std::isfinite(x)) return false;
+  if (d.light != PR_INVALID_INDEX && d.light >= scene.lights().size()) return false;
   const dev::PathReservoir& r = h.r;
   const float nums[] = {h.b1,        h.b2,  h.wx,  h.wy,    h.wz,     r.b1,     r.b2,
                         r.wx,        r.wy,  r.wz,  r.g_src, r.rest_r, r.rest_g, r.rest_b,

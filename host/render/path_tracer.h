@@ -76,7 +76,7 @@ class PathTracer : public Integrator {
   cl::Buffer noEye_;        // the eye-vertex argument when nothing is written there
   // --resample: each path's candidates as it goes, its sample's reservoir, next-event
   // estimation's candidate until pt_shadow, and x_1 (when the caller gives no eye buffer).
-  cl::Buffer rsTrack_, rsRes_, rsPending_, rsEye_;
+  cl::Buffer rsTrack_, rsRes_, rsPending_, rsEye_, diRes_, diPending_;
   // Temporal reuse: pass s < chains_ keeps its final reservoirs in history_[s] for pass s of the
   // next frame (pt_resample writes historyOut_, copied there): chains_ = spp as far as 1 GiB
   // allows; later passes resample within the frame alone.

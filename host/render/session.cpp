@@ -158,10 +158,11 @@ std::string RenderSession::writeHistory(const std::string& key) {
 }
 
 bool RenderSession::readHistory(const std::string& data, const std::string& key, int frame) {
-  if (!pathTracer_ || !pathTracer_->readHistory(data, key, frame)) return false;
-  // What moved between that frame and the next is measured from that frame's scene.
+  if (!pathTracer_) return false;
+  // What moved between that frame and the next is measured from that frame's scene, whose light
+  // table the records are checked against.
   gpu_->setTime(frame / options_.fps);
-  return true;
+  return pathTracer_->readHistory(data, key, frame);
 }
 
 FrameRange RenderSession::frameRange() const {

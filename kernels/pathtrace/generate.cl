@@ -1,7 +1,7 @@
 // pt_generate: one work-item per pixel. Reads the camera; writes a fresh PathState with the
 // camera ray through a jittered point of the pixel (random dimensions 0 and 1), and zero radiance;
 // with write_eye (--eye-paths, --resample), marks the sample's EyeVertex empty, and with
-// resample its reservoir. Every path is live: the first
+// resample its reservoirs. Every path is live: the first
 // bounce's queue lists them all (pixel `first` on, in order).
 #include "shared/arena.h"
 #include "shared/bvh.h"
@@ -13,8 +13,14 @@ PR_KERNEL void pt_generate(PR_PARAMS(PR_ARGS_PT_GENERATE)) {
   const uint i = (uint)get_global_id(0);
   if (i >= count) return;
   Rng rng = rng_make(seed, PR_RNG_CAMERA, frame, i, sample);
+  // With resample, sample `sample`'s point in the pixel is the same in every frame (as Cycles'
+  // without an animated seed): where nothing moved, its x_1 is then the previous frame's, whose
+  // paths the temporal shift takes unchanged. Its other numbers change with the frame.
+  Rng at = resample ? rng_make(seed, PR_RNG_CAMERA, 0u, i, sample) : rng;
+  const float2 jitter = rng_next2(&at);
+  rng_skip(&rng, 1u);
   PathState s;
-  s.ray = camera_ray(&cam, i, rng_next2(&rng));
+  s.ray = camera_ray(&cam, i, jitter);
   s.tp_r = s.tp_g = s.tp_b = 1.0f;
   s.last_pdf = 0.0f;
   s.depth = 0u;
@@ -37,6 +43,8 @@ PR_KERNEL void pt_generate(PR_PARAMS(PR_ARGS_PT_GENERATE)) {
   if (resample) {                                 // an empty reservoir (shared/resample.h)
     rs_res[i].prim = PR_INVALID_INDEX;
     rs_res[i].w_sum = 0.0f;
+    di_res[i].light = PR_INVALID_INDEX;
+    di_res[i].w_sum = 0.0f;
   }
   queue[i - first] = i;
 }

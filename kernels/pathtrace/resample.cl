@@ -1,19 +1,21 @@
-// pt_resample (--resample): one work-item per pixel of the film's rows [first, end). Its sample's
-// reservoir (the canonical one: a path of its own eye path, chosen by pt_shade and pt_shadow) is
-// merged with those of rsp.neighbors pixels within rsp.radius and, with `temporal`, with the
-// previous frame's final reservoir at the pixel where x_1 was then seen. Each path is moved to
-// this pixel's x_1 by reconnection (shared/resample.h) and weighed by pairwise MIS with
-// confidences (shared/mis.h) against the canonical one: the other domain's path needs this
-// pixel's target at it (one shadow ray), and the canonical path the other domain's target at it
-// (one more). The previous frame's paths are taken only where nothing that moved comes near
-// them (rs_temporal_ok), the same test both ways. The kept path's f W, times the camera's weight
-// of x_1, goes into the sample's radiance, and the reservoir, with x_1, to history_out for the
-// next frame, stamped with `stamp` (the previous frame's record counts only if its stamp is one
-// less: a device's rows move between frames). Neighbours outside [first, end) or without an x_1
-// are domains that make no paths here and are left out, which keeps the weights a partition of
-// unity.
+// pt_resample (--resample): one work-item per pixel of the film's rows [first, end). Its
+// sample's two reservoirs, the paths' (shared/resample.h) and x_1's direct light's
+// (shared/resample_direct.h), are each merged with those of rsp.neighbors pixels within
+// rsp.radius and, with `temporal`, with the previous frame's final reservoir at the pixel where
+// x_1 was then seen. The pixel's own reservoir is the canonical one. A path is moved to this
+// pixel's x_1 by reconnection, a light's point unchanged (Jacobian 1), and weighed by pairwise
+// MIS with confidences (shared/mis.h) against the canonical sample: the other domain's sample
+// needs this pixel's target at it (one shadow ray), and the canonical sample the other domain's
+// target at it (one more). The previous frame's samples are taken only where nothing that moved
+// comes near them (rs_temporal_ok, di_temporal_ok), the same test both ways. Each kept sample's
+// f W, times the camera's weight of x_1, goes into the sample's radiance, and the reservoirs,
+// with x_1, to history_out for the next frame, stamped with `stamp` (the previous frame's record
+// counts only if its stamp is one less: a device's rows move between frames). Neighbours outside
+// [first, end) or without an x_1 are domains that make no samples here and are left out, which
+// keeps the weights a partition of unity.
 #include "shared/path_state.h"
 #include "shared/resample.h"
+#include "shared/resample_direct.h"
 
 #define PR_RS_MAX_NEIGHBORS 16  // --resample-neighbors at most
 
@@ -83,29 +85,154 @@ PR_INLINE EyeVertex rs_history_eye(__global const PathHistory* h) {
   return e;
 }
 
+// Where a merge stands: the sum of resampling weights, the canonical sample's MIS terms and the
+// sample kept (PR_RS_KEPT_*, or its domain), with its f and target here (and, for a path, its new
+// segment's g).
+typedef struct {
+  float w_sum, canon;
+  float3 f;
+  float p, g;
+  uint kept;
+} RsMerge;
+
+#define PR_RS_KEPT_NONE 0xffffffffu
+#define PR_RS_KEPT_CANONICAL 0xfffffffeu
+
+PR_INLINE RsMerge rs_merge_begin(void) {
+  RsMerge m;
+  m.w_sum = m.canon = m.p = m.g = 0.0f;
+  m.f = make_float3(0.0f, 0.0f, 0.0f);
+  m.kept = PR_RS_KEPT_NONE;
+  return m;
+}
+
+// Offers a sample of resampling weight w (f, target p and g here; domain d) to merge mg.
+PR_INLINE void rs_merge_take(RsMerge* mg, float w, float u, float3 f, float p, float g, uint d) {
+  if (!(w > 0.0f) || !(w < PR_INF_F)) return;
+  mg->w_sum += w;
+  if (!ris_accept(u, mg->w_sum, w)) return;
+  mg->f = f;
+  mg->p = p;
+  mg->g = g;
+  mg->kept = d;
+}
+
+// Domain d's path ri (confidence c_i; past: the previous frame's, seen from xi) into mg, and the
+// canonical path rc's MIS term against that domain. same: xi is x (the previous frame's x_1 is
+// this one's): the shift is then the identity both ways, and where the path meets nothing that
+// moved, its target, f and g are the ones it keeps (its segments seen clear when it was made).
+PR_INLINE void rs_merge_path(const SceneData* s, const RsPrimary* x, const RsPrimary* xi,
+                             __global const PathReservoir* rc, __global const PathReservoir* ri,
+                             int past, int same, float c_i, float kf, float total, float u, uint d,
+                             __global const float* moved, const ResampleParams* rsp, RsMerge* mg,
+                             uint* traced) {
+  const int has_c = rs_has_path(rc);
+  if (rs_has_path(ri) &&
+      (!past || rs_temporal_ok(s, moved, rsp->moved_count, ri, xi->h.p, x->h.p))) {
+    float3 f = make_float3(ri->f_r, ri->f_g, ri->f_b);
+    float g = ri->g_src, jac = 1.0f;
+    const float p = same ? ri->p_hat : rs_target_at(s, x, ri, rsp, &f, &g, &jac, traced);
+    if (p > 0.0f && jac > 0.0f) {
+      const float m = mis_pairwise_neighbor(c_i, ri->p_hat / jac, 1.0f, p, kf, total);
+      rs_merge_take(mg, gris_weight(m, p, ri->w_sum / ri->p_hat * jac), u, f, p, g, d);
+    }
+  }
+  float p_back = 0.0f;
+  if (has_c && (!past || rs_temporal_ok(s, moved, rsp->moved_count, rc, xi->h.p, x->h.p))) {
+    float3 f;
+    float g, jac = 1.0f;
+    const float p = same ? rc->p_hat : rs_target_at(s, xi, rc, rsp, &f, &g, &jac, traced);
+    p_back = p * jac;
+  }
+  mg->canon += mis_pairwise_canonical_term(c_i, p_back, 1.0f, has_c ? rc->p_hat : 0.0f, kf, total);
+}
+
+// The same for the direct light's reservoirs (Jacobian 1).
+PR_INLINE void rs_merge_direct(const SceneData* s, const RsPrimary* x, const RsPrimary* xi,
+                               __global const DirectReservoir* dc,
+                               __global const DirectReservoir* di, int past, int same, float c_i,
+                               float kf, float total, float u, uint d, __global const float* moved,
+                               uint moved_count, RsMerge* mg, uint* traced) {
+  const int has_c = di_has_light(dc);
+  if (di_has_light(di) && (!past || di_temporal_ok(s, moved, moved_count, di, xi->h.p, x->h.p))) {
+    float3 f = make_float3(di->f_r, di->f_g, di->f_b);
+    const float p = same ? di->p_hat : di_target_at(s, x, di, &f, traced);
+    if (p > 0.0f) {
+      const float m = mis_pairwise_neighbor(c_i, di->p_hat, 1.0f, p, kf, total);
+      rs_merge_take(mg, gris_weight(m, p, di->w_sum / di->p_hat), u, f, p, 0.0f, d);
+    }
+  }
+  float p_back = 0.0f;
+  if (has_c && (!past || di_temporal_ok(s, moved, moved_count, dc, xi->h.p, x->h.p))) {
+    float3 f;
+    p_back = same ? dc->p_hat : di_target_at(s, xi, dc, &f, traced);
+  }
+  mg->canon += mis_pairwise_canonical_term(c_i, p_back, 1.0f, has_c ? dc->p_hat : 0.0f, kf, total);
+}
+
+// The canonical sample (target p_c, sum of weights w_c, f at its own pixel) into mg, once every
+// domain's term is in; `domains` of them.
+PR_INLINE void rs_merge_canonical(RsMerge* mg, float p_c, float w_c, float3 f, float g,
+                                  uint domains, float total, float u) {
+  const float m = domains ? mis_pairwise_canonical(mg->canon, 1.0f, total) : 1.0f;
+  rs_merge_take(mg, gris_weight(m, p_c, w_c / p_c), u, f, p_c, g, PR_RS_KEPT_CANONICAL);
+}
+
+// A merge's kept sample's share of the radiance: f W times the camera's weight of x_1.
+PR_INLINE void rs_merge_add(const RsMerge* mg, float3 tp, __global float4* radiance) {
+  const float3 c = tp * mg->f * (mg->w_sum / mg->p);
+  if (max3(c) < PR_INF_F) *radiance += (float4)(c.x, c.y, c.z, 0.0f);
+}
+
+// The history record of pixel j's sample: its x_1 and stamp, with empty reservoirs.
+PR_INLINE void rs_history_start(__global PathHistory* out, const EyeVertex* e, uint stamp) {
+  out->prim = e->prim;
+  out->inst = e->inst;
+  out->b1 = e->b1;
+  out->b2 = e->b2;
+  out->wx = e->wx;
+  out->wy = e->wy;
+  out->wz = e->wz;
+  out->stamp = stamp;
+  out->r.prim = PR_INVALID_INDEX;
+  out->r.w_sum = 0.0f;
+  out->r.m = 0.0f;
+  out->d.light = PR_INVALID_INDEX;
+  out->d.w_sum = 0.0f;
+  out->d.m = 0.0f;
+}
+
+// Whether two eye vertices are the same x_1 seen the same way.
+PR_INLINE int rs_same_eye(const EyeVertex* a, const EyeVertex* b) {
+  return a->prim == b->prim && a->inst == b->inst && a->b1 == b->b1 && a->b2 == b->b2 &&
+         a->wx == b->wx && a->wy == b->wy && a->wz == b->wz;
+}
+
+// The previous frame's record that this pixel's x_1 (at p) continues, or PR_INVALID_INDEX.
+PR_INLINE uint rs_history_pixel(const CameraParams* prev_cam, float3 p, uint first, uint end,
+                                __global const PathHistory* history, uint stamp) {
+  const uint q = rs_project(prev_cam, p);
+  if (q == PR_INVALID_INDEX || q < first || q >= end || history[q].stamp + 1u != stamp ||
+      history[q].prim == PR_INVALID_INDEX)
+    return PR_INVALID_INDEX;
+  return q;
+}
+
 PR_KERNEL void pt_resample(PR_PARAMS(PR_ARGS_PT_RESAMPLE_SPATIAL)) {
   const uint j = (uint)get_global_id(0) + first;
   if (j >= end) return;
   const EyeVertex e = eye[j];
   __global PathHistory* out = history_out + j;
-  out->prim = e.prim;
-  out->inst = e.inst;
-  out->b1 = e.b1;
-  out->b2 = e.b2;
-  out->wx = e.wx;
-  out->wy = e.wy;
-  out->wz = e.wz;
-  out->stamp = stamp;
-  out->r.prim = PR_INVALID_INDEX;
-  out->r.w_sum = 0.0f;
-  out->r.m = 0.0f;
+  rs_history_start(out, &e, stamp);
   if (e.prim == PR_INVALID_INDEX) return;  // no x_1: nothing was resampled
   const SceneData s = PR_SCENE();
   __global const PathReservoir* rc = rs_res + j;
+  __global const DirectReservoir* dc = di_res + j;
   const RsPrimary x = rs_primary(&s, &e, &rsp);
-  const int has_c = rs_has_path(rc);
   Rng rng = rng_make(seed, PR_RNG_PATH_RESAMPLE, frame, j, sample);
   rng.dim = 0x10000u;  // apart from the paths' offers (PR_RS_DIM)
+  Rng rng_d = rng;
+  rng_d.dim = 0x20000u;  // the direct light's merge
   // The domains: neighbours with an x_1 (confidence 1), then the previous frame's pixel.
   uint nb[PR_RS_MAX_NEIGHBORS];
   float un[PR_RS_MAX_NEIGHBORS];
@@ -119,81 +246,57 @@ PR_KERNEL void pt_resample(PR_PARAMS(PR_ARGS_PT_RESAMPLE_SPATIAL)) {
     ++k;
   }
   const float u_t = rng_next(&rng);
-  float total = 1.0f + (float)k;
-  uint q = PR_INVALID_INDEX;
-  float c_t = 0.0f;
-  if (temporal) {
-    q = rs_project(&prev_cam, x.h.p);
-    if (q != PR_INVALID_INDEX && (q < first || q >= end || history[q].stamp + 1u != stamp ||
-                                  history[q].prim == PR_INVALID_INDEX))
-      q = PR_INVALID_INDEX;
-    if (q != PR_INVALID_INDEX) c_t = fmin(history[q].r.m, rsp.max_m);
-    if (!(c_t > 0.0f)) q = PR_INVALID_INDEX;
-    total += c_t;
-  }
-  const uint domains = k + (q != PR_INVALID_INDEX ? 1u : 0u);
-  const float kf = (float)domains;
-  float w_sum = 0.0f, canon_terms = 0.0f;
-  float3 f_kept = make_float3(0.0f, 0.0f, 0.0f);
-  float p_kept = 0.0f, g_kept = 0.0f;
-  __global const PathReservoir* kept = 0;
+  const uint q =
+      temporal ? rs_history_pixel(&prev_cam, x.h.p, first, end, history, stamp) : PR_INVALID_INDEX;
+  // Each reservoir's confidence of the previous frame (0: not a domain of that reservoir).
+  const float c_t = q != PR_INVALID_INDEX ? fmin(history[q].r.m, rsp.max_m) : 0.0f;
+  const float c_td = q != PR_INVALID_INDEX ? fmin(history[q].d.m, rsp.max_m) : 0.0f;
+  const uint dom_p = k + (c_t > 0.0f ? 1u : 0u), dom_d = k + (c_td > 0.0f ? 1u : 0u);
+  const float total_p = 1.0f + (float)k + c_t, total_d = 1.0f + (float)k + c_td;
+  const int has_c = rs_has_path(rc), has_dc = di_has_light(dc);
+  RsMerge mp = rs_merge_begin(), md = rs_merge_begin();
   uint traced = 0u;
-  for (uint d = 0u; d < domains; ++d) {
+  for (uint d = 0u; d < k + (q != PR_INVALID_INDEX ? 1u : 0u); ++d) {
     const int past = d == k;
-    __global const PathReservoir* ri = past ? &history[q].r : rs_res + nb[d];
     const EyeVertex ei = past ? rs_history_eye(history + q) : eye[nb[d]];
-    const float c_i = past ? c_t : 1.0f;
-    const int ri_path = rs_has_path(ri);
+    const int same = past && rs_same_eye(&ei, &e);
     RsPrimary xi;
-    if (has_c || (past && ri_path)) xi = rs_primary(&s, &ei, &rsp);
-    // The other domain's path, here.
-    if (ri_path && (!past || rs_temporal_ok(&s, moved, rsp.moved_count, ri, xi.h.p, x.h.p))) {
-      float3 f;
-      float g, jac;
-      const float p = rs_target_at(&s, &x, ri, &rsp, &f, &g, &jac, &traced);
-      if (p > 0.0f && jac > 0.0f) {
-        const float m = mis_pairwise_neighbor(c_i, ri->p_hat / jac, 1.0f, p, kf, total);
-        const float w = gris_weight(m, p, ri->w_sum / ri->p_hat * jac);
-        if (w > 0.0f && w < PR_INF_F) {
-          w_sum += w;
-          if (ris_accept(past ? u_t : un[d], w_sum, w)) {
-            f_kept = f;
-            p_kept = p;
-            g_kept = g;
-            kept = ri;
-          }
-        }
-      }
-    }
-    // The canonical path in the other domain, for its own weight.
-    float p_back = 0.0f;
-    if (has_c && (!past || rs_temporal_ok(&s, moved, rsp.moved_count, rc, xi.h.p, x.h.p))) {
-      float3 f;
-      float g, jac;
-      const float p = rs_target_at(&s, &xi, rc, &rsp, &f, &g, &jac, &traced);
-      p_back = p * jac;
-    }
-    canon_terms +=
-        mis_pairwise_canonical_term(c_i, p_back, 1.0f, has_c ? rc->p_hat : 0.0f, kf, total);
+    if (same)
+      xi = x;
+    else if (has_c || has_dc || past)
+      xi = rs_primary(&s, &ei, &rsp);
+    const float u_d = rng_next(&rng_d);
+    if (!past || c_t > 0.0f)
+      rs_merge_path(&s, &x, &xi, rc, past ? &history[q].r : rs_res + nb[d], past, same,
+                    past ? c_t : 1.0f, (float)dom_p, total_p, past ? u_t : un[d], d, moved, &rsp,
+                    &mp, &traced);
+    if (!past || c_td > 0.0f)
+      rs_merge_direct(&s, &x, &xi, dc, past ? &history[q].d : di_res + nb[d], past, same,
+                      past ? c_td : 1.0f, (float)dom_d, total_d, u_d, d, moved, rsp.moved_count,
+                      &md, &traced);
   }
-  if (has_c) {
-    const float m = domains ? mis_pairwise_canonical(canon_terms, 1.0f, total) : 1.0f;
-    const float w = gris_weight(m, rc->p_hat, rc->w_sum / rc->p_hat);
-    if (w > 0.0f && w < PR_INF_F) {
-      w_sum += w;
-      if (ris_accept(rng_next(&rng), w_sum, w)) {
-        f_kept = make_float3(rc->f_r, rc->f_g, rc->f_b);
-        p_kept = rc->p_hat;
-        g_kept = rc->g_src;
-        kept = rc;
-      }
-    }
-  }
+  const float u_c = rng_next(&rng), u_dc = rng_next(&rng_d);
+  if (has_c)
+    rs_merge_canonical(&mp, rc->p_hat, rc->w_sum, make_float3(rc->f_r, rc->f_g, rc->f_b), rc->g_src,
+                       dom_p, total_p, u_c);
+  if (has_dc)
+    rs_merge_canonical(&md, dc->p_hat, dc->w_sum, make_float3(dc->f_r, dc->f_g, dc->f_b), 0.0f,
+                       dom_d, total_d, u_dc);
   if (traced) atomic_add(rays + PR_PT_RECONNECT, traced);
-  out->r.m = total;
-  if (!(p_kept > 0.0f)) return;
-  const float3 c = x.tp * f_kept * (w_sum / p_kept);
-  if (!(max3(c) < PR_INF_F)) return;
-  radiance[j] += (float4)(c.x, c.y, c.z, 0.0f);
-  rs_keep(&out->r, kept, f_kept, p_kept, g_kept, w_sum, total);
+  out->r.m = total_p;
+  out->d.m = total_d;
+  if (mp.p > 0.0f) {
+    rs_merge_add(&mp, x.tp, radiance + j);
+    __global const PathReservoir* kept = mp.kept == PR_RS_KEPT_CANONICAL ? rc
+                                         : mp.kept == k                  ? &history[q].r
+                                                                         : rs_res + nb[mp.kept];
+    rs_keep(&out->r, kept, mp.f, mp.p, mp.g, mp.w_sum, total_p);
+  }
+  if (md.p > 0.0f) {
+    rs_merge_add(&md, x.tp, radiance + j);
+    __global const DirectReservoir* kept = md.kept == PR_RS_KEPT_CANONICAL ? dc
+                                           : md.kept == k                  ? &history[q].d
+                                                                           : di_res + nb[md.kept];
+    di_keep(&out->d, kept, md.f, md.p, md.w_sum, total_d);
+  }
 }

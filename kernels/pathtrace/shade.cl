@@ -14,6 +14,7 @@
 #include "shared/reuse.h"
 #include "shared/path_state.h"
 #include "shared/resample.h"
+#include "shared/resample_direct.h"
 
 // L's density of the path over that of the eye path's vertices beyond x_1 (eye_ratio holds
 // the rest), for a path ending at x_t on light l (normal n_tri, start density `start`) at z0,
@@ -174,19 +175,23 @@ PR_INLINE void rs_next_event(PathReservoir* c, PR_GLOBAL const PathTrack* t,
   rs_suffix_push(&c->suffix, c->sp, at_infinity ? ch->wi : ch->pos, at_infinity);
 }
 
-// --resample: next-event estimation at vertex `rel` beyond x_1 (depth: the path's), to the
-// reservoir once pt_shadow finds it unoccluded where rel >= 1: its candidate into *pending, and
-// the shadow ray's op (1 + the random dimension that offers it; 0: into the radiance).
+// --resample: next-event estimation (contribution c) at vertex `rel` beyond x_1 (depth: the
+// path's; at_x1: it is x_1), to a reservoir once pt_shadow finds it unoccluded: at x_1 the
+// direct light's, where rel >= 1 the paths'. Its candidate goes into *di_pending or *pending, and
+// the shadow ray's op is returned (1 + the random dimension that offers it, PR_RS_OP_DIRECT for
+// the direct light; 0: into the radiance).
 PR_INLINE uint rs_next_event_pending(const SceneData* s, PR_GLOBAL const PathTrack* t,
-                                     PR_GLOBAL PathReservoir* pending, const ResampleParams* rsp,
-                                     uint rel, uint depth, const SurfaceHit* h,
-                                     const ShadingFrame* f, float3 wo, float dist2,
-                                     const NextEventChoice* ch) {
+                                     PR_GLOBAL PathReservoir* pending,
+                                     PR_GLOBAL DirectReservoir* di_pending,
+                                     const ResampleParams* rsp, int at_x1, uint rel, uint depth,
+                                     const SurfaceHit* h, const ShadingFrame* f, float3 wo,
+                                     float dist2, const NextEventChoice* ch, float3 c) {
+  if (at_x1) return di_next_event_pending(s, di_pending, ch, c, PR_RS_DIM(depth, 1u));
   if (rel < 1u) return 0u;
-  PathReservoir c;
-  rs_next_event(&c, t, rsp, rel, h, f, wo, dist2, ch,
+  PathReservoir cand;
+  rs_next_event(&cand, t, rsp, rel, h, f, wo, dist2, ch,
                 light_at_infinity(s->lights.lights[ch->light].type));
-  *pending = c;
+  *pending = cand;
   return PR_RS_DIM(depth, 1u) + 1u;
 }
 
@@ -196,31 +201,40 @@ PR_INLINE float4 pt_rgb(float3 c) {
 }
 
 // The path escaped: the environment's light into the sample's radiance, or with --resample from
-// x_2 on (rel >= 2), to its reservoir.
+// x_1 (rel 1) to the direct light's reservoir and from x_2 on (rel >= 2) to the paths'.
 PR_INLINE void pt_escape(const SceneData* s, const PathState* p, uint rel,
                          __global const PathTrack* track, __global PathReservoir* res,
-                         const RsKey* key, __global float4* radiance) {
+                         __global DirectReservoir* di, const RsKey* key,
+                         __global float4* radiance) {
   float3 add;
   if (!pt_escaped(s, p, &add)) return;
+  const float3 d = make_float3(p->ray.dx, p->ray.dy, p->ray.dz);
+  const float3 prev = make_float3(p->prev_x, p->prev_y, p->prev_z);
+  const float3 prev_n = make_float3(p->prev_nx, p->prev_ny, p->prev_nz);
+  const float pdf_light = rel ? environment_pdf(s, prev, prev_n, d) : 0.0f;
+  const float w = (p->flags & PR_PATH_SPECULAR) ? 1.0f : power_heuristic(p->last_pdf, pdf_light);
+  if (rel == 1u && di_offer_hit(s, p, track, s->lights.env_light, 0.0f, 0.0f, d,
+                                environment_radiance(s, d), 1.0f, w, di, key))
+    return;
   if (rel < 2u) {
     *radiance += pt_rgb(add);
     return;
   }
-  const float3 d = make_float3(p->ray.dx, p->ray.dy, p->ray.dz);
-  const float3 prev = make_float3(p->prev_x, p->prev_y, p->prev_z);
-  const float3 prev_n = make_float3(p->prev_nx, p->prev_ny, p->prev_nz);
-  const float pdf_light = environment_pdf(s, prev, prev_n, d);
-  const float w = (p->flags & PR_PATH_SPECULAR) ? 1.0f : power_heuristic(p->last_pdf, pdf_light);
   rs_offer_emission(track, res, p, rel, environment_radiance(s, d), w, pdf_light, 1, d, key);
 }
 
-// Emission at h, weighted w by the path tracer, into the sample's radiance, or with --resample
-// from x_3 on (rel >= 2) to its reservoir.
+// Emission at h (reached along d at squared distance dist2), weighted w by the path tracer, into
+// the sample's radiance, or with --resample at x_2 (rel 1) to the direct light's reservoir and
+// from x_3 on (rel >= 2) to the paths'.
 PR_INLINE void pt_emission(const SceneData* s, const PathState* p, const SurfaceHit* h, uint rel,
-                           float w, float3 tp, __global const PathTrack* track,
-                           __global PathReservoir* res, const RsKey* key,
+                           float3 d, float dist2, float w, float3 tp,
+                           __global const PathTrack* track, __global PathReservoir* res,
+                           __global DirectReservoir* di, const RsKey* key,
                            __global float4* radiance) {
   const float3 le = surface_emission(s, h);
+  if (rel == 1u && di_offer_hit(s, p, track, emitter_light(s, h), h->b1, h->b2, d, le,
+                                fabs(dot(h->ng, d)) / dist2, w, di, key))
+    return;
   if (rel < 2u) {
     *radiance += pt_rgb(tp * le * w);
     return;
@@ -299,7 +313,7 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
   const RsKey key = {seed, frame, p.pixel, sample};
   const Hit hit = hits[i];
   if (hit.prim == PR_INVALID_INDEX) {
-    pt_escape(&s, &p, rel, track, rs_res + i, &key, radiance + i);
+    pt_escape(&s, &p, rel, track, rs_res + i, di_res + i, &key, radiance + i);
     p.alive = 0u;
     states[i] = p;
     return 0u;
@@ -320,7 +334,8 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
   if (s.sd.materials[h.material].flags & PR_MAT_EMISSIVE) {
     const float w =
         pt_emission_weight(&s, &p, &h, d, dist2, joinable, light_paths, trace_cdf, trace_total);
-    pt_emission(&s, &p, &h, rel, w, tp, track, rs_res + i, &key, radiance + i);
+    pt_emission(&s, &p, &h, rel, d, dist2, w, tp, track, rs_res + i, di_res + i, &key,
+                radiance + i);
   }
   p.depth += 1u;
   const ShadingFrame f = shading_frame(&s, &h, wo);
@@ -358,8 +373,9 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
                                        trace_total);
         }
         const uint rel_here = rsp.enabled && p.x1_depth ? p.depth - p.x1_depth : 0u;
-        const uint op = rs_next_event_pending(&s, track, rs_pending + i, &rsp, rel_here, p.depth,
-                                              &h, &f, wo, dist2, &ch);
+        const int at_x1 = rsp.enabled && p.x1_depth == p.depth;
+        const uint op = rs_next_event_pending(&s, track, rs_pending + i, di_pending + i, &rsp,
+                                              at_x1, rel_here, p.depth, &h, &f, wo, dist2, &ch, c);
         pt_shadow_set(shadows + i, shadow, tp * c, op);
         out = PR_SHADE_SHADOW;
       }

@@ -323,6 +323,8 @@ typedef struct {
   float3 fr_cos, le;  // the BSDF times the cosine, and the light's radiance (--resample)
   float3 wi;          // the direction towards the light
   float pdf;          // the density it was sampled with
+  float b1, b2;       // a triangle light's point: barycentrics (--resample)
+  float g;            // a triangle light's |cos| at the point over the squared distance; else 1
 } NextEventChoice;
 
 PR_INLINE int next_event(const SceneData* s, const SurfaceHit* h, const ShadingFrame* f, float3 wo,
@@ -365,6 +367,10 @@ PR_INLINE int next_event(const SceneData* s, const SurfaceHit* h, const ShadingF
     choice->le = le;
     choice->wi = ls.wi;
     choice->pdf = ls.pdf;
+    choice->b1 = b1;
+    choice->b2 = b2;
+    choice->g =
+        light_is_triangle(l.type) ? fabs(dot(ls.wi, ls.normal)) / (ls.dist * ls.dist) : 1.0f;
   }
   if (light_is_triangle(l.type)) {
     *shadow = surface_ray_to(s, h, ls.pos, ls.normal);

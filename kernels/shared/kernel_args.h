@@ -116,20 +116,21 @@
 // `count` of them), which pt_shade compacts: the live paths into next_queue, the paths with a
 // shadow ray into shadow_queue, counted in queue_sizes (PR_QUEUE_*, shared/path_state.h).
 
-#define PR_ARGS_PT_GENERATE(X)     \
-  X(FRAME, VAL, CameraParams, cam) \
-  X(FRAME, VAL, uint, seed)        \
-  X(FRAME, VAL, uint, frame)       \
-  X(PASS, VAL, uint, sample)       \
-  X(FRAME, OUT, PathState, states) \
-  X(FRAME, OUT, float4, radiance)  \
-  X(FRAME, VAL, uint, count)       \
-  X(FRAME, OUT, EyeVertex, eye)    \
-  X(FRAME, VAL, uint, write_eye)   \
-  X(FRAME, OUT, uint, queue)       \
-  X(FRAME, VAL, uint, first)       \
-  X(FRAME, VAL, uint, resample)    \
-  X(FRAME, OUT, PathReservoir, rs_res)
+#define PR_ARGS_PT_GENERATE(X)         \
+  X(FRAME, VAL, CameraParams, cam)     \
+  X(FRAME, VAL, uint, seed)            \
+  X(FRAME, VAL, uint, frame)           \
+  X(PASS, VAL, uint, sample)           \
+  X(FRAME, OUT, PathState, states)     \
+  X(FRAME, OUT, float4, radiance)      \
+  X(FRAME, VAL, uint, count)           \
+  X(FRAME, OUT, EyeVertex, eye)        \
+  X(FRAME, VAL, uint, write_eye)       \
+  X(FRAME, OUT, uint, queue)           \
+  X(FRAME, VAL, uint, first)           \
+  X(FRAME, VAL, uint, resample)        \
+  X(FRAME, OUT, PathReservoir, rs_res) \
+  X(FRAME, OUT, DirectReservoir, di_res)
 
 #define PR_ARGS_PT_EXTEND(X)      \
   PR_ARGS_SCENE(X)                \
@@ -162,25 +163,29 @@
 
 // --resample: the paths' candidates, offered by pt_shade and pt_shadow to their pixel's
 // reservoir (shared/resample.h).
-#define PR_ARGS_PT_RESAMPLE(X)         \
-  X(FRAME, VAL, ResampleParams, rsp)   \
-  X(FRAME, OUT, PathTrack, rs_track)   \
-  X(FRAME, OUT, PathReservoir, rs_res) \
-  X(FRAME, OUT, PathReservoir, rs_pending)
+#define PR_ARGS_PT_RESAMPLE(X)             \
+  X(FRAME, VAL, ResampleParams, rsp)       \
+  X(FRAME, OUT, PathTrack, rs_track)       \
+  X(FRAME, OUT, PathReservoir, rs_res)     \
+  X(FRAME, OUT, PathReservoir, rs_pending) \
+  X(FRAME, OUT, DirectReservoir, di_res)   \
+  X(FRAME, OUT, DirectReservoir, di_pending)
 
-#define PR_ARGS_PT_SHADOW(X)           \
-  PR_ARGS_SCENE(X)                     \
-  X(FRAME, OUT, float4, radiance)      \
-  X(FRAME, IN, ShadowRay, shadows)     \
-  X(FRAME, OUT, uint, rays)            \
-  X(FRAME, IN, uint, shadow_queue)     \
-  X(PASS, VAL, uint, count)            \
-  X(FRAME, VAL, uint, seed)            \
-  X(FRAME, VAL, uint, frame)           \
-  X(PASS, VAL, uint, sample)           \
-  X(FRAME, VAL, uint, resample)        \
-  X(FRAME, OUT, PathReservoir, rs_res) \
-  X(FRAME, IN, PathReservoir, rs_pending)
+#define PR_ARGS_PT_SHADOW(X)              \
+  PR_ARGS_SCENE(X)                        \
+  X(FRAME, OUT, float4, radiance)         \
+  X(FRAME, IN, ShadowRay, shadows)        \
+  X(FRAME, OUT, uint, rays)               \
+  X(FRAME, IN, uint, shadow_queue)        \
+  X(PASS, VAL, uint, count)               \
+  X(FRAME, VAL, uint, seed)               \
+  X(FRAME, VAL, uint, frame)              \
+  X(PASS, VAL, uint, sample)              \
+  X(FRAME, VAL, uint, resample)           \
+  X(FRAME, OUT, PathReservoir, rs_res)    \
+  X(FRAME, IN, PathReservoir, rs_pending) \
+  X(FRAME, OUT, DirectReservoir, di_res)  \
+  X(FRAME, IN, DirectReservoir, di_pending)
 
 // pt_resample: each pixel sample's reservoir with its neighbours' and the previous frame's by
 // reconnection, into its radiance and history_out (one pass over the film's pixels [first, end)).
@@ -191,6 +196,7 @@
   X(FRAME, VAL, ResampleParams, rsp)      \
   X(FRAME, IN, EyeVertex, eye)            \
   X(FRAME, IN, PathReservoir, rs_res)     \
+  X(FRAME, IN, DirectReservoir, di_res)   \
   X(FRAME, OUT, float4, radiance)         \
   X(FRAME, VAL, uint, seed)               \
   X(FRAME, VAL, uint, frame)              \

@@ -85,10 +85,26 @@ typedef struct {
 #define PR_RS_ESCAPES 0x100u  // the last point of sp is a direction: the path ends at infinity
 #define PR_RS_LONG 0x200u     // more points than sp holds
 
-// A pixel sample's resampled path as the next frame's temporal reuse finds it: the reservoir
-// and the x_1 it is a path of (surface and the direction it was seen from). 192 bytes.
+// A pixel sample's direct light at x_1 and its reservoir (ReSTIR DI beside the paths' one): a
+// point y on a light that x_1 sees, from next-event estimation at x_1 or its BSDF sample's
+// emitter hit, MIS-weighted against each other as the path tracer weighs them. y is kept as
+// itself (a triangle light's point, the environment's direction, a punctual light), so moving it
+// to another x_1 has Jacobian 1: f is in area measure on triangle lights (the geometry term at y
+// included), in solid angle for the environment and per light for punctual ones. 48 bytes.
+typedef struct {
+  u32 light;         // the light (PR_INVALID_INDEX: none kept)
+  float b1, b2;      // a triangle light's point: barycentrics on its triangle
+  float wx, wy, wz;  // the environment's: the direction towards it
+  float f_r, f_g, f_b;
+  float p_hat, w_sum, m;  // as PathReservoir's
+} DirectReservoir;
+
+// A pixel sample's resampled paths as the next frame's temporal reuse finds them: the
+// reservoirs and the x_1 they are paths of (surface and the direction it was seen from).
+// 240 bytes.
 typedef struct {
   PathReservoir r;
+  DirectReservoir d;
   u32 prim, inst;  // x_1 (prim PR_INVALID_INDEX: none)
   float b1, b2;
   float wx, wy, wz;
@@ -135,6 +151,7 @@ PR_STATIC_ASSERT(offsetof(pr::dev::PathState, depth) == 48, "PathState layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::PathState, flags) == 64, "PathState layout");
 PR_STATIC_ASSERT(sizeof(pr::dev::ShadowRay) == 48, "ShadowRay layout");
 PR_STATIC_ASSERT(sizeof(pr::dev::PathReservoir) == 160, "PathReservoir layout");
-PR_STATIC_ASSERT(sizeof(pr::dev::PathHistory) == 192, "PathHistory layout");
+PR_STATIC_ASSERT(sizeof(pr::dev::PathHistory) == 240, "PathHistory layout");
+PR_STATIC_ASSERT(sizeof(pr::dev::DirectReservoir) == 48, "DirectReservoir layout");
 PR_STATIC_ASSERT(sizeof(pr::dev::PathTrack) == 160, "PathTrack layout");
 PR_STATIC_ASSERT(sizeof(pr::dev::ResampleParams) == 48, "ResampleParams layout");
