@@ -108,8 +108,9 @@ TEST(Resample, SlatsHideNeighboursPaths) {
   const std::string scene = b.write(test::tempDir("rs-slats"), "slats");
   const std::string size = "--width 96 --height 72 --force-diffuse --max-depth 5 ";
   const Image ref = render(scene, size + "--spp 2048 --seed 1", "rs-slats-ref");
-  const Image img =
-      render(scene, size + "--spp 1024 --seed 2 --resample --resample-radius 16", "rs-slats");
+  const Image img = render(
+      scene, size + "--spp 1024 --seed 2 --resample --resample-neighbors 3 --resample-radius 16",
+      "rs-slats");
   expectRegionsAgree(img, ref, 0.04);
 }
 
@@ -200,7 +201,8 @@ TEST(Resample, NeighboursLowerTheError) {
   const Image ref = demoReference();
   const Image own =
       render(demoScene(), size + "--spp 8 --seed 2 --resample --resample-neighbors 0", "rs-own");
-  const Image shared = render(demoScene(), size + "--spp 8 --seed 2 --resample", "rs-shared");
+  const Image shared =
+      render(demoScene(), size + "--spp 8 --seed 2 --resample --resample-neighbors 3", "rs-shared");
   const double eOwn = compareImages(own, ref).relMse, eShared = compareImages(shared, ref).relMse;
   EXPECT_LT(eShared * 1.2, eOwn) << "relMSE with neighbours " << eShared << ", alone " << eOwn;
 }

@@ -31,11 +31,12 @@ enum class MaterialModel { Energy, Gltf };
 const char* materialModelName(MaterialModel m);
 
 // Path resampling across pixels and frames (--resample; docs/design.md section 5): the path
-// tracer's paths beyond x_1 resampled with those of `neighbors` pixels within `radius` pixels
-// and with the previous frame's.
+// tracer's paths beyond x_1, and its direct light at x_1, resampled with those of `neighbors`
+// pixels within `radius` pixels and with the previous frame's. One neighbour: with the previous
+// frame's paths it reached a given error sooner than three on both animations measured.
 struct ResampleSettings {
   bool enabled = false;
-  int neighbors = 3;
+  int neighbors = 1;
   float radius = 10.0f;    // pixels
   float roughness = 0.2f;  // GGX roughness below which a vertex is not reconnected
   float distance = 0.0f;   // shortest reconnected segment; 0: 1% of the scene's radius

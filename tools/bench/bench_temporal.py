@@ -1,7 +1,7 @@
 """Path resampling across frames, measured on animations: per frame relMSE against path-traced
 references, seconds per frame, flicker, and the equal-error speed-up over the path tracer, for
 the path tracer, `--resample` within each frame (`--resample-history 0`), `--resample` with the
-previous frames' paths (3 neighbours, the default, and 1), and `--mode reuse`.
+previous frames' paths (1 neighbour, the default, and 3), and `--mode reuse`.
 
   /usr/bin/python3 -m tools.bench.bench_temporal                     # ~10-15 min on 2 cores
   /usr/bin/python3 -m tools.bench.bench_temporal --scenes atrium --seeds 1
@@ -28,7 +28,7 @@ SETTINGS = {
     "pathtrace": ("pathtrace", ()),
     "resample, one frame": ("pathtrace", ("--resample", "--resample-history", "0")),
     "resample": ("pathtrace", ("--resample",)),
-    "resample, 1 neighbour": ("pathtrace", ("--resample", "--resample-neighbors", "1")),
+    "resample, 3 neighbours": ("pathtrace", ("--resample", "--resample-neighbors", "3")),
     "reuse": ("reuse", ()),
 }
 
