@@ -96,6 +96,8 @@ class DynamicAccel {
   void setInstances(const std::vector<InstanceInput>& instances);
 
   uint32_t meshCount() const { return uint32_t(meshes_.size()); }
+  // Mesh m's BVH root in meshNodes().
+  uint32_t meshRoot(uint32_t m) const { return meshes_[m].rootNode; }
   uint32_t meshTriangleCount() const { return uint32_t(meshTris_.size()); }
   int width() const { return width_; }
   // All meshes' wide BVHs concatenated, with absolute node and packet references.

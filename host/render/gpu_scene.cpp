@@ -229,6 +229,8 @@ void GpuScene::setTime(double t) {
   instances_.resize(n);
   anyMoved_ = firstFrame_;
   if (lastTransforms_.size() != n) lastTransforms_.assign(n, glm::mat4(0.0f));
+  const std::vector<glm::mat4> was = lastTransforms_;
+  std::vector<bool> rigid(n);
   for (size_t i = 0; i < n; ++i) {
     const glm::mat4 m = scene_.instanceTransform(i, t);
     inputs[i].mesh = scene_.instances[i].mesh;
@@ -243,6 +245,7 @@ void GpuScene::setTime(double t) {
     const bool moved = firstFrame_ || std::memcmp(&m, &lastTransforms_[i], sizeof m) != 0 ||
                        reshaped[scene_.instances[i].mesh];
     s.moved = moved ? 1u : 0u;
+    rigid[i] = !firstFrame_ && !reshaped[scene_.instances[i].mesh];
     anyMoved_ = anyMoved_ || moved;
     lastTransforms_[i] = m;
   }
@@ -250,9 +253,9 @@ void GpuScene::setTime(double t) {
     const std::vector<accel::Aabb> before = dsg_.instanceBounds();
     dsg_.setInstances(inputs);
     deviceAccel_.uploadFrame(ctx_, dsg_);
-    collectMovedBoxes(before);
+    collectMoved(before, was, rigid);
   } else {
-    movedBoxes_.clear();
+    moved_.clear();
   }
   // The moved flags change even when no transform does (all back to 0), so always upload.
   const uint64_t bytes = std::max<size_t>(n, 1) * sizeof(dev::ShadingInstance);
@@ -277,21 +280,36 @@ void GpuScene::setTime(double t) {
   firstFrame_ = false;
 }
 
-void GpuScene::collectMovedBoxes(const std::vector<accel::Aabb>& before) {
-  movedBoxes_.clear();
+void GpuScene::collectMoved(const std::vector<accel::Aabb>& before,
+                            const std::vector<glm::mat4>& was, const std::vector<bool>& rigid) {
+  moved_.clear();
   const std::vector<accel::Aabb>& after = dsg_.instanceBounds();
   // Enlarged by a little of the scene's size, so that rounding in the kernels' segment tests
   // cannot miss a surface on a box's face.
   const float pad = 1e-4f * sceneRadius_;
-  auto add = [&](const accel::Aabb& b) {
-    if (b.empty()) return;
-    for (int a = 0; a < 3; ++a) movedBoxes_.push_back(b.lo[a] - pad - 1e-4f * std::fabs(b.lo[a]));
-    for (int a = 0; a < 3; ++a) movedBoxes_.push_back(b.hi[a] + pad + 1e-4f * std::fabs(b.hi[a]));
+  auto box = [&](const std::vector<accel::Aabb>& bounds, size_t i, float* out) {
+    if (i >= bounds.size() || bounds[i].empty()) {  // a box no point is in
+      for (int a = 0; a < 3; ++a) out[a] = 1.0f, out[3 + a] = -1.0f;
+      return;
+    }
+    const accel::Aabb& b = bounds[i];
+    for (int a = 0; a < 3; ++a) out[a] = b.lo[a] - pad - 1e-4f * std::fabs(b.lo[a]);
+    for (int a = 0; a < 3; ++a) out[3 + a] = b.hi[a] + pad + 1e-4f * std::fabs(b.hi[a]);
   };
   for (size_t i = 0; i < instances_.size(); ++i) {
     if (!instances_[i].moved) continue;
-    if (i < before.size()) add(before[i]);
-    if (i < after.size()) add(after[i]);
+    dev::MovedInstance m{};
+    box(before, i, m.box);
+    box(after, i, m.box + 6);
+    m.root = PR_INVALID_INDEX;
+    const glm::mat4& now = lastTransforms_[i];
+    const float d0 = glm::determinant(was[i]), d1 = glm::determinant(now);
+    if (rigid[i] && std::isfinite(d0) && std::isfinite(d1) && d0 != 0.0f && d1 != 0.0f) {
+      m.root = dsg_.meshRoot(scene_.instances[i].mesh);
+      toRows(glm::inverse(was[i]), m.before);
+      toRows(glm::inverse(now), m.after);
+    }
+    moved_.push_back(m);
   }
 }
 

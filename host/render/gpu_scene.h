@@ -72,10 +72,11 @@ class GpuScene {
   bool anyInstanceMoved() const { return anyMoved_; }
   // Whether the last setTime changed a light (the light table, and so every light pdf).
   bool anyLightMoved() const;
-  // Boxes (lo xyz, hi xyz; 6 floats each) that hold every instance the last setTime moved or
-  // reshaped, where it was before and where it is now, a little enlarged: where this frame's
-  // scene may differ from the previous one's (path resampling's temporal reuse).
-  const std::vector<float>& movedBoxes() const { return movedBoxes_; }
+  // Every instance the last setTime moved or reshaped: its bounds before and now, a little
+  // enlarged, and where it moved rigidly its mesh's BVH root and both world-to-object
+  // transforms: where this frame's scene may differ from the previous one's (path resampling's
+  // temporal reuse).
+  const std::vector<dev::MovedInstance>& movedInstances() const { return moved_; }
   // Host seconds the last setTime spent deforming meshes and rebuilding their BVHs.
   double lastDeformSeconds() const { return deformSeconds_; }
   bool hasAlphaMaterials() const { return hasAlpha_; }
@@ -91,8 +92,10 @@ class GpuScene {
   // shape changed (*changed, per dynamic mesh). Returns whether any did.
   bool deformMeshes(double t, std::vector<bool>* changed);
   void buildLights(double t);
-  // movedBoxes_ from the instances' bounds before this frame's setInstances and after.
-  void collectMovedBoxes(const std::vector<accel::Aabb>& before);
+  // moved_ from the instances' bounds and transforms before this frame's setInstances and after
+  // (rigid: not reshaped, and the transforms before are known).
+  void collectMoved(const std::vector<accel::Aabb>& before, const std::vector<glm::mat4>& was,
+                    const std::vector<bool>& rigid);
   std::vector<dev::Light> lightsAt(double t) const;
   cl::Buffer upload(const char* name, const void* data, uint64_t bytes, uint64_t* counter);
 
@@ -113,7 +116,7 @@ class GpuScene {
   double deformedAt_ = std::nan("");  // the time deformed_ holds (NaN: none yet)
   std::vector<dev::ShadingInstance> instances_;
   std::vector<glm::mat4> lastTransforms_;
-  std::vector<float> movedBoxes_;
+  std::vector<dev::MovedInstance> moved_;
   bool firstFrame_ = true;
   bool anyMoved_ = true;
   bool hasAlpha_ = false;

@@ -90,19 +90,19 @@ void PathTracer::beginFrame(int frame, const dev::CameraParams& camera,
   written_ = 0;
   ++stamp_;
   if (settings_.resample.enabled) {
-    const std::vector<float>& boxes = scene_.movedBoxes();
-    const uint64_t bytes = std::max<uint64_t>(boxes.size() * 4, 24);
+    const std::vector<dev::MovedInstance>& moved = scene_.movedInstances();
+    const uint64_t bytes = std::max<uint64_t>(moved.size(), 1) * sizeof(dev::MovedInstance);
     if (bytes > movedBytes_) {
       if (movedBytes_) ctx_.release(movedBytes_);
       bytes_ += bytes - movedBytes_;
-      moved_ = ctx_.allocate("moved boxes", bytes, CL_MEM_READ_ONLY);
+      moved_ = ctx_.allocate("moved instances", bytes, CL_MEM_READ_ONLY);
       ctx_.zero(moved_, bytes);
       movedBytes_ = bytes;
     }
-    if (!boxes.empty())
-      CL_CHECK(
-          ctx_.queue().enqueueWriteBuffer(moved_, CL_FALSE, 0, boxes.size() * 4, boxes.data()));
-    rsp.moved_count = cl_uint(boxes.size() / 6);
+    if (!moved.empty())
+      CL_CHECK(ctx_.queue().enqueueWriteBuffer(
+          moved_, CL_FALSE, 0, moved.size() * sizeof(dev::MovedInstance), moved.data()));
+    rsp.moved_count = cl_uint(moved.size());
   }
   // Resampling needs every sample's x_1, which the path tracer alone does not keep.
   const cl::Buffer& eyeOut = settings_.resample.enabled && settings_.lightPaths == 0 ? rsEye_ : eye;

@@ -124,11 +124,10 @@ PR_INLINE void rs_merge_take(RsMerge* mg, float w, float u, float3 f, float p, f
 PR_INLINE void rs_merge_path(const SceneData* s, const RsPrimary* x, const RsPrimary* xi,
                              __global const PathReservoir* rc, __global const PathReservoir* ri,
                              int past, int same, float c_i, float kf, float total, float u, uint d,
-                             __global const float* moved, const ResampleParams* rsp, RsMerge* mg,
-                             uint* traced) {
+                             __global const MovedInstance* moved, const ResampleParams* rsp,
+                             RsMerge* mg, uint* traced) {
   const int has_c = rs_has_path(rc);
-  if (rs_has_path(ri) &&
-      (!past || rs_temporal_ok(s, moved, rsp->moved_count, ri, xi->h.p, x->h.p))) {
+  if (rs_has_path(ri) && (!past || rs_temporal_ok(s, moved, rsp->moved_count, ri, xi, x))) {
     float3 f = make_float3(ri->f_r, ri->f_g, ri->f_b);
     float g = ri->g_src, jac = 1.0f;
     const float p = same ? ri->p_hat : rs_target_at(s, x, ri, rsp, &f, &g, &jac, traced);
@@ -138,7 +137,7 @@ PR_INLINE void rs_merge_path(const SceneData* s, const RsPrimary* x, const RsPri
     }
   }
   float p_back = 0.0f;
-  if (has_c && (!past || rs_temporal_ok(s, moved, rsp->moved_count, rc, xi->h.p, x->h.p))) {
+  if (has_c && (!past || rs_temporal_ok(s, moved, rsp->moved_count, rc, xi, x))) {
     float3 f;
     float g, jac = 1.0f;
     const float p = same ? rc->p_hat : rs_target_at(s, xi, rc, rsp, &f, &g, &jac, traced);
@@ -151,10 +150,11 @@ PR_INLINE void rs_merge_path(const SceneData* s, const RsPrimary* x, const RsPri
 PR_INLINE void rs_merge_direct(const SceneData* s, const RsPrimary* x, const RsPrimary* xi,
                                __global const DirectReservoir* dc,
                                __global const DirectReservoir* di, int past, int same, float c_i,
-                               float kf, float total, float u, uint d, __global const float* moved,
-                               uint moved_count, RsMerge* mg, uint* traced) {
+                               float kf, float total, float u, uint d,
+                               __global const MovedInstance* moved, uint moved_count, RsMerge* mg,
+                               uint* traced) {
   const int has_c = di_has_light(dc);
-  if (di_has_light(di) && (!past || di_temporal_ok(s, moved, moved_count, di, xi->h.p, x->h.p))) {
+  if (di_has_light(di) && (!past || di_temporal_ok(s, moved, moved_count, di, xi, x))) {
     float3 f = make_float3(di->f_r, di->f_g, di->f_b);
     const float p = same ? di->p_hat : di_target_at(s, x, di, &f, traced);
     if (p > 0.0f) {
@@ -163,7 +163,7 @@ PR_INLINE void rs_merge_direct(const SceneData* s, const RsPrimary* x, const RsP
     }
   }
   float p_back = 0.0f;
-  if (has_c && (!past || di_temporal_ok(s, moved, moved_count, dc, xi->h.p, x->h.p))) {
+  if (has_c && (!past || di_temporal_ok(s, moved, moved_count, dc, xi, x))) {
     float3 f;
     p_back = same ? dc->p_hat : di_target_at(s, xi, dc, &f, traced);
   }

@@ -208,7 +208,7 @@
   X(PASS, IN, PathHistory, history)       \
   X(FRAME, OUT, PathHistory, history_out) \
   X(FRAME, VAL, CameraParams, prev_cam)   \
-  X(FRAME, IN, float, moved)              \
+  X(FRAME, IN, MovedInstance, moved)      \
   X(FRAME, VAL, uint, stamp)
 
 // ---- The film (kernels/accumulate.cl) ----

@@ -131,6 +131,17 @@ typedef struct {
   float pad0, pad1;
 } PathTrack;
 
+// An instance that moved or changed shape since the previous frame, for pt_resample's temporal
+// test: its bounds then and now (lo xyz, hi xyz each, a little enlarged) and, where it moved
+// rigidly, its mesh's BVH root and its world-to-object transforms then and now (3 x 4 rows),
+// against which a segment is tested exactly; a deformed one is its boxes alone. 160 bytes.
+typedef struct {
+  float box[12];
+  u32 root;  // PR_INVALID_INDEX: deformed
+  u32 pad0, pad1, pad2;
+  float before[12], after[12];
+} MovedInstance;
+
 // What the resampling kernels are told. 48 bytes.
 typedef struct {
   u32 enabled;      // 0: the path tracer alone
@@ -140,7 +151,7 @@ typedef struct {
   float min_dist2;  // squared distance below which x_1 x_2 is too short to reconnect
   u32 width, height;
   float max_m;      // the confidence a reservoir of the previous frame counts at most
-  u32 moved_count;  // boxes in `moved` (pt_resample): where the scene changed since then
+  u32 moved_count;  // records in `moved` (pt_resample): what changed since the previous frame
   u32 pad0, pad1, pad2;
 } ResampleParams;
 
@@ -155,3 +166,4 @@ PR_STATIC_ASSERT(sizeof(pr::dev::PathHistory) == 240, "PathHistory layout");
 PR_STATIC_ASSERT(sizeof(pr::dev::DirectReservoir) == 48, "DirectReservoir layout");
 PR_STATIC_ASSERT(sizeof(pr::dev::PathTrack) == 160, "PathTrack layout");
 PR_STATIC_ASSERT(sizeof(pr::dev::ResampleParams) == 48, "ResampleParams layout");
+PR_STATIC_ASSERT(sizeof(pr::dev::MovedInstance) == 160, "MovedInstance layout");

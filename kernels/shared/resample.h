@@ -161,9 +161,10 @@ PR_INLINE void rs_candidate(PathReservoir* c, PR_GLOBAL const PathTrack* t, floa
 // A path of the previous frame is a path of this one where nothing that moved between the two
 // frames comes near it: then its vertices, the visibility of its segments, its BSDFs and its
 // lights are the same in both scenes (lights that move turn temporal reuse off for the frame).
-// `moved` lists boxes (lo xyz, hi xyz) that hold every instance that moved or changed shape, where
-// it was and where it is; a path is reused only where its suffix, and both reconnection segments
-// (from the previous frame's x_1 and from this one's), meet none of them. The test is one
+// `moved` lists every instance that moved or changed shape (MovedInstance): a path is reused only
+// where none of its vertices lies on one and its suffix, and both reconnection segments (from the
+// previous frame's x_1 and from this one's), meet none, then or now (exactly where an instance
+// moved rigidly; by its bounds where it deformed). The test is one
 // function of the path and the two x_1, so the shift and its inverse are defined on the same
 // paths, and the previous frame's target at a path is this frame's, which pt_resample evaluates.
 // This is the arena's exact invalidation (reuse/invalidate.cl) for eye paths: a stored path that
@@ -213,28 +214,63 @@ PR_INLINE int rs_box_hit(PR_GLOBAL const float* b, float3 o, float3 d, float tma
   return 1;
 }
 
-// Whether the ray (segment: tmax 1 and d the far end minus o) meets none of the moved boxes.
-PR_INLINE int rs_clear(PR_GLOBAL const float* moved, u32 count, float3 o, float3 d, float tmax) {
+// Whether the ray o + t d, 0 <= t <= tmax, meets instance m then or now: its boxes, and where it
+// moved rigidly its triangles at either transform (its mesh's BVH, in object space, is the same
+// in both frames).
+PR_INLINE int rs_meets(const SceneData* s, PR_GLOBAL const MovedInstance* m, float3 o, float3 d,
+                       float tmax) {
+  if (!rs_box_hit(m->box, o, d, tmax) && !rs_box_hit(m->box + 6, o, d, tmax)) return 0;
+  if (m->root == PR_INVALID_INDEX) return 1;
+  for (int k = 0; k < 2; ++k) {
+    PR_GLOBAL const float* w = k ? m->after : m->before;
+    BvhRay r = bvh_ray(xform_point(w, o), xform_vector(w, d), 0.0f, tmax);
+    Hit h = hit_none();
+    if (bvh_traverse(s->geom.mesh_nodes, s->geom.mesh_tris, m->root, &r, &h, 0u, 1)) return 1;
+  }
+  return 0;
+}
+
+// Whether the ray (segment: tmax 1 and d the far end minus o) meets none of the moved instances.
+PR_INLINE int rs_clear(const SceneData* s, PR_GLOBAL const MovedInstance* moved, u32 count,
+                       float3 o, float3 d, float tmax) {
   for (u32 k = 0u; k < count; ++k)
-    if (rs_box_hit(moved + 6u * k, o, d, tmax)) return 0;
+    if (rs_meets(s, moved + k, o, d, tmax)) return 0;
   return 1;
 }
 
+// Whether point p lies outside every moved instance's boxes (a path's point known by position
+// alone, which may have been on one).
+PR_INLINE int rs_apart(PR_GLOBAL const MovedInstance* moved, u32 count, float3 p) {
+  for (u32 k = 0u; k < count; ++k)
+    for (int b = 0; b < 2; ++b)
+      if (rs_box_hit(moved[k].box + 6 * b, p, make_float3(0.0f, 0.0f, 0.0f), 0.0f)) return 0;
+  return 1;
+}
+
+// Whether surface point (prim, inst) is where it was: its instance did not move.
+PR_INLINE int rs_unmoved(const SceneData* s, u32 inst) {
+  return inst == PR_INVALID_INDEX || !s->sd.instances[inst].moved;
+}
+
 // Whether path r can be taken between frames, reconnected to x_1 at xa in one and at xb in the
-// other: its suffix kept whole and no segment near what moved.
-PR_INLINE int rs_temporal_ok(const SceneData* s, PR_GLOBAL const float* moved, u32 count,
-                             PR_GLOBAL const PathReservoir* r, float3 xa, float3 xb) {
+// other: its suffix kept whole, no vertex on what moved and no segment meeting it.
+PR_INLINE int rs_temporal_ok(const SceneData* s, PR_GLOBAL const MovedInstance* moved, u32 count,
+                             PR_GLOBAL const PathReservoir* r, const RsPrimary* xa,
+                             const RsPrimary* xb) {
   if (r->prim == PR_INVALID_INDEX || (r->suffix & PR_RS_LONG)) return 0;
   const u32 n = r->suffix & PR_RS_COUNT_MASK;
   if (n == 0u) return 0;
+  if (!rs_unmoved(s, xa->h.inst) || !rs_unmoved(s, xb->h.inst) || !rs_unmoved(s, r->inst)) return 0;
   const float3 x2 = surface_at(&s->sd, r->prim, r->inst, r->b1, r->b2).p;
-  if (!rs_clear(moved, count, xa, x2 - xa, 1.0f) || !rs_clear(moved, count, xb, x2 - xb, 1.0f))
+  if (!rs_clear(s, moved, count, xa->h.p, x2 - xa->h.p, 1.0f) ||
+      !rs_clear(s, moved, count, xb->h.p, x2 - xb->h.p, 1.0f))
     return 0;
   float3 a = x2;
   for (u32 k = 0u; k < n; ++k) {
     const float3 p = make_float3(r->sp[3u * k], r->sp[3u * k + 1u], r->sp[3u * k + 2u]);
-    if (k + 1u == n && (r->suffix & PR_RS_ESCAPES)) return rs_clear(moved, count, a, p, PR_INF_F);
-    if (!rs_clear(moved, count, a, p - a, 1.0f)) return 0;
+    if (k + 1u == n && (r->suffix & PR_RS_ESCAPES))
+      return rs_clear(s, moved, count, a, p, PR_INF_F);
+    if (!rs_apart(moved, count, p) || !rs_clear(s, moved, count, a, p - a, 1.0f)) return 0;
     a = p;
   }
   return 1;

@@ -78,18 +78,23 @@ PR_INLINE float di_target_at(const SceneData* s, const RsPrimary* x,
 }
 
 // Whether reservoir r's light can be taken between frames, seen from x_1 at xa in one and at xb
-// in the other: neither segment (ray, towards a light at infinity) meets what moved.
-PR_INLINE int di_temporal_ok(const SceneData* s, PR_GLOBAL const float* moved, u32 count,
-                             PR_GLOBAL const DirectReservoir* r, float3 xa, float3 xb) {
-  if (r->light == PR_INVALID_INDEX) return 0;
+// in the other: neither x_1 on what moved, nor either segment (ray, towards a light at infinity)
+// meeting it.
+PR_INLINE int di_temporal_ok(const SceneData* s, PR_GLOBAL const MovedInstance* moved, u32 count,
+                             PR_GLOBAL const DirectReservoir* r, const RsPrimary* pa,
+                             const RsPrimary* pb) {
+  if (r->light == PR_INVALID_INDEX || !rs_unmoved(s, pa->h.inst) || !rs_unmoved(s, pb->h.inst))
+    return 0;
+  const float3 xa = pa->h.p, xb = pb->h.p;
   const Light l = s->lights.lights[r->light];
   if (light_is_triangle(l.type)) {
     const float3 y = surface_at(&s->sd, l.prim, l.inst, r->b1, r->b2).p;
-    return rs_clear(moved, count, xa, y - xa, 1.0f) && rs_clear(moved, count, xb, y - xb, 1.0f);
+    return rs_clear(s, moved, count, xa, y - xa, 1.0f) &&
+           rs_clear(s, moved, count, xb, y - xb, 1.0f);
   }
   if (r->light == s->lights.env_light) {
     const float3 w = make_float3(r->wx, r->wy, r->wz);
-    return rs_clear(moved, count, xa, w, PR_INF_F) && rs_clear(moved, count, xb, w, PR_INF_F);
+    return rs_clear(s, moved, count, xa, w, PR_INF_F) && rs_clear(s, moved, count, xb, w, PR_INF_F);
   }
   LightSample la, lb;
   float b1, b2;
@@ -98,7 +103,8 @@ PR_INLINE int di_temporal_ok(const SceneData* s, PR_GLOBAL const float* moved, u
       !light_sample_towards(&l, s->lights.env, 1.0f, xb, make_float3(0.0f, 0.0f, 0.0f), 0.0f, 0.0f,
                             &lb, &b1, &b2))
     return 0;
-  return rs_clear(moved, count, xa, la.wi, la.dist) && rs_clear(moved, count, xb, lb.wi, lb.dist);
+  return rs_clear(s, moved, count, xa, la.wi, la.dist) &&
+         rs_clear(s, moved, count, xb, lb.wi, lb.dist);
 }
 
 // A candidate into *c: light li at (b1, b2) or along dir, its f at its own x_1, resampling
