@@ -5,6 +5,14 @@ previous frames' paths (1 neighbour, the default, and 3), and `--mode reuse`.
 
   /usr/bin/python3 -m tools.bench.bench_temporal                     # ~10-15 min on 2 cores
   /usr/bin/python3 -m tools.bench.bench_temporal --scenes atrium --seeds 1
+  /usr/bin/python3 -m tools.bench.bench_temporal --cycles VENV/bin/python   # and Cycles 5.2
+
+With --cycles (a Python that has PyPI's bpy 5.2, Python 3.13, in a virtual environment of its
+own: a benchmark peer, not a dependency), Blender's Cycles renders the measured frames too
+(tools/bench/cycles_frames.py: the materials as Blender imports them, CPU, 2 threads), at each
+spp of the sweep, and is measured against its own reference frames at the reference spp (cached
+like ours), so that each renderer's relMSE is its distance from what it converges to. It has no
+history to warm up; its seconds are those of its renders, without Blender's start and import.
 
 The first --warm frames of each run are rendered and not measured: temporal reuse needs a few
 frames of history, as a user's sequence has after its start. Every figure is the median over
@@ -14,15 +22,17 @@ does. Needs numpy, hence /usr/bin/python3.
 """
 
 import argparse
+import hashlib
 import json
 import math
+import subprocess
 import sys
 import tempfile
 from pathlib import Path
 
 from .benchlib import ATRIUM, REPO, median
 from .evaluation.metrics import LOWEST, flicker, interp_time
-from .evaluation.run import Runner, die, load_scenes, references, warm_up
+from .evaluation.run import Runner, die, file_sha, load_scenes, references, warm_up
 
 SETTINGS = {
     "pathtrace": ("pathtrace", ()),
@@ -50,6 +60,7 @@ def parse_args():
     ap.add_argument("--cache", default=str(REPO / "out" / "bench-temporal-cache"),
                     help="reference frames, kept between runs")
     ap.add_argument("--json", help="write the figures here too")
+    ap.add_argument("--cycles", help="a Python with bpy 5.2: measure Cycles too")
     ap.add_argument("--quiet", action="store_true")
     args = ap.parse_args()
     args.sweep_spp = sorted({int(s) for s in args.sweep_spp.split(",")} | {args.spp})
@@ -86,6 +97,54 @@ def measure(runner, sc, ref_exrs, refs, args):
                 runs[name][spp].append((e, t, sum(fl) / len(fl)))
     return {name: {s: tuple(median([r[i] for r in rs]) for i in range(3)) for s, rs in by.items()}
             for name, by in runs.items()}
+
+
+CYCLES = "Cycles 5.2 (its own reference)"
+CYCLES_FRAMES = REPO / "tools" / "bench" / "cycles_frames.py"
+
+
+def cycles_render(args, sc, spp, seed, size, out):
+    """Cycles' measured frames at spp into out/f_%04d.exr; their render seconds."""
+    out.mkdir(parents=True, exist_ok=True)
+    cmd = [args.cycles, str(CYCLES_FRAMES), str(sc.path), str(out),
+           "--frames", f"{args.warm}-{args.frames - 1}", "--spp", str(spp), "--width", str(size[1]),
+           "--height", str(size[0]), "--max-depth", str(args.max_depth), "--seed", str(seed)]
+    proc = subprocess.run(cmd, capture_output=True, text=True)
+    if proc.returncode != 0:
+        die(f"Cycles failed ({proc.returncode}): {' '.join(cmd)}\n{proc.stderr.strip()[-2000:]}", 1)
+    recs = [json.loads(line) for line in proc.stdout.splitlines() if line.startswith("{")]
+    if len(recs) != args.frames - args.warm:
+        die(f"expected {args.frames - args.warm} frames from: {' '.join(cmd)}", 1)
+    if not args.quiet:
+        print(f"  {sc.key:16s} cycles    spp {spp:3d} seed {seed}       frames "
+              f"{args.warm}-{args.frames - 1}: median {median([r['render_s'] for r in recs]):.3f} "
+              "s/frame", flush=True)
+    return [r["render_s"] for r in recs]
+
+
+def cycles_measure(runner, sc, size, args, cache, tmp):
+    """Cycles' row, {spp: (relMSE, s/frame, flicker)}, against its own reference frames."""
+    key = hashlib.sha1(json.dumps([file_sha(sc.path), list(size), sc.ref_spp, args.max_depth,
+                                   "cycles-5.2"]).encode()).hexdigest()[:16]
+    frames = range(args.warm, args.frames)
+    ref_dir = cache / f"{sc.key}_cycles_{key}"
+    ref_exrs = [ref_dir / f"f_{f:04d}.exr" for f in frames]
+    if not all(p.is_file() for p in ref_exrs):
+        print(f"  Cycles references for {sc.key}: {len(ref_exrs)} frame(s) at {sc.ref_spp} spp",
+              flush=True)
+        cycles_render(args, sc, sc.ref_spp, 1000, size, ref_dir)
+    refs = runner.read(ref_exrs)
+    runs = {s: [] for s in args.sweep_spp}
+    for seed in args.seeds:
+        for spp in args.sweep_spp:
+            out = tmp / f"cycles_{sc.key}_{spp}_{seed}"
+            secs = cycles_render(args, sc, spp, seed, size, out)
+            exrs = [out / f"f_{f:04d}.exr" for f in frames]
+            e = [runner.diff(x, r)["relmse"] for x, r in zip(exrs, ref_exrs)]
+            imgs = runner.read(exrs)
+            fl = [flicker(imgs[k - 1], imgs[k], refs[k - 1], refs[k]) for k in range(1, len(imgs))]
+            runs[spp].append((sum(e) / len(e), median(secs), sum(fl) / len(fl)))
+    return {s: tuple(median([r[i] for r in rs]) for i in range(3)) for s, rs in runs.items()}
 
 
 def report(sc, fig, args):
@@ -130,6 +189,8 @@ def main():
         for sc in scenes:
             ref_exrs, refs, _ = references(runner, sc, cache)
             fig = measure(runner, sc, ref_exrs, refs, args)
+            if args.cycles:
+                fig[CYCLES] = cycles_measure(runner, sc, refs[0].shape[:2], args, cache, tmp)
             l, o = report(sc, fig, args)
             lines += l
             out[sc.key] = o
