@@ -31,6 +31,8 @@
   S(PathReservoir)           \
   S(PathTrack)               \
   S(PathHistory)             \
+  S(DirectReservoir)         \
+  S(MovedInstance)           \
   S(ResampleParams)          \
   S(PathHeader)              \
   S(LightVertex)             \
@@ -126,8 +128,15 @@
   F(PathReservoir, f_r)               \
   F(PathReservoir, w_sum)             \
   F(PathReservoir, sp)                \
+  F(PathHistory, d)                   \
   F(PathHistory, prim)                \
   F(PathHistory, stamp)               \
+  F(DirectReservoir, wx)              \
+  F(DirectReservoir, p_hat)           \
+  F(DirectReservoir, m)               \
+  F(MovedInstance, root)              \
+  F(MovedInstance, before)            \
+  F(MovedInstance, after)             \
   F(PathTrack, x1_ok)                 \
   F(PathTrack, pdf)                   \
   F(PathTrack, g_src)                 \
