@@ -307,7 +307,7 @@ void GpuScene::collectMoved(const std::vector<accel::Aabb>& before,
     if (rigid[i] && std::isfinite(d0) && std::isfinite(d1) && d0 != 0.0f && d1 != 0.0f) {
       m.root = dsg_.meshRoot(scene_.instances[i].mesh);
       toRows(glm::inverse(was[i]), m.before);
-      toRows(glm::inverse(now), m.after);
+      std::memcpy(m.after, instances_[i].world_to_object, sizeof m.after);  // setTime's inverse
     }
     moved_.push_back(m);
   }
