@@ -176,7 +176,8 @@ void addSamplingOptions(CLI::App* render, RenderArgs& a) {
   render->add_flag("--resample", ro.resample.enabled,
                    "Resample the paths beyond each first surface with those of neighbouring "
                    "pixels and of the previous frame, reconnected there and weighed by pairwise "
-                   "MIS (unbiased; --mode pathtrace only for now)");
+                   "MIS (unbiased; with --mode reuse/retrace the eye paths, weighted against "
+                   "the connections, which are added as without it)");
   render
       ->add_option("--resample-neighbors", ro.resample.neighbors,
                    "Pixels whose paths each pixel takes (--resample; 0: its own alone)")
@@ -203,6 +204,13 @@ void addSamplingOptions(CLI::App* render, RenderArgs& a) {
                    "Confidence the previous frame's paths count at most, in samples (--resample; "
                    "0: no reuse between frames)")
       ->check(CLI::Range(0, 1000))
+      ->capture_default_str();
+  render
+      ->add_option("--resample-mis-count", ro.resample.misCount,
+                   "Samples a resampled eye path counts as in its MIS weights against the "
+                   "connections to stored light paths, which count as --paths-per-pixel "
+                   "(--mode reuse/retrace with --resample)")
+      ->check(finiteIn(0.01, 1e6))
       ->capture_default_str();
 }
 

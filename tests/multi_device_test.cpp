@@ -2,6 +2,8 @@
 // frames byte-identical to a single device's with PoCL's two drivers, which compute alike.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -72,9 +74,10 @@ std::string oneDevice() {
   return two.substr(0, two.find(" --device", 1));
 }
 
-// Each stats line names both devices, whose rows tile the image; the top-level rays are the
-// devices' sums.
-void checkStats(const std::string& file, int frames) {
+// Each stats line names both devices, whose rows tile the image (or, where passes_of is given,
+// whose sample passes are passes_of[0] and passes_of[1], each over every row); the top-level rays
+// are the devices' sums.
+void checkStats(const std::string& file, int frames, const std::vector<int>& passes_of = {}) {
   std::ifstream in(file);
   std::string line;
   int lines = 0;
@@ -82,12 +85,21 @@ void checkStats(const std::string& file, int frames) {
     ++lines;
     const auto j = nlohmann::json::parse(line);
     ASSERT_EQ(j["devices"].size(), 2u) << line;
-    int rows = 0;
+    int rows = 0, passes = 0;
     double share = 0.0;
     std::map<std::string, uint64_t> rays;
     for (const auto& d : j["devices"]) {
-      EXPECT_EQ(d["row_begin"].get<int>(), rows) << line;
-      rows += d["rows"].get<int>();
+      if (passes_of.empty()) {
+        EXPECT_EQ(d["row_begin"].get<int>(), rows) << line;
+        rows += d["rows"].get<int>();
+      } else {
+        EXPECT_EQ(d["row_begin"].get<int>(), 0) << line;
+        EXPECT_EQ(d["rows"].get<int>(), kHeight) << line;
+        EXPECT_EQ(d["pass_begin"].get<int>(), passes) << line;
+        EXPECT_EQ(d["passes"].get<int>(), passes_of[passes ? 1 : 0]) << line;
+        passes += d["passes"].get<int>();
+        rows = kHeight;
+      }
       share += d["share"].get<double>();
       EXPECT_GT(d["rows"].get<int>(), 0) << line;
       EXPECT_GT(d["wall_s"].get<double>(), 0.0) << line;
@@ -97,7 +109,7 @@ void checkStats(const std::string& file, int frames) {
     EXPECT_EQ(rows, kHeight) << line;
     EXPECT_NEAR(share, 1.0, 1e-12) << line;
     for (const auto& [k, v] : rays) EXPECT_EQ(j["rays"][k].get<uint64_t>(), v) << k;
-    if (lines == 1) {
+    if (lines == 1 && passes_of.empty()) {
       EXPECT_EQ(j["devices"][0]["rows"].get<int>(), kHeight / 2) << line;
     }
   }
@@ -123,6 +135,50 @@ TEST(MultiDeviceCli, TwoDevicesEqualOne) {
       EXPECT_TRUE(samePixels(frameFile(dir + "/one", f), frameFile(dir + "/two", f)))
           << "frame " << f;
     checkStats(dir + "/two.jsonl", kFrames);
+  }
+}
+
+// The largest difference between two frames' channels relative to the larger of the two (0 for
+// equal frames).
+double largestRelativeDifference(const std::string& a, const std::string& b) {
+  const Image x = readExr(a), y = readExr(b);
+  EXPECT_EQ(x.rgba.size(), y.rgba.size());
+  double worst = 0.0;
+  for (size_t k = 0; k < std::min(x.rgba.size(), y.rgba.size()); ++k) {
+    const double d = std::fabs(double(x.rgba[k]) - y.rgba[k]);
+    const double m = std::max(std::fabs(double(x.rgba[k])), std::fabs(double(y.rgba[k])));
+    worst = std::max(worst, d > 0.0 ? d / m : 0.0);
+  }
+  return worst;
+}
+
+// With --resample a pixel's paths take its neighbours' and the previous frame's, anywhere in the
+// image, so the devices split the sample passes instead of the rows: each renders every pixel and
+// their films' sums are added. Every sample is one device's, and two devices' sums of passes
+// [0, k) and [k, spp) added are one device's sum in its order, so frames with moving objects, in
+// both modes, equal one device's byte for byte (with the rows split instead, some pixel of every
+// frame was 45-100% off). Each stats line names both devices, each with every row and half the
+// passes.
+TEST(MultiDeviceCli, TwoDevicesEqualOneWithResampling) {
+  const std::string two = test::twoPoclDevices();
+  const std::string range = " --frames 0-3 --resample";
+  for (const char* mode : {"reuse", "pathtrace"}) {
+    SCOPED_TRACE(mode);
+    std::string args = common(mode);
+    args.replace(args.find("--spp 2"), 7, "--spp 3");
+    const std::string dir = test::tempDir("multi-rs");
+    auto r = test::runPathreuse(args + range + oneDevice() + " --out '" + dir + "/one/f_%04d.exr'",
+                                test::kTwoPoclDrivers);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    r = test::runPathreuse(
+        args + range + two + " --out '" + dir + "/two/f_%04d.exr' --stats '" + dir + "/two.jsonl'",
+        test::kTwoPoclDrivers);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    for (int f = 0; f <= 3; ++f)
+      EXPECT_TRUE(samePixels(frameFile(dir + "/one", f), frameFile(dir + "/two", f)))
+          << "frame " << f << ": largest relative difference "
+          << largestRelativeDifference(frameFile(dir + "/one", f), frameFile(dir + "/two", f));
+    checkStats(dir + "/two.jsonl", 4, {2, 1});  // --spp 3
   }
 }
 

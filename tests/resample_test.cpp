@@ -226,5 +226,62 @@ TEST(Resample, HistoryLowersTheError) {
   EXPECT_LT(eKept * 1.2, eNone) << "relMSE with history " << eKept << ", without " << eNone;
 }
 
+// --mode reuse with --resample: the eye paths are resampled, each path weighted by its share
+// against the connections to stored light paths as rebuilt at the x_1 it moves to
+// (rs_eye_share), and the connections are added as without it. The demo converges to the path
+// tracer's image region by region.
+TEST(Resample, WithReuseConvergesToThePathTracerRegionByRegion) {
+  const Image ref = demoReference();
+  const Image img = test::frameImage(
+      test::renderFrames(demoScene(), "0",
+                         "--mode reuse --width 96 --height 72 --spp 512 --seed 2 --resample "
+                         "--resample-neighbors 3 --resample-radius 16",
+                         "rs-reuse"),
+      0);
+  expectRegionsAgree(img, ref, 0.05);
+}
+
+// A lamp above an opaque shade lights a spot on the ceiling, and the spot lights the floor the
+// camera sees. The stored light paths make those floor-ceiling-lamp paths far more densely than
+// the eye paths' BSDF samples from the floor do, so the eye paths keep a small share of them,
+// which differs from one x_1 to the next. Resampled in --mode reuse with neighbours and the
+// previous frames' paths, frame 3 agrees with the path tracer region by region; giving a path
+// the eye path's whole weight where a neighbour takes it puts the floor's regions about 6% too
+// high.
+TEST(Resample, WithReuseWeighsEachPathAtItsNewFirstVertex) {
+  test::GltfBuilder b;
+  const int white = b.addMaterial({glm::vec4(0.8f, 0.8f, 0.8f, 1), 0, 1});
+  const int lamp = b.addMaterial({glm::vec4(0, 0, 0, 1), 0, 1, glm::vec3(1.0f), 40.0f});
+  b.addNode(b.addQuad({-3, 0, -3}, {-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, white));
+  b.addNode(b.addQuad({-3, 3, -3}, {3, 3, -3}, {3, 3, 3}, {-3, 3, 3}, white));
+  b.addNode(b.addBox(glm::vec3(-0.4f, 2.45f, -0.4f), glm::vec3(0.4f, 2.5f, 0.4f), white));
+  b.addNode(b.addQuad({-0.2f, 2.55f, -0.2f}, {-0.2f, 2.55f, 0.2f}, {0.2f, 2.55f, 0.2f},
+                      {0.2f, 2.55f, -0.2f}, lamp));
+  b.addCamera(glm::vec3(0.0f, 2.0f, 4.0f), glm::vec3(0.0f, 0.0f, -0.5f), 0.9f, 4.0f / 3.0f);
+  const std::string scene = b.write(test::tempDir("rs-shade"), "shade");
+  const std::string args = " --width 64 --height 48 --fps 1000 --max-depth 3 --force-diffuse ";
+  const Image ref = test::frameImage(
+      test::renderFrames(scene, "3", "--mode pathtrace" + args + "--spp 2048 --seed 1",
+                         "rs-shade-ref"),
+      3);
+  const Image img = test::frameImage(
+      test::renderFrames(scene, "0-3",
+                         "--mode reuse" + args +
+                             "--spp 256 --seed 2 --resample --resample-neighbors 3 "
+                             "--resample-radius 16",
+                         "rs-shade"),
+      3);
+  expectRegionsAgree(img, ref, 0.04, 10);
+}
+
+// With --resample, reuse still equals retrace bit for bit, the previous frames' paths included.
+TEST(Resample, WithReuseEqualsRetrace) {
+  const std::string args = " --width 48 --height 36 --spp 2 --resample";
+  const std::string a = test::renderFrames(demoScene(), "0-3", "--mode reuse" + args, "rs-rr-a");
+  const std::string b = test::renderFrames(demoScene(), "0-3", "--mode retrace" + args, "rs-rr-b");
+  for (int f = 0; f <= 3; ++f)
+    EXPECT_EQ(test::frameImage(a, f).rgba, test::frameImage(b, f).rgba) << "frame " << f;
+}
+
 }  // namespace
 }  // namespace pr

@@ -43,8 +43,7 @@ Image Film::read(uint64_t* badSamples) {
   return img;
 }
 
-void Film::readRows(Image* image, uint64_t* badSamples) {
-  PR_CHECK(image->width == width_ && image->height == height_);
+std::vector<float> Film::readSums(uint64_t* badSamples) {
   const size_t n = end() - first();
   std::vector<float> sums(n * 4);
   if (n > 0)
@@ -53,12 +52,21 @@ void Film::readRows(Image* image, uint64_t* badSamples) {
   cl_uint bad = 0;
   CL_CHECK(ctx_.queue().enqueueReadBuffer(bad_, CL_TRUE, 0, 4, &bad));
   if (badSamples) *badSamples = bad;
-  float* out = image->rgba.data() + size_t(first()) * 4;
+  return sums;
+}
+
+void Film::mean(const float* sums, size_t n, float* rgba) {
   for (size_t i = 0; i < n; ++i) {
     const float count = sums[i * 4 + 3];
-    for (int c = 0; c < 3; ++c) out[i * 4 + c] = count > 0.0f ? sums[i * 4 + c] / count : 0.0f;
-    out[i * 4 + 3] = 1.0f;
+    for (int c = 0; c < 3; ++c) rgba[i * 4 + c] = count > 0.0f ? sums[i * 4 + c] / count : 0.0f;
+    rgba[i * 4 + 3] = 1.0f;
   }
+}
+
+void Film::readRows(Image* image, uint64_t* badSamples) {
+  PR_CHECK(image->width == width_ && image->height == height_);
+  const std::vector<float> sums = readSums(badSamples);
+  mean(sums.data(), sums.size() / 4, image->rgba.data() + size_t(first()) * 4);
 }
 
 }  // namespace pr

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include "cl/context.h"
 #include "io/image.h"
@@ -22,6 +23,11 @@ class Film {
   Image read(uint64_t* badSamples = nullptr);
   // The same for the range's rows only, written into `image` (of the film's size).
   void readRows(Image* image, uint64_t* badSamples = nullptr);
+  // The range's sums as they stand (rgb sum and sample count per pixel, 4 floats), for films
+  // of several devices that are added before the mean (render/multi_device.h).
+  std::vector<float> readSums(uint64_t* badSamples = nullptr);
+  // The mean of n pixels' sums into n rgba pixels (alpha 1; 0 where no sample counted).
+  static void mean(const float* sums, size_t n, float* rgba);
 
   // Rows [rowBegin, rowEnd) are rendered (default: all).
   void setRows(int rowBegin, int rowEnd);

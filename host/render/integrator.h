@@ -36,6 +36,17 @@ class Integrator {
   // leaving the film partial, once pr::interrupted(); the caller then drops the frame.
   virtual void renderFrame(int frame, const dev::CameraParams& camera, FrameStats* stats) = 0;
   virtual uint64_t deviceBytes() const = 0;
+  // Sample passes [begin, end) of each frame are rendered (default: all, end -1 for spp):
+  // several devices split a frame's passes rather than its rows with --resample
+  // (render/multi_device.h).
+  virtual void setPasses(int begin, int end) {
+    passBegin_ = begin;
+    passEnd_ = end;
+  }
+
+ protected:
+  int passEnd(int spp) const { return passEnd_ < 0 ? spp : passEnd_; }
+  int passBegin_ = 0, passEnd_ = -1;
 };
 
 }  // namespace pr

@@ -74,7 +74,42 @@ MultiDeviceSession::MultiDeviceSession(const Scene& scene,
     sessions_[i] = std::make_unique<RenderSession>(scene, *devices[i], options);
   });
   // The first frame: an even split.
-  setRows(splitRows(height(), std::vector<double>(devices.size(), 1.0)));
+  const std::vector<double> even(devices.size(), 1.0);
+  if (options.resample.enabled && devices.size() > 1) {
+    spp_ = options.spp;
+    passes_ = splitRows(spp_, even);
+    int begin = 0;
+    for (size_t i = 0; i < sessions_.size(); ++i) {
+      sessions_[i]->setPasses(begin, begin + passes_[i]);
+      begin += passes_[i];
+    }
+    rows_.assign(devices.size(), height());
+    return;
+  }
+  setRows(splitRows(height(), even));
+}
+
+void MultiDeviceSession::renderPasses(int frame, Image* img, std::vector<DeviceFrame>* parts) {
+  const size_t n = sessions_.size();
+  std::vector<std::vector<float>> sums(n);
+  std::vector<DeviceFrame>& p = *parts;
+  int begin = 0;
+  for (size_t i = 0; i < n; ++i) {
+    p[i].rowEnd = height();
+    p[i].passBegin = begin;
+    p[i].passEnd = begin += passes_[i];
+    p[i].share = double(passes_[i]) / spp_;
+  }
+  forEachDevice(n, [&](size_t i) {
+    const auto t0 = std::chrono::steady_clock::now();
+    sums[i] = sessions_[i]->renderSums(frame, &p[i].stats);
+    p[i].wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  });
+  // In device order, so that the frame does not depend on which device finished first.
+  std::vector<float>& total = sums[0];
+  for (size_t i = 1; i < n; ++i)
+    for (size_t k = 0; k < total.size(); ++k) total[k] += sums[i][k];
+  Film::mean(total.data(), total.size() / 4, img->rgba.data());
 }
 
 void MultiDeviceSession::setRows(const std::vector<int>& rows) {
@@ -94,19 +129,28 @@ Image MultiDeviceSession::renderFrame(int frame, FrameStats* total,
   std::vector<DeviceFrame> local(n);
   std::vector<DeviceFrame>& p = parts ? *parts : local;
   p.assign(n, DeviceFrame{});
-  int begin = 0;
   for (size_t i = 0; i < n; ++i) {
     p[i].index = devices_[i]->index;
     p[i].name = devices_[i]->name;
-    p[i].rowBegin = begin;
-    p[i].rowEnd = begin += rows_[i];
   }
-  // Each thread writes only its own rows of `img`.
-  forEachDevice(n, [&](size_t i) {
-    const auto t0 = std::chrono::steady_clock::now();
-    sessions_[i]->renderRows(frame, &img, &p[i].stats);
-    p[i].wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  });
+  if (!passes_.empty()) {
+    renderPasses(frame, &img, &p);
+  } else {
+    int begin = 0;
+    for (size_t i = 0; i < n; ++i) {
+      p[i].rowBegin = begin;
+      p[i].rowEnd = begin += rows_[i];
+      p[i].passEnd = sessions_[i]->spp();
+      p[i].share = double(rows_[i]) / height();
+    }
+    // Each thread writes only its own rows of `img`.
+    forEachDevice(n, [&](size_t i) {
+      const auto t0 = std::chrono::steady_clock::now();
+      sessions_[i]->renderRows(frame, &img, &p[i].stats);
+      p[i].wallSeconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    });
+  }
 
   if (total) {
     FrameStats& t = *total;
@@ -126,7 +170,7 @@ Image MultiDeviceSession::renderFrame(int frame, FrameStats* total,
   }
 
   // The next frame's split: rows in proportion to rows per second of each device's part.
-  if (n > 1) {
+  if (n > 1 && passes_.empty()) {
     double known = 0.0;
     int counted = 0;
     for (size_t i = 0; i < n; ++i)

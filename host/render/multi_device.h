@@ -5,6 +5,15 @@
 // replicated on every device: the same slots and keys give the same light paths, so no arena
 // moves between devices. The devices render concurrently, one host thread each; the rows of a
 // frame are split in proportion to each device's throughput in the previous frame.
+//
+// With --resample a pixel's paths are resampled with its neighbours' and with the previous
+// frame's paths anywhere in the image, which a device holding some rows does not have. There the
+// devices split the sample passes instead: each renders every pixel in a fixed range of passes
+// (an even split, kept for the run, since pass s of a frame resamples with pass s of the previous
+// one on its own device), and the films' sums are added in device order before the mean. Every
+// sample is then the one a single device computes, and with two devices so is the frame, bit for
+// bit (the first device's sum of passes [0, k) plus the second's of [k, spp) is one device's sum,
+// in its order); with more, the sums' float rounding differs.
 #pragma once
 
 #include <memory>
@@ -25,7 +34,9 @@ struct DeviceFrame {
   int index = 0;  // the device's index in `pathreuse devices`
   std::string name;
   int rowBegin = 0, rowEnd = 0;
-  double wallSeconds = 0.0;  // its thread: scene update, kernels, reading its rows
+  int passBegin = 0, passEnd = 0;  // its sample passes
+  double share = 0.0;              // of the frame's pixel samples
+  double wallSeconds = 0.0;        // its thread: scene update, kernels, reading its rows
   FrameStats stats;
 };
 
@@ -56,11 +67,15 @@ class MultiDeviceSession {
 
  private:
   void setRows(const std::vector<int>& rows);
+  // Frame f with the passes split (--resample): every device's film summed into `img`.
+  void renderPasses(int frame, Image* img, std::vector<DeviceFrame>* parts);
 
   std::vector<const DeviceEntry*> devices_;
   std::vector<std::unique_ptr<RenderSession>> sessions_;
   std::vector<int> rows_;
   std::vector<double> throughput_;  // rows per second of the last frame each device rendered
+  std::vector<int> passes_;         // with --resample and several devices, passes per device
+  int spp_ = 0;
 };
 
 }  // namespace pr

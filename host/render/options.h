@@ -43,6 +43,10 @@ struct ResampleSettings {
   // Temporal reuse: the confidence the previous frame's reservoir counts at most (ReSTIR's M
   // cap); 0: none, each frame alone.
   int history = 20;
+  // --mode reuse: the samples a resampled eye path counts as in its MIS weights against the
+  // connections to stored light paths (which count as C, --paths-per-pixel). 4: the least error
+  // on both animations of bench_temporal among 1, 4, 16 and 64 (docs/design.md section 5).
+  float misCount = 4.0f;
 };
 
 struct FrameRange {

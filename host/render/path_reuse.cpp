@@ -91,6 +91,7 @@ PathReuse::PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseS
     pt.seed = settings_.seed;
     pt.fixedNoise = settings_.fixedNoise;
     pt.lightPaths = settings_.pathsPerPixel;
+    pt.resample = settings_.resamplePaths;
     eyePaths_ = std::make_unique<PathTracer>(ctx, scene, film, pt);
     bytes_ += eyePaths_->deviceBytes();
   }
@@ -110,6 +111,8 @@ dev::ReuseParams PathReuse::frameParams(int frame) const {
   // With eye paths, strategy E's paths are the path tracer's.
   rp.mis_threshold = settings_.eyePaths ? 0.0f : settings_.misThreshold;
   rp.eye_paths = settings_.eyePaths ? 1u : 0u;
+  // pt_shade weighs the eye paths with the same count (PathTracer::resampleParams).
+  rp.eye_count = settings_.resamplePaths.enabled ? settings_.resamplePaths.misCount : 1.0f;
   PR_CHECK(settings_.resample <= PR_MAX_CONNECTIONS);  // the CLI allows 1-4
   rp.resample = settings_.resample;
   rp.trace_total = scene_.traceTotalPower();
@@ -218,7 +221,7 @@ bool PathReuse::tracePasses(int frame, const dev::CameraParams& camera, const de
   }
   if (eyePaths_) eyePaths_->beginFrame(frame, camera, sceneArgs, radiance_, eye_);
   const cl_uint first = film_.first(), n = film_.end();
-  for (int s = 0; s < settings_.spp; ++s) {
+  for (int s = passBegin_; s < passEnd(settings_.spp); ++s) {
     // With eye paths, the path tracer's pass writes the sample's radiance and its first eye
     // vertex, where eye_hit would.
     if (eyePaths_) {

@@ -37,6 +37,9 @@ struct PathReuseSettings {
   uint64_t connectRecordBytes = uint64_t(128) << 20;
   bool retraceAll = false;  // --mode retrace
   bool fixedNoise = false;  // camera samples keyed by frame 0 on every frame
+  // --resample: the eye paths resampled across pixels and frames (kernels/shared/resample.h),
+  // with their share against the connections; its distance resolved (> 0, scene units).
+  ResampleSettings resamplePaths;
 };
 
 class PathReuse : public Integrator {
@@ -44,6 +47,10 @@ class PathReuse : public Integrator {
   PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseSettings& settings);
   void renderFrame(int frame, const dev::CameraParams& camera, FrameStats* stats) override;
   uint64_t deviceBytes() const override { return bytes_; }
+  void setPasses(int begin, int end) override {
+    Integrator::setPasses(begin, end);
+    if (eyePaths_) eyePaths_->setPasses(begin, end);
+  }
 
   // connect's terms per pixel sample, and the pixel samples of one launch (eye paths).
   uint32_t connectRecordCap() const { return recordCap_; }
@@ -55,6 +62,8 @@ class PathReuse : public Integrator {
         sizeof(dev::LightVertex) + (settings_.eyePaths ? sizeof(dev::EyePathRatio) : 0);
     return uint64_t(slots_) * (sizeof(dev::PathHeader) + stride_ * vertex);
   }
+  // The eye paths' path tracer (null with --no-eye-paths): its --resample history is the run's.
+  PathTracer* eyePaths() { return eyePaths_.get(); }
   // The arena as it stands (for tests and diagnostics).
   void readArena(std::vector<dev::PathHeader>* headers, std::vector<dev::LightVertex>* vertices);
 

@@ -70,6 +70,7 @@ dev::ResampleParams PathTracer::resampleParams() const {
   p.width = film_.width();
   p.height = film_.height();
   p.max_m = float(r.history);
+  p.eye_count = r.enabled && settings_.lightPaths > 0 ? r.misCount : 1.0f;
   return p;
 }
 
@@ -83,7 +84,8 @@ void PathTracer::beginFrame(int frame, const dev::CameraParams& camera,
   dev::ResampleParams rsp = resampleParams();
   // The previous frame's reservoirs are taken where every chain was kept, the frame follows it
   // and no light changed (a light pdf in a kept path would differ).
-  temporal_ = chains_ > 0 && written_ >= chains_ && frame == frame_ + 1 && !scene_.anyLightMoved();
+  temporal_ = chainedPasses() > 0 && written_ >= chainedPasses() && frame == frame_ + 1 &&
+              !scene_.anyLightMoved();
   const dev::CameraParams prevCamera = temporal_ ? camera_ : camera;
   frame_ = frame;
   camera_ = camera;
@@ -220,7 +222,7 @@ void PathTracer::tracePass(int sample, StageTimer* timer) {
       const size_t rec = sizeof(dev::PathHistory);
       CL_CHECK(ctx_.queue().enqueueCopyBuffer(historyOut_, history_[size_t(sample)], first * rec,
                                               first * rec, (n - first) * rec));
-      written_ = std::max(written_, sample + 1);
+      ++written_;
     }
   }
 }
@@ -312,7 +314,7 @@ bool PathTracer::readHistory(const std::string& data, const std::string& key, in
   frame_ = h.frame;
   stamp_ = h.stamp;
   camera_ = h.camera;
-  written_ = chains_;
+  written_ = chainedPasses();
   return true;
 }
 
@@ -328,7 +330,7 @@ void PathTracer::reportRays(FrameStats* stats) {
 void PathTracer::renderFrame(int frame, const dev::CameraParams& camera, FrameStats* stats) {
   StageTimer timer;
   beginFrame(frame, camera, scene_.kernelArgs(), radiance_, noEye_);
-  for (int s = 0; s < settings_.spp; ++s) {
+  for (int s = passBegin_; s < passEnd(settings_.spp); ++s) {
     tracePass(s, &timer);
     film_.accumulate(radiance_, &timer);
     // Wait for each pass, so that an interrupt stops a frame of many samples within one pass.

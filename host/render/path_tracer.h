@@ -4,6 +4,7 @@
 // with MIS, Russian roulette.
 #pragma once
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -51,12 +52,16 @@ class PathTracer : public Integrator {
   // names everything else it depends on (scene, options); a history of another key, size or frame
   // is not read (returns false). readHistory's frame is the frame that wrote it; the caller sets
   // the scene to that frame's time before the next frame.
-  bool hasHistory() const { return chains_ > 0 && written_ >= chains_; }
+  bool hasHistory() const { return chainedPasses() > 0 && written_ >= chainedPasses(); }
   std::string writeHistory(const std::string& key);
   bool readHistory(const std::string& data, const std::string& key, int frame);
 
  private:
   dev::ResampleParams resampleParams() const;
+  // This device's passes that keep a chain: each wrote its chain when the frame is whole.
+  int chainedPasses() const {
+    return std::max(0, std::min(chains_, passEnd(settings_.spp)) - passBegin_);
+  }
 
   Context& ctx_;
   GpuScene& scene_;
@@ -84,7 +89,7 @@ class PathTracer : public Integrator {
   cl::Buffer historyOut_, moved_;
   uint64_t movedBytes_ = 0;
   int chains_ = 0;
-  int written_ = 0;             // passes of the frame since beginFrame whose history is kept
+  int written_ = 0;             // passes of the frame since beginFrame whose chain is written
   int frame_ = -2;              // the frame of the last beginFrame
   dev::CameraParams camera_{};  // and its camera
   bool temporal_ = false;       // this frame resamples with the previous frame's history

@@ -136,7 +136,7 @@ void printStart(const RenderOptions& o, MultiDeviceSession& session, const Frame
 
 // The stats file's line for one frame.
 std::string statsLine(int f, const RenderOptions& o, const FrameStats& fs,
-                      const std::vector<DeviceFrame>& parts, int height) {
+                      const std::vector<DeviceFrame>& parts) {
   nlohmann::ordered_json j;
   j["frame"] = f;
   j["mode"] = renderModeName(o.mode);
@@ -148,7 +148,8 @@ std::string statsLine(int f, const RenderOptions& o, const FrameStats& fs,
   if (!fs.counters.empty()) j["counters"] = fs.counters;
   j["device_bytes"] = fs.deviceBytes;
   j["bad_samples"] = fs.badSamples;
-  // Per device: its rows, their share of the image, its wall and kernel times.
+  // Per device: its rows and sample passes, their share of the frame's pixel samples, its wall
+  // and kernel times.
   nlohmann::ordered_json list = nlohmann::ordered_json::array();
   for (const DeviceFrame& p : parts) {
     nlohmann::ordered_json d;
@@ -156,7 +157,9 @@ std::string statsLine(int f, const RenderOptions& o, const FrameStats& fs,
     d["name"] = p.name;
     d["row_begin"] = p.rowBegin;
     d["rows"] = p.rowEnd - p.rowBegin;
-    d["share"] = double(p.rowEnd - p.rowBegin) / height;
+    d["pass_begin"] = p.passBegin;
+    d["passes"] = p.passEnd - p.passBegin;
+    d["share"] = p.share;
     d["wall_s"] = p.wallSeconds;
     d["stages_s"] = p.stats.stageSeconds;
     d["rays"] = p.stats.rays;
@@ -250,7 +253,11 @@ std::string historyKey(const RenderOptions& o) {
                       r.roughness,
                       r.distance,
                       r.history,
-                      o.allowOutsideUris};
+                      r.misCount,
+                      o.allowOutsideUris,
+                      int(o.mode),  // --mode reuse: the eye paths' share against the connections
+                      o.lightPaths,
+                      o.pathsPerPixel};
   return j.dump() + scene + expandKernelSource("pathtrace/shade.cl") +
          expandKernelSource("pathtrace/resample.cl");
 }
@@ -317,7 +324,7 @@ int renderFrames(const RenderOptions& o, MultiDeviceSession& session, const Fram
     ++t.rendered;
     fs.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     for (const auto& [k, v] : fs.rays) t.raysSoFar += v;
-    if (stats) stats->writeLine(statsLine(f, o, fs, parts, session.height()));
+    if (stats) stats->writeLine(statsLine(f, o, fs, parts));
     if (fs.badSamples > 0) {
       t.badSamples += fs.badSamples;
       ++t.badFrames;

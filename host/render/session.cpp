@@ -115,16 +115,17 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
   gpu_ = std::make_unique<GpuScene>(ctx_, scene, sceneOptions);
   film_ = std::make_unique<Film>(ctx_, width_, height_);
   const RenderOptions& o = options_;
-  if (o.resample.enabled && o.mode != RenderMode::PathTrace)
-    throw InputError("--resample: works with --mode pathtrace only for now");
+  if (o.resample.enabled && o.mode != RenderMode::PathTrace && !o.eyePaths)
+    throw InputError("--resample: resamples the eye paths, which --no-eye-paths turns off");
+  ResampleSettings resample = o.resample;
+  if (!(resample.distance > 0.0f)) resample.distance = 0.01f * gpu_->sceneRadius();
   if (o.mode == RenderMode::PathTrace) {
     PathTracerSettings p;
     p.spp = o.spp;
     p.maxDepth = o.maxDepth;
     p.seed = o.seed;
     p.fixedNoise = o.fixedNoise;
-    p.resample = o.resample;
-    if (!(p.resample.distance > 0.0f)) p.resample.distance = 0.01f * gpu_->sceneRadius();
+    p.resample = resample;
     auto tracer = std::make_unique<PathTracer>(ctx_, *gpu_, *film_, p);
     pathTracer_ = tracer.get();
     integrator_ = std::move(tracer);
@@ -145,7 +146,10 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
     r.eyePaths = o.eyePaths;
     r.retraceAll = o.mode == RenderMode::Retrace;
     r.fixedNoise = o.fixedNoise;
-    integrator_ = std::make_unique<PathReuse>(ctx_, *gpu_, *film_, r);
+    r.resamplePaths = resample;
+    auto reuse = std::make_unique<PathReuse>(ctx_, *gpu_, *film_, r);
+    pathTracer_ = reuse->eyePaths();
+    integrator_ = std::move(reuse);
   }
 }
 
@@ -179,9 +183,24 @@ Image RenderSession::renderFrame(int frame, FrameStats* stats) {
 }
 
 void RenderSession::renderRows(int frame, Image* image, FrameStats* stats) {
-  const double time = frame / options_.fps;
   FrameStats local;
   FrameStats* fs = stats ? stats : &local;
+  render(frame, fs);
+  film_->readRows(image, &fs->badSamples);
+  fs->deviceBytes = ctx_.bytesInUse();
+}
+
+std::vector<float> RenderSession::renderSums(int frame, FrameStats* stats) {
+  FrameStats local;
+  FrameStats* fs = stats ? stats : &local;
+  render(frame, fs);
+  std::vector<float> sums = film_->readSums(&fs->badSamples);
+  fs->deviceBytes = ctx_.bytesInUse();
+  return sums;
+}
+
+void RenderSession::render(int frame, FrameStats* fs) {
+  const double time = frame / options_.fps;
   const auto t0 = std::chrono::steady_clock::now();
   gpu_->setTime(time);
   fs->hostSeconds["scene"] =
@@ -191,8 +210,6 @@ void RenderSession::renderRows(int frame, Image* image, FrameStats* stats) {
   fs->frame = frame;
   for (const auto& [k, v] : ctx_.takeBuildSeconds()) fs->buildSeconds[k] += v;
   integrator_->renderFrame(frame, gpu_->camera(camera_, time, width_, height_), fs);
-  film_->readRows(image, &fs->badSamples);
-  fs->deviceBytes = ctx_.bytesInUse();
 }
 
 }  // namespace pr

@@ -44,6 +44,10 @@ class RenderSession {
   // Rows [rowBegin, rowEnd) of each frame are rendered (default: all). The light paths of
   // path reuse cover every slot whatever the rows (render/multi_device.h).
   void setRows(int rowBegin, int rowEnd) { film_->setRows(rowBegin, rowEnd); }
+  // Sample passes [begin, end) of each frame are rendered (default: all; render/integrator.h),
+  // and renderSums gives the film's sums (Film::readSums) for another device's to be added.
+  void setPasses(int begin, int end) { integrator_->setPasses(begin, end); }
+  std::vector<float> renderSums(int frame, FrameStats* stats);
 
   // --resample's history between frames (render/path_tracer.h): whether the last frame left
   // one, its bytes, and reading the one frame `frame` wrote (which also sets the scene to
@@ -54,6 +58,7 @@ class RenderSession {
 
   int width() const { return width_; }
   int height() const { return height_; }
+  int spp() const { return options_.spp; }
   Context& context() { return ctx_; }
   Integrator& integrator() { return *integrator_; }
   // The frames of the animation at the session's fps, and the range the options ask for.
@@ -61,6 +66,9 @@ class RenderSession {
   FrameRange frameRange() const;
 
  private:
+  // Frame f into the film (its stats into *fs).
+  void render(int frame, FrameStats* fs);
+
   const Scene& scene_;
   RenderOptions options_;
   int camera_ = 0;
@@ -70,7 +78,9 @@ class RenderSession {
   std::unique_ptr<GpuScene> gpu_;
   std::unique_ptr<Film> film_;
   std::unique_ptr<Integrator> integrator_;
-  PathTracer* pathTracer_ = nullptr;  // integrator_, where it is the path tracer
+  // The path tracer whose --resample history is the run's: integrator_ itself, or reuse's eye
+  // paths.
+  PathTracer* pathTracer_ = nullptr;
 };
 
 }  // namespace pr

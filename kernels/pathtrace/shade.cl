@@ -18,13 +18,14 @@
 
 // L's density of the path over that of the eye path's vertices beyond x_1 (eye_ratio holds
 // the rest), for a path ending at x_t on light l (normal n_tri, start density `start`) at z0,
-// with cos_x = |cos| at x_t and rev = the light-tracing density of x_{t-1} from x_t (1 at t = 2).
+// with cos_x = |cos| at x_t and rev = the light-tracing density of x_{t-1} from x_t (1 at t = 2);
+// C = light_paths samples of L against eye_count of the eye path.
 PR_INLINE float eye_paths_light_side(const Light* l, float3 n_tri, float start, u32 light_paths,
-                                     float eye_ratio, float3 z0, float3 xt, float cos_x,
-                                     float rev) {
+                                     float eye_count, float eye_ratio, float3 z0, float3 xt,
+                                     float cos_x, float rev) {
   const float3 d = xt - z0;
   const float d2 = dot(d, d);
-  return (float)light_paths * start *
+  return (float)light_paths / eye_count * start *
          eye_paths_emit_density(l, n_tri, d * (1.0f / sqrt(d2)), cos_x, d2) * rev * eye_ratio;
 }
 
@@ -51,15 +52,19 @@ PR_INLINE int pt_escaped(const SceneData* s, const PathState* p, float3* add) {
 }
 
 // The weight of emission found at h along d (dist2 from the previous vertex): against next-event
-// estimation, and where the connections can make the path too (joinable), times their share.
+// estimation, and where the connections can make the path too (joinable), times their share;
+// its parts into *ew.
 PR_INLINE float pt_emission_weight(const SceneData* s, const PathState* p, const SurfaceHit* h,
                                    float3 d, float dist2, int joinable, u32 light_paths,
-                                   __global const float* trace_cdf, float trace_total) {
+                                   float eye_count, __global const float* trace_cdf,
+                                   float trace_total, EyeWeight* ew) {
   const float3 prev = make_float3(p->prev_x, p->prev_y, p->prev_z);
   const float3 prev_n = make_float3(p->prev_nx, p->prev_ny, p->prev_nz);
   float w = 1.0f;
   if (!(p->flags & PR_PATH_SPECULAR))
     w = power_heuristic(p->last_pdf, emitter_pdf(s, h, prev, prev_n));
+  ew->pt = w;
+  ew->n = ew->h = ew->l = 0.0f;
   const u32 li = joinable ? emitter_light(s, h) : PR_INVALID_INDEX;
   if (li != PR_INVALID_INDEX) {
     // The connections' share of the path (eye_paths.h); the eye path's N and H split the rest.
@@ -69,23 +74,29 @@ PR_INLINE float pt_emission_weight(const SceneData* s, const PathState* p, const
     const int spec = (p->flags & PR_PATH_SPECULAR) != 0u;
     const float dens_h =
         spec ? 1.0f : solid_angle_to_area_pdf(p->last_pdf, fabs(dot(n_tri, d)), dist2);
-    const float dens_l = eye_paths_light_side(&l, n_tri, start, light_paths, p->eye_ratio, h->p,
-                                              prev, p->seg_cos, 1.0f);
+    const float dens_l = eye_paths_light_side(&l, n_tri, start, light_paths, eye_count,
+                                              p->eye_ratio, h->p, prev, p->seg_cos, 1.0f);
     const float dens_n = spec ? 0.0f : start;
     if (dens_l > 0.0f) w *= 1.0f - mis_power_share(dens_n / dens_l, dens_h / dens_l);
+    ew->n = dens_n;
+    ew->h = dens_h;
+    ew->l = dens_l;
   }
   return w;
 }
 
-// The weight of a next-event sample at a joinable vertex h: the power heuristic against BSDF
-// sampling, times what the connections leave of the path.
+// The weight of a next-event sample at vertex h: the power heuristic against BSDF sampling,
+// times, where h is joinable, what the connections leave of the path; its parts into *ew.
 PR_INLINE float pt_next_event_weight(const SceneData* s, const PathState* p, const SurfaceHit* h,
-                                     const ShadingFrame* f, const NextEventChoice* ch, int has_rev,
-                                     float dist2, u32 light_paths, __global const float* trace_cdf,
-                                     float trace_total) {
+                                     const ShadingFrame* f, const NextEventChoice* ch, int joinable,
+                                     int has_rev, float dist2, u32 light_paths, float eye_count,
+                                     __global const float* trace_cdf, float trace_total,
+                                     EyeWeight* ew) {
   const Light l = s->lights.lights[ch->light];
   float w = ch->delta ? 1.0f : power_heuristic(ch->pdf_light, ch->pdf_bsdf);
-  if (eye_paths_light(&l)) {
+  ew->pt = w;
+  ew->n = ew->h = ew->l = 0.0f;
+  if (joinable && eye_paths_light(&l)) {
     const float3 n_tri =
         light_is_triangle(l.type) ? eye_paths_light_normal(s, &l) : make_float3(0.0f, 0.0f, 1.0f);
     const float3 dz = ch->pos - h->p;
@@ -96,24 +107,30 @@ PR_INLINE float pt_next_event_weight(const SceneData* s, const PathState* p, con
                              ? solid_angle_to_area_pdf(ch->pdf_bsdf, fabs(dot(n_tri, wi)), dz2)
                              : 0.0f;
     const float rev = has_rev ? solid_angle_to_area_pdf(ch->pdf_bsdf_rev, p->seg_cos, dist2) : 1.0f;
-    const float dens_l = eye_paths_light_side(&l, n_tri, dens_n, light_paths, p->eye_ratio, ch->pos,
-                                              h->p, fabs(dot(f->ng, wi)), rev);
+    const float dens_l =
+        eye_paths_light_side(&l, n_tri, dens_n, light_paths, eye_count, p->eye_ratio, ch->pos, h->p,
+                             fabs(dot(f->ng, wi)), rev);
     if (dens_l > 0.0f) w *= 1.0f - mis_power_share(dens_n / dens_l, dens_h / dens_l);
+    ew->n = dens_n;
+    ew->h = dens_h;
+    ew->l = dens_l;
   }
   return w;
 }
 
 // --resample, at a hit `rel` vertices beyond x_1 (2 and on: x_3 ...) or, escaped along d
-// (escaped), from the vertex `rel` - 1 beyond it: the path's end on an emitter (le, weighted w
-// by the path tracer, pdf_light its light pdf) offered to the pixel's reservoir.
+// (escaped), from the vertex `rel` - 1 beyond it: the path's end on an emitter (le, weighted
+// ew->pt by the path tracer and with ew's share against the connections, pdf_light its light
+// pdf) offered to the pixel's reservoir.
 PR_INLINE void rs_offer_emission(PR_GLOBAL const PathTrack* t, PR_GLOBAL PathReservoir* r,
-                                 const PathState* p, uint rel, float3 le, float w, float pdf_light,
-                                 int escaped, float3 d, const RsKey* key) {
+                                 const PathState* p, uint rel, float3 le, const EyeWeight* ew,
+                                 float pdf_light, int escaped, float3 d, const RsKey* key) {
   const int t2 = rel == 2u && !(p->flags & PR_PATH_SPECULAR);
-  const float3 rest = make_float3(t->rest_r, t->rest_g, t->rest_b) * le * (t2 ? 1.0f : w);
+  const float3 rest = make_float3(t->rest_r, t->rest_g, t->rest_b) * le * (t2 ? 1.0f : ew->pt);
   PathReservoir c;
   rs_candidate(&c, t, make_float3(t->f2_r, t->f2_g, t->f2_b), make_float3(t->wx, t->wy, t->wz),
-               t->g_src, rest, t->pdf, t2 ? PR_RS_HIT2 : PR_RS_DEEP, pdf_light, p->last_pdf);
+               t->g_src, rest, t->pdf, t2 ? PR_RS_HIT2 : PR_RS_DEEP, pdf_light, p->last_pdf, ew,
+               rel == 2u);
   if (escaped) rs_suffix_push(&c.suffix, c.sp, d, 1);
   rs_offer_keyed(r, &c, key, PR_RS_DIM(p->depth + 1u, 0u));
 }
@@ -142,6 +159,7 @@ PR_INLINE void rs_track_step(PR_GLOBAL PathTrack* t, const ResampleParams* rsp, 
     t->wy = step->wi.y;
     t->wz = step->wi.z;
     t->rest_r = t->rest_g = t->rest_b = 1.0f;
+    t->pdf2 = pdf;
     t->g_src = !step->delta && rs_reconnectable(t->x1_ok, h, f, wo, dist2, step->wi, rsp)
                    ? fabs(dot(h->ng, wo)) / dist2
                    : 0.0f;
@@ -159,38 +177,38 @@ PR_INLINE void rs_track_step(PR_GLOBAL PathTrack* t, const ResampleParams* rsp, 
 PR_INLINE void rs_next_event(PathReservoir* c, PR_GLOBAL const PathTrack* t,
                              const ResampleParams* rsp, uint rel, const SurfaceHit* h,
                              const ShadingFrame* f, float3 wo, float dist2,
-                             const NextEventChoice* ch, int at_infinity) {
+                             const NextEventChoice* ch, int at_infinity, const EyeWeight* ew) {
   if (rel == 1u) {
     const float g = rs_reconnectable(t->x1_ok, h, f, wo, dist2, ch->wi, rsp)
                         ? fabs(dot(h->ng, wo)) / dist2
                         : 0.0f;
     rs_candidate(c, t, ch->fr_cos, ch->wi, g, ch->le, t->pdf * ch->pdf,
-                 ch->delta ? PR_RS_DEEP : PR_RS_NEE2, ch->pdf_light, ch->pdf_bsdf);
+                 ch->delta ? PR_RS_DEEP : PR_RS_NEE2, ch->pdf_light, ch->pdf_bsdf, ew, 1);
   } else {
-    const float w = ch->delta ? 1.0f : power_heuristic(ch->pdf_light, ch->pdf_bsdf);
-    const float3 rest = make_float3(t->rest_r, t->rest_g, t->rest_b) * ch->fr_cos * ch->le * w;
+    const float3 rest = make_float3(t->rest_r, t->rest_g, t->rest_b) * ch->fr_cos * ch->le * ew->pt;
     rs_candidate(c, t, make_float3(t->f2_r, t->f2_g, t->f2_b), make_float3(t->wx, t->wy, t->wz),
-                 t->g_src, rest, t->pdf * ch->pdf, PR_RS_DEEP, 0.0f, 0.0f);
+                 t->g_src, rest, t->pdf * ch->pdf, PR_RS_DEEP, 0.0f, 0.0f, ew, 0);
   }
   rs_suffix_push(&c->suffix, c->sp, at_infinity ? ch->wi : ch->pos, at_infinity);
 }
 
-// --resample: next-event estimation (contribution c) at vertex `rel` beyond x_1 (depth: the
-// path's; at_x1: it is x_1), to a reservoir once pt_shadow finds it unoccluded: at x_1 the
-// direct light's, where rel >= 1 the paths'. Its candidate goes into *di_pending or *pending, and
-// the shadow ray's op is returned (1 + the random dimension that offers it, PR_RS_OP_DIRECT for
-// the direct light; 0: into the radiance).
+// --resample: next-event estimation (contribution c) at path p's vertex h, to a reservoir once
+// pt_shadow finds it unoccluded: at x_1 the direct light's, from x_2 on the paths'. Its candidate
+// goes into *di_pending or *pending, and the shadow ray's op is returned (1 + the random
+// dimension that offers it, PR_RS_OP_DIRECT for the direct light; 0: into the radiance).
 PR_INLINE uint rs_next_event_pending(const SceneData* s, PR_GLOBAL const PathTrack* t,
                                      PR_GLOBAL PathReservoir* pending,
                                      PR_GLOBAL DirectReservoir* di_pending,
-                                     const ResampleParams* rsp, int at_x1, uint rel, uint depth,
+                                     const ResampleParams* rsp, const PathState* p,
                                      const SurfaceHit* h, const ShadingFrame* f, float3 wo,
-                                     float dist2, const NextEventChoice* ch, float3 c) {
-  if (at_x1) return di_next_event_pending(s, di_pending, ch, c, PR_RS_DIM(depth, 1u));
-  if (rel < 1u) return 0u;
+                                     float dist2, const NextEventChoice* ch, float3 c,
+                                     const EyeWeight* ew) {
+  if (!rsp->enabled || !p->x1_depth) return 0u;
+  const uint depth = p->depth, rel = depth - p->x1_depth;
+  if (rel == 0u) return di_next_event_pending(s, di_pending, ch, c, PR_RS_DIM(depth, 1u));
   PathReservoir cand;
   rs_next_event(&cand, t, rsp, rel, h, f, wo, dist2, ch,
-                light_at_infinity(s->lights.lights[ch->light].type));
+                light_at_infinity(s->lights.lights[ch->light].type), ew);
   *pending = cand;
   return PR_RS_DIM(depth, 1u) + 1u;
 }
@@ -220,14 +238,15 @@ PR_INLINE void pt_escape(const SceneData* s, const PathState* p, uint rel,
     *radiance += pt_rgb(add);
     return;
   }
-  rs_offer_emission(track, res, p, rel, environment_radiance(s, d), w, pdf_light, 1, d, key);
+  const EyeWeight ew = {w, 0.0f, 0.0f, 0.0f};  // the connections make no path to the sky
+  rs_offer_emission(track, res, p, rel, environment_radiance(s, d), &ew, pdf_light, 1, d, key);
 }
 
-// Emission at h (reached along d at squared distance dist2), weighted w by the path tracer, into
-// the sample's radiance, or with --resample at x_2 (rel 1) to the direct light's reservoir and
-// from x_3 on (rel >= 2) to the paths'.
+// Emission at h (reached along d at squared distance dist2), weighted w by the path tracer (ew:
+// its parts), into the sample's radiance, or with --resample at x_2 (rel 1) to the direct light's
+// reservoir and from x_3 on (rel >= 2) to the paths'.
 PR_INLINE void pt_emission(const SceneData* s, const PathState* p, const SurfaceHit* h, uint rel,
-                           float3 d, float dist2, float w, float3 tp,
+                           float3 d, float dist2, float w, const EyeWeight* ew, float3 tp,
                            __global const PathTrack* track, __global PathReservoir* res,
                            __global DirectReservoir* di, const RsKey* key,
                            __global float4* radiance) {
@@ -241,13 +260,15 @@ PR_INLINE void pt_emission(const SceneData* s, const PathState* p, const Surface
   }
   const float pdf_light = emitter_pdf(s, h, make_float3(p->prev_x, p->prev_y, p->prev_z),
                                       make_float3(p->prev_nx, p->prev_ny, p->prev_nz));
-  rs_offer_emission(track, res, p, rel, le, w, pdf_light, 0, h->p, key);
+  rs_offer_emission(track, res, p, rel, le, ew, pdf_light, 0, h->p, key);
 }
 
 // --resample: the hit `rel` >= 1 vertices beyond x_1 (at p) joins the tracked path, with the
 // transmittance tr of the segment to it.
-PR_INLINE void rs_track_hit(__global PathTrack* t, uint rel, const Hit* hit, float3 p, float3 tr) {
-  if (rel == 1u) {  // x_2
+PR_INLINE void rs_track_hit(__global PathTrack* t, uint rel, const Hit* hit, float3 p, float3 tr,
+                            float p2) {
+  if (rel == 1u) {  // x_2, p2 its density per unit area from x_1
+    t->p2 = p2;
     t->prim = hit->prim;
     t->inst = hit->inst;
     t->b1 = hit->u;
@@ -326,15 +347,18 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
   const float3 tr = volume_transmittance(&s, &h, d, hit.t);
   float3 tp = make_float3(p.tp_r, p.tp_g, p.tp_b) * tr;
   const float dist2 = hit.t * hit.t;
-  if (rel) rs_track_hit(track, rel, &hit, h.p, tr);
+  if (rel)
+    rs_track_hit(track, rel, &hit, h.p, tr,
+                 solid_angle_to_area_pdf(p.last_pdf, fabs(dot(h.ng, d)), dist2));
   // Connections can make the paths that end after x_t, t >= 2 (x_t: the vertex `ray` left).
   const int joinable =
       light_paths > 0u && (p.eye_flags & PR_EYE_JOINABLE) && p.depth >= p.x1_depth + 1u;
 
   if (s.sd.materials[h.material].flags & PR_MAT_EMISSIVE) {
-    const float w =
-        pt_emission_weight(&s, &p, &h, d, dist2, joinable, light_paths, trace_cdf, trace_total);
-    pt_emission(&s, &p, &h, rel, d, dist2, w, tp, track, rs_res + i, di_res + i, &key,
+    EyeWeight ew;
+    const float w = pt_emission_weight(&s, &p, &h, d, dist2, joinable, light_paths, rsp.eye_count,
+                                       trace_cdf, trace_total, &ew);
+    pt_emission(&s, &p, &h, rel, d, dist2, w, &ew, tp, track, rs_res + i, di_res + i, &key,
                 radiance + i);
   }
   p.depth += 1u;
@@ -367,15 +391,13 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
       const int here_joinable =
           light_paths > 0u && (p.eye_flags & PR_EYE_JOINABLE) && p.depth >= p.x1_depth + 1u;
       if (next_event(&s, &h, &f, wo, !here_joinable, &rng, &shadow, &c, &ch)) {
-        if (here_joinable) {
-          // The path tracer's weight, times what the connections leave of the path.
-          c = c * pt_next_event_weight(&s, &p, &h, &f, &ch, has_rev, dist2, light_paths, trace_cdf,
-                                       trace_total);
-        }
-        const uint rel_here = rsp.enabled && p.x1_depth ? p.depth - p.x1_depth : 0u;
-        const int at_x1 = rsp.enabled && p.x1_depth == p.depth;
-        const uint op = rs_next_event_pending(&s, track, rs_pending + i, di_pending + i, &rsp,
-                                              at_x1, rel_here, p.depth, &h, &f, wo, dist2, &ch, c);
+        EyeWeight ew;
+        const float w =
+            pt_next_event_weight(&s, &p, &h, &f, &ch, here_joinable, has_rev, dist2, light_paths,
+                                 rsp.eye_count, trace_cdf, trace_total, &ew);
+        if (here_joinable) c = c * w;  // next_event left the weight to this
+        const uint op = rs_next_event_pending(&s, track, rs_pending + i, di_pending + i, &rsp, &p,
+                                              &h, &f, wo, dist2, &ch, c, &ew);
         pt_shadow_set(shadows + i, shadow, tp * c, op);
         out = PR_SHADE_SHADOW;
       }

@@ -75,6 +75,7 @@ typedef struct {
   __global const LightVertex* vertices;
   uint j;       // the pixel sample; its light paths are slots j C + c (mod N_L)
   float inv_c;  // 1 / C: each path's share
+  float mis_c;  // the eye path's count over C, in L's weight against it (eye_path_weight)
   Reservoir res;
   Rng rr;  // the reservoir's draws
   ConnectCounts n;
@@ -303,7 +304,7 @@ PR_INLINE float3 light_vertex_value(const Connector* cn, const EyePoint* x, cons
       pdf_arrive > 0.0f ? solid_angle_to_area_pdf(pdf_x, fabs(dot(y->f.ng, dir)), dist2) : 0.0f;
   const float mis = cn->rp->eye_paths
                         ? eye_path_weight(cn->ratios[vk - cn->vertices], k, pdf_x,
-                                          fabs(dot(y->h.ng, dir)), dist2, pdf_rev, cn->inv_c)
+                                          fabs(dot(y->h.ng, dir)), dist2, pdf_rev, cn->mis_c)
                         : mis_connection_weight(PR_STRATEGY_L, p_l, p_e, cn->rp->mis_threshold);
   const float3 tpy = make_float3(vk->tp_r, vk->tp_g, vk->tp_b);
   *ray = surface_segment(cn->s, &x->h, &y->h);
@@ -609,6 +610,7 @@ PR_KERNEL void connect(PR_PARAMS(PR_ARGS_CONNECT)) {
   cn.vertices = vertices;
   cn.j = i * rp.spp + sample;
   cn.inv_c = 1.0f / (float)rp.paths_per_pixel;
+  cn.mis_c = rp.eye_count / (float)rp.paths_per_pixel;
   cn.rr = rng_make(rp.seed, PR_RNG_RESAMPLE, rp.frame, i, sample);
   cn.history_cap = history_cap;
   cn.ratios = ratios;

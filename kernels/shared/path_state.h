@@ -78,7 +78,9 @@ typedef struct {
   float m;              // its confidence: how many pixel samples' domains it has resampled
   u32 suffix;           // the points in sp (PR_RS_SUFFIX at most) | PR_RS_ESCAPES | PR_RS_LONG
   float sp[3 * PR_RS_SUFFIX];  // x_3, x_4, ... and the light's point, in world space
-  float pad0, pad1;
+  // PR_RS_JOINED (--mode reuse): the connections' share of the path rebuilt at another x_1 from
+  // these two ratios, free of x_1 (rs_eye_share).
+  float rn, rh;
 } PathReservoir;
 
 #define PR_RS_COUNT_MASK 0xffu
@@ -114,6 +116,12 @@ typedef struct {
 #define PR_RS_DEEP 0u  // the weight is in `rest` (t >= 3, or a delta light)
 #define PR_RS_NEE2 1u  // next-event estimation at x_2: w = power heuristic (light, x_2's BSDF)
 #define PR_RS_HIT2 2u  // x_2's BSDF sample met an emitter or escaped: w = (x_2's BSDF, light)
+#define PR_RS_KIND_MASK 0xfu
+// Flags beside the kind (--mode reuse, where the connections to stored light paths make the
+// paths from x_2 on too): the path's f holds the eye path's share of it (PR_RS_JOINED), and x_2
+// is its last vertex before the light (PR_RS_LAST2).
+#define PR_RS_JOINED 0x10u
+#define PR_RS_LAST2 0x20u
 
 // Where a path's candidates stand as pt_shade follows it (one per pixel). 160 bytes.
 typedef struct {
@@ -128,7 +136,8 @@ typedef struct {
   float wx, wy, wz;
   u32 suffix;                  // as PathReservoir's: the points met after x_2
   float sp[3 * PR_RS_SUFFIX];  // their positions
-  float pad0, pad1;
+  float p2;                    // the eye path's density of x_2 per unit area (from x_1)
+  float pdf2;                  // x_2's solid-angle pdf of omega_2
 } PathTrack;
 
 // An instance that moved or changed shape since the previous frame, for pt_resample's temporal
@@ -152,7 +161,10 @@ typedef struct {
   u32 width, height;
   float max_m;      // the confidence a reservoir of the previous frame counts at most
   u32 moved_count;  // records in `moved` (pt_resample): what changed since the previous frame
-  u32 pad0, pad1, pad2;
+  // --mode reuse: the samples a resampled eye path counts as in its weights against the
+  // connections (ReuseParams.eye_count; 1 without --resample).
+  float eye_count;
+  u32 pad1, pad2;
 } ResampleParams;
 
 PR_NAMESPACE_END

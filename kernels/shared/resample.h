@@ -43,9 +43,28 @@ PR_INLINE int rs_reconnectable(int x1_ok, const SurfaceHit* h2, const ShadingFra
 
 // The MIS weight of a t = 2 path at x_2 against the other way of sampling its last segment.
 PR_INLINE float rs_weight2(u32 kind, float pdf_light, float pdf_bsdf) {
-  if (kind == PR_RS_NEE2) return power_heuristic(pdf_light, pdf_bsdf);
-  if (kind == PR_RS_HIT2) return power_heuristic(pdf_bsdf, pdf_light);
+  if ((kind & PR_RS_KIND_MASK) == PR_RS_NEE2) return power_heuristic(pdf_light, pdf_bsdf);
+  if ((kind & PR_RS_KIND_MASK) == PR_RS_HIT2) return power_heuristic(pdf_bsdf, pdf_light);
   return 1.0f;
+}
+
+// --mode reuse: what the eye path keeps of a path that the connections to stored light paths
+// (L) make too: the path tracer's weight `pt` and, with l > 0, the densities of the path beyond
+// x_1 under next-event estimation (n), BSDF sampling (h) and L (l), in the ratios pt_shade
+// weighs with (shared/eye_paths.h). l = 0: L does not make the path.
+typedef struct {
+  float pt, n, h, l;
+} EyeWeight;
+
+// The eye path's share of a PR_RS_JOINED path, 1 - L's power share, at an x_1 whose density of
+// x_2 per unit area is p2, with x_2's solid-angle pdf of omega_2 pdf2 (from that x_1). Of the
+// densities, only these two depend on x_1: the eye path's of x_2, and of x_3 where x_2 is not the
+// last vertex (omega_2's pdf times the cosine and distance at x_3, which do not). So the path
+// keeps its ratios with them divided out (rn, rh: rs_candidate) and this puts them back.
+PR_INLINE float rs_eye_share(u32 kind, float rn, float rh, float p2, float pdf2) {
+  if (!(kind & PR_RS_JOINED)) return 1.0f;
+  const float u = p2 * pdf2;
+  return 1.0f - mis_power_share(rn * ((kind & PR_RS_LAST2) ? p2 : u), rh * u);
 }
 
 // A pixel sample's x_1, rebuilt from its EyeVertex; ok: rough enough to reconnect from.
@@ -89,8 +108,9 @@ PR_INLINE float3 rs_shift(const SceneData* s, const RsPrimary* x, PR_GLOBAL cons
   const float3 f1 = bsdf_eval(&x->f.bsdf, x->wol, w1l, &pdf1) * fabs(w1l.z);
   const float3 w2l = to_local(w2, f2.t, f2.b, f2.n);
   const float3 fx2 = bsdf_eval(&f2.bsdf, to_local(wo2, f2.t, f2.b, f2.n), w2l, &pdf2) * fabs(w2l.z);
-  const float w = rs_weight2(r->kind, r->pdf_light, pdf2);
   *g_dst = fabs(dot(h2.ng, w1)) / d2;
+  const float w = rs_weight2(r->kind, r->pdf_light, pdf2) *
+                  rs_eye_share(r->kind, r->rn, r->rh, pdf1 * *g_dst, pdf2);
   *seg = surface_segment(s, &x->h, &h2);
   return f1 * fx2 * make_float3(r->rest_r, r->rest_g, r->rest_b) * w;
 }
@@ -124,11 +144,12 @@ PR_INLINE void rs_offer_keyed(PR_GLOBAL PathReservoir* r, const PathReservoir* c
 
 // A candidate of the path tracked in t, into *c: x_2's factor f2 along w2 (g its segment's
 // g_src), the rest beyond, the path's density pdf from x_1 on; at t = 2 the light's and x_2's
-// BSDF's pdfs of w2 for its weight. (Written through a pointer: a struct this large returned by
-// value leaves an LLVM intrinsic that Oclgrind cannot run.)
+// BSDF's pdfs of w2 for its weight; ew: the eye path's weight against L, last2: x_2 is the path's
+// last vertex. (Written through a pointer: a struct this large returned by value leaves an LLVM
+// intrinsic that Oclgrind cannot run.)
 PR_INLINE void rs_candidate(PathReservoir* c, PR_GLOBAL const PathTrack* t, float3 f2, float3 w2,
                             float g, float3 rest, float pdf, u32 kind, float pdf_light,
-                            float pdf_bsdf) {
+                            float pdf_bsdf, const EyeWeight* ew, int last2) {
   c->prim = t->prim;
   c->inst = t->inst;
   c->b1 = t->b1;
@@ -141,8 +162,18 @@ PR_INLINE void rs_candidate(PathReservoir* c, PR_GLOBAL const PathTrack* t, floa
   c->rest_g = rest.y;
   c->rest_b = rest.z;
   c->pdf_light = pdf_light;
-  // The weight of a t = 2 path is in its f, not in rest.
-  const float w = rs_weight2(kind, pdf_light, pdf_bsdf);
+  // The weight of a t = 2 path is in its f, not in rest, and so is the eye path's share of a
+  // path L makes too, with its ratios free of x_1 for rs_eye_share.
+  float w = rs_weight2(kind, pdf_light, pdf_bsdf);
+  c->rn = c->rh = 0.0f;
+  if (ew->l > 0.0f) {
+    w *= 1.0f - mis_power_share(ew->n / ew->l, ew->h / ew->l);
+    const float pdf2 = last2 ? pdf_bsdf : t->pdf2;
+    const float base = ew->l * t->p2;
+    c->rn = ew->n / (last2 ? base : base * pdf2);
+    c->rh = ew->h > 0.0f ? ew->h / (base * pdf2) : 0.0f;
+    kind |= PR_RS_JOINED | (last2 ? PR_RS_LAST2 : 0u);
+  }
   const float3 f = make_float3(t->f1_r, t->f1_g, t->f1_b) * f2 * rest * w;
   c->f_r = f.x;
   c->f_g = f.y;
@@ -153,7 +184,6 @@ PR_INLINE void rs_candidate(PathReservoir* c, PR_GLOBAL const PathTrack* t, floa
   c->m = 1.0f;
   c->suffix = t->suffix;
   for (int k = 0; k < 3 * PR_RS_SUFFIX; ++k) c->sp[k] = t->sp[k];
-  c->pad0 = c->pad1 = 0.0f;
 }
 
 // --- Temporal reuse ----------------------------------------------------------------------------

@@ -27,7 +27,8 @@ typedef struct {
   u32 resample;         // RIS-chosen connections per eye vertex, at most PR_MAX_CONNECTIONS;
                         // 0 = every candidate
   u32 eye_paths;        // 1: connections weighted against the path tracer's (--eye-paths)
-  u32 pad0, pad1, pad2;
+  float eye_count;      // the samples an eye path counts as in those weights (1; --resample-mis)
+  u32 pad1, pad2;
 } ReuseParams;
 
 // Most resampled connections per eye vertex (ReuseParams.resample; reservoir slots in connect).

@@ -1,7 +1,8 @@
 """Path resampling across frames, measured on animations: per frame relMSE against path-traced
 references, seconds per frame, flicker, and the equal-error speed-up over the path tracer, for
 the path tracer, `--resample` within each frame (`--resample-history 0`), `--resample` with the
-previous frames' paths (1 neighbour, the default, and 3), and `--mode reuse`.
+previous frames' paths (1 neighbour, the default, and 3), and `--mode reuse` without and with
+`--resample`.
 
   /usr/bin/python3 -m tools.bench.bench_temporal                     # ~10-15 min on 2 cores
   /usr/bin/python3 -m tools.bench.bench_temporal --scenes atrium --seeds 1
@@ -40,6 +41,8 @@ SETTINGS = {
     "resample": ("pathtrace", ("--resample",)),
     "resample, 3 neighbours": ("pathtrace", ("--resample", "--resample-neighbors", "3")),
     "reuse": ("reuse", ()),
+    "reuse, resample": ("reuse", ("--resample",)),
+    "reuse, resample, no neighbours": ("reuse", ("--resample", "--resample-neighbors", "0")),
 }
 
 
@@ -61,8 +64,16 @@ def parse_args():
                     help="reference frames, kept between runs")
     ap.add_argument("--json", help="write the figures here too")
     ap.add_argument("--cycles", help="a Python with bpy 5.2: measure Cycles too")
+    ap.add_argument("--settings", default=";".join(SETTINGS),
+                    help="the settings measured, by name, separated by ';'")
     ap.add_argument("--quiet", action="store_true")
     args = ap.parse_args()
+    args.settings = [n.strip() for n in args.settings.split(";")]
+    for n in args.settings:
+        if n not in SETTINGS:
+            die(f"--settings: no setting {n!r} (there are: {'; '.join(SETTINGS)})")
+    if "pathtrace" not in args.settings:
+        die("--settings: the speed-ups are over 'pathtrace', which must be one of them")
     args.sweep_spp = sorted({int(s) for s in args.sweep_spp.split(",")} | {args.spp})
     args.seeds = [int(s) for s in args.seeds.split(",")]
     if args.frames - args.warm < 2 or args.warm < 0:
@@ -83,10 +94,11 @@ def parse_args():
 def measure(runner, sc, ref_exrs, refs, args):
     """{setting: {spp: (relMSE, s/frame, flicker)}}, medians over seeds of the measured frames'
     mean relMSE, median seconds and mean flicker."""
-    runs = {name: {s: [] for s in args.sweep_spp} for name in SETTINGS}
+    runs = {name: {s: [] for s in args.sweep_spp} for name in args.settings}
     for seed in args.seeds:
         for spp in args.sweep_spp:
-            for name, (mode, extra) in SETTINGS.items():
+            for name in args.settings:
+                mode, extra = SETTINGS[name]
                 recs, imgs, _, diffs = runner.render(sc.path, mode, spp, seed, sc.frames[0],
                                                      sc.frames[-1], extra=extra, refs=ref_exrs)
                 w = args.warm
@@ -156,8 +168,9 @@ def report(sc, fig, args):
              f"0-{args.frames - 1} measured, seeds {','.join(map(str, args.seeds))})", "",
              "| setting | " + " | ".join(f"spp {s}: relMSE, s/frame" for s in args.sweep_spp)
              + f" | equal-error speed-up (target: path tracer at {args.spp} spp) "
+             f"| relMSE x s at {args.spp} spp: the path tracer's over this "
              f"| flicker at {args.spp} spp, / path tracer's |",
-             "|---|" + "---|" * (len(args.sweep_spp) + 2)]
+             "|---|" + "---|" * (len(args.sweep_spp) + 3)]
     out = {}
     for name, by in fig.items():
         pts = [(by[s][1], by[s][0]) for s in args.sweep_spp]
@@ -166,10 +179,15 @@ def report(sc, fig, args):
         fl = by[args.spp][2] / pt[2] if pt[2] > 0 else math.nan
         cells = [f"{by[s][0]:.4f}, {by[s][1]:.3f}" for s in args.sweep_spp]
         sps = "not reached" if sp is None else f"{sp:.2f}x" + (" (at least)" if how == LOWEST else "")
-        lines.append(f"| {name} | " + " | ".join(cells) + f" | {sps} | {fl:.2f} |")
+        # The path tracer's error falls as 1 / spp at a time that grows as spp, so this is the
+        # equal-error speed-up at this setting's error where the target is passed below 1 spp.
+        work = by[args.spp][0] * by[args.spp][1]
+        gain = pt[0] * pt[1] / work if work > 0 else math.nan
+        lines.append(f"| {name} | " + " | ".join(cells) + f" | {sps} | {gain:.2f}x | {fl:.2f} |")
         out[name] = {"points": {str(s): dict(zip(("relmse", "s_per_frame", "flicker"), by[s]))
                                 for s in args.sweep_spp},
                      "equal_error_speedup": sp, "speedup_lower_bound": how == LOWEST,
+                     "relmse_seconds_gain": gain,
                      "flicker_ratio": fl}
     return lines + [""], out
 

@@ -59,6 +59,9 @@ run "cornell-orbit-pathtrace-resample" scenes/cornell-orbit.gltf --frames 0-1 --
   --resample --env-color 0.4,0.5,0.6
 run "cornell-dynamic-pathtrace-resample" scenes/cornell-dynamic.gltf --frames 0-1 \
   --mode pathtrace --resample
+# With reuse: the eye paths' shares against the connections, rebuilt where a path moves.
+run "cornell-dynamic-reuse-resample" scenes/cornell-dynamic.gltf --frames 0-1 --mode reuse \
+  --resample
 # Resampled connections (two shadow rays per eye vertex).
 run "cornell-dynamic-reuse-ris" scenes/cornell-dynamic.gltf --frames 0-1 --mode reuse --connections 2 \
   --no-eye-paths
