@@ -75,8 +75,8 @@ MultiDeviceSession::MultiDeviceSession(const Scene& scene,
   });
   // The first frame: an even split.
   const std::vector<double> even(devices.size(), 1.0);
+  spp_ = options.spp;
   if (options.resample.enabled && devices.size() > 1) {
-    spp_ = options.spp;
     passes_ = splitRows(spp_, even);
     int begin = 0;
     for (size_t i = 0; i < sessions_.size(); ++i) {
@@ -140,7 +140,7 @@ Image MultiDeviceSession::renderFrame(int frame, FrameStats* total,
     for (size_t i = 0; i < n; ++i) {
       p[i].rowBegin = begin;
       p[i].rowEnd = begin += rows_[i];
-      p[i].passEnd = sessions_[i]->spp();
+      p[i].passEnd = spp_;
       p[i].share = double(rows_[i]) / height();
     }
     // Each thread writes only its own rows of `img`.

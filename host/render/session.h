@@ -58,7 +58,6 @@ class RenderSession {
 
   int width() const { return width_; }
   int height() const { return height_; }
-  int spp() const { return options_.spp; }
   Context& context() { return ctx_; }
   Integrator& integrator() { return *integrator_; }
   // The frames of the animation at the session's fps, and the range the options ask for.

@@ -92,11 +92,12 @@ PR_INLINE float pt_next_event_weight(const SceneData* s, const PathState* p, con
                                      int has_rev, float dist2, u32 light_paths, float eye_count,
                                      __global const float* trace_cdf, float trace_total,
                                      EyeWeight* ew) {
-  const Light l = s->lights.lights[ch->light];
   float w = ch->delta ? 1.0f : power_heuristic(ch->pdf_light, ch->pdf_bsdf);
   ew->pt = w;
   ew->n = ew->h = ew->l = 0.0f;
-  if (joinable && eye_paths_light(&l)) {
+  if (!joinable) return w;  // the plain path tracer: no light record to read
+  const Light l = s->lights.lights[ch->light];
+  if (eye_paths_light(&l)) {
     const float3 n_tri =
         light_is_triangle(l.type) ? eye_paths_light_normal(s, &l) : make_float3(0.0f, 0.0f, 1.0f);
     const float3 dz = ch->pos - h->p;
