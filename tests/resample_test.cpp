@@ -5,8 +5,8 @@
 // frames'; where objects move, the paths their motion disturbs are left behind. Mutations checked
 // by hand when this was written: a dropped reconnection Jacobian fails the furnace and the demo's
 // regions; a skipped reconnection shadow ray fails the slats; taking every previous path fails the
-// shelf; the direct light's canonical MIS term dropped, or its shadow ray skipped, fails the
-// direct-light scene.
+// shelf, and so does a reshaped shelf's present shape taken for its previous one; the direct
+// light's canonical MIS term dropped, or its shadow ray skipped, fails the direct-light scene.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -119,7 +119,14 @@ TEST(Resample, SlatsHideNeighboursPaths) {
 // frames 0-4, agrees with the path tracer's region by region: the previous frame's paths whose
 // light the shelf blocked (or no longer blocks) are not reused. Reusing every path of the
 // previous frame instead fails it.
-TEST(Resample, TemporalReuseLeavesPathsThatMovingObjectsDisturb) {
+// A shelf under a lamp, in place in even frames and far above in odd ones (its shadow on the wall
+// comes and goes). It is moved (translated) or reshaped (a morph target moves its vertices), whose
+// shape of the previous frame the temporal test takes from the BVH kept for it; frame 5 resampled
+// with the previous frames' paths agrees with the path tracer region by region.
+class TemporalShelf : public testing::TestWithParam<bool> {};
+
+TEST_P(TemporalShelf, ReuseLeavesPathsThatMovingObjectsDisturb) {
+  const bool morph = GetParam();
   test::GltfBuilder b;
   const int white = b.addMaterial({glm::vec4(0.8f, 0.8f, 0.8f, 1), 0, 1});
   const int lamp = b.addMaterial({glm::vec4(0, 0, 0, 1), 0, 1, glm::vec3(1.0f), 10.0f});
@@ -127,27 +134,40 @@ TEST(Resample, TemporalReuseLeavesPathsThatMovingObjectsDisturb) {
   b.addNode(b.addQuad({-3, 0, -2}, {3, 0, -2}, {3, 3, -2}, {-3, 3, -2}, white));
   b.addNode(b.addQuad({-1.0f, 2.9f, -1.5f}, {1.0f, 2.9f, -1.5f}, {1.0f, 2.9f, -0.5f},
                       {-1.0f, 2.9f, -0.5f}, lamp));
-  const int shelf = b.addNode(b.addBox(glm::vec3(-3, 1.4f, -2), glm::vec3(3, 1.5f, -0.9f), white));
+  const glm::vec3 up(0, 20.0f, 0);
+  const int shelf = b.addNode(b.addBox(glm::vec3(-3, 1.4f, -2), glm::vec3(3, 1.5f, -0.9f), white,
+                                       false, morph ? up : glm::vec3(0.0f)));
   std::vector<float> times;
   std::vector<glm::vec3> keys;
+  std::vector<std::vector<float>> weights;
   for (int f = 0; f <= 5; ++f) {
     times.push_back(float(f));
-    keys.push_back(glm::vec3(0, f % 2 ? 20.0f : 0.0f, 0));
+    keys.push_back(f % 2 ? up : glm::vec3(0.0f));
+    weights.push_back({f % 2 ? 1.0f : 0.0f});
   }
-  b.animateTranslation(shelf, times, keys);
+  if (morph)
+    b.animateWeights(shelf, times, weights);
+  else
+    b.animateTranslation(shelf, times, keys);
   b.addCamera(glm::vec3(0, 2.2f, 3.0f), glm::vec3(0, 0.2f, -0.5f), 0.9f, 4.0f / 3.0f);
-  const std::string scene = b.write(test::tempDir("rs-shelf"), "shelf");
+  const std::string tag = morph ? "rs-shelf-morph" : "rs-shelf";
+  const std::string scene = b.write(test::tempDir(tag), "shelf");
   const std::string size = "--width 64 --height 48 --fps 1 --force-diffuse --max-depth 5 ";
   const Image ref = test::frameImage(
       test::renderFrames(scene, "5", "--mode pathtrace " + size + "--spp 2048 --seed 1",
-                         "rs-shelf-ref"),
+                         tag + "-ref"),
       5);
   const Image img = test::frameImage(
       test::renderFrames(scene, "0-5", "--mode pathtrace " + size + "--spp 128 --seed 2 --resample",
-                         "rs-shelf"),
+                         tag),
       5);
   expectRegionsAgree(img, ref, 0.04, 10);
 }
+
+INSTANTIATE_TEST_SUITE_P(Resample, TemporalShelf, testing::Values(false, true),
+                         [](const testing::TestParamInfo<bool>& i) {
+                           return std::string(i.param ? "Reshaped" : "Moved");
+                         });
 
 // Direct light alone (--max-depth 2: every term is x_1's, so the direct light's reservoir holds
 // all of it): an emissive quad, a point light, a directional light and the environment over a

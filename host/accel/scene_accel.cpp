@@ -130,6 +130,7 @@ uint32_t DynamicAccel::addMesh(const std::vector<glm::vec3>& positions,
   m.bounds = bvh.bounds;
   m.stats = bvh.stats;
   parts_.push_back({bvh.wide.words, bvh.packets, bvh.triangles});
+  previous_.emplace_back();
   // Rebase to absolute indices in the concatenated buffers.
   rebaseWide(bvh.wide.words, width_, m.rootNode, uint32_t(meshPackets_.size()));
   meshNodes_.insert(meshNodes_.end(), bvh.wide.words.begin(), bvh.wide.words.end());
@@ -151,6 +152,7 @@ void DynamicAccel::replaceMesh(uint32_t index, const std::vector<glm::vec3>& pos
   m.triangleCount = uint32_t(bvh.triangles.size());
   m.bounds = bvh.bounds;
   m.stats = bvh.stats;
+  previous_[index] = std::move(parts_[index]);
   parts_[index] = {std::move(bvh.wide.words), std::move(bvh.packets), std::move(bvh.triangles)};
   concatenate();
 }
@@ -169,6 +171,17 @@ void DynamicAccel::concatenate() {
     meshNodes_.insert(meshNodes_.end(), words.begin(), words.end());
     meshPackets_.insert(meshPackets_.end(), p.packets.begin(), p.packets.end());
     meshTris_.insert(meshTris_.end(), p.triangles.begin(), p.triangles.end());
+  }
+  // The previous shapes after every mesh, so meshes' roots and triangle ranges do not move.
+  for (size_t i = 0; i < meshes_.size(); ++i) {
+    const Part& p = previous_[i];
+    meshes_[i].previousRoot = PR_INVALID_INDEX;
+    if (p.words.empty()) continue;
+    meshes_[i].previousRoot = meshNodeCount();
+    std::vector<uint32_t> words = p.words;
+    rebaseWide(words, width_, meshes_[i].previousRoot, uint32_t(meshPackets_.size()));
+    meshNodes_.insert(meshNodes_.end(), words.begin(), words.end());
+    meshPackets_.insert(meshPackets_.end(), p.packets.begin(), p.packets.end());
   }
 }
 

@@ -86,7 +86,9 @@ class DynamicAccel {
                    uint32_t primBase, const BuildOptions& options = {});
 
   // Builds mesh m's BVH again over new vertex positions (a deforming mesh: same triangles, same
-  // prim numbers). The concatenated arrays are rebuilt; setInstances must follow.
+  // prim numbers). The concatenated arrays are rebuilt; setInstances must follow. The BVH it
+  // replaces stays in meshNodes() (previousRoot), for what tests a segment against the shape the
+  // mesh had in the previous frame; no instance refers to it.
   void replaceMesh(uint32_t m, const std::vector<glm::vec3>& positions,
                    const std::vector<uint32_t>& indices, const BuildOptions& options = {});
 
@@ -98,6 +100,8 @@ class DynamicAccel {
   uint32_t meshCount() const { return uint32_t(meshes_.size()); }
   // Mesh m's BVH root in meshNodes().
   uint32_t meshRoot(uint32_t m) const { return meshes_[m].rootNode; }
+  // The root of mesh m's BVH before the last replaceMesh (PR_INVALID_INDEX: never replaced).
+  uint32_t previousRoot(uint32_t m) const { return meshes_[m].previousRoot; }
   uint32_t meshTriangleCount() const { return uint32_t(meshTris_.size()); }
   int width() const { return width_; }
   // All meshes' wide BVHs concatenated, with absolute node and packet references.
@@ -116,6 +120,7 @@ class DynamicAccel {
  private:
   struct Mesh {
     uint32_t rootNode = 0, firstTriangle = 0, triangleCount = 0, primBase = 0;
+    uint32_t previousRoot = PR_INVALID_INDEX;
     Aabb bounds;
     BvhStats stats;
   };
@@ -129,6 +134,7 @@ class DynamicAccel {
   int width_;
   std::vector<Mesh> meshes_;
   std::vector<Part> parts_;
+  std::vector<Part> previous_;  // per mesh: its BVH before the last replaceMesh (empty: none)
   uint32_t nextPrimBase_ = 0;
   std::vector<uint32_t> meshNodes_;
   std::vector<dev::BvhTriPacket> meshPackets_;

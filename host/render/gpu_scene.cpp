@@ -230,7 +230,7 @@ void GpuScene::setTime(double t) {
   anyMoved_ = firstFrame_;
   if (lastTransforms_.size() != n) lastTransforms_.assign(n, glm::mat4(0.0f));
   const std::vector<glm::mat4> was = lastTransforms_;
-  std::vector<bool> rigid(n);
+  std::vector<bool> reshapedInstance(n);
   for (size_t i = 0; i < n; ++i) {
     const glm::mat4 m = scene_.instanceTransform(i, t);
     inputs[i].mesh = scene_.instances[i].mesh;
@@ -245,7 +245,7 @@ void GpuScene::setTime(double t) {
     const bool moved = firstFrame_ || std::memcmp(&m, &lastTransforms_[i], sizeof m) != 0 ||
                        reshaped[scene_.instances[i].mesh];
     s.moved = moved ? 1u : 0u;
-    rigid[i] = !firstFrame_ && !reshaped[scene_.instances[i].mesh];
+    reshapedInstance[i] = reshaped[scene_.instances[i].mesh];
     anyMoved_ = anyMoved_ || moved;
     lastTransforms_[i] = m;
   }
@@ -253,7 +253,7 @@ void GpuScene::setTime(double t) {
     const std::vector<accel::Aabb> before = dsg_.instanceBounds();
     dsg_.setInstances(inputs);
     deviceAccel_.uploadFrame(ctx_, dsg_);
-    collectMoved(before, was, rigid);
+    collectMoved(before, was, reshapedInstance);
   } else {
     moved_.clear();
   }
@@ -281,7 +281,7 @@ void GpuScene::setTime(double t) {
 }
 
 void GpuScene::collectMoved(const std::vector<accel::Aabb>& before,
-                            const std::vector<glm::mat4>& was, const std::vector<bool>& rigid) {
+                            const std::vector<glm::mat4>& was, const std::vector<bool>& reshaped) {
   moved_.clear();
   const std::vector<accel::Aabb>& after = dsg_.instanceBounds();
   // Enlarged by a little of the scene's size, so that rounding in the kernels' segment tests
@@ -301,11 +301,16 @@ void GpuScene::collectMoved(const std::vector<accel::Aabb>& before,
     dev::MovedInstance m{};
     box(before, i, m.box);
     box(after, i, m.box + 6);
-    m.root = PR_INVALID_INDEX;
+    m.root = m.root_before = PR_INVALID_INDEX;
     const glm::mat4& now = lastTransforms_[i];
     const float d0 = glm::determinant(was[i]), d1 = glm::determinant(now);
-    if (rigid[i] && std::isfinite(d0) && std::isfinite(d1) && d0 != 0.0f && d1 != 0.0f) {
-      m.root = dsg_.meshRoot(scene_.instances[i].mesh);
+    const uint32_t mesh = scene_.instances[i].mesh;
+    // A deformed mesh's shape then is the BVH its replaceMesh of this frame kept.
+    const uint32_t then = reshaped[i] ? dsg_.previousRoot(mesh) : dsg_.meshRoot(mesh);
+    if (!firstFrame_ && then != PR_INVALID_INDEX && std::isfinite(d0) && std::isfinite(d1) &&
+        d0 != 0.0f && d1 != 0.0f) {
+      m.root = dsg_.meshRoot(mesh);
+      m.root_before = then;
       toRows(glm::inverse(was[i]), m.before);
       std::memcpy(m.after, instances_[i].world_to_object, sizeof m.after);  // setTime's inverse
     }

@@ -73,9 +73,9 @@ class GpuScene {
   // Whether the last setTime changed a light (the light table, and so every light pdf).
   bool anyLightMoved() const;
   // Every instance the last setTime moved or reshaped: its bounds before and now, a little
-  // enlarged, and where it moved rigidly its mesh's BVH root and both world-to-object
-  // transforms: where this frame's scene may differ from the previous one's (path resampling's
-  // temporal reuse).
+  // enlarged, its mesh's BVH roots (the previous shape's where it deformed) and both
+  // world-to-object transforms: where this frame's scene may differ from the previous one's
+  // (path resampling's temporal reuse).
   const std::vector<dev::MovedInstance>& movedInstances() const { return moved_; }
   // Host seconds the last setTime spent deforming meshes and rebuilding their BVHs.
   double lastDeformSeconds() const { return deformSeconds_; }
@@ -93,9 +93,9 @@ class GpuScene {
   bool deformMeshes(double t, std::vector<bool>* changed);
   void buildLights(double t);
   // moved_ from the instances' bounds and transforms before this frame's setInstances and after
-  // (rigid: not reshaped, and the transforms before are known).
+  // (reshaped: per instance, its mesh deformed this frame).
   void collectMoved(const std::vector<accel::Aabb>& before, const std::vector<glm::mat4>& was,
-                    const std::vector<bool>& rigid);
+                    const std::vector<bool>& reshaped);
   std::vector<dev::Light> lightsAt(double t) const;
   cl::Buffer upload(const char* name, const void* data, uint64_t bytes, uint64_t* counter);
 

@@ -282,7 +282,7 @@ PR_INLINE void rs_track_hit(__global PathTrack* t, uint rel, const Hit* hit, flo
     t->rest_r *= tr.x;
     t->rest_g *= tr.y;
     t->rest_b *= tr.z;
-    rs_track_push(t, p);
+    rs_track_push(t, p, hit->inst != PR_INVALID_INDEX);
   }
 }
 

@@ -135,6 +135,7 @@
   F(DirectReservoir, p_hat)           \
   F(DirectReservoir, m)               \
   F(MovedInstance, root)              \
+  F(MovedInstance, root_before)       \
   F(MovedInstance, before)            \
   F(MovedInstance, after)             \
   F(PathTrack, x1_ok)                 \

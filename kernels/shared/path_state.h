@@ -86,6 +86,9 @@ typedef struct {
 #define PR_RS_COUNT_MASK 0xffu
 #define PR_RS_ESCAPES 0x100u  // the last point of sp is a direction: the path ends at infinity
 #define PR_RS_LONG 0x200u     // more points than sp holds
+// Bit k of these: point k of sp lay on a DSG instance. Known by position alone, such a point is
+// tested against the moved instances' boxes; a point of the SSG is on none of them.
+#define PR_RS_ON_DSG_SHIFT 16u
 
 // A pixel sample's direct light at x_1 and its reservoir (ReSTIR DI beside the paths' one): a
 // point y on a light that x_1 sees, from next-event estimation at x_1 or its BSDF sample's
@@ -141,13 +144,16 @@ typedef struct {
 } PathTrack;
 
 // An instance that moved or changed shape since the previous frame, for pt_resample's temporal
-// test: its bounds then and now (lo xyz, hi xyz each, a little enlarged) and, where it moved
-// rigidly, its mesh's BVH root and its world-to-object transforms then and now (3 x 4 rows),
-// against which a segment is tested exactly; a deformed one is its boxes alone. 160 bytes.
+// test: its bounds then and now (lo xyz, hi xyz each, a little enlarged), its mesh's BVH roots
+// then and now (the same where it moved rigidly; the previous shape's where it deformed) and its
+// world-to-object transforms then and now (3 x 4 rows), against which a segment is tested
+// exactly. Where no shape of the previous frame is known (the first frame), it is its boxes
+// alone. 160 bytes.
 typedef struct {
   float box[12];
-  u32 root;  // PR_INVALID_INDEX: deformed
-  u32 pad0, pad1, pad2;
+  u32 root;         // now (PR_INVALID_INDEX: its boxes alone)
+  u32 root_before;  // then
+  u32 pad1, pad2;
   float before[12], after[12];
 } MovedInstance;
 

@@ -193,10 +193,11 @@ PR_INLINE void rs_candidate(PathReservoir* c, PR_GLOBAL const PathTrack* t, floa
 // lights are the same in both scenes (lights that move turn temporal reuse off for the frame).
 // `moved` lists every instance that moved or changed shape (MovedInstance): a path is reused only
 // where none of its vertices lies on one and its suffix, and both reconnection segments (from the
-// previous frame's x_1 and from this one's), meet none, then or now (exactly where an instance
-// moved rigidly; by its bounds where it deformed). The test is one
-// function of the path and the two x_1, so the shift and its inverse are defined on the same
-// paths, and the previous frame's target at a path is this frame's, which pt_resample evaluates.
+// previous frame's x_1 and from this one's), meet none, then or now: exactly, against each
+// frame's shape at that frame's transform. A suffix point, known by its position alone, is
+// tested against the boxes where it lay on a DSG instance. The test is one function of the path
+// and the two x_1, so the shift and its inverse are defined on the same paths, and the previous
+// frame's target at a path is this frame's, which pt_resample evaluates.
 // This is the arena's exact invalidation (reuse/invalidate.cl) for eye paths: a stored path that
 // a moving object disturbs is never reused.
 
@@ -214,8 +215,8 @@ PR_INLINE void rs_suffix_push(u32* suffix, float* sp, float3 p, int direction) {
   if (direction) *suffix |= PR_RS_ESCAPES;
 }
 
-// The same for the path pt_shade follows: point p, met after x_2.
-PR_INLINE void rs_track_push(PR_GLOBAL PathTrack* t, float3 p) {
+// The same for the path pt_shade follows: point p, met after x_2 (on_dsg: on a DSG instance).
+PR_INLINE void rs_track_push(PR_GLOBAL PathTrack* t, float3 p, int on_dsg) {
   const u32 n = t->suffix & PR_RS_COUNT_MASK;
   if (n >= PR_RS_SUFFIX) {
     t->suffix |= PR_RS_LONG;
@@ -225,6 +226,7 @@ PR_INLINE void rs_track_push(PR_GLOBAL PathTrack* t, float3 p) {
   t->sp[3u * n + 1u] = p.y;
   t->sp[3u * n + 2u] = p.z;
   t->suffix += 1u;
+  if (on_dsg) t->suffix |= 1u << (PR_RS_ON_DSG_SHIFT + n);
 }
 
 // Whether the ray o + t d, 0 <= t <= tmax, meets box b (6 floats).
@@ -244,9 +246,8 @@ PR_INLINE int rs_box_hit(PR_GLOBAL const float* b, float3 o, float3 d, float tma
   return 1;
 }
 
-// Whether the ray o + t d, 0 <= t <= tmax, meets instance m then or now: its boxes, and where it
-// moved rigidly its triangles at either transform (its mesh's BVH, in object space, is the same
-// in both frames).
+// Whether the ray o + t d, 0 <= t <= tmax, meets instance m then or now: its boxes, and then its
+// triangles, each frame's shape (its mesh's BVH, in object space) at that frame's transform.
 PR_INLINE int rs_meets(const SceneData* s, PR_GLOBAL const MovedInstance* m, float3 o, float3 d,
                        float tmax) {
   if (!rs_box_hit(m->box, o, d, tmax) && !rs_box_hit(m->box + 6, o, d, tmax)) return 0;
@@ -255,7 +256,9 @@ PR_INLINE int rs_meets(const SceneData* s, PR_GLOBAL const MovedInstance* m, flo
     PR_GLOBAL const float* w = k ? m->after : m->before;
     BvhRay r = bvh_ray(xform_point(w, o), xform_vector(w, d), 0.0f, tmax);
     Hit h = hit_none();
-    if (bvh_traverse(s->geom.mesh_nodes, s->geom.mesh_tris, m->root, &r, &h, 0u, 1)) return 1;
+    if (bvh_traverse(s->geom.mesh_nodes, s->geom.mesh_tris, k ? m->root : m->root_before, &r, &h,
+                     0u, 1))
+      return 1;
   }
   return 0;
 }
@@ -282,6 +285,11 @@ PR_INLINE int rs_unmoved(const SceneData* s, u32 inst) {
   return inst == PR_INVALID_INDEX || !s->sd.instances[inst].moved;
 }
 
+// Whether a and b are the same point (then segments from each to one end are one segment).
+PR_INLINE int rs_same_point(float3 a, float3 b) {
+  return a.x == b.x && a.y == b.y && a.z == b.z;
+}
+
 // Whether path r can be taken between frames, reconnected to x_1 at xa in one and at xb in the
 // other: its suffix kept whole, no vertex on what moved and no segment meeting it.
 PR_INLINE int rs_temporal_ok(const SceneData* s, PR_GLOBAL const MovedInstance* moved, u32 count,
@@ -293,14 +301,16 @@ PR_INLINE int rs_temporal_ok(const SceneData* s, PR_GLOBAL const MovedInstance* 
   if (!rs_unmoved(s, xa->h.inst) || !rs_unmoved(s, xb->h.inst) || !rs_unmoved(s, r->inst)) return 0;
   const float3 x2 = surface_at(&s->sd, r->prim, r->inst, r->b1, r->b2).p;
   if (!rs_clear(s, moved, count, xa->h.p, x2 - xa->h.p, 1.0f) ||
-      !rs_clear(s, moved, count, xb->h.p, x2 - xb->h.p, 1.0f))
+      (!rs_same_point(xa->h.p, xb->h.p) && !rs_clear(s, moved, count, xb->h.p, x2 - xb->h.p, 1.0f)))
     return 0;
   float3 a = x2;
   for (u32 k = 0u; k < n; ++k) {
     const float3 p = make_float3(r->sp[3u * k], r->sp[3u * k + 1u], r->sp[3u * k + 2u]);
     if (k + 1u == n && (r->suffix & PR_RS_ESCAPES))
       return rs_clear(s, moved, count, a, p, PR_INF_F);
-    if (!rs_apart(moved, count, p) || !rs_clear(s, moved, count, a, p - a, 1.0f)) return 0;
+    const int on_dsg = (r->suffix >> (PR_RS_ON_DSG_SHIFT + k)) & 1u;
+    if ((on_dsg && !rs_apart(moved, count, p)) || !rs_clear(s, moved, count, a, p - a, 1.0f))
+      return 0;
     a = p;
   }
   return 1;

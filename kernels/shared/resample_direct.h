@@ -86,15 +86,17 @@ PR_INLINE int di_temporal_ok(const SceneData* s, PR_GLOBAL const MovedInstance* 
   if (r->light == PR_INVALID_INDEX || !rs_unmoved(s, pa->h.inst) || !rs_unmoved(s, pb->h.inst))
     return 0;
   const float3 xa = pa->h.p, xb = pb->h.p;
+  const int one = rs_same_point(xa, xb);  // one segment, tested once
   const Light l = s->lights.lights[r->light];
   if (light_is_triangle(l.type)) {
     const float3 y = surface_at(&s->sd, l.prim, l.inst, r->b1, r->b2).p;
     return rs_clear(s, moved, count, xa, y - xa, 1.0f) &&
-           rs_clear(s, moved, count, xb, y - xb, 1.0f);
+           (one || rs_clear(s, moved, count, xb, y - xb, 1.0f));
   }
   if (r->light == s->lights.env_light) {
     const float3 w = make_float3(r->wx, r->wy, r->wz);
-    return rs_clear(s, moved, count, xa, w, PR_INF_F) && rs_clear(s, moved, count, xb, w, PR_INF_F);
+    return rs_clear(s, moved, count, xa, w, PR_INF_F) &&
+           (one || rs_clear(s, moved, count, xb, w, PR_INF_F));
   }
   LightSample la, lb;
   float b1, b2;
@@ -104,7 +106,7 @@ PR_INLINE int di_temporal_ok(const SceneData* s, PR_GLOBAL const MovedInstance* 
                             &lb, &b1, &b2))
     return 0;
   return rs_clear(s, moved, count, xa, la.wi, la.dist) &&
-         rs_clear(s, moved, count, xb, lb.wi, lb.dist);
+         (one || rs_clear(s, moved, count, xb, lb.wi, lb.dist));
 }
 
 // A candidate into *c: light li at (b1, b2) or along dir, its f at its own x_1, resampling

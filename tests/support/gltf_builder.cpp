@@ -133,6 +133,10 @@ int GltfBuilder::addQuad(glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, int
 }
 
 int GltfBuilder::addBox(glm::vec3 lo, glm::vec3 hi, int material, bool inward) {
+  return addBox(lo, hi, material, inward, glm::vec3(0.0f));
+}
+
+int GltfBuilder::addBox(glm::vec3 lo, glm::vec3 hi, int material, bool inward, glm::vec3 shift) {
   std::vector<glm::vec3> p;
   std::vector<uint32_t> idx;
   // Each face: four corners counter-clockwise seen from outside.
@@ -149,7 +153,10 @@ int GltfBuilder::addBox(glm::vec3 lo, glm::vec3 hi, int material, bool inward) {
     else
       idx.insert(idx.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
   }
-  return addMesh(p, idx, material);
+  if (shift == glm::vec3(0.0f)) return addMesh(p, idx, material);
+  MeshAttributes a;
+  a.targetPositions.emplace_back(p.size(), shift);
+  return addMesh(p, idx, material, a);
 }
 
 int GltfBuilder::addNode(int mesh, glm::vec3 t, glm::quat r, glm::vec3 s) {

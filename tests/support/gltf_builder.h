@@ -50,6 +50,8 @@ class GltfBuilder {
   int addSphere(float radius, int segments, int rings, int material);
   // Axis-aligned box as 12 triangles; `inward` flips the winding (a room seen from inside).
   int addBox(glm::vec3 lo, glm::vec3 hi, int material, bool inward = false);
+  // The same with one morph target, which moves the whole box by `shift`.
+  int addBox(glm::vec3 lo, glm::vec3 hi, int material, bool inward, glm::vec3 shift);
   // A quad (two triangles) a, b, c, d in order.
   int addQuad(glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, int material);
   int addNode(int mesh, glm::vec3 translation = glm::vec3(0.0f),
