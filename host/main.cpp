@@ -102,6 +102,7 @@ struct RenderArgs {
   std::string mode = "reuse", lightSampler = "auto", materialModel = "energy";
   std::string terminator = "on", bvhWidth = "auto", connections = "auto";
   CLI::Option* connectionMis = nullptr;  // to tell whether it was given
+  bool resample = false, noResample = false;
 };
 
 void addSceneOptions(CLI::App* render, RenderArgs& a) {
@@ -173,16 +174,20 @@ void addSamplingOptions(CLI::App* render, RenderArgs& a) {
                    "at most 4, power between)")
       ->check(CLI::IsMember({"auto", "bvh", "exhaustive", "power"}))
       ->capture_default_str();
-  render->add_flag("--resample", ro.resample.enabled,
-                   "Resample the paths beyond each first surface with those of neighbouring "
-                   "pixels and of the previous frame, reconnected there and weighed by pairwise "
-                   "MIS (unbiased; with --mode reuse/retrace the eye paths, weighted against "
-                   "the connections, which are added as without it)");
+  auto* on = render->add_flag(
+      "--resample", a.resample,
+      "Resample the paths beyond each first surface with those of neighbouring pixels and of the "
+      "previous frame, reconnected there and weighed by pairwise MIS (unbiased; with --mode "
+      "reuse/retrace the eye paths, weighted against the connections, which are added as "
+      "without it). On by default in reuse/retrace, off in pathtrace");
+  auto* off = render->add_flag("--no-resample", a.noResample,
+                               "Reuse/retrace without path resampling (the estimator before it)");
+  on->excludes(off);
   render
       ->add_option("--resample-neighbors", ro.resample.neighbors,
-                   "Pixels whose paths each pixel takes (--resample; 0: its own alone)")
-      ->check(CLI::Range(0, 16))
-      ->capture_default_str();
+                   "Pixels whose paths each pixel takes (--resample; 0: its own alone; default: "
+                   "1 in pathtrace mode, 0 in reuse/retrace)")
+      ->check(CLI::Range(0, 16));
   render
       ->add_option("--resample-radius", ro.resample.radius,
                    "Radius in pixels within which the neighbours are drawn (--resample)")
@@ -362,6 +367,7 @@ pr::RenderOptions toRenderOptions(const RenderArgs& a) {
                     : a.lightSampler == "power"      ? pr::LightSampler::Power
                                                      : pr::LightSampler::Auto;
   ro.bvhWidth = a.bvhWidth == "auto" ? 0 : std::stoi(a.bvhWidth);
+  if (a.resample || a.noResample) ro.resample.asked = a.resample;
   if (ro.eyePaths && a.connectionMis->count() > 0 && !ro.quiet)
     std::cerr << "note: --connection-mis is used with --no-eye-paths only; eye paths weigh "
                  "whole paths by MIS instead\n";

@@ -130,7 +130,7 @@ bool samePixels(const std::string& a, const std::string& b) {
 // resumed: frame 0 and 2 are kept, 1 and 3-5 are rendered, and every frame equals the
 // uninterrupted run's bit for bit, in both reuse and path-tracing modes.
 TEST(Resume, FinishesARunBitForBitAsAnUninterruptedOne) {
-  for (const char* mode : {"reuse", "pathtrace"}) {
+  for (const char* mode : {"reuse --no-resample", "pathtrace"}) {
     SCOPED_TRACE(mode);
     const std::string dir = test::tempDir("resume");
     const std::string common =
@@ -158,36 +158,43 @@ TEST(Resume, FinishesARunBitForBitAsAnUninterruptedOne) {
   }
 }
 
-// --resample takes each frame's paths into the next: --resume keeps the last frame's beside its
-// EXR, so a run cut after frame 2 and resumed equals the uninterrupted one bit for bit. A history
-// that does not match (cut short, or of other options) is not used: the run starts afresh and
-// says so.
+// --resample (reuse's default) takes each frame's paths into the next: --resume keeps the last
+// frame's beside its EXR, so a run cut after frame 2 and resumed equals the uninterrupted one bit
+// for bit (a frame cut short within a run is rendered again without them: the frames before and
+// the Resume test above show that). A history that does not match (cut short, or of other
+// options) is not used: the run starts afresh and says so.
 TEST(Resume, GoesOnFromTheResampledPathsOfTheLastFrame) {
-  const std::string dir = test::tempDir("resume-rs");
-  const std::string base = "render '" + kScene +
-                           "' --exr-float --width 64 --height 48 --mode pathtrace --resample "
-                           "--resume";
-  const std::string common = base + " --spp 2";
-  auto r =
-      test::runPathreuse(common + " --quiet --frames 0-5 --out '" + dir + "/whole/f_%04d.exr'");
-  ASSERT_EQ(r.exitCode, 0) << r.err;
-  r = test::runPathreuse(common + " --frames 0-2 --out '" + dir + "/cut/f_%04d.exr'");
-  ASSERT_EQ(r.exitCode, 0) << r.err;
-  ASSERT_TRUE(fs::is_regular_file(dir + "/cut/f_0002.exr.history"));
-  EXPECT_FALSE(fs::exists(dir + "/cut/f_0001.exr.history"));  // only the last frame's is kept
-  r = test::runPathreuse(common + " --frames 0-5 --out '" + dir + "/cut/f_%04d.exr'");
-  ASSERT_EQ(r.exitCode, 0) << r.err;
-  EXPECT_NE(r.err.find("goes on from frame 2's resampled paths"), std::string::npos) << r.err;
-  char name[32];
-  for (int f = 0; f <= 5; ++f) {
-    std::snprintf(name, sizeof name, "/f_%04d.exr", f);
-    EXPECT_TRUE(samePixels(dir + "/whole" + name, dir + "/cut" + name)) << "frame " << f;
+  const std::string base = "render '" + kScene + "' --exr-float --width 64 --height 48 --resume";
+  for (const char* mode : {"--mode reuse", "--mode pathtrace --resample"}) {
+    SCOPED_TRACE(mode);
+    const std::string dir = test::tempDir("resume-rs");
+    const std::string common = base + " --spp 2 " + mode;
+    auto r =
+        test::runPathreuse(common + " --quiet --frames 0-5 --out '" + dir + "/whole/f_%04d.exr'");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    r = test::runPathreuse(common + " --frames 0-2 --out '" + dir + "/cut/f_%04d.exr'");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    ASSERT_TRUE(fs::is_regular_file(dir + "/cut/f_0002.exr.history"));
+    EXPECT_FALSE(fs::exists(dir + "/cut/f_0001.exr.history"));  // only the last frame's is kept
+    r = test::runPathreuse(common + " --frames 0-5 --out '" + dir + "/cut/f_%04d.exr'");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.err.find("goes on from frame 2's resampled paths"), std::string::npos) << r.err;
+    char name[32];
+    for (int f = 0; f <= 5; ++f) {
+      std::snprintf(name, sizeof name, "/f_%04d.exr", f);
+      EXPECT_TRUE(samePixels(dir + "/whole" + name, dir + "/cut" + name)) << "frame " << f;
+    }
   }
   // Not used: a record naming a triangle the scene lacks (its checksum made right), a file cut
   // short, or one of another spp (its key differs). Each time the next frame starts afresh.
+  const std::string dir = test::tempDir("resume-rs");
+  const std::string pt = base + " --mode pathtrace --resample";
+  auto r =
+      test::runPathreuse(pt + " --spp 2 --quiet --frames 0-5 --out '" + dir + "/cut/f_%04d.exr'");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
   const auto refused = [&](int f, const std::string& extra, const char* why) {
     SCOPED_TRACE(why);
-    r = test::runPathreuse(base + extra + " --frames 0-" + std::to_string(f) + " --out '" + dir +
+    r = test::runPathreuse(pt + extra + " --frames 0-" + std::to_string(f) + " --out '" + dir +
                            "/cut/f_%04d.exr'");
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_NE(r.err.find("history starts afresh at frame " + std::to_string(f)), std::string::npos)
@@ -196,7 +203,7 @@ TEST(Resume, GoesOnFromTheResampledPathsOfTheLastFrame) {
   std::string bytes;
   const std::string history5 = dir + "/cut/f_0005.exr.history";
   ASSERT_TRUE(readFile(history5, &bytes));
-  const size_t records = 2 * 64 * 48, record = 192;  // 2 chains (spp) of a record per pixel
+  const size_t records = 2 * 64 * 48, record = 240;  // 2 chains (spp) of a PathHistory per pixel
   ASSERT_GT(bytes.size(), records * record + 8);
   const size_t head = bytes.size() - 8 - records * record;
   size_t k = 0;

@@ -76,7 +76,7 @@ MultiDeviceSession::MultiDeviceSession(const Scene& scene,
   // The first frame: an even split.
   const std::vector<double> even(devices.size(), 1.0);
   spp_ = options.spp;
-  if (options.resample.enabled && devices.size() > 1) {
+  if (resolveResample(options).enabled && devices.size() > 1) {
     passes_ = splitRows(spp_, even);
     int begin = 0;
     for (size_t i = 0; i < sessions_.size(); ++i) {

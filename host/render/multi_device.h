@@ -64,6 +64,8 @@ class MultiDeviceSession {
   FrameRange frameRange() const { return sessions_[0]->frameRange(); }
   // Rows of each device for the next frame.
   const std::vector<int>& rows() const { return rows_; }
+  // With --resample and several devices: the sample passes of each (a fixed split); else empty.
+  const std::vector<int>& passes() const { return passes_; }
 
  private:
   void setRows(const std::vector<int>& rows);

@@ -23,6 +23,14 @@ int defaultConnections(bool gpu) {
   return gpu ? 2 : 0;
 }
 
+ResampleSettings resolveResample(const RenderOptions& o) {
+  ResampleSettings r = o.resample;
+  const bool reuse = o.mode != RenderMode::PathTrace;
+  r.enabled = r.asked.value_or(reuse && o.eyePaths);
+  if (r.neighbors < 0) r.neighbors = reuse ? 0 : 1;
+  return r;
+}
+
 const char* renderModeName(RenderMode m) {
   switch (m) {
     case RenderMode::Reuse:

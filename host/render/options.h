@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -32,11 +33,16 @@ const char* materialModelName(MaterialModel m);
 
 // Path resampling across pixels and frames (--resample; docs/design.md section 5): the path
 // tracer's paths beyond x_1, and its direct light at x_1, resampled with those of `neighbors`
-// pixels within `radius` pixels and with the previous frame's. One neighbour: with the previous
-// frame's paths it reached a given error sooner than three on both animations measured.
+// pixels within `radius` pixels and with the previous frame's.
 struct ResampleSettings {
-  bool enabled = false;
-  int neighbors = 1;
+  // --resample / --no-resample as given; unset: resolveResample's default for the mode.
+  std::optional<bool> asked;
+  bool enabled = false;  // resolved: what the integrator does
+  // -1: the mode's default. With --mode pathtrace 1: with the previous frame's paths it reached a
+  // given error sooner than 3 on both animations measured. With reuse/retrace 0: the connections
+  // already share the light paths between pixels, and a neighbour cost more time than it saved
+  // on all three animations of bench_temporal.
+  int neighbors = -1;
   float radius = 10.0f;    // pixels
   float roughness = 0.2f;  // GGX roughness below which a vertex is not reconnected
   float distance = 0.0f;   // shortest reconnected segment; 0: 1% of the scene's radius
@@ -102,6 +108,12 @@ struct RenderOptions {
   float envStrength = 1.0f;
   float envRotate = 0.0f;  // degrees about +Y
 };
+
+// o.resample with `enabled` and `neighbors` resolved: --resample / --no-resample where given; else
+// on in --mode reuse/retrace with eye paths (it reached each animation's error at least as
+// soon, with a third or less of the flicker: docs/design.md section 5) and off in pathtrace
+// mode, which stays the plain path tracer, and with --no-eye-paths, which it needs.
+ResampleSettings resolveResample(const RenderOptions& o);
 
 // "R,G,B": three finite non-negative numbers. Throws InputError naming --env-color.
 void parseColor(const std::string& text, float rgb[3]);

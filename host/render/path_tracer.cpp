@@ -269,18 +269,20 @@ std::string PathTracer::writeHistory(const std::string& key) {
   h.key = Hash128().add(key).low();
   h.frame = frame_;
   h.stamp = stamp_;
-  h.chains = cl_uint(chains_);
+  // This device's chains alone: those of its passes (the others it never writes).
+  h.chains = cl_uint(chainedPasses());
   h.first = film_.first();
   h.end = film_.end();
   h.record = sizeof(dev::PathHistory);
   h.camera = camera_;
   const size_t bytes = size_t(h.end - h.first) * h.record;
-  std::string out(sizeof h + bytes * history_.size() + sizeof(uint64_t), '\0');
+  std::string out(sizeof h + bytes * h.chains + sizeof(uint64_t), '\0');
   std::memcpy(&out[0], &h, sizeof h);
   Hash128 sum;
-  for (size_t c = 0; c < history_.size(); ++c) {
+  for (size_t c = 0; c < h.chains; ++c) {
     char* at = &out[sizeof h + c * bytes];
-    CL_CHECK(ctx_.queue().enqueueReadBuffer(history_[c], CL_TRUE, h.first * h.record, bytes, at));
+    CL_CHECK(ctx_.queue().enqueueReadBuffer(history_[size_t(passBegin_) + c], CL_TRUE,
+                                            h.first * h.record, bytes, at));
     sum.add(at, bytes);
   }
   const uint64_t check = sum.low();
@@ -290,26 +292,28 @@ std::string PathTracer::writeHistory(const std::string& key) {
 
 bool PathTracer::readHistory(const std::string& data, const std::string& key, int frame) {
   HistoryHeader h{};
-  if (chains_ == 0 || data.size() < sizeof h) return false;
+  if (chainedPasses() == 0 || data.size() < sizeof h) return false;
   std::memcpy(&h, data.data(), sizeof h);
   if (std::memcmp(h.magic, kHistoryMagic, sizeof h.magic) != 0 ||
-      h.key != Hash128().add(key).low() || h.frame != frame || h.chains != cl_uint(chains_) ||
-      h.first != film_.first() || h.end != film_.end() || h.record != sizeof(dev::PathHistory))
+      h.key != Hash128().add(key).low() || h.frame != frame ||
+      h.chains != cl_uint(chainedPasses()) || h.first != film_.first() || h.end != film_.end() ||
+      h.record != sizeof(dev::PathHistory))
     return false;
   const size_t bytes = size_t(h.end - h.first) * h.record;
-  if (data.size() != sizeof h + bytes * history_.size() + sizeof(uint64_t)) return false;
+  if (data.size() != sizeof h + bytes * h.chains + sizeof(uint64_t)) return false;
   Hash128 sum;
-  for (size_t c = 0; c < history_.size(); ++c) sum.add(data.data() + sizeof h + c * bytes, bytes);
+  for (size_t c = 0; c < h.chains; ++c) sum.add(data.data() + sizeof h + c * bytes, bytes);
   uint64_t check = 0;
   std::memcpy(&check, data.data() + data.size() - sizeof check, sizeof check);
   if (sum.low() != check) return false;
-  for (size_t k = 0; k < bytes * history_.size(); k += h.record) {
+  for (size_t k = 0; k < bytes * h.chains; k += h.record) {
     dev::PathHistory rec;
     std::memcpy(&rec, data.data() + sizeof h + k, sizeof rec);
     if (!validRecord(rec, scene_)) return false;
   }
-  for (size_t c = 0; c < history_.size(); ++c)
-    CL_CHECK(ctx_.queue().enqueueWriteBuffer(history_[c], CL_TRUE, h.first * h.record, bytes,
+  for (size_t c = 0; c < h.chains; ++c)
+    CL_CHECK(ctx_.queue().enqueueWriteBuffer(history_[size_t(passBegin_) + c], CL_TRUE,
+                                             h.first * h.record, bytes,
                                              data.data() + sizeof h + c * bytes));
   frame_ = h.frame;
   stamp_ = h.stamp;

@@ -125,7 +125,8 @@ void noteUnlitScene(const Scene& scene, const RenderOptions& o) {
 void printStart(const RenderOptions& o, MultiDeviceSession& session, const FrameRange& range) {
   std::cerr << "rendering " << o.scene << " frames " << range.first << "-" << range.last << " at "
             << session.width() << "x" << session.height() << ", " << o.spp << " spp, mode "
-            << renderModeName(o.mode) << ", on ";
+            << renderModeName(o.mode) << (resolveResample(o).enabled ? ", resampled" : "")
+            << ", on ";
   for (size_t i = 0; i < session.deviceCount(); ++i)
     std::cerr << (i ? " + " : "") << session.device(i).name;
   if (auto* reuse = dynamic_cast<PathReuse*>(&session.session(0).integrator()))
@@ -140,6 +141,7 @@ std::string statsLine(int f, const RenderOptions& o, const FrameStats& fs,
   nlohmann::ordered_json j;
   j["frame"] = f;
   j["mode"] = renderModeName(o.mode);
+  j["resample"] = resolveResample(o).enabled;
   j["wall_s"] = fs.wallSeconds;
   j["stages_s"] = fs.stageSeconds;
   j["host_s"] = fs.hostSeconds;
@@ -217,21 +219,22 @@ void printSummary(const RenderOptions& o, const FrameRange& range, const Tally& 
 
 // --resume with --resample: the resampled paths' history of frame f, kept beside its EXR so that a
 // resumed run (or the next chunk of frames, where it starts after this one ended) goes on as one
-// uninterrupted run; one device only (rows move between devices).
+// uninterrupted run. With several devices each keeps the chains of its own sample passes.
 std::string historyPath(const RenderOptions& o, int f) {
   return formatOutPath(o.outPattern, f) + ".history";
 }
 
-bool keepsHistory(const RenderOptions& o, const MultiDeviceSession& session) {
-  return o.resume && o.resample.enabled && o.resample.history > 0 && session.deviceCount() == 1;
+bool keepsHistory(const RenderOptions& o) {
+  const ResampleSettings r = resolveResample(o);
+  return o.resume && r.enabled && r.history > 0;
 }
 
 // Everything a history depends on besides its frame and size: the scene file, the options that
-// change what a path is worth, and the kernels that made it.
-std::string historyKey(const RenderOptions& o) {
+// change what a path is worth, the devices' split of the passes, and the kernels that made it.
+std::string historyKey(const RenderOptions& o, const MultiDeviceSession& session) {
   std::string scene;
   readFile(o.scene, &scene);
-  const ResampleSettings& r = o.resample;
+  const ResampleSettings r = resolveResample(o);
   nlohmann::json j = {o.scene,
                       o.spp,
                       o.maxDepth,
@@ -257,9 +260,39 @@ std::string historyKey(const RenderOptions& o) {
                       o.allowOutsideUris,
                       int(o.mode),  // --mode reuse: the eye paths' share against the connections
                       o.lightPaths,
-                      o.pathsPerPixel};
+                      o.pathsPerPixel,
+                      session.passes()};
   return j.dump() + scene + expandKernelSource("pathtrace/shade.cl") +
          expandKernelSource("pathtrace/resample.cl");
+}
+
+// The devices' histories in one file: per device, its size (8 bytes) and its history ("" where
+// the device chains no passes).
+std::string packHistories(MultiDeviceSession& session, const std::string& key) {
+  std::string out;
+  for (size_t i = 0; i < session.deviceCount(); ++i) {
+    RenderSession& s = session.session(i);
+    const std::string h = s.hasHistory() ? s.writeHistory(key) : std::string();
+    const uint64_t n = h.size();
+    out.append(reinterpret_cast<const char*>(&n), sizeof n);
+    out += h;
+  }
+  return out;
+}
+
+bool unpackHistories(const std::string& data, MultiDeviceSession& session, const std::string& key,
+                     int frame) {
+  size_t at = 0;
+  for (size_t i = 0; i < session.deviceCount(); ++i) {
+    uint64_t n = 0;
+    if (data.size() - at < sizeof n) return false;
+    std::memcpy(&n, data.data() + at, sizeof n);
+    at += sizeof n;
+    if (n > data.size() - at) return false;
+    if (n > 0 && !session.session(i).readHistory(data.substr(at, n), key, frame)) return false;
+    at += n;
+  }
+  return at == data.size();
 }
 
 // Before a frame f whose previous frame this run did not render: the history frame f - 1 left,
@@ -269,7 +302,7 @@ void readHistory(const RenderOptions& o, MultiDeviceSession& session, const std:
   if (f == 0) return;
   std::string data;
   const bool read =
-      readFile(historyPath(o, f - 1), &data) && session.session(0).readHistory(data, key, f - 1);
+      readFile(historyPath(o, f - 1), &data) && unpackHistories(data, session, key, f - 1);
   if (!o.quiet)
     std::cerr << (read ? "note: --resume: goes on from frame " + std::to_string(f - 1) +
                              "'s resampled paths\n"
@@ -281,8 +314,7 @@ void readHistory(const RenderOptions& o, MultiDeviceSession& session, const std:
 // After frame f is written: its history replaces the previous frame's.
 void writeHistory(const RenderOptions& o, MultiDeviceSession& session, const std::string& key,
                   int f) {
-  if (session.session(0).hasHistory())
-    writeFileAtomic(historyPath(o, f), session.session(0).writeHistory(key));
+  writeFileAtomic(historyPath(o, f), packHistories(session, key));
   std::error_code ec;
   std::filesystem::remove(historyPath(o, f - 1), ec);
 }
@@ -293,8 +325,8 @@ int renderFrames(const RenderOptions& o, MultiDeviceSession& session, const Fram
   const bool progress = !o.quiet && isatty(STDERR_FILENO);
   Tally t;
   int f = range.first;
-  const bool history = keepsHistory(o, session);
-  const std::string key = history ? historyKey(o) : std::string();
+  const bool history = keepsHistory(o);
+  const std::string key = history ? historyKey(o, session) : std::string();
   int lastRendered = -2;
   endLoadingPhase();  // a signal from here on finishes cleanly between launches
   for (; f <= range.last && !interrupted(); ++f) {
@@ -308,10 +340,6 @@ int renderFrames(const RenderOptions& o, MultiDeviceSession& session, const Fram
       std::cerr << "note: --resume: the connection history starts afresh at frame " << f
                 << " (frames from here differ from an uninterrupted run's, unbiased)\n";
     if (history && lastRendered != f - 1) readHistory(o, session, key, f);
-    if (!history && o.resample.enabled && o.resample.history > 0 && t.skipped > 0 &&
-        t.rendered == 0 && !o.quiet)  // several devices: not kept
-      std::cerr << "note: --resume: the resampled paths' history starts afresh at frame " << f
-                << " (frames from here differ from an uninterrupted run's, unbiased)\n";
     const auto t0 = std::chrono::steady_clock::now();
     FrameStats fs;
     std::vector<DeviceFrame> parts;

@@ -115,9 +115,9 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
   gpu_ = std::make_unique<GpuScene>(ctx_, scene, sceneOptions);
   film_ = std::make_unique<Film>(ctx_, width_, height_);
   const RenderOptions& o = options_;
-  if (o.resample.enabled && o.mode != RenderMode::PathTrace && !o.eyePaths)
+  ResampleSettings resample = resolveResample(o);
+  if (resample.enabled && o.mode != RenderMode::PathTrace && !o.eyePaths)
     throw InputError("--resample: resamples the eye paths, which --no-eye-paths turns off");
-  ResampleSettings resample = o.resample;
   if (!(resample.distance > 0.0f)) resample.distance = 0.01f * gpu_->sceneRadius();
   if (o.mode == RenderMode::PathTrace) {
     PathTracerSettings p;

@@ -10,7 +10,8 @@ cd "$(dirname "$0")/../.."
 build="$(cd "${1:-build}" && pwd)"
 frames="${2:-0-11}"
 shift $(($# > 2 ? 2 : $#))
-opts=(--width 64 --height 48 --spp 2)
+# Without path resampling: chunks that run at the same time start its history afresh.
+opts=(--width 64 --height 48 --spp 2 --no-resample)
 [ $# -gt 0 ] && opts=("$@")
 [ -n "${PATHREUSE_TEST_DEVICE:-}" ] && opts+=(--device "$PATHREUSE_TEST_DEVICE")
 work="$(mktemp -d /tmp/pathreuse-slurm-XXXXXX)"
