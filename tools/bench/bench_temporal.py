@@ -1,8 +1,8 @@
 """Path resampling across frames, measured on animations: per frame relMSE against path-traced
 references, seconds per frame, flicker, and the equal-error speed-up over the path tracer, for
 the path tracer, `--resample` within each frame (`--resample-history 0`), `--resample` with the
-previous frames' paths (1 neighbour, the default, and 3), and `--mode reuse` without and with
-`--resample`.
+previous frames' paths (1 neighbour, the default, and 3), and `--mode reuse` without path
+resampling (`--no-resample`), as it is by default (resampled, no neighbours) and with 1 neighbour.
 
   /usr/bin/python3 -m tools.bench.bench_temporal                     # ~10-15 min on 2 cores
   /usr/bin/python3 -m tools.bench.bench_temporal --scenes atrium --seeds 1
@@ -40,9 +40,9 @@ SETTINGS = {
     "resample, one frame": ("pathtrace", ("--resample", "--resample-history", "0")),
     "resample": ("pathtrace", ("--resample",)),
     "resample, 3 neighbours": ("pathtrace", ("--resample", "--resample-neighbors", "3")),
-    "reuse": ("reuse", ()),
-    "reuse, resample": ("reuse", ("--resample",)),
-    "reuse, resample, no neighbours": ("reuse", ("--resample", "--resample-neighbors", "0")),
+    "reuse, no resample": ("reuse", ("--no-resample",)),
+    "reuse": ("reuse", ()),  # resampled, no neighbours: the default
+    "reuse, 1 neighbour": ("reuse", ("--resample-neighbors", "1")),
 }
 
 

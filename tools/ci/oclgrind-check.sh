@@ -36,14 +36,18 @@ run() {
 }
 
 # Frames 0-2: the second and third frames invalidate and re-trace what the sphere disturbs.
-# Reuse and retrace with eye paths (the default); the connections alone (--no-eye-paths: eye_hit,
-# next-event estimation, strategy E and the delta-chain extension in connect) further down.
+# Reuse and retrace with eye paths, resampled (the default), and reuse without resampling; the
+# connections alone (--no-eye-paths: eye_hit, next-event estimation, strategy E and the
+# delta-chain extension in connect) further down.
 for mode in pathtrace reuse retrace; do
   run "cornell-dynamic-$mode" scenes/cornell-dynamic.gltf --frames 0-2 --mode "$mode"
 done
+run "cornell-dynamic-reuse-no-resample" scenes/cornell-dynamic.gltf --frames 0-1 --mode reuse \
+  --no-resample
 run "cornell-orbit-reuse-connections" scenes/cornell-orbit.gltf --frames 0-1 --mode reuse \
   --no-eye-paths
-# A skinned and a morphing mesh: deformed, BVH rebuilt and shading vertices uploaded per frame.
+# A skinned and a morphing mesh: deformed, BVH rebuilt and shading vertices uploaded per frame;
+# resampling's temporal test traverses their previous shapes' BVHs.
 run "cornell-skinned-reuse" scenes/cornell-skinned.gltf --frames 0-2 --mode reuse
 # The light BVH's kernels and the choice by power (on the demo scenes --light-sampler auto
 # weighs every light), the tree on the many-lights atrium too: a deep tree, point and spot
@@ -59,9 +63,10 @@ run "cornell-orbit-pathtrace-resample" scenes/cornell-orbit.gltf --frames 0-1 --
   --resample --env-color 0.4,0.5,0.6
 run "cornell-dynamic-pathtrace-resample" scenes/cornell-dynamic.gltf --frames 0-1 \
   --mode pathtrace --resample
-# With reuse: the eye paths' shares against the connections, rebuilt where a path moves.
+# With reuse and a neighbour: the eye paths' shares against the connections, rebuilt where a
+# path moves to another x_1.
 run "cornell-dynamic-reuse-resample" scenes/cornell-dynamic.gltf --frames 0-1 --mode reuse \
-  --resample
+  --resample-neighbors 1
 # Resampled connections (two shadow rays per eye vertex).
 run "cornell-dynamic-reuse-ris" scenes/cornell-dynamic.gltf --frames 0-1 --mode reuse --connections 2 \
   --no-eye-paths
