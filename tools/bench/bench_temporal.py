@@ -7,6 +7,7 @@ resampling (`--no-resample`), as it is by default (resampled, no neighbours) and
   /usr/bin/python3 -m tools.bench.bench_temporal                     # ~10-15 min on 2 cores
   /usr/bin/python3 -m tools.bench.bench_temporal --scenes atrium --seeds 1
   /usr/bin/python3 -m tools.bench.bench_temporal --cycles VENV/bin/python   # and Cycles 5.2
+  /usr/bin/python3 -m tools.bench.bench_temporal --cycles VENV/bin/python --luxcore LUXVENV/bin/python
 
 With --cycles (a Python that has PyPI's bpy 5.2, Python 3.13, in a virtual environment of its
 own: a benchmark peer, not a dependency), Blender's Cycles renders the measured frames too
@@ -14,6 +15,12 @@ own: a benchmark peer, not a dependency), Blender's Cycles renders the measured 
 spp of the sweep, and is measured against its own reference frames at the reference spp (cached
 like ours), so that each renderer's relMSE is its distance from what it converges to. It has no
 history to warm up; its seconds are those of its renders, without Blender's start and import.
+
+With --luxcore too (a Python that has PyPI's pyluxcore 2.11, Python 3.12, in a virtual environment
+of its own), LuxCoreRender's BIDIRCPU renders the same frames (tools/bench/luxcore_frames.py, from
+triangles that --cycles's bpy exports: tools/bench/scene_export.py), Russian roulette off, against
+its own references at --luxcore-ref-spp (128: its frames take several times ours); its seconds
+are from its session's start to its halt.
 
 The first --warm frames of each run are rendered and not measured: temporal reuse needs a few
 frames of history, as a user's sequence has after its start. Every figure is the median over
@@ -26,6 +33,7 @@ import argparse
 import hashlib
 import json
 import math
+import os
 import subprocess
 import sys
 import tempfile
@@ -64,6 +72,10 @@ def parse_args():
                     help="reference frames, kept between runs")
     ap.add_argument("--json", help="write the figures here too")
     ap.add_argument("--cycles", help="a Python with bpy 5.2: measure Cycles too")
+    ap.add_argument("--luxcore", help="a Python with pyluxcore 2.11: measure LuxCore BIDIR too "
+                    "(needs --cycles's Python to export the frames)")
+    ap.add_argument("--luxcore-ref-spp", type=int, default=128,
+                    help="LuxCore's reference spp (its 4-spp frame takes 7x ours)")
     ap.add_argument("--settings", default=";".join(SETTINGS),
                     help="the settings measured, by name, separated by ';'")
     ap.add_argument("--quiet", action="store_true")
@@ -72,6 +84,8 @@ def parse_args():
     for n in args.settings:
         if n not in SETTINGS:
             die(f"--settings: no setting {n!r} (there are: {'; '.join(SETTINGS)})")
+    if args.luxcore and not args.cycles:
+        die("--luxcore: give --cycles too (its bpy exports the frames LuxCore renders)")
     if "pathtrace" not in args.settings:
         die("--settings: the speed-ups are over 'pathtrace', which must be one of them")
     args.sweep_spp = sorted({int(s) for s in args.sweep_spp.split(",")} | {args.spp})
@@ -112,45 +126,85 @@ def measure(runner, sc, ref_exrs, refs, args):
 
 
 CYCLES = "Cycles 5.2 (its own reference)"
-CYCLES_FRAMES = REPO / "tools" / "bench" / "cycles_frames.py"
+LUXCORE = "LuxCore 2.11 BIDIR (its own reference)"
+BENCH = REPO / "tools" / "bench"
 
 
-def cycles_render(args, sc, spp, seed, size, out):
-    """Cycles' measured frames at spp into out/f_%04d.exr; their render seconds."""
-    out.mkdir(parents=True, exist_ok=True)
-    cmd = [args.cycles, str(CYCLES_FRAMES), str(sc.path), str(out),
-           "--frames", f"{args.warm}-{args.frames - 1}", "--spp", str(spp), "--width", str(size[1]),
-           "--height", str(size[0]), "--max-depth", str(args.max_depth), "--seed", str(seed)]
-    proc = subprocess.run(cmd, capture_output=True, text=True)
+def peer_frames(args, cmd, name, key, spp, seed):
+    """Runs a peer's frame script; the render seconds of the measured frames."""
+    env = None
+    if name == "luxcore":
+        libs = sorted(Path(os.path.abspath(args.luxcore)).parent.parent.glob(
+            "lib/python3*/site-packages/pyluxcore.libs/libtbbmalloc*.so*"))
+        if len(libs) < 2:
+            die(f"--luxcore {args.luxcore}: no pyluxcore.libs/libtbbmalloc* beside it", 1)
+        env = dict(os.environ, LD_PRELOAD=":".join(map(str, libs)))
+    proc = subprocess.run(cmd, capture_output=True, text=True, env=env)
     if proc.returncode != 0:
-        die(f"Cycles failed ({proc.returncode}): {' '.join(cmd)}\n{proc.stderr.strip()[-2000:]}", 1)
+        die(f"{name} failed ({proc.returncode}): {' '.join(cmd)}\n{proc.stderr.strip()[-2000:]}", 1)
     recs = [json.loads(line) for line in proc.stdout.splitlines() if line.startswith("{")]
     if len(recs) != args.frames - args.warm:
         die(f"expected {args.frames - args.warm} frames from: {' '.join(cmd)}", 1)
     if not args.quiet:
-        print(f"  {sc.key:16s} cycles    spp {spp:3d} seed {seed}       frames "
+        print(f"  {key:16s} {name:9s} spp {spp:3d} seed {seed}       frames "
               f"{args.warm}-{args.frames - 1}: median {median([r['render_s'] for r in recs]):.3f} "
               "s/frame", flush=True)
     return [r["render_s"] for r in recs]
 
 
-def cycles_measure(runner, sc, size, args, cache, tmp):
-    """Cycles' row, {spp: (relMSE, s/frame, flicker)}, against its own reference frames."""
-    key = hashlib.sha1(json.dumps([file_sha(sc.path), list(size), sc.ref_spp, args.max_depth,
-                                   "cycles-5.2"]).encode()).hexdigest()[:16]
+def frame_args(args, spp, seed, size):
+    return ["--frames", f"{args.warm}-{args.frames - 1}", "--spp", str(spp), "--width",
+            str(size[1]), "--height", str(size[0]), "--max-depth", str(args.max_depth), "--seed",
+            str(seed)]
+
+
+def cycles_render(args, sc, spp, seed, size, out):
+    """Cycles' measured frames at spp into out/f_%04d.exr; their render seconds."""
+    out.mkdir(parents=True, exist_ok=True)
+    cmd = [args.cycles, str(BENCH / "cycles_frames.py"), str(sc.path), str(out)]
+    return peer_frames(args, cmd + frame_args(args, spp, seed, size), "cycles", sc.key, spp, seed)
+
+
+def luxcore_export(args, sc, size, cache):
+    """The measured frames as triangles (tools/bench/scene_export.py), kept in the cache."""
+    key = hashlib.sha1(json.dumps([file_sha(sc.path), list(size), args.warm, args.frames,
+                                   file_sha(BENCH / "scene_export.py")]).encode()).hexdigest()[:16]
+    out = cache / f"{sc.key}_export_{key}"
+    if not (out / "scene.json").is_file():
+        out.mkdir(parents=True, exist_ok=True)
+        cmd = [args.cycles, str(BENCH / "scene_export.py"), str(sc.path), str(out), "--frames",
+               f"{args.warm}-{args.frames - 1}", "--width", str(size[1]), "--height", str(size[0])]
+        proc = subprocess.run(cmd, capture_output=True, text=True)
+        if proc.returncode != 0 or not (out / "scene.json").is_file():
+            die(f"export failed ({proc.returncode}): {' '.join(cmd)}\n{proc.stderr[-2000:]}", 1)
+    return out
+
+
+def luxcore_render(args, export, sc, spp, seed, size, out):
+    """LuxCore's measured frames at spp into out/f_%04d.exr; their render seconds."""
+    out.mkdir(parents=True, exist_ok=True)
+    cmd = [args.luxcore, str(BENCH / "luxcore_frames.py"), str(export), str(out)]
+    return peer_frames(args, cmd + frame_args(args, spp, seed, size), "luxcore", sc.key, spp, seed)
+
+
+def peer_measure(runner, sc, size, args, cache, tmp, name, ref_spp, render):
+    """A peer's row, {spp: (relMSE, s/frame, flicker)}, against its own reference frames;
+    render(spp, seed, out) renders the measured frames."""
+    key = hashlib.sha1(json.dumps([file_sha(sc.path), list(size), ref_spp,
+                                   args.max_depth, name]).encode()).hexdigest()[:16]
     frames = range(args.warm, args.frames)
-    ref_dir = cache / f"{sc.key}_cycles_{key}"
+    ref_dir = cache / f"{sc.key}_{name.split('-')[0]}_{key}"
     ref_exrs = [ref_dir / f"f_{f:04d}.exr" for f in frames]
     if not all(p.is_file() for p in ref_exrs):
-        print(f"  Cycles references for {sc.key}: {len(ref_exrs)} frame(s) at {sc.ref_spp} spp",
+        print(f"  {name} references for {sc.key}: {len(ref_exrs)} frame(s) at {ref_spp} spp",
               flush=True)
-        cycles_render(args, sc, sc.ref_spp, 1000, size, ref_dir)
+        render(ref_spp, 1000, ref_dir)
     refs = runner.read(ref_exrs)
     runs = {s: [] for s in args.sweep_spp}
     for seed in args.seeds:
         for spp in args.sweep_spp:
-            out = tmp / f"cycles_{sc.key}_{spp}_{seed}"
-            secs = cycles_render(args, sc, spp, seed, size, out)
+            out = tmp / f"{name}_{sc.key}_{spp}_{seed}"
+            secs = render(spp, seed, out)
             exrs = [out / f"f_{f:04d}.exr" for f in frames]
             e = [runner.diff(x, r)["relmse"] for x, r in zip(exrs, ref_exrs)]
             imgs = runner.read(exrs)
@@ -207,8 +261,16 @@ def main():
         for sc in scenes:
             ref_exrs, refs, _ = references(runner, sc, cache)
             fig = measure(runner, sc, ref_exrs, refs, args)
+            size = refs[0].shape[:2]
             if args.cycles:
-                fig[CYCLES] = cycles_measure(runner, sc, refs[0].shape[:2], args, cache, tmp)
+                fig[CYCLES] = peer_measure(
+                    runner, sc, size, args, cache, tmp, "cycles-5.2", sc.ref_spp,
+                    lambda spp, seed, out: cycles_render(args, sc, spp, seed, size, out))
+            if args.luxcore:
+                export = luxcore_export(args, sc, size, cache)
+                fig[LUXCORE] = peer_measure(
+                    runner, sc, size, args, cache, tmp, "luxcore-2.11-bidir", args.luxcore_ref_spp,
+                    lambda spp, seed, out: luxcore_render(args, export, sc, spp, seed, size, out))
             l, o = report(sc, fig, args)
             lines += l
             out[sc.key] = o
