@@ -51,6 +51,7 @@ SETTINGS = {
     "reuse, no resample": ("reuse", ("--no-resample",)),
     "reuse": ("reuse", ()),  # resampled, no neighbours: the default
     "reuse, 1 neighbour": ("reuse", ("--resample-neighbors", "1")),
+    "reuse, connection history": ("reuse", ("--connection-history", "20")),
 }
 
 
