@@ -15,6 +15,39 @@ TEST(RenderOptions, FrameRanges) {
     EXPECT_THROW(parseFrameRange(bad), InputError) << bad;
 }
 
+// Path resampling is on by default in reuse and retrace (with eye paths, which it resamples),
+// without neighbours there; off in pathtrace, where --resample takes one neighbour. What is given
+// wins.
+TEST(RenderOptions, ResamplingDefaultsByMode) {
+  RenderOptions o;
+  struct Case {
+    RenderMode mode;
+    bool eyePaths;
+    std::optional<bool> asked;
+    bool enabled;
+    int neighbors;
+  };
+  const Case cases[] = {
+      {RenderMode::Reuse, true, std::nullopt, true, 0},
+      {RenderMode::Retrace, true, std::nullopt, true, 0},
+      {RenderMode::Reuse, false, std::nullopt, false, 0},
+      {RenderMode::PathTrace, true, std::nullopt, false, 1},
+      {RenderMode::Reuse, true, false, false, 0},
+      {RenderMode::PathTrace, true, true, true, 1},
+  };
+  for (const Case& c : cases) {
+    o.mode = c.mode;
+    o.eyePaths = c.eyePaths;
+    o.resample.asked = c.asked;
+    const ResampleSettings r = resolveResample(o);
+    EXPECT_EQ(r.enabled, c.enabled) << renderModeName(c.mode) << " " << c.eyePaths;
+    EXPECT_EQ(r.neighbors, c.neighbors) << renderModeName(c.mode);
+  }
+  o.mode = RenderMode::Reuse;
+  o.resample.neighbors = 3;
+  EXPECT_EQ(resolveResample(o).neighbors, 3);
+}
+
 TEST(RenderOptions, OutPatterns) {
   EXPECT_EQ(formatOutPath("out/frame_%04d.exr", 7), "out/frame_0007.exr");
   EXPECT_EQ(formatOutPath("f%d.exr", 12), "f12.exr");
