@@ -137,6 +137,14 @@ void addOutputOptions(CLI::App* render, RenderArgs& a) {
       "--resume", ro.resume,
       "Skip frames whose complete EXR already exists (a truncated one is rendered again); "
       "append to the stats file");
+  render
+      ->add_option("--warm-up", ro.warmUp,
+                   "With path resampling: before a run's first frame f (or one after a gap), "
+                   "render frames f - N .. f - 1 without writing them, so that its paths have "
+                   "the history an uninterrupted run gives them (where the previous frame's "
+                   "history is not read with --resume); from frame 0 on, the very same frames")
+      ->check(CLI::Range(0, 1000))
+      ->capture_default_str();
   render->add_flag("-q,--quiet", ro.quiet, "No progress line or summary");
 }
 

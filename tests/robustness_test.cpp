@@ -223,6 +223,32 @@ TEST(Resume, GoesOnFromTheResampledPathsOfTheLastFrame) {
   refused(8, " --spp 3", "another spp");
 }
 
+// A chunk of frames that cannot read the history of the frame before it (rendered at the same
+// time as the chunk before, say) warms up: --warm-up N renders the N frames before its first one
+// without writing them. From frame 0 on they are the uninterrupted run's frames, bit for bit;
+// without warm-up the chunk's first frame starts afresh and differs.
+TEST(Resume, WarmUpFramesGiveAChunkTheHistoryOfTheFramesBefore) {
+  const std::string dir = test::tempDir("warm-up");
+  const std::string common =
+      "render '" + kScene + "' --quiet --exr-float --width 64 --height 48 --spp 2 --mode reuse";
+  auto r = test::runPathreuse(common + " --frames 0-4 --out '" + dir + "/whole/f_%04d.exr'");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  r = test::runPathreuse(common + " --frames 2-4 --warm-up 2 --out '" + dir + "/warm/f_%04d.exr'");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  r = test::runPathreuse(common + " --frames 2-4 --out '" + dir + "/cold/f_%04d.exr'");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  char name[32];
+  for (int f = 0; f <= 4; ++f) {
+    std::snprintf(name, sizeof name, "/f_%04d.exr", f);
+    if (f < 2) {
+      EXPECT_FALSE(fs::exists(dir + "/warm" + name)) << "warm-up frame " << f << " was written";
+      continue;
+    }
+    EXPECT_TRUE(samePixels(dir + "/whole" + name, dir + "/warm" + name)) << "frame " << f;
+  }
+  EXPECT_FALSE(samePixels(dir + "/whole/f_0002.exr", dir + "/cold/f_0002.exr"));
+}
+
 TEST(Resume, AFrameOfAnotherSizeIsRenderedAgain) {
   const std::string dir = test::tempDir("resize");
   const std::string common =

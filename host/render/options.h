@@ -87,6 +87,9 @@ struct RenderOptions {
   int bvhWidth = 0;  // 0: defaultBvhWidth of the device
   std::string statsFile;
   bool resume = false;  // skip frames whose complete EXR exists; append to the stats file
+  // With path resampling: frames rendered, not written, before a frame whose previous frame the
+  // run neither rendered nor read the history of (host/render/renderer.cpp).
+  int warmUp = 0;
   // Camera samples keyed by frame 0 on every frame (the scene still moves with the frame):
   // the same noise pattern each frame, to measure how much flicker fresh noise adds.
   bool fixedNoise = false;

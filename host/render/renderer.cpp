@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -295,20 +296,36 @@ bool unpackHistories(const std::string& data, MultiDeviceSession& session, const
   return at == data.size();
 }
 
-// Before a frame f whose previous frame this run did not render: the history frame f - 1 left,
-// if any.
-void readHistory(const RenderOptions& o, MultiDeviceSession& session, const std::string& key,
+// Before a frame f > 0 whose previous frame this run did not render: whether the history frame
+// f - 1 left was read.
+bool readHistory(const RenderOptions& o, MultiDeviceSession& session, const std::string& key,
                  int f) {
-  if (f == 0) return;
   std::string data;
   const bool read =
       readFile(historyPath(o, f - 1), &data) && unpackHistories(data, session, key, f - 1);
-  if (!o.quiet)
-    std::cerr << (read ? "note: --resume: goes on from frame " + std::to_string(f - 1) +
-                             "'s resampled paths\n"
-                       : "note: --resume: the resampled paths' history starts afresh at frame " +
-                             std::to_string(f) +
-                             " (frames from here differ from an uninterrupted run's, unbiased)\n");
+  if (read && !o.quiet)
+    std::cerr << "note: --resume: goes on from frame " << f - 1 << "'s resampled paths\n";
+  return read;
+}
+
+// The same frame f without that history: frames f - --warm-up .. f - 1 rendered and not written,
+// or the history starts afresh (both said when `say`).
+void warmUp(const RenderOptions& o, MultiDeviceSession& session, int f, bool say) {
+  const int first = std::max(0, f - o.warmUp);
+  if (say && !o.quiet) {
+    if (first < f)
+      std::cerr << "note: --warm-up: frames " << first << "-" << f - 1
+                << " rendered and not written, for frame " << f << "'s resampled paths"
+                << (first == 0 ? " (as an uninterrupted run's)\n" : "\n");
+    else
+      std::cerr << "note: --resume: the resampled paths' history starts afresh at frame " << f
+                << " (frames from here differ from an uninterrupted run's, unbiased)\n";
+  }
+  for (int w = first; w < f && !interrupted(); ++w) {
+    FrameStats fs;
+    std::vector<DeviceFrame> parts;
+    session.renderFrame(w, &fs, &parts);
+  }
 }
 
 // After frame f is written: its history replaces the previous frame's.
@@ -326,6 +343,8 @@ int renderFrames(const RenderOptions& o, MultiDeviceSession& session, const Fram
   Tally t;
   int f = range.first;
   const bool history = keepsHistory(o);
+  const ResampleSettings rs = resolveResample(o);
+  const bool resampled = rs.enabled && rs.history > 0;
   const std::string key = history ? historyKey(o, session) : std::string();
   int lastRendered = -2;
   endLoadingPhase();  // a signal from here on finishes cleanly between launches
@@ -339,7 +358,11 @@ int renderFrames(const RenderOptions& o, MultiDeviceSession& session, const Fram
         o.mode != RenderMode::PathTrace && !o.quiet)
       std::cerr << "note: --resume: the connection history starts afresh at frame " << f
                 << " (frames from here differ from an uninterrupted run's, unbiased)\n";
-    if (history && lastRendered != f - 1) readHistory(o, session, key, f);
+    if (lastRendered != f - 1 && f > 0 && resampled) {
+      const bool read = history && readHistory(o, session, key, f);
+      // A run's first frame without --resume and --warm-up starts afresh as ever: no note.
+      if (!read && (history || o.warmUp > 0)) warmUp(o, session, f, true);
+    }
     const auto t0 = std::chrono::steady_clock::now();
     FrameStats fs;
     std::vector<DeviceFrame> parts;
