@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "util/check.h"
+#include "util/interrupt.h"
 
 namespace pr {
 
@@ -65,6 +66,25 @@ std::vector<int> splitRows(int height, const std::vector<double>& weights) {
   return rows;
 }
 
+std::vector<int> balancePasses(const std::vector<int>& passes, const std::vector<double>& seconds) {
+  PR_CHECK(passes.size() == seconds.size() && !passes.empty());
+  std::vector<double> rate(passes.size());
+  int spp = 0;
+  for (size_t i = 0; i < passes.size(); ++i) {
+    if (passes[i] <= 0 || !(seconds[i] > 0.0) || !std::isfinite(seconds[i])) return passes;
+    rate[i] = passes[i] / seconds[i];
+    spp += passes[i];
+  }
+  const std::vector<int> next = splitRows(spp, rate);
+  const auto slowest = [&](const std::vector<int>& split) {
+    double t = 0.0;
+    for (size_t i = 0; i < split.size(); ++i) t = std::max(t, split[i] / rate[i]);
+    return t;
+  };
+  // A margin, so that timing noise does not move chains back and forth.
+  return slowest(next) < 0.85 * slowest(passes) ? next : passes;
+}
+
 MultiDeviceSession::MultiDeviceSession(const Scene& scene,
                                        const std::vector<const DeviceEntry*>& devices,
                                        const RenderOptions& options)
@@ -87,6 +107,28 @@ MultiDeviceSession::MultiDeviceSession(const Scene& scene,
     return;
   }
   setRows(splitRows(height(), even));
+}
+
+void MultiDeviceSession::setPassSplit(const std::vector<int>& passes) {
+  PR_CHECK(!passes_.empty() && passes.size() == passes_.size());
+  const auto owner = [](const std::vector<int>& split, int pass) {
+    size_t i = 0;
+    for (int end = split[0]; pass >= end && i + 1 < split.size();) end += split[++i];
+    return i;
+  };
+  // The chains that change device, read before their device frees them.
+  std::vector<std::pair<int, std::string>> moving;
+  for (int s = 0; s < std::min(spp_, sessions_[0]->chains()); ++s)
+    if (owner(passes_, s) != owner(passes, s))
+      moving.emplace_back(s, sessions_[owner(passes_, s)]->chain(s));
+  passes_ = passes;
+  int begin = 0;
+  for (size_t i = 0; i < sessions_.size(); ++i) {
+    sessions_[i]->setPasses(begin, begin + passes_[i]);
+    begin += passes_[i];
+  }
+  PR_CHECK(begin == spp_);
+  for (const auto& [s, records] : moving) sessions_[owner(passes_, s)]->setChain(s, records);
 }
 
 void MultiDeviceSession::renderPasses(int frame, Image* img, std::vector<DeviceFrame>* parts) {
@@ -135,6 +177,10 @@ Image MultiDeviceSession::renderFrame(int frame, FrameStats* total,
   }
   if (!passes_.empty()) {
     renderPasses(frame, &img, &p);
+    std::vector<double> seconds(n);
+    for (size_t i = 0; i < n; ++i) seconds[i] = p[i].wallSeconds;
+    const std::vector<int> next = balancePasses(passes_, seconds);
+    if (next != passes_ && !interrupted()) setPassSplit(next);
   } else {
     int begin = 0;
     for (size_t i = 0; i < n; ++i) {

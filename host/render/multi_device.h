@@ -8,12 +8,15 @@
 //
 // With --resample a pixel's paths are resampled with its neighbours' and with the previous
 // frame's paths anywhere in the image, which a device holding some rows does not have. There the
-// devices split the sample passes instead: each renders every pixel in a fixed range of passes
-// (an even split, kept for the run, since pass s of a frame resamples with pass s of the previous
-// one on its own device), and the films' sums are added in device order before the mean. Every
-// sample is then the one a single device computes, and with two devices so is the frame, bit for
-// bit (the first device's sum of passes [0, k) plus the second's of [k, spp) is one device's sum,
-// in its order); with more, the sums' float rounding differs.
+// devices split the sample passes instead: each renders every pixel in a range of passes, and the
+// films' sums are added in device order before the mean. Pass s of a frame resamples with pass s
+// of the previous one, whose chain of reservoirs the device holding pass s keeps (only its own
+// passes' chains). The first frame splits the passes evenly; after each frame the split follows
+// the devices' passes per second where that shortens the frame by over 15%
+// (balancePasses), and a pass that changes device takes its chain along. Every sample is then
+// the one a single device computes. So is the frame, bit for bit, where every device after the
+// first holds one pass (one device's sum in its order: the first's sum of passes [0, k), then
+// pass k); otherwise the sums' grouping differs in float rounding alone.
 #pragma once
 
 #include <memory>
@@ -44,6 +47,12 @@ struct DeviceFrame {
 // there are as many rows as weights, every part gets at least one. Returns the rows per part.
 std::vector<int> splitRows(int height, const std::vector<double>& weights);
 
+// The next frame's split of the sample passes, given each device's `passes` and the `seconds` it
+// took over them: in proportion to passes per second (every device at least one pass while there
+// are enough), where that makes the slowest device's predicted time over 15% shorter; else
+// `passes`, also where some device rendered none or took no time.
+std::vector<int> balancePasses(const std::vector<int>& passes, const std::vector<double>& seconds);
+
 class MultiDeviceSession {
  public:
   // Builds one RenderSession per device (concurrently); `scene` must outlive this. Throws as
@@ -64,8 +73,12 @@ class MultiDeviceSession {
   FrameRange frameRange() const { return sessions_[0]->frameRange(); }
   // Rows of each device for the next frame.
   const std::vector<int>& rows() const { return rows_; }
-  // With --resample and several devices: the sample passes of each (a fixed split); else empty.
+  // With --resample and several devices: the sample passes of each for the next frame; else
+  // empty.
   const std::vector<int>& passes() const { return passes_; }
+  // Sets that split (as many parts as devices, summing to spp); the chains of the passes that
+  // change device move with them.
+  void setPassSplit(const std::vector<int>& passes);
 
  private:
   void setRows(const std::vector<int>& rows);

@@ -55,8 +55,52 @@ PathTracer::PathTracer(Context& ctx, GpuScene& scene, Film& film,
     const uint64_t fit = std::max<uint64_t>(1, (uint64_t(1) << 30) / perChain);
     chains_ =
         settings.resample.history > 0 ? int(std::min<uint64_t>(uint64_t(settings.spp), fit)) : 0;
-    for (int c = 0; c < chains_; ++c) history_.push_back(alloc("path history", perChain));
+    // Allocated for this device's own passes once they are known (syncChains).
+    history_.resize(size_t(chains_));
+    chainBytes_ = perChain;
   }
+}
+
+void PathTracer::setPasses(int begin, int end) {
+  // A whole history stays whole: the caller moves the chains of passes changing device.
+  const bool whole = hasHistory();
+  Integrator::setPasses(begin, end);
+  syncChains();
+  written_ = whole ? chainedPasses() : 0;
+}
+
+void PathTracer::syncChains() {
+  for (int c = 0; c < chains_; ++c) {
+    cl::Buffer& b = history_[size_t(c)];
+    const bool own = c >= passBegin_ && c < passEnd(settings_.spp);
+    if (own && !b()) {
+      b = ctx_.allocate("path history", chainBytes_);
+      ctx_.zero(b, chainBytes_);  // stamp 0: no previous path
+      bytes_ += chainBytes_;
+    } else if (!own && b()) {
+      b = cl::Buffer();
+      ctx_.release(chainBytes_);
+      bytes_ -= chainBytes_;
+    }
+  }
+}
+
+std::string PathTracer::chain(int pass) {
+  PR_CHECK(pass >= passBegin_ && pass < std::min(chains_, passEnd(settings_.spp)));
+  const size_t rec = sizeof(dev::PathHistory), first = film_.first();
+  std::string out((film_.end() - first) * rec, '\0');
+  CL_CHECK(ctx_.queue().enqueueReadBuffer(history_[size_t(pass)], CL_TRUE, first * rec, out.size(),
+                                          &out[0]));
+  return out;
+}
+
+void PathTracer::setChain(int pass, const std::string& records) {
+  syncChains();
+  PR_CHECK(pass >= passBegin_ && pass < std::min(chains_, passEnd(settings_.spp)));
+  const size_t rec = sizeof(dev::PathHistory), first = film_.first();
+  PR_CHECK(records.size() == (film_.end() - first) * rec);
+  CL_CHECK(ctx_.queue().enqueueWriteBuffer(history_[size_t(pass)], CL_TRUE, first * rec,
+                                           records.size(), records.data()));
 }
 
 dev::ResampleParams PathTracer::resampleParams() const {
@@ -80,6 +124,7 @@ void PathTracer::beginFrame(int frame, const dev::CameraParams& camera,
   // The film's pixels [first, n) only; buffers are indexed by pixel over the whole image.
   const cl_uint n = film_.end();
   const cl_uint rngFrame = settings_.fixedNoise ? 0 : cl_uint(frame);
+  syncChains();
   ctx_.zero(rays_, dev::PR_PT_COUNT * 4);
   dev::ResampleParams rsp = resampleParams();
   // The previous frame's reservoirs are taken where every chain was kept, the frame follows it
@@ -311,6 +356,7 @@ bool PathTracer::readHistory(const std::string& data, const std::string& key, in
     std::memcpy(&rec, data.data() + sizeof h + k, sizeof rec);
     if (!validRecord(rec, scene_)) return false;
   }
+  syncChains();
   for (size_t c = 0; c < h.chains; ++c)
     CL_CHECK(ctx_.queue().enqueueWriteBuffer(history_[size_t(passBegin_) + c], CL_TRUE,
                                              h.first * h.record, bytes,

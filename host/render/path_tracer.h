@@ -56,8 +56,18 @@ class PathTracer : public Integrator {
   std::string writeHistory(const std::string& key);
   bool readHistory(const std::string& data, const std::string& key, int frame);
 
+  // Several devices: each holds the chains of its own passes alone, and a pass moving to another
+  // device takes its chain along (render/multi_device.h): the records of pass `pass`'s chain
+  // over the film's rows, and writing them where the pass now is.
+  void setPasses(int begin, int end) override;
+  int chains() const { return chains_; }  // passes [0, chains) keep one, on whichever device
+  std::string chain(int pass);
+  void setChain(int pass, const std::string& records);
+
  private:
   dev::ResampleParams resampleParams() const;
+  // Allocates the chains of this device's passes (zeroed: no history) and frees the others'.
+  void syncChains();
   // This device's passes that keep a chain: each wrote its chain when the frame is whole.
   int chainedPasses() const {
     return std::max(0, std::min(chains_, passEnd(settings_.spp)) - passBegin_);
@@ -84,11 +94,13 @@ class PathTracer : public Integrator {
   cl::Buffer rsTrack_, rsRes_, rsPending_, rsEye_, diRes_, diPending_;
   // Temporal reuse: pass s < chains_ keeps its final reservoirs in history_[s] for pass s of the
   // next frame (pt_resample writes historyOut_, copied there): chains_ = spp as far as 1 GiB
-  // allows; later passes resample within the frame alone.
+  // allows; later passes resample within the frame alone. Only this device's passes' chains
+  // are allocated; the others' buffers are empty.
   std::vector<cl::Buffer> history_;
   cl::Buffer historyOut_, moved_;
   uint64_t movedBytes_ = 0;
   int chains_ = 0;
+  uint64_t chainBytes_ = 0;     // one chain: a record per pixel of the image
   int written_ = 0;             // passes of the frame since beginFrame whose chain is written
   int frame_ = -2;              // the frame of the last beginFrame
   dev::CameraParams camera_{};  // and its camera

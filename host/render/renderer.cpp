@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <numeric>
 
 #include <nlohmann/json.hpp>
 
@@ -231,7 +232,8 @@ bool keepsHistory(const RenderOptions& o) {
 }
 
 // Everything a history depends on besides its frame and size: the scene file, the options that
-// change what a path is worth, the devices' split of the passes, and the kernels that made it.
+// change what a path is worth, the number of devices, and the kernels that made it. (The split of
+// the passes is in the file, and the run that reads it takes that split.)
 std::string historyKey(const RenderOptions& o, const MultiDeviceSession& session) {
   std::string scene;
   readFile(o.scene, &scene);
@@ -262,38 +264,9 @@ std::string historyKey(const RenderOptions& o, const MultiDeviceSession& session
                       int(o.mode),  // --mode reuse: the eye paths' share against the connections
                       o.lightPaths,
                       o.pathsPerPixel,
-                      session.passes()};
+                      session.deviceCount()};
   return j.dump() + scene + expandKernelSource("pathtrace/shade.cl") +
          expandKernelSource("pathtrace/resample.cl");
-}
-
-// The devices' histories in one file: per device, its size (8 bytes) and its history ("" where
-// the device chains no passes).
-std::string packHistories(MultiDeviceSession& session, const std::string& key) {
-  std::string out;
-  for (size_t i = 0; i < session.deviceCount(); ++i) {
-    RenderSession& s = session.session(i);
-    const std::string h = s.hasHistory() ? s.writeHistory(key) : std::string();
-    const uint64_t n = h.size();
-    out.append(reinterpret_cast<const char*>(&n), sizeof n);
-    out += h;
-  }
-  return out;
-}
-
-bool unpackHistories(const std::string& data, MultiDeviceSession& session, const std::string& key,
-                     int frame) {
-  size_t at = 0;
-  for (size_t i = 0; i < session.deviceCount(); ++i) {
-    uint64_t n = 0;
-    if (data.size() - at < sizeof n) return false;
-    std::memcpy(&n, data.data() + at, sizeof n);
-    at += sizeof n;
-    if (n > data.size() - at) return false;
-    if (n > 0 && !session.session(i).readHistory(data.substr(at, n), key, frame)) return false;
-    at += n;
-  }
-  return at == data.size();
 }
 
 // Before a frame f > 0 whose previous frame this run did not render: whether the history frame
@@ -398,6 +371,59 @@ int renderFrames(const RenderOptions& o, MultiDeviceSession& session, const Fram
 }
 
 }  // namespace
+
+// The devices' histories in one file: the split of the passes (the device count, 4 bytes, then
+// each device's passes, 4 bytes each; 0 where the devices split rows), then per device its
+// history's size (8 bytes) and its history ("" where the device chains no passes).
+std::string packHistories(MultiDeviceSession& session, const std::string& key) {
+  std::string out;
+  const auto put = [&out](const auto& v) {
+    out.append(reinterpret_cast<const char*>(&v), sizeof v);
+  };
+  put(uint32_t(session.deviceCount()));
+  for (size_t i = 0; i < session.deviceCount(); ++i)
+    put(int32_t(session.passes().empty() ? 0 : session.passes()[i]));
+  for (size_t i = 0; i < session.deviceCount(); ++i) {
+    RenderSession& s = session.session(i);
+    const std::string h = s.hasHistory() ? s.writeHistory(key) : std::string();
+    put(uint64_t(h.size()));
+    out += h;
+  }
+  return out;
+}
+
+bool unpackHistories(const std::string& data, MultiDeviceSession& session, const std::string& key,
+                     int frame) {
+  size_t at = 0;
+  const auto get = [&](auto* v) {
+    if (data.size() - at < sizeof *v) return false;
+    std::memcpy(v, data.data() + at, sizeof *v);
+    at += sizeof *v;
+    return true;
+  };
+  uint32_t devices = 0;
+  if (!get(&devices) || devices != session.deviceCount()) return false;
+  std::vector<int> split(devices);
+  int spp = 0;
+  for (int& p : split) {
+    int32_t v = 0;
+    if (!get(&v) || v < 0 || v > 1 << 20) return false;
+    spp += p = v;
+  }
+  if (!session.passes().empty()) {
+    if (spp != std::accumulate(session.passes().begin(), session.passes().end(), 0) ||
+        (size_t(spp) >= split.size() && std::count(split.begin(), split.end(), 0) > 0))
+      return false;
+    if (split != session.passes()) session.setPassSplit(split);  // the writing run's
+  }
+  for (size_t i = 0; i < session.deviceCount(); ++i) {
+    uint64_t n = 0;
+    if (!get(&n) || n > data.size() - at) return false;
+    if (n > 0 && !session.session(i).readHistory(data.substr(at, n), key, frame)) return false;
+    at += n;
+  }
+  return at == data.size();
+}
 
 int runRender(const RenderOptions& o) {
   installInterruptHandlers(o.scene);

@@ -169,6 +169,18 @@ bool RenderSession::readHistory(const std::string& data, const std::string& key,
   return pathTracer_->readHistory(data, key, frame);
 }
 
+int RenderSession::chains() const {
+  return pathTracer_ ? pathTracer_->chains() : 0;
+}
+
+std::string RenderSession::chain(int pass) {
+  return pathTracer_->chain(pass);
+}
+
+void RenderSession::setChain(int pass, const std::string& records) {
+  pathTracer_->setChain(pass, records);
+}
+
 FrameRange RenderSession::frameRange() const {
   FrameRange range = options_.frames;
   if (!options_.framesGiven) range = {0, frameCount_ - 1};

@@ -55,6 +55,11 @@ class RenderSession {
   bool hasHistory() const;
   std::string writeHistory(const std::string& key);
   bool readHistory(const std::string& data, const std::string& key, int frame);
+  // The records of pass `pass`'s chain of that history, and writing them on the device the
+  // pass moved to (render/multi_device.h); pass < the passes chained, this device's.
+  int chains() const;
+  std::string chain(int pass);
+  void setChain(int pass, const std::string& records);
 
   int width() const { return width_; }
   int height() const { return height_; }
