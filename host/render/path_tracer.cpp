@@ -204,7 +204,6 @@ void PathTracer::beginFrame(int frame, const dev::CameraParams& camera,
     resampleArgs_.first = film_.first();
     resampleArgs_.end = n;
     resampleArgs_.rays = rays_;
-    resampleArgs_.history_out = historyOut_;
     resampleArgs_.prev_cam = prevCamera;
     resampleArgs_.moved = moved_;
     resampleArgs_.stamp = stamp_;
@@ -261,12 +260,13 @@ void PathTracer::tracePass(int sample, StageTimer* timer) {
     resampleArgs_.sample = cl_uint(sample);
     resampleArgs_.temporal = temporal_ && chained ? 1u : 0u;
     resampleArgs_.history = chained ? history_[size_t(sample)] : historyOut_;
+    resampleArgs_.history_out = historyOut_;
     resampleArgs_.set(resample_, kargs::kPass);
     ctx_.launch1D(resample_, 0, n - first, "resample", timer);
     if (chained) {
-      const size_t rec = sizeof(dev::PathHistory);
-      CL_CHECK(ctx_.queue().enqueueCopyBuffer(historyOut_, history_[size_t(sample)], first * rec,
-                                              first * rec, (n - first) * rec));
+      // The records just written become the chain, and the chain's old ones, all read, the next
+      // pass's output (each pass writes every record of the film's rows): no copy.
+      std::swap(historyOut_, history_[size_t(sample)]);
       ++written_;
     }
   }

@@ -93,7 +93,7 @@ class PathTracer : public Integrator {
   // estimation's candidate until pt_shadow, and x_1 (when the caller gives no eye buffer).
   cl::Buffer rsTrack_, rsRes_, rsPending_, rsEye_, diRes_, diPending_;
   // Temporal reuse: pass s < chains_ keeps its final reservoirs in history_[s] for pass s of the
-  // next frame (pt_resample writes historyOut_, copied there): chains_ = spp as far as 1 GiB
+  // next frame (pt_resample writes historyOut_, swapped with it): chains_ = spp as far as 1 GiB
   // allows; later passes resample within the frame alone. Only this device's passes' chains
   // are allocated; the others' buffers are empty.
   std::vector<cl::Buffer> history_;

@@ -191,24 +191,24 @@
 // reconnection, into its radiance and history_out (one pass over the film's pixels [first, end)).
 // temporal: `history` holds this pass's reservoirs of the previous frame, seen by prev_cam, and
 // `moved` (rsp.moved_count boxes) where the scene changed since.
-#define PR_ARGS_PT_RESAMPLE_SPATIAL(X)    \
-  PR_ARGS_SCENE(X)                        \
-  X(FRAME, VAL, ResampleParams, rsp)      \
-  X(FRAME, IN, EyeVertex, eye)            \
-  X(FRAME, IN, PathReservoir, rs_res)     \
-  X(FRAME, IN, DirectReservoir, di_res)   \
-  X(FRAME, OUT, float4, radiance)         \
-  X(FRAME, VAL, uint, seed)               \
-  X(FRAME, VAL, uint, frame)              \
-  X(PASS, VAL, uint, sample)              \
-  X(FRAME, VAL, uint, first)              \
-  X(FRAME, VAL, uint, end)                \
-  X(FRAME, OUT, uint, rays)               \
-  X(PASS, VAL, uint, temporal)            \
-  X(PASS, IN, PathHistory, history)       \
-  X(FRAME, OUT, PathHistory, history_out) \
-  X(FRAME, VAL, CameraParams, prev_cam)   \
-  X(FRAME, IN, MovedInstance, moved)      \
+#define PR_ARGS_PT_RESAMPLE_SPATIAL(X)   \
+  PR_ARGS_SCENE(X)                       \
+  X(FRAME, VAL, ResampleParams, rsp)     \
+  X(FRAME, IN, EyeVertex, eye)           \
+  X(FRAME, IN, PathReservoir, rs_res)    \
+  X(FRAME, IN, DirectReservoir, di_res)  \
+  X(FRAME, OUT, float4, radiance)        \
+  X(FRAME, VAL, uint, seed)              \
+  X(FRAME, VAL, uint, frame)             \
+  X(PASS, VAL, uint, sample)             \
+  X(FRAME, VAL, uint, first)             \
+  X(FRAME, VAL, uint, end)               \
+  X(FRAME, OUT, uint, rays)              \
+  X(PASS, VAL, uint, temporal)           \
+  X(PASS, IN, PathHistory, history)      \
+  X(PASS, OUT, PathHistory, history_out) \
+  X(FRAME, VAL, CameraParams, prev_cam)  \
+  X(FRAME, IN, MovedInstance, moved)     \
   X(FRAME, VAL, uint, stamp)
 
 // ---- The film (kernels/accumulate.cl) ----
