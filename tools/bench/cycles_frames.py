@@ -14,30 +14,17 @@ pattern is the same, as Blender's default). Writes OUTDIR/f_%04d.exr (linear flo
 one JSON line per frame: {"frame": f, "render_s": seconds of bpy.ops.render.render}.
 """
 
-import argparse
 import json
 import sys
 import time
 
 import bpy
 
+from peer_args import peer_args
+
 
 def parse_args():
-    argv = sys.argv[1:]
-    ap = argparse.ArgumentParser(prog="cycles_frames.py")
-    ap.add_argument("scene")
-    ap.add_argument("outdir")
-    ap.add_argument("--frames", required=True, help="A-B")
-    ap.add_argument("--spp", type=int, required=True)
-    ap.add_argument("--width", type=int, required=True)
-    ap.add_argument("--height", type=int, required=True)
-    ap.add_argument("--max-depth", type=int, required=True)
-    ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--threads", type=int, default=2)
-    a = ap.parse_args(argv)
-    first, _, last = a.frames.partition("-")
-    a.first, a.last = int(first), int(last or first)
-    return a
+    return peer_args("cycles_frames.py", "scene")
 
 
 def first_camera(path, scene):

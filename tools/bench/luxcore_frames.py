@@ -17,7 +17,6 @@ OUTDIR/f_%04d.exr (linear float RGB) and prints one JSON line per frame: {"frame
 seconds from the session's start (scene preprocessing included) to its halt at N spp}.
 """
 
-import argparse
 import json
 import math
 import os
@@ -27,23 +26,12 @@ import time
 import numpy as np
 import pyluxcore
 
+from peer_args import peer_args
+
 
 def parse_args():
-    ap = argparse.ArgumentParser(prog="luxcore_frames.py")
-    ap.add_argument("export")
-    ap.add_argument("outdir")
-    ap.add_argument("--frames", required=True, help="A-B")
-    ap.add_argument("--spp", type=int, required=True)
-    ap.add_argument("--width", type=int, required=True)
-    ap.add_argument("--height", type=int, required=True)
-    ap.add_argument("--max-depth", type=int, required=True)
-    ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--threads", type=int, default=2)
-    ap.add_argument("--verbose", action="store_true", help="LuxCore's log on stderr")
-    a = ap.parse_args(sys.argv[1:])
-    first, _, last = a.frames.partition("-")
-    a.first, a.last = int(first), int(last or first)
-    return a
+    return peer_args("luxcore_frames.py", "export", extra=lambda ap: ap.add_argument(
+        "--verbose", action="store_true", help="LuxCore's log on stderr"))
 
 
 def properties(lines):

@@ -12,7 +12,6 @@ index k, triangle corners p<k> and their shading normals n<k>, float32, 3 rows p
 Image textures are not exported: the benchmark scenes have none.
 """
 
-import argparse
 import json
 import math
 import sys
@@ -22,19 +21,11 @@ import numpy as np
 from mathutils import Vector
 
 from cycles_frames import first_camera
+from peer_args import peer_args
 
 
 def parse_args():
-    ap = argparse.ArgumentParser(prog="scene_export.py")
-    ap.add_argument("scene")
-    ap.add_argument("outdir")
-    ap.add_argument("--frames", required=True, help="A-B")
-    ap.add_argument("--width", type=int, required=True)
-    ap.add_argument("--height", type=int, required=True)
-    a = ap.parse_args(sys.argv[1:])
-    first, _, last = a.frames.partition("-")
-    a.first, a.last = int(first), int(last or first)
-    return a
+    return peer_args("scene_export.py", "scene", render=False)
 
 
 def principled(mat):
