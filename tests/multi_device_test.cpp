@@ -123,8 +123,9 @@ std::vector<int> checkStats(const std::string& file, int frames, int spp = 0) {
         EXPECT_EQ(d["rows"].get<int>(), kHeight) << line;
         EXPECT_EQ(d["pass_begin"].get<int>(), passes) << line;
         EXPECT_GE(d["passes"].get<int>(), 1) << line;
-        if (lines == 1)
+        if (lines == 1) {
           EXPECT_EQ(d["passes"].get<int>(), splitRows(spp, {1.0, 1.0})[passes ? 1 : 0]) << line;
+        }
         if (passes > 0) second.push_back(d["passes"].get<int>());
         passes += d["passes"].get<int>();
         rows = kHeight;
@@ -138,7 +139,9 @@ std::vector<int> checkStats(const std::string& file, int frames, int spp = 0) {
     EXPECT_EQ(rows, kHeight) << line;
     EXPECT_NEAR(share, 1.0, 1e-12) << line;
     for (const auto& [k, v] : rays) EXPECT_EQ(j["rays"][k].get<uint64_t>(), v) << k;
-    if (spp > 0) EXPECT_EQ(passes, spp) << line;
+    if (spp > 0) {
+      EXPECT_EQ(passes, spp) << line;
+    }
     if (lines == 1 && spp == 0) {
       EXPECT_EQ(j["devices"][0]["rows"].get<int>(), kHeight / 2) << line;
     }
@@ -215,9 +218,10 @@ TEST(MultiDeviceCli, TwoDevicesEqualOneWithResampling) {
     ASSERT_EQ(second.size(), 4u);
     for (int f = 0; f <= 3; ++f) {
       const std::string a = frameFile(dir + "/one", f), b = frameFile(dir + "/two", f);
-      if (second[size_t(f)] == 1)
+      if (second[size_t(f)] == 1) {
         EXPECT_TRUE(samePixels(a, b))
             << "frame " << f << ": largest relative difference " << largestRelativeDifference(a, b);
+      }
       EXPECT_LT(largestRelativeDifference(a, b), 1e-5) << "frame " << f;
     }
   }
@@ -327,7 +331,9 @@ TEST(MultiDeviceSession, PassesChangingDeviceTakeTheirPathsAlong) {
   const std::vector<std::vector<int>> splits = {{2, 2}, {1, 3}, {3, 1}, {3, 1}, {2, 2}};
   renderWithSplits([&](int f) { return splits[size_t(f)]; },
                    [&](int f, const Image& a, const Image& b) {
-                     if (splits[size_t(f)][1] == 1) EXPECT_TRUE(a.rgba == b.rgba) << "frame " << f;
+                     if (splits[size_t(f)][1] == 1) {
+                       EXPECT_TRUE(a.rgba == b.rgba) << "frame " << f;
+                     }
                      EXPECT_LT(largestRelativeDifference(a, b), 1e-5) << "frame " << f;
                    });
 }
