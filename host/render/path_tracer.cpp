@@ -85,22 +85,33 @@ void PathTracer::syncChains() {
   }
 }
 
-std::string PathTracer::chain(int pass) {
+size_t PathTracer::chainRowsBytes() const {
+  return size_t(film_.end() - film_.first()) * sizeof(dev::PathHistory);
+}
+
+void PathTracer::readChain(int pass, char* out) {
   PR_CHECK(pass >= passBegin_ && pass < std::min(chains_, passEnd(settings_.spp)));
-  const size_t rec = sizeof(dev::PathHistory), first = film_.first();
-  std::string out((film_.end() - first) * rec, '\0');
-  CL_CHECK(ctx_.queue().enqueueReadBuffer(history_[size_t(pass)], CL_TRUE, first * rec, out.size(),
-                                          &out[0]));
+  CL_CHECK(ctx_.queue().enqueueReadBuffer(history_[size_t(pass)], CL_TRUE,
+                                          film_.first() * sizeof(dev::PathHistory),
+                                          chainRowsBytes(), out));
+}
+
+void PathTracer::writeChain(int pass, const char* records) {
+  PR_CHECK(pass >= passBegin_ && pass < std::min(chains_, passEnd(settings_.spp)));
+  CL_CHECK(ctx_.queue().enqueueWriteBuffer(history_[size_t(pass)], CL_TRUE,
+                                           film_.first() * sizeof(dev::PathHistory),
+                                           chainRowsBytes(), records));
+}
+
+std::string PathTracer::chain(int pass) {
+  std::string out(chainRowsBytes(), '\0');
+  readChain(pass, &out[0]);
   return out;
 }
 
 void PathTracer::setChain(int pass, const std::string& records) {
-  syncChains();
-  PR_CHECK(pass >= passBegin_ && pass < std::min(chains_, passEnd(settings_.spp)));
-  const size_t rec = sizeof(dev::PathHistory), first = film_.first();
-  PR_CHECK(records.size() == (film_.end() - first) * rec);
-  CL_CHECK(ctx_.queue().enqueueWriteBuffer(history_[size_t(pass)], CL_TRUE, first * rec,
-                                           records.size(), records.data()));
+  PR_CHECK(records.size() == chainRowsBytes());
+  writeChain(pass, records.data());
 }
 
 dev::ResampleParams PathTracer::resampleParams() const {
@@ -326,8 +337,7 @@ std::string PathTracer::writeHistory(const std::string& key) {
   Hash128 sum;
   for (size_t c = 0; c < h.chains; ++c) {
     char* at = &out[sizeof h + c * bytes];
-    CL_CHECK(ctx_.queue().enqueueReadBuffer(history_[size_t(passBegin_) + c], CL_TRUE,
-                                            h.first * h.record, bytes, at));
+    readChain(passBegin_ + int(c), at);
     sum.add(at, bytes);
   }
   const uint64_t check = sum.low();
@@ -358,9 +368,7 @@ bool PathTracer::readHistory(const std::string& data, const std::string& key, in
   }
   syncChains();
   for (size_t c = 0; c < h.chains; ++c)
-    CL_CHECK(ctx_.queue().enqueueWriteBuffer(history_[size_t(passBegin_) + c], CL_TRUE,
-                                             h.first * h.record, bytes,
-                                             data.data() + sizeof h + c * bytes));
+    writeChain(passBegin_ + int(c), data.data() + sizeof h + c * bytes);
   frame_ = h.frame;
   stamp_ = h.stamp;
   camera_ = h.camera;

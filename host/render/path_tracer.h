@@ -68,6 +68,11 @@ class PathTracer : public Integrator {
   dev::ResampleParams resampleParams() const;
   // Allocates the chains of this device's passes (zeroed: no history) and frees the others'.
   void syncChains();
+  // One chain's records of the film's rows (chainRowsBytes of them), read or written; `pass` is
+  // this device's and chained.
+  size_t chainRowsBytes() const;
+  void readChain(int pass, char* out);
+  void writeChain(int pass, const char* records);
   // This device's passes that keep a chain: each wrote its chain when the frame is whole.
   int chainedPasses() const {
     return std::max(0, std::min(chains_, passEnd(settings_.spp)) - passBegin_);
