@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Installs the Debian packages that pathreuse's build, tests and PoCL need (python3-venv for
-# tools/setup/intel-opencl.sh, the second platform of the tests; oclgrind for tools/ci/oclgrind-check.sh;
-# clang-format for tools/ci/format-check.sh; Slurm and munge for tools/slurm/'s single-node test
-# cluster).
+# tools/setup/intel-opencl.sh, the second platform of the tests; oclgrind for
+# tools/ci/oclgrind-check.sh; clang-format for tools/ci/format-check.sh; ccache, through which
+# CMakeLists.txt compiles where it is present; Slurm and munge for tools/slurm/'s single-node
+# test cluster).
 # Idempotent: runs apt-get only when something is missing.
 set -euo pipefail
 
@@ -13,7 +14,7 @@ packages=(
   libopenexr-dev libcli11-dev libgtest-dev zlib1g-dev
   assimp-testmodels python3
   python3-matplotlib python3-numpy
-  python3-venv oclgrind clang-format
+  python3-venv oclgrind clang-format ccache
   slurmctld slurmd slurm-client munge
 )
 
