@@ -284,6 +284,11 @@ void addReuseOptions(CLI::App* render, RenderArgs& a) {
       "where they sample a path better, and eye paths elsewhere (dark corners, occluded rooms). "
       "On by default; --no-eye-paths: the connections alone at the first eye vertex, with "
       "next-event estimation, strategy E and the delta-chain extension there");
+  render->add_flag(
+      "--light-tracing,!--no-light-tracing", ro.lightTracing,
+      "Reuse/retrace with eye paths: also join every stored light vertex to the camera (light "
+      "tracing, strategy T), weighted against the eye paths and the connections over whole "
+      "paths: the technique for caustics seen on diffuse surfaces");
 }
 
 void addMaterialOptions(CLI::App* render, RenderArgs& a) {
@@ -379,6 +384,9 @@ pr::RenderOptions toRenderOptions(const RenderArgs& a) {
   if (ro.eyePaths && a.connectionMis->count() > 0 && !ro.quiet)
     std::cerr << "note: --connection-mis is used with --no-eye-paths only; eye paths weigh "
                  "whole paths by MIS instead\n";
+  if (ro.lightTracing && ro.mode == pr::RenderMode::PathTrace && !ro.quiet)
+    std::cerr << "note: --light-tracing joins stored light paths to the camera in --mode reuse or "
+                 "retrace; the path tracer has none\n";
   ro.connections = a.connections == "auto"  ? -1
                    : a.connections == "all" ? 0
                                             : std::stoi(a.connections);

@@ -5,6 +5,7 @@
 // whose total does not depend on thread order).
 #include "shared/common.h"
 #include "shared/kernel_args.h"
+#include "shared/splat.h"
 
 PR_KERNEL void accumulate(PR_PARAMS(PR_ARGS_ACCUMULATE)) {
   const uint i = (uint)get_global_id(0);
@@ -17,4 +18,16 @@ PR_KERNEL void accumulate(PR_PARAMS(PR_ARGS_ACCUMULATE)) {
     return;
   }
   film[px] += (float4)(l.x, l.y, l.z, 1.0f);
+}
+
+// splat_film (strategy T): one work-item per pixel of the film's range (launched from its first
+// pixel, up to `end`). Adds the pixel's splats (shared/splat.h) to its film sum, not to its
+// count, and clears them for the next frame.
+PR_KERNEL void splat_film(PR_PARAMS(PR_ARGS_SPLAT_FILM)) {
+  const uint i = (uint)get_global_id(0);
+  if (i >= end) return;
+  __global uint* w = splat + (size_t)i * PR_SPLAT_WORDS;
+  const float r = splat_value(w[0], w[1]), g = splat_value(w[2], w[3]), b = splat_value(w[4], w[5]);
+  film[i] += (float4)(r, g, b, 0.0f);
+  for (uint k = 0u; k < PR_SPLAT_WORDS; ++k) w[k] = 0u;
 }

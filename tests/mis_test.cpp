@@ -206,14 +206,49 @@ TEST(EyePathShare, KeptRatiosGiveTheWeightOfTheWholePathsDensities) {
                           : tri    ? de * area(k == 1 ? rev_join : rev[1], n_tri, dir[1], t[1])
                                    : 0.0;
         const double expect = 1.0 / (1.0 + (dn / dl) * (dn / dl) + (dh / dl) * (dh / dl));
-        const float got = eye_path_weight(r, k, pdf_x, cos_z, d2, rev_join, 1.0f / C);
+        const float got = eye_path_weight(r, k, pdf_x, cos_z, d2, rev_join, 1.0f / C, 0.0f);
         EXPECT_NEAR(got, expect, 1e-4 * std::max(1.0, expect)) << "trial " << trial << " k " << k;
+        // With strategy T (density dt): T takes its power share of all four, L its own of the
+        // rest.
+        const double dt = dl * std::exp(6.0 * u(gen) - 3.0);
+        const double share_t = dt * dt / (dt * dt + dl * dl + dn * dn + dh * dh);
+        const float got_t =
+            eye_path_weight(r, k, pdf_x, cos_z, d2, rev_join, 1.0f / C, float(dt / dl));
+        EXPECT_NEAR(got_t, expect * (1.0 - share_t), 1e-4) << "trial " << trial << " k " << k;
         ++checked;
       }
       eye_path_walk_leave(&w, k, delta[k], delta[k] ? 0.0f : fwd[k], delta[k] ? 0.0f : rev[k]);
     }
   }
   EXPECT_GT(checked, 500);
+}
+
+// Strategy T's share, L's and the eye path's add to 1 for any densities (0, tiny, huge, infinite,
+// NaN), and T off (t = 0) leaves L's and the eye path's shares as they were, bit for bit.
+TEST(EyePathShare, TheSharesOfTAndLAndTheEyePathAddToOne) {
+  const float inf = std::numeric_limits<float>::infinity();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const std::vector<float> special = {0.0f, 1e-30f, 1e-3f, 1.0f, 1e3f, 1e30f, inf, nan};
+  std::mt19937 gen(29);
+  std::uniform_real_distribution<float> logu(-12.0f, 12.0f), u(0.0f, 1.0f);
+  auto draw = [&] { return u(gen) < 0.3f ? special[gen() % special.size()] : std::exp(logu(gen)); };
+  for (int trial = 0; trial < 20000; ++trial) {
+    const float t = draw(), n = draw(), h = draw();
+    const float w_t = eye_paths_camera_share(t, n, h);
+    const float w_l = mis_power_share(n, h) * eye_paths_camera_rest(t, n, h);
+    const float w_e = eye_paths_eye_share(n, h, t);
+    ASSERT_GE(w_t, 0.0f);
+    ASSERT_LE(w_t, 1.0f);
+    ASSERT_NEAR(double(w_t) + w_l + w_e, 1.0, 1e-5) << t << " " << n << " " << h;
+    if (!(t > 0.0f)) {
+      ASSERT_EQ(w_t, 0.0f);
+      ASSERT_EQ(w_e, 1.0f - mis_power_share(n, h));
+    }
+    if (t > 0.0f && t < inf && n == n && h == h && n < inf && h < inf) {
+      const double a = double(t) * t, den = a + 1.0 + double(n) * n + double(h) * h;
+      ASSERT_NEAR(w_t, a / den, 1e-5) << t << " " << n << " " << h;
+    }
+  }
 }
 
 // The power heuristic over density ratios for any number of strategies: each strategy's weight,

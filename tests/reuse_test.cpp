@@ -521,6 +521,73 @@ TEST(Reuse, EqualsRetraceWithEyePaths) {
   expectReuseEqualsRetrace(sweepScene(), "0-7", 0, 7, "--fps 8 --eye-paths");
 }
 
+// Strategy T (--light-tracing, kernels/reuse/camera_splat.cl): every stored vertex z_k, k >= 2,
+// joined to the camera, with its share against the eye paths and the connections over whole
+// paths (kernels/shared/eye_paths.h). The shares must add to 1 on every path, or the image moves
+// (splats 1.5 times too large, or T's density 4 times too small in the others' weights, fail
+// these): the glossy sphere's caustic of the Cornell box, resampled eye paths, glossy and delta
+// materials with area and point lights and an emitter among the light vertices, every wall a
+// light; and reuse equals retrace with it.
+TEST(Reuse, LightTracingConvergesToThePathTracer) {
+  const std::string cornell = test::sourcePath("scenes/cornell-dynamic.gltf");
+  expectSameImage(cornell, "--max-depth 6 --eye-paths --light-tracing --no-resample", 48, 36, 64,
+                  2);
+  expectSameImage(sweepScene(), "--max-depth 6 --eye-paths --light-tracing --no-resample", 48, 36,
+                  32, 2);
+}
+
+// The path tracer's error on the sphere's caustic is large; reuse without T is small there, and
+// converges to the path tracer (above). So T's image is held against it, pixel by pixel: the
+// mean of their differences over each of 4x4 regions is within its standard error (from the
+// differences' spread, which the scene's own structure does not enter). Splats 1.5 times too
+// large give z of 15 here.
+// At frame `frame`, rendering frames 0 to it (resampled paths' temporal reuse).
+void expectLightTracingAgrees(const std::string& scene, const std::string& args, int w, int h,
+                              int spp, int c, int frame = 0) {
+  const std::string base = "--width " + std::to_string(w) + " --height " + std::to_string(h) +
+                           " --spp " + std::to_string(spp) + " --paths-per-pixel " +
+                           std::to_string(c) + " --light-paths " + std::to_string(w * h * spp * c) +
+                           " --eye-paths " + args;
+  const std::string frames = "0-" + std::to_string(frame);
+  const Image a = test::frameImage(
+      renderReuse(scene, frames, base + " --light-tracing --seed 3", "lt-on"), frame);
+  Image d = test::frameImage(renderReuse(scene, frames, base + " --seed 9", "lt-off"), frame);
+  ASSERT_EQ(a.rgba.size(), d.rgba.size());
+  for (size_t i = 0; i < d.rgba.size(); ++i) d.rgba[i] = a.rgba[i] - d.rgba[i];
+  const Moments lit = regionMean(a, 0, 0, w, h, 1);
+  EXPECT_GT(lit.mean, 1e-3) << scene << ": an unlit image";
+  double worst = 0;
+  for (int ry = 0; ry < 4; ++ry)
+    for (int rx = 0; rx < 4; ++rx)
+      for (int ch = 0; ch < 3; ++ch) {
+        const int x0 = rx * w / 4, x1 = (rx + 1) * w / 4, y0 = ry * h / 4, y1 = (ry + 1) * h / 4;
+        const Moments m = regionMean(d, x0, y0, x1, y1, ch);
+        const double z = m.stderr_ > 0 ? std::fabs(m.mean) / m.stderr_ : 0.0;
+        worst = std::max(worst, z);
+        EXPECT_LE(z, 4.5) << scene << " " << args << " region " << rx << "," << ry << " channel "
+                          << ch << ": with T minus without " << m.mean << " +- " << m.stderr_;
+      }
+  ::testing::Test::RecordProperty("worst_z", std::to_string(worst));
+}
+
+TEST(Reuse, LightTracingAgreesWithReuseWithoutIt) {
+  const std::string cornell = test::sourcePath("scenes/cornell-dynamic.gltf");
+  expectLightTracingAgrees(cornell, "--max-depth 6 --no-resample", 48, 36, 64, 2);
+  // Frame 3 of the orbiting camera: the previous frames' paths, moved to this frame's x_1
+  // (rs_shift), weigh T too (T's ratio there a quarter of what it is fails this).
+  expectLightTracingAgrees(test::sourcePath("scenes/cornell-orbit.gltf"),
+                           "--max-depth 6 --resample", 48, 36, 64, 2, 3);
+}
+
+TEST(Reuse, WhiteFurnaceConvergesWithLightTracing) {
+  expectFurnace(16, 20, 16384, "--eye-paths --light-tracing --no-resample", "furnace-lt");
+}
+
+TEST(Reuse, EqualsRetraceWithLightTracing) {
+  expectReuseEqualsRetrace(test::sourcePath("scenes/cornell-dynamic.gltf"), "20-27", 20, 27,
+                           "--eye-paths --light-tracing");
+}
+
 // Twice the variance of a mode, from two renders with different seeds: mean over pixels and
 // channels of (a - b)^2, relative as in the evaluation's relMSE.
 double twiceRelativeVariance(const std::string& scene, const std::string& args,

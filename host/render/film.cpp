@@ -12,6 +12,7 @@ Film::Film(Context& ctx, int width, int height)
   film_ = ctx_.allocate("film", uint64_t(pixels()) * 16);
   bad_ = ctx_.allocate("bad sample counter", 4);
   accumulate_ = kargs::kernel<kargs::AccumulateArgs>(ctx_, "accumulate.cl");
+  splatFilm_ = kargs::kernel<kargs::SplatFilmArgs>(ctx_, "accumulate.cl");
   clear();
 }
 
@@ -35,6 +36,15 @@ void Film::accumulate(const cl::Buffer& radiance, StageTimer* timer) {
   a.pixel_count = pixels();
   a.set(accumulate_);
   ctx_.launch1D(accumulate_, first(), end(), "accumulate", timer);
+}
+
+void Film::addSplats(const cl::Buffer& splat, StageTimer* timer) {
+  kargs::SplatFilmArgs a;
+  a.splat = splat;
+  a.film = film_;
+  a.end = end();
+  a.set(splatFilm_);
+  ctx_.launch1D(splatFilm_, first(), end(), "splat_film", timer);
 }
 
 Image Film::read(uint64_t* badSamples) {

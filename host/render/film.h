@@ -19,6 +19,9 @@ class Film {
   void clear();
   // Adds the radiance (float4 per pixel, indexed by pixel) of the range's pixels.
   void accumulate(const cl::Buffer& radiance, StageTimer* timer);
+  // Adds the range's fixed-point splats (kernels/shared/splat.h, 6 words per pixel, indexed by
+  // pixel) to the sums, not to the counts, and clears them.
+  void addSplats(const cl::Buffer& splat, StageTimer* timer);
   // The mean radiance per pixel (alpha 1), and how many samples were non-finite and dropped.
   Image read(uint64_t* badSamples = nullptr);
   // The same for the range's rows only, written into `image` (of the film's size).
@@ -46,7 +49,7 @@ class Film {
   int width_, height_;
   int rowBegin_ = 0, rowEnd_ = 0;
   cl::Buffer film_, bad_;
-  cl::Kernel accumulate_;
+  cl::Kernel accumulate_, splatFilm_;
 };
 
 }  // namespace pr

@@ -103,6 +103,9 @@ struct RenderOptions {
   int connectionHistory = 0;   // cap on a pixel sample's carried reservoir, per C; 0 = off
   int connectionHistoryPeriod = 1;  // frames between moves of the history's light-path offset
   bool eyePaths = true;  // full eye paths, weighted against the connections over whole paths
+  // Strategy T: the stored light paths' vertices joined to the camera (light tracing), weighted
+  // against the eye paths and the connections (kernels/shared/eye_paths.h). Needs eye paths.
+  bool lightTracing = false;
   ResampleSettings resample;
   // The environment light (scene/environment.h): a map file, "none", or "" (a uniform one of
   // envColor where --env-color is given, else white where the scene has no lights, else none).

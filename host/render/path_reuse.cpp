@@ -7,6 +7,7 @@
 #include "util/check.h"
 #include "render/path_tracer.h"
 #include "shared/reuse.h"
+#include "shared/splat.h"
 #include "util/error.h"
 #include "util/interrupt.h"
 
@@ -47,6 +48,10 @@ PathReuse::PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseS
       ctx, "reuse/connect.cl", opts + (settings_.eyePaths ? " -DPR_CONNECT_DEFERRED=1" : ""));
   if (settings_.eyePaths)
     connectShadow_ = kargs::kernel<kargs::ConnectShadowArgs>(ctx, "reuse/connect_shadow.cl", opts);
+  // Strategy T's weights need the eye paths' ratios (kernels/shared/eye_paths.h).
+  PR_CHECK(!settings_.lightTracing || settings_.eyePaths);
+  if (settings_.lightTracing)
+    cameraSplat_ = kargs::kernel<kargs::CameraSplatArgs>(ctx, "reuse/camera_splat.cl", opts);
   auto alloc = [&](const char* name, uint64_t bytes) {
     bytes_ += bytes;
     cl::Buffer b = ctx_.allocate(name, bytes);
@@ -67,6 +72,8 @@ PathReuse::PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseS
   eye_ = alloc("eye vertices", uint64_t(film.pixels()) * sizeof(dev::EyeVertex));
   radiance_ = alloc("sample radiance", uint64_t(film.pixels()) * 16);
   counters_ = alloc("reuse counters", dev::PR_C_COUNT * 4);
+  splat_ = alloc("camera splats",
+                 (settings_.lightTracing ? uint64_t(film.pixels()) : 1) * PR_SPLAT_WORDS * 4);
   // Without a history, one element each: the kernels take them but never read them.
   const bool history = settings_.historyCap > 0;
   changed_ = alloc("changed slot stamps", uint64_t(history ? slots_ : 1) * 4);
@@ -91,6 +98,7 @@ PathReuse::PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseS
     pt.seed = settings_.seed;
     pt.fixedNoise = settings_.fixedNoise;
     pt.lightPaths = settings_.pathsPerPixel;
+    pt.lightTracingPaths = settings_.lightTracing ? slots_ : 0;
     pt.resample = settings_.resamplePaths;
     eyePaths_ = std::make_unique<PathTracer>(ctx, scene, film, pt);
     bytes_ += eyePaths_->deviceBytes();
@@ -125,7 +133,9 @@ dev::ReuseParams PathReuse::frameParams(int frame) const {
 void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameStats* stats) {
   StageTimer timer;
   ctx_.zero(counters_, dev::PR_C_COUNT * 4);
-  const dev::ReuseParams rp = frameParams(frame);
+  dev::ReuseParams rp = frameParams(frame);
+  if (settings_.lightTracing)
+    rp.lt_scale = lightTracingScale(camera, slots_, settings_.spp, settings_.pathsPerPixel);
 
   // 1. Which slots must be traced again. With a connection history, retrace learns the same
   // changed slots as reuse (invalidate marks them and leaves the arena alone), so that the
@@ -174,8 +184,29 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
   }
 
   if (!tracePasses(frame, camera, rp, sceneArgs, frameStamp, &timer)) return;
+  // Once per frame, by the device with the first pass (several devices add their films).
+  if (settings_.lightTracing && passBegin_ == 0) splatToCamera(camera, rp, sceneArgs, &timer);
   if (eyePaths_) eyePaths_->reportRays(stats);
   report(&timer, toTrace, stats);
+}
+
+void PathReuse::splatToCamera(const dev::CameraParams& camera, const dev::ReuseParams& rp,
+                              const kargs::SceneArgs& sceneArgs, StageTimer* timer) {
+  kargs::CameraSplatArgs a;
+  kargs::setScene(&a, sceneArgs);
+  a.rp = rp;
+  a.cam = camera;
+  a.headers = headers_;
+  a.vertices = vertices_;
+  a.ratios = ratios_;
+  a.splat = splat_;
+  a.first = film_.first();
+  a.end = film_.end();
+  a.film_scale = float(settings_.spp);  // the film's mean divides by its samples
+  a.counters = counters_;
+  a.set(cameraSplat_);
+  ctx_.launch1D(cameraSplat_, slots_, "camera_splat", timer);
+  film_.addSplats(splat_, timer);
 }
 
 bool PathReuse::tracePasses(int frame, const dev::CameraParams& camera, const dev::ReuseParams& rp,
@@ -194,6 +225,7 @@ bool PathReuse::tracePasses(int frame, const dev::CameraParams& camera, const de
   kargs::ConnectArgs cn;
   kargs::setScene(&cn, sceneArgs);
   cn.rp = rp;
+  cn.cam = camera;
   cn.eye = eye_;
   cn.headers = headers_;
   cn.vertices = vertices_;

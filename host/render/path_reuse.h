@@ -32,6 +32,7 @@ struct PathReuseSettings {
   uint32_t historyCap = 0;     // connection history (connect.cl): carried candidates per C; 0: off
   uint32_t historyPeriod = 1;  // frames between moves of the history's light-path offset (>= 1)
   bool eyePaths = true;        // connections weighted against the path tracer's eye paths
+  bool lightTracing = false;   // strategy T: camera_splat (needs eyePaths)
   // Device memory for connect's terms (eye paths): each launch of connect and connect_shadow
   // takes as many pixel samples as fit.
   uint64_t connectRecordBytes = uint64_t(128) << 20;
@@ -73,6 +74,9 @@ class PathReuse : public Integrator {
   dev::ReuseParams frameParams(int frame) const;
   // The frame's sample passes: first hits (or the eye paths), connections, the film. False when
   // interrupted.
+  // Strategy T: the arena's vertices joined to the camera, into the film.
+  void splatToCamera(const dev::CameraParams& camera, const dev::ReuseParams& rp,
+                     const kargs::SceneArgs& sceneArgs, StageTimer* timer);
   bool tracePasses(int frame, const dev::CameraParams& camera, const dev::ReuseParams& rp,
                    const kargs::SceneArgs& sceneArgs, cl_uint frameStamp, StageTimer* timer);
   // Reads the counters and adds them and the stage times to stats.
@@ -85,7 +89,8 @@ class PathReuse : public Integrator {
   uint32_t slots_ = 0, stride_ = 0;
   bool first_ = true;
   uint32_t frames_ = 0;  // frames rendered with a connection history: its clock
-  cl::Kernel invalidate_, lightTrace_, eyeHit_, connect_, connectShadow_;
+  cl::Kernel invalidate_, lightTrace_, eyeHit_, connect_, connectShadow_, cameraSplat_;
+  cl::Buffer splat_;  // strategy T's fixed-point sums per pixel (kernels/shared/splat.h)
   cl::Buffer headers_, vertices_, ratios_, list_, allSlots_, eye_, radiance_, counters_;
   cl::Buffer changed_, history_;  // the connection history's slot stamps and pixel reservoirs
   // connect's terms for connect_shadow (--eye-paths): recordCap_ per pixel sample, for

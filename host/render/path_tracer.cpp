@@ -114,6 +114,13 @@ void PathTracer::setChain(int pass, const std::string& records) {
   writeChain(pass, records.data());
 }
 
+float lightTracingScale(const dev::CameraParams& camera, uint32_t lightPaths, int spp,
+                        uint32_t pathsPerPixel) {
+  const double pixels = double(camera.width) * camera.height;
+  return float(double(lightPaths) * dev::camera_plane_area(&camera) /
+               (double(spp) * pathsPerPixel * pixels));
+}
+
 dev::ResampleParams PathTracer::resampleParams() const {
   dev::ResampleParams p{};
   const ResampleSettings& r = settings_.resample;
@@ -138,6 +145,9 @@ void PathTracer::beginFrame(int frame, const dev::CameraParams& camera,
   syncChains();
   ctx_.zero(rays_, dev::PR_PT_COUNT * 4);
   dev::ResampleParams rsp = resampleParams();
+  if (settings_.lightTracingPaths > 0 && settings_.lightPaths > 0)
+    rsp.lt_scale =
+        lightTracingScale(camera, settings_.lightTracingPaths, settings_.spp, settings_.lightPaths);
   // The previous frame's reservoirs are taken where every chain was kept, the frame follows it
   // and no light changed (a light pdf in a kept path would differ).
   temporal_ = chainedPasses() > 0 && written_ >= chainedPasses() && frame == frame_ + 1 &&
@@ -216,6 +226,7 @@ void PathTracer::beginFrame(int frame, const dev::CameraParams& camera,
     resampleArgs_.end = n;
     resampleArgs_.rays = rays_;
     resampleArgs_.prev_cam = prevCamera;
+    resampleArgs_.cam = camera;
     resampleArgs_.moved = moved_;
     resampleArgs_.stamp = stamp_;
     resampleArgs_.set(resample_, kargs::kScene | kargs::kFrame);

@@ -26,9 +26,17 @@ struct PathTracerSettings {
   // vertex; the ends of eye paths on lights are weighted against those connections
   // (kernels/shared/eye_paths.h). 0: the path tracer alone.
   uint32_t lightPaths = 0;
+  // --light-tracing: the N_L stored light paths that strategy T joins to the camera, against
+  // which the eye paths are weighted too (0: off).
+  uint32_t lightTracingPaths = 0;
   // --resample (kernels/shared/resample.h), its distance resolved (> 0, scene units).
   ResampleSettings resample;
 };
+
+// Strategy T's scale N_L A / (spp C W H) (kernels/shared/eye_paths.h): light paths, samples per
+// pixel, light paths per camera sample and the camera's image (plane area A, W x H pixels).
+float lightTracingScale(const dev::CameraParams& camera, uint32_t lightPaths, int spp,
+                        uint32_t pathsPerPixel);
 
 class PathTracer : public Integrator {
  public:

@@ -36,7 +36,8 @@ PR_KERNEL void pt_generate(PR_PARAMS(PR_ARGS_PT_GENERATE)) {
   s.eye_ratio = 1.0f;
   s.seg_cos = 0.0f;
   s.eye_flags = 0u;
-  s.pad = 0u;
+  const float cos_t = s.ray.dx * cam.fx + s.ray.dy * cam.fy + s.ray.dz * cam.fz;
+  s.lt = cos_t * cos_t * cos_t;  // strategy T's camera factor at x_1 needs it (pt_shade)
   states[i] = s;
   radiance[i] = (float4)(0.0f, 0.0f, 0.0f, 0.0f);
   if (write_eye) eye[i].prim = PR_INVALID_INDEX;  // until pt_shade meets x_1

@@ -211,7 +211,7 @@ PR_INLINE int rs_same_eye(const EyeVertex* a, const EyeVertex* b) {
 // The previous frame's record that this pixel's x_1 (at p) continues, or PR_INVALID_INDEX.
 PR_INLINE uint rs_history_pixel(const CameraParams* prev_cam, float3 p, uint first, uint end,
                                 __global const PathHistory* history, uint stamp) {
-  const uint q = rs_project(prev_cam, p);
+  const uint q = camera_pixel(prev_cam, p);
   if (q == PR_INVALID_INDEX || q < first || q >= end || history[q].stamp + 1u != stamp ||
       history[q].prim == PR_INVALID_INDEX)
     return PR_INVALID_INDEX;
@@ -228,7 +228,7 @@ PR_KERNEL void pt_resample(PR_PARAMS(PR_ARGS_PT_RESAMPLE_SPATIAL)) {
   const SceneData s = PR_SCENE();
   __global const PathReservoir* rc = rs_res + j;
   __global const DirectReservoir* dc = di_res + j;
-  const RsPrimary x = rs_primary(&s, &e, &rsp);
+  const RsPrimary x = rs_primary(&s, &e, &rsp, &cam);
   Rng rng = rng_make(seed, PR_RNG_PATH_RESAMPLE, frame, j, sample);
   rng.dim = 0x10000u;  // apart from the paths' offers (PR_RS_DIM)
   Rng rng_d = rng;
@@ -264,7 +264,7 @@ PR_KERNEL void pt_resample(PR_PARAMS(PR_ARGS_PT_RESAMPLE_SPATIAL)) {
     if (same)
       xi = x;
     else if (has_c || has_dc || past)
-      xi = rs_primary(&s, &ei, &rsp);
+      xi = rs_primary(&s, &ei, &rsp, &cam);
     const float u_d = rng_next(&rng_d);
     if (!past || c_t > 0.0f)
       rs_merge_path(&s, &x, &xi, rc, past ? &history[q].r : rs_res + nb[d], past, same,

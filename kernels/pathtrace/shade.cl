@@ -57,14 +57,16 @@ PR_INLINE int pt_escaped(const SceneData* s, const PathState* p, float3* add) {
 PR_INLINE float pt_emission_weight(const SceneData* s, const PathState* p, const SurfaceHit* h,
                                    float3 d, float dist2, int joinable, u32 light_paths,
                                    float eye_count, __global const float* trace_cdf,
-                                   float trace_total, EyeWeight* ew) {
+                                   float trace_total, u32 max_depth, EyeWeight* ew) {
   const float3 prev = make_float3(p->prev_x, p->prev_y, p->prev_z);
   const float3 prev_n = make_float3(p->prev_nx, p->prev_ny, p->prev_nz);
   float w = 1.0f;
   if (!(p->flags & PR_PATH_SPECULAR))
     w = power_heuristic(p->last_pdf, emitter_pdf(s, h, prev, prev_n));
   ew->pt = w;
-  ew->n = ew->h = ew->l = 0.0f;
+  ew->n = ew->h = ew->l = ew->t = 0.0f;
+  // Strategy T: x_1 .. x_t before the light, t = p->depth; its ratio was fixed at x_2.
+  ew->t_len = eye_paths_camera_len(p->depth, max_depth);
   const u32 li = joinable ? emitter_light(s, h) : PR_INVALID_INDEX;
   if (li != PR_INVALID_INDEX) {
     // The connections' share of the path (eye_paths.h); the eye path's N and H split the rest.
@@ -77,7 +79,8 @@ PR_INLINE float pt_emission_weight(const SceneData* s, const PathState* p, const
     const float dens_l = eye_paths_light_side(&l, n_tri, start, light_paths, eye_count,
                                               p->eye_ratio, h->p, prev, p->seg_cos, 1.0f);
     const float dens_n = spec ? 0.0f : start;
-    if (dens_l > 0.0f) w *= 1.0f - mis_power_share(dens_n / dens_l, dens_h / dens_l);
+    ew->t = p->x1_depth == 1u && ew->t_len ? p->lt : 0.0f;
+    if (dens_l > 0.0f) w *= eye_paths_eye_share(dens_n / dens_l, dens_h / dens_l, ew->t);
     ew->n = dens_n;
     ew->h = dens_h;
     ew->l = dens_l;
@@ -91,10 +94,11 @@ PR_INLINE float pt_next_event_weight(const SceneData* s, const PathState* p, con
                                      const ShadingFrame* f, const NextEventChoice* ch, int joinable,
                                      int has_rev, float dist2, u32 light_paths, float eye_count,
                                      __global const float* trace_cdf, float trace_total,
-                                     EyeWeight* ew) {
+                                     u32 max_depth, EyeWeight* ew) {
   float w = ch->delta ? 1.0f : power_heuristic(ch->pdf_light, ch->pdf_bsdf);
   ew->pt = w;
-  ew->n = ew->h = ew->l = 0.0f;
+  ew->n = ew->h = ew->l = ew->t = 0.0f;
+  ew->t_len = eye_paths_camera_len(p->depth, max_depth);  // x_1 .. x_t, t = p->depth
   if (!joinable) return w;  // the plain path tracer: no light record to read
   const Light l = s->lights.lights[ch->light];
   if (eye_paths_light(&l)) {
@@ -111,7 +115,11 @@ PR_INLINE float pt_next_event_weight(const SceneData* s, const PathState* p, con
     const float dens_l =
         eye_paths_light_side(&l, n_tri, dens_n, light_paths, eye_count, p->eye_ratio, ch->pos, h->p,
                              fabs(dot(f->ng, wi)), rev);
-    if (dens_l > 0.0f) w *= 1.0f - mis_power_share(dens_n / dens_l, dens_h / dens_l);
+    // T's ratio: at x_2 from the light's pdf of the step to x_1 (x_1's camera factor in p->lt),
+    // beyond x_2 as fixed there.
+    if (p->x1_depth == 1u && ew->t_len)
+      ew->t = p->depth == 2u ? eye_paths_camera_ratio(p->lt, ch->pdf_bsdf_rev, dist2) : p->lt;
+    if (dens_l > 0.0f) w *= eye_paths_eye_share(dens_n / dens_l, dens_h / dens_l, ew->t);
     ew->n = dens_n;
     ew->h = dens_h;
     ew->l = dens_l;
@@ -239,7 +247,7 @@ PR_INLINE void pt_escape(const SceneData* s, const PathState* p, uint rel,
     *radiance += pt_rgb(add);
     return;
   }
-  const EyeWeight ew = {w, 0.0f, 0.0f, 0.0f};  // the connections make no path to the sky
+  const EyeWeight ew = {w, 0.0f, 0.0f, 0.0f, 0.0f, 0};  // the connections make no path to the sky
   rs_offer_emission(track, res, p, rel, environment_radiance(s, d), &ew, pdf_light, 1, d, key);
 }
 
@@ -294,6 +302,23 @@ PR_INLINE void pt_eye_arrive(PathState* p, const SurfaceHit* h, float3 d, float 
   p->eye_ratio = mis_ratio_arrive(p->eye_ratio,
                                   solid_angle_to_area_pdf(p->last_pdf, fabs(dot(h->ng, d)), dist2),
                                   (p->flags & PR_PATH_SPECULAR) != 0u);
+}
+
+PR_INLINE void pt_write_eye(__global EyeVertex* out, const SurfaceHit* h, const Hit* hit, float3 wo,
+                            float3 tp, uint depth) {
+  EyeVertex e;
+  eye_vertex_set(&e, h, hit, wo, tp, depth);
+  *out = e;
+}
+
+// Strategy T: leaving x_2 (of an x_1 seen straight from the camera) along wi, T's density over
+// L's for the vertices beyond, from the light tracer's pdf of the step from x_2 to x_1.
+PR_INLINE void pt_camera_leave(PathState* p, const ShadingFrame* f, float3 wi, float3 wo,
+                               float dist2, float lt_scale) {
+  if (!(lt_scale > 0.0f) || p->x1_depth != 1u || p->depth != 2u) return;
+  p->lt = (p->eye_flags & PR_EYE_JOINABLE)
+              ? eye_paths_camera_ratio(p->lt, eye_paths_bsdf_pdf(f, wi, wo), dist2)
+              : 0.0f;
 }
 
 PR_INLINE void pt_shadow_set(__global ShadowRay* r, Ray ray, float3 c, uint op) {
@@ -358,7 +383,7 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
   if (s.sd.materials[h.material].flags & PR_MAT_EMISSIVE) {
     EyeWeight ew;
     const float w = pt_emission_weight(&s, &p, &h, d, dist2, joinable, light_paths, rsp.eye_count,
-                                       trace_cdf, trace_total, &ew);
+                                       trace_cdf, trace_total, max_depth, &ew);
     pt_emission(&s, &p, &h, rel, d, dist2, w, &ew, tp, track, rs_res + i, di_res + i, &key,
                 radiance + i);
   }
@@ -369,11 +394,11 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
     if (p.x1_depth == 0u) {
       if (!delta_here && p.depth < max_depth) {
         // x_1: the eye vertex that connect joins to the stored light paths (and, resampling, the
-        // vertex that pt_resample reconnects from).
+        // vertex pt_resample reconnects from); p.lt, cos^3 of the camera ray's angle until now,
+        // becomes its camera factor for strategy T.
         p.x1_depth = p.depth;
-        EyeVertex e;
-        eye_vertex_set(&e, &h, &hit, wo, tp, p.depth);
-        eye[p.pixel] = e;
+        p.lt = p.depth == 1u ? eye_paths_camera_factor(rsp.lt_scale, p.lt * dist2) : 0.0f;
+        pt_write_eye(eye + p.pixel, &h, &hit, wo, tp, p.depth);
       }
     } else if (light_paths > 0u) {
       pt_eye_arrive(&p, &h, d, dist2, delta_here);
@@ -395,7 +420,7 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
         EyeWeight ew;
         const float w =
             pt_next_event_weight(&s, &p, &h, &f, &ch, here_joinable, has_rev, dist2, light_paths,
-                                 rsp.eye_count, trace_cdf, trace_total, &ew);
+                                 rsp.eye_count, trace_cdf, trace_total, max_depth, &ew);
         if (here_joinable) c = c * w;  // next_event left the weight to this
         const uint op = rs_next_event_pending(&s, track, rs_pending + i, di_pending + i, &rsp, &p,
                                               &h, &f, wo, dist2, &ch, c, &ew);
@@ -418,6 +443,7 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
       if (p.depth >= 3u && !russian_roulette(max3(tp), rr, &tp)) p.alive = 0u;
       if (rsp.enabled && p.x1_depth && p.alive)
         rs_track_step(track, &rsp, p.depth - p.x1_depth, &h, &f, wo, dist2, &step, q);
+      pt_camera_leave(&p, &f, step.wi, wo, dist2, rsp.lt_scale);
       if (has_rev)  // x_{t-1}'s light-tracing density from here (1 where this is delta)
         p.eye_ratio = mis_ratio_leave(
             p.eye_ratio, delta_here ? 1.0f : pt_light_density(&f, &p, step.wi, wo, dist2),

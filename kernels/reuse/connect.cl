@@ -38,6 +38,7 @@
 #define PR_CONNECT_DEFERRED 0
 #endif
 // After reuse.h: its FP_CONTRACT OFF (shared/bvh.h) holds here too.
+#include "shared/camera.h"
 #include "shared/eye_paths.h"
 #include "shared/mis.h"
 
@@ -76,6 +77,8 @@ typedef struct {
   uint j;       // the pixel sample; its light paths are slots j C + c (mod N_L)
   float inv_c;  // 1 / C: each path's share
   float mis_c;  // the eye path's count over C, in L's weight against it (eye_path_weight)
+  float
+      cam_x;  // strategy T: the camera factor of the eye sample's x_1 (0: T cannot make its paths)
   Reservoir res;
   Rng rr;  // the reservoir's draws
   ConnectCounts n;
@@ -130,15 +133,6 @@ typedef struct {
   uint depth;  // eye vertices up to this one
 } EyePoint;
 
-// A stored light vertex k >= 1 rebuilt as a shaded surface.
-typedef struct {
-  SurfaceHit h;
-  ShadingFrame f;
-  float3 wprev;   // towards the previous light vertex
-  float3 wprevl;  // the same in the shading frame
-  int delta;
-} LightPoint;
-
 PR_INLINE EyePoint eye_point(const SceneData* s, const SurfaceHit* h, float3 wo, float3 tp,
                              uint depth) {
   EyePoint x;
@@ -158,37 +152,9 @@ PR_INLINE EyePoint eye_point_at(const SceneData* s, u32 prim, u32 inst, float b1
   return eye_point(s, &h, wo, tp, depth);
 }
 
-PR_INLINE LightPoint light_point(const SceneData* s, __global const LightVertex* v) {
-  LightPoint y;
-  y.h = surface_interp(&s->sd, v->prim, v->inst, v->b1, v->b2, 0);  // ns as stored
-  y.h.p = vertex_pos(v);
-  y.h.ng = oct_decode(v->ng_oct);
-  y.h.ns = oct_decode(v->ns_oct);
-  y.wprev = -vertex_dir(v);
-  y.f = shading_frame(s, &y.h, y.wprev);
-  y.wprevl = to_local(y.wprev, y.f.t, y.f.b, y.f.n);
-  y.delta = bsdf_is_delta(&y.f.bsdf);
-  return y;
-}
-
 // The eye side's BSDF towards dir and its solid-angle pdf of sampling dir.
 PR_INLINE float3 eye_point_eval(const EyePoint* x, float3 dir, float* pdf) {
   return bsdf_eval(&x->f.bsdf, x->wol, to_local(dir, x->f.t, x->f.b, x->f.n), pdf);
-}
-
-// The light side of a connection reached along dir (unit, from the eye side): its BSDF towards
-// -dir with the pdf of leaving along it (and that of arriving from it, pdf_rev), |cos| at its
-// shading normal and the shading-normal correction of light paths. 0 where it faces away from
-// the eye side.
-PR_INLINE int light_point_eval(const SceneData* s, const LightPoint* y, float3 dir, float3* f,
-                               float* pdf, float* pdf_rev, float* cos_t, float* corr) {
-  if (dot(-dir, y->f.ng) <= 0.0f && !surface_lifted(s, &y->h, &y->f)) return 0;
-  // The light path's BSDF: the view is towards the eye side (the adjoint of wprev's).
-  *f = bsdf_eval_mode(&y->f.bsdf, y->wprevl, to_local(-dir, y->f.t, y->f.b, y->f.n), PR_IMPORTANCE,
-                      pdf, pdf_rev);
-  *cos_t = fabs(dot(y->f.n, dir));
-  *corr = shading_normal_correction(y->wprev, -dir, y->f.n, y->f.ng);
-  return 1;
 }
 
 // The light paths of the eye sample: slot of its c-th path.
@@ -294,17 +260,21 @@ PR_INLINE float3 light_vertex_value(const Connector* cn, const EyePoint* x, cons
   const float3 dir = dxy * (1.0f / sqrt(dist2));  // from x to y
   if (dot(dir, x->f.ng) <= 0.0f && !surface_lifted(cn->s, &x->h, &x->f)) return zero;
   float3 f_y;
-  float pdf_unused, pdf_rev, cos_y, corr;
-  if (!light_point_eval(cn->s, y, dir, &f_y, &pdf_unused, &pdf_rev, &cos_y, &corr)) return zero;
+  float pdf_leave, pdf_rev, cos_y, corr;
+  if (!light_point_eval(cn->s, y, dir, &f_y, &pdf_leave, &pdf_rev, &cos_y, &corr)) return zero;
   float pdf_x;
   const float3 f_x = eye_point_eval(x, dir, &pdf_x);
   const float p_l =
       solid_angle_to_area_pdf(pdf_arrive, fabs(dot(y->f.ng, vertex_dir(vk))), vk->t * vk->t);
   const float p_e =
       pdf_arrive > 0.0f ? solid_angle_to_area_pdf(pdf_x, fabs(dot(y->f.ng, dir)), dist2) : 0.0f;
+  // T's density over L's: the path has k + 1 vertices before the light.
+  const float t = eye_paths_camera_len(k + 1u, cn->rp->max_depth)
+                      ? eye_paths_camera_ratio(cn->cam_x, pdf_leave, dist2)
+                      : 0.0f;
   const float mis = cn->rp->eye_paths
                         ? eye_path_weight(cn->ratios[vk - cn->vertices], k, pdf_x,
-                                          fabs(dot(y->h.ng, dir)), dist2, pdf_rev, cn->mis_c)
+                                          fabs(dot(y->h.ng, dir)), dist2, pdf_rev, cn->mis_c, t)
                         : mis_connection_weight(PR_STRATEGY_L, p_l, p_e, cn->rp->mis_threshold);
   const float3 tpy = make_float3(vk->tp_r, vk->tp_g, vk->tp_b);
   *ray = surface_segment(cn->s, &x->h, &y->h);
@@ -592,6 +562,14 @@ PR_INLINE void connect_count(const ConnectCounts* n, uint shadow_rays, uint boun
   if (n->history_dropped) atomic_add(counters + PR_C_HISTORY_DROPPED, n->history_dropped);
 }
 
+// Strategy T makes the paths of an x_1 seen straight from the camera (--eye-paths: L at x_1
+// alone): its camera factor at p, 0 where T cannot make them.
+PR_INLINE float connect_camera_factor(const ReuseParams* rp, const CameraParams* cam,
+                                      const EyeVertex* e, float3 p) {
+  if (!rp->eye_paths || e->depth != 1u || !(rp->lt_scale > 0.0f)) return 0.0f;
+  return eye_paths_camera_factor(rp->lt_scale, camera_cos3_d2(cam, p));
+}
+
 PR_KERNEL void connect(PR_PARAMS(PR_ARGS_CONNECT)) {
   const uint i = (uint)get_global_id(0);
   if (i >= rp.pixel_count || i >= record_end) return;
@@ -620,6 +598,7 @@ PR_KERNEL void connect(PR_PARAMS(PR_ARGS_CONNECT)) {
   connector_empty(&cn);
   EyePoint x = eye_point_at(&s, e.prim, e.inst, e.b1, e.b2, make_float3(e.wx, e.wy, e.wz),
                             make_float3(e.tp_r, e.tp_g, e.tp_b), e.depth);
+  cn.cam_x = connect_camera_factor(&rp, &cam, &e, x.h.p);
   uint shadow_rays = 0u, bounce_rays = 0u;
   // The first eye vertex's connections go to the history, where there is one.
   int history_open = history_cap > 0u;

@@ -39,6 +39,35 @@ PR_INLINE Ray camera_ray(const CameraParams* c, u32 pixel, float2 jitter) {
   return r;
 }
 
+// The pixel of camera c that sees world point p (PR_INVALID_INDEX: behind it or outside).
+PR_INLINE u32 camera_pixel(const CameraParams* c, float3 p) {
+  const float3 v = p - make_float3(c->px, c->py, c->pz);
+  const float z = dot(v, make_float3(c->fx, c->fy, c->fz));
+  if (!(z > 0.0f)) return PR_INVALID_INDEX;
+  const float nx = dot(v, make_float3(c->rx, c->ry, c->rz)) / (z * c->tan_half_fov * c->aspect);
+  const float ny = dot(v, make_float3(c->ux, c->uy, c->uz)) / (z * c->tan_half_fov);
+  const float sx = 0.5f * (nx + 1.0f) * (float)c->width;
+  const float sy = 0.5f * (1.0f - ny) * (float)c->height;
+  if (!(sx >= 0.0f && sy >= 0.0f && sx < (float)c->width && sy < (float)c->height))
+    return PR_INVALID_INDEX;
+  return (u32)sy * c->width + (u32)sx;
+}
+
+// The area A of the image plane at distance 1 (both tangents of the field of view).
+PR_INLINE float camera_plane_area(const CameraParams* c) {
+  return 4.0f * c->tan_half_fov * c->tan_half_fov * c->aspect;
+}
+
+// cos^3 of the angle between the camera's axis and the way to p, times p's squared distance: a
+// pixel's camera samples have density W H / (A x this) x |cos at p| per unit area at p (uniform
+// on the pixel's part of the image plane), and a pixel's importance is its inverse likewise.
+PR_INLINE float camera_cos3_d2(const CameraParams* c, float3 p) {
+  const float3 v = p - make_float3(c->px, c->py, c->pz);
+  const float d2 = dot(v, v);
+  const float cos_t = dot(v, make_float3(c->fx, c->fy, c->fz)) / sqrt(d2);
+  return cos_t * cos_t * cos_t * d2;
+}
+
 PR_NAMESPACE_END
 
 PR_STATIC_ASSERT(sizeof(pr::dev::CameraParams) == 80, "CameraParams layout");

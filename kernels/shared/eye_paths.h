@@ -124,13 +124,69 @@ PR_INLINE void eye_path_walk_leave(EyePathWalk* w, u32 k, int delta, float pdf_f
   w->delta_k = delta;
 }
 
-// L's weight for joining x_1 to z_k (stored ratios r): pdf_x is x_1's BSDF pdf towards z_k,
-// cos_z the |cos| there with dist2 the squared distance, pdf_rev z_k's pdf of sampling z_{k-1}
-// arriving from x_1, and inv_c 1 / C.
-PR_INLINE float eye_path_weight(EyePathRatio r, u32 k, float pdf_x, float cos_z, float dist2,
-                                float pdf_rev, float inv_c) {
+// N's and H's densities of a path over L's (*n, *h), for L joining x_1 to z_k (stored ratios
+// r): pdf_x is x_1's BSDF pdf towards z_k, cos_z the |cos| there with dist2 the squared
+// distance, pdf_rev z_k's pdf of sampling z_{k-1} arriving from x_1, and inv_c 1 / C.
+PR_INLINE void eye_path_ratios(EyePathRatio r, u32 k, float pdf_x, float cos_z, float dist2,
+                               float pdf_rev, float inv_c, float* n, float* h) {
   const float e = solid_angle_to_area_pdf(pdf_x, cos_z, dist2) * inv_c;
-  return mis_power_share(e * (k == 1u ? 1.0f : pdf_rev) * r.n, e * pdf_rev * r.h);
+  *n = e * (k == 1u ? 1.0f : pdf_rev) * r.n;
+  *h = e * pdf_rev * r.h;
+}
+
+// --- Strategy T (--light-tracing) -----------------------------------------------------------
+//
+// camera_splat joins a stored vertex z_k (k >= 2, z_k and z_{k-1} non-delta) to the camera: the
+// path's x_1 is z_k, seen straight from the camera, and every vertex beyond it came from the
+// light. T takes its power share t^2 / (t^2 + 1 + n^2 + h^2) of such a path, with t, n and h its
+// densities under T, N and H over L's; L and the eye path keep their shares of the rest. T's
+// density over L's is N_L p(x_1 | x_2) / (spp C p_cam(x_1)): the light tracer's density of x_1
+// from x_2 against the camera's (spp samples of each pixel, C light paths each). The |cos| at
+// x_1 is in both, so t = x_1's camera factor lt_scale cos^3 d^2 (lt_scale = N_L A / (spp C W H),
+// camera_cos3_d2) times pdf_w / |x_1 x_2|^2, pdf_w the light tracer's solid-angle pdf of the
+// step from x_2 to x_1. A path of m vertices before the light is T's only where the arena holds
+// z_m: m + 2 <= max_depth. Everything that weighs such a path computes t alike: pt_shade (N, H),
+// connect (L), the resampled paths (rs_eye_share) and camera_splat.
+
+// The camera factor of an x_1 seen straight from the camera (cos3_d2: camera_cos3_d2).
+PR_INLINE float eye_paths_camera_factor(float lt_scale, float cos3_d2) {
+  return lt_scale * cos3_d2;
+}
+
+// t, from x_1's camera factor, the light tracer's solid-angle pdf of the step from x_2 to x_1
+// and the squared distance between them.
+PR_INLINE float eye_paths_camera_ratio(float factor, float pdf_w, float dist2) {
+  return factor * pdf_w / dist2;
+}
+
+// Whether a path of m vertices before the light can be T's (the arena's depth).
+PR_INLINE int eye_paths_camera_len(u32 m, u32 max_depth) {
+  return m + 2u <= max_depth;
+}
+
+// T's share of a path, from t, n and h (0 where t is not positive: T cannot make the path).
+PR_INLINE float eye_paths_camera_share(float t, float n, float h) {
+  if (!(t > 0.0f)) return 0.0f;
+  const float r[3] = {1.0f / t, n / t, h / t};
+  return mis_power_share_n(r, 3u);
+}
+
+// What T leaves of a share: 1 - its own (1 exactly where T cannot make the path).
+PR_INLINE float eye_paths_camera_rest(float t, float n, float h) {
+  return 1.0f - eye_paths_camera_share(t, n, h);
+}
+
+// L's weight for joining x_1 to z_k (as eye_path_ratios), with t T's density over L's.
+PR_INLINE float eye_path_weight(EyePathRatio r, u32 k, float pdf_x, float cos_z, float dist2,
+                                float pdf_rev, float inv_c, float t) {
+  float n, h;
+  eye_path_ratios(r, k, pdf_x, cos_z, dist2, pdf_rev, inv_c, &n, &h);
+  return mis_power_share(n, h) * eye_paths_camera_rest(t, n, h);
+}
+
+// The eye path's share of a path that L makes too: what L and T leave of it.
+PR_INLINE float eye_paths_eye_share(float n, float h, float t) {
+  return (1.0f - mis_power_share(n, h)) * eye_paths_camera_rest(t, n, h);
 }
 
 PR_NAMESPACE_END

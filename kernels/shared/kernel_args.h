@@ -82,6 +82,7 @@
 #define PR_ARGS_CONNECT(X)                  \
   PR_ARGS_SCENE(X)                          \
   X(FRAME, VAL, ReuseParams, rp)            \
+  X(FRAME, VAL, CameraParams, cam)          \
   X(PASS, VAL, uint, sample)                \
   X(FRAME, IN, EyeVertex, eye)              \
   X(FRAME, IN, PathHeader, headers)         \
@@ -104,6 +105,21 @@
   X(FRAME, VAL, uint, record_cap)        \
   X(PASS, VAL, uint, record_first)       \
   X(PASS, VAL, uint, record_end)
+
+// camera_splat (strategy T): the arena's vertices joined to the camera, into `splat` (fixed
+// point per pixel of [first, end), shared/splat.h) times film_scale.
+#define PR_ARGS_CAMERA_SPLAT(X)       \
+  PR_ARGS_SCENE(X)                    \
+  X(FRAME, VAL, ReuseParams, rp)      \
+  X(FRAME, VAL, CameraParams, cam)    \
+  X(FRAME, IN, PathHeader, headers)   \
+  X(FRAME, IN, LightVertex, vertices) \
+  X(FRAME, IN, EyePathRatio, ratios)  \
+  X(FRAME, OUT, uint, splat)          \
+  X(FRAME, VAL, uint, first)          \
+  X(FRAME, VAL, uint, end)            \
+  X(FRAME, VAL, float, film_scale)    \
+  X(FRAME, OUT, uint, counters)
 
 #define PR_ARGS_CONNECT_SHADOW(X) \
   PR_ARGS_SCENE(X)                \
@@ -208,6 +224,7 @@
   X(PASS, IN, PathHistory, history)      \
   X(PASS, OUT, PathHistory, history_out) \
   X(FRAME, VAL, CameraParams, prev_cam)  \
+  X(FRAME, VAL, CameraParams, cam)       \
   X(FRAME, IN, MovedInstance, moved)     \
   X(FRAME, VAL, uint, stamp)
 
@@ -220,6 +237,12 @@
   X(FRAME, VAL, uint, count)       \
   X(FRAME, VAL, uint, pixel_count)
 
+#define PR_ARGS_SPLAT_FILM(X) \
+  X(FRAME, OUT, uint, splat)  \
+  X(FRAME, OUT, float4, film) \
+  X(FRAME, VAL, uint, first)  \
+  X(FRAME, VAL, uint, end)
+
 // Every kernel with a table: K(kernel name, the host's argument struct, its table).
 #define PR_KERNEL_TABLES(K)                                    \
   K(invalidate, InvalidateArgs, PR_ARGS_INVALIDATE)            \
@@ -227,12 +250,14 @@
   K(eye_hit, EyeHitArgs, PR_ARGS_EYE_HIT)                      \
   K(connect, ConnectArgs, PR_ARGS_CONNECT)                     \
   K(connect_shadow, ConnectShadowArgs, PR_ARGS_CONNECT_SHADOW) \
+  K(camera_splat, CameraSplatArgs, PR_ARGS_CAMERA_SPLAT)       \
   K(pt_generate, PtGenerateArgs, PR_ARGS_PT_GENERATE)          \
   K(pt_extend, PtExtendArgs, PR_ARGS_PT_EXTEND)                \
   K(pt_shade, PtShadeArgs, PR_ARGS_PT_SHADE)                   \
   K(pt_shadow, PtShadowArgs, PR_ARGS_PT_SHADOW)                \
   K(pt_resample, PtResampleArgs, PR_ARGS_PT_RESAMPLE_SPATIAL)  \
-  K(accumulate, AccumulateArgs, PR_ARGS_ACCUMULATE)
+  K(accumulate, AccumulateArgs, PR_ARGS_ACCUMULATE)            \
+  K(splat_film, SplatFilmArgs, PR_ARGS_SPLAT_FILM)
 
 // A parameter's name: scene entries carry their group's prefix (geometry and shading both have
 // `instances`), the others their own name.

@@ -116,7 +116,7 @@
   F(PathState, flags)                 \
   F(PathState, prev_x)                \
   F(PathState, prev_nx)               \
-  F(PathState, pad)                   \
+  F(PathState, lt)                    \
   F(LightNode, power)                 \
   F(LightNode, index)                 \
   F(LightNode, cos_o)                 \
@@ -143,6 +143,7 @@
   F(PathTrack, g_src)                 \
   F(ResampleParams, min_dist2)        \
   F(ResampleParams, moved_count)      \
+  F(ResampleParams, lt_scale)         \
   F(PathHeader, end)                  \
   F(PathHeader, valid)                \
   F(PathHeader, escape_z)             \
@@ -164,4 +165,5 @@
   F(Light, leaf)                      \
   F(ReuseParams, clamp)               \
   F(ReuseParams, cx)                  \
-  F(ReuseParams, resample)
+  F(ReuseParams, resample)            \
+  F(ReuseParams, lt_scale)

@@ -36,7 +36,10 @@ typedef struct {
   float eye_ratio;  // prod of light-tracing densities of x_2..x_{t-1} / eye densities of x_2..x_t
   float seg_cos;    // |cos| of `ray` with the geometric normal of the vertex it leaves
   u32 eye_flags;    // PR_EYE_*
-  u32 pad;
+  // Strategy T (--light-tracing, shared/eye_paths.h): until x_1, cos^3 of the camera ray's angle
+  // with the camera's axis; at x_1 its camera factor (eye_paths_camera_factor); from x_2 on the
+  // path's density under T over that under L (0: T cannot make the path).
+  float lt;
 } PathState;
 
 #define PR_PATH_SPECULAR 1u  // the last bounce was delta (or the ray is the camera ray)
@@ -125,6 +128,9 @@ typedef struct {
 // is its last vertex before the light (PR_RS_LAST2).
 #define PR_RS_JOINED 0x10u
 #define PR_RS_LAST2 0x20u
+// A PR_RS_JOINED path short enough for strategy T (eye_paths_camera_len), which makes it where
+// its x_1 is seen straight from the camera.
+#define PR_RS_CAMERA 0x40u
 
 // Where a path's candidates stand as pt_shade follows it (one per pixel). 160 bytes.
 typedef struct {
@@ -170,7 +176,9 @@ typedef struct {
   // --mode reuse: the samples a resampled eye path counts as in its weights against the
   // connections (ReuseParams.eye_count; 1 without --resample).
   float eye_count;
-  u32 pad1, pad2;
+  // Strategy T: N_L A / (spp C W H) (eye_paths_camera_factor); 0: off.
+  float lt_scale;
+  u32 pad2;
 } ResampleParams;
 
 PR_NAMESPACE_END

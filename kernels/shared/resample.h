@@ -12,6 +12,7 @@
 
 #include "shared/arena.h"
 #include "shared/camera.h"
+#include "shared/eye_paths.h"
 #include "shared/integrator.h"
 #include "shared/mis.h"
 #include "shared/path_state.h"
@@ -51,33 +52,43 @@ PR_INLINE float rs_weight2(u32 kind, float pdf_light, float pdf_bsdf) {
 // --mode reuse: what the eye path keeps of a path that the connections to stored light paths
 // (L) make too: the path tracer's weight `pt` and, with l > 0, the densities of the path beyond
 // x_1 under next-event estimation (n), BSDF sampling (h) and L (l), in the ratios pt_shade
-// weighs with (shared/eye_paths.h). l = 0: L does not make the path.
+// weighs with (shared/eye_paths.h). l = 0: L does not make the path. t: T's density over L's
+// (eye_paths_camera_ratio; 0: T does not make it); t_len: the path is short enough for T.
 typedef struct {
-  float pt, n, h, l;
+  float pt, n, h, l, t;
+  int t_len;
 } EyeWeight;
 
-// The eye path's share of a PR_RS_JOINED path, 1 - L's power share, at an x_1 whose density of
-// x_2 per unit area is p2, with x_2's solid-angle pdf of omega_2 pdf2 (from that x_1). Of the
-// densities, only these two depend on x_1: the eye path's of x_2, and of x_3 where x_2 is not the
-// last vertex (omega_2's pdf times the cosine and distance at x_3, which do not). So the path
-// keeps its ratios with them divided out (rn, rh: rs_candidate) and this puts them back.
-PR_INLINE float rs_eye_share(u32 kind, float rn, float rh, float p2, float pdf2) {
+// The eye path's share of a PR_RS_JOINED path, what L and T leave of it, at an x_1 whose density
+// of x_2 per unit area is p2, with x_2's solid-angle pdf of omega_2 pdf2 (from that x_1) and T's
+// density over L's t there. Of N's and H's densities over L's, only these two factors depend on
+// x_1: the eye path's density of x_2, and of x_3 where x_2 is not the last vertex (omega_2's pdf
+// times the cosine and distance at x_3, which do not). So the path keeps its ratios with them
+// divided out (rn, rh: rs_candidate) and this puts them back.
+PR_INLINE float rs_eye_share(u32 kind, float rn, float rh, float p2, float pdf2, float t) {
   if (!(kind & PR_RS_JOINED)) return 1.0f;
   const float u = p2 * pdf2;
-  return 1.0f - mis_power_share(rn * ((kind & PR_RS_LAST2) ? p2 : u), rh * u);
+  return eye_paths_eye_share(rn * ((kind & PR_RS_LAST2) ? p2 : u), rh * u, t);
 }
 
-// A pixel sample's x_1, rebuilt from its EyeVertex; ok: rough enough to reconnect from.
+// A pixel sample's x_1, rebuilt from its EyeVertex; ok: rough enough to reconnect from; cam:
+// its camera factor for strategy T (0: T cannot make its paths).
 typedef struct {
   SurfaceHit h;
   ShadingFrame f;
   float3 wo, wol, tp;
   int ok;
+  float cam;
 } RsPrimary;
 
-PR_INLINE RsPrimary rs_primary(const SceneData* s, const EyeVertex* e, const ResampleParams* rp) {
+// The x_1 of EyeVertex e, seen by camera c (an x_1 of the previous frame: depth 0, cam 0).
+PR_INLINE RsPrimary rs_primary(const SceneData* s, const EyeVertex* e, const ResampleParams* rp,
+                               const CameraParams* c) {
   RsPrimary x;
   x.h = surface_at(&s->sd, e->prim, e->inst, e->b1, e->b2);
+  x.cam = e->depth == 1u && rp->lt_scale > 0.0f
+              ? eye_paths_camera_factor(rp->lt_scale, camera_cos3_d2(c, x.h.p))
+              : 0.0f;
   x.wo = make_float3(e->wx, e->wy, e->wz);
   x.f = shading_frame(s, &x.h, x.wo);
   x.wol = to_local(x.wo, x.f.t, x.f.b, x.f.n);
@@ -103,14 +114,18 @@ PR_INLINE float3 rs_shift(const SceneData* s, const RsPrimary* x, PR_GLOBAL cons
   const ShadingFrame f2 = shading_frame(s, &h2, wo2);
   const float3 w2 = make_float3(r->wx, r->wy, r->wz);
   if (!rs_reconnectable(1, &h2, &f2, wo2, d2, w2, rp)) return zero;
-  float pdf1, pdf2;
+  float pdf1, pdf2, pdf2_rev;
   const float3 w1l = to_local(w1, x->f.t, x->f.b, x->f.n);
   const float3 f1 = bsdf_eval(&x->f.bsdf, x->wol, w1l, &pdf1) * fabs(w1l.z);
   const float3 w2l = to_local(w2, f2.t, f2.b, f2.n);
-  const float3 fx2 = bsdf_eval(&f2.bsdf, to_local(wo2, f2.t, f2.b, f2.n), w2l, &pdf2) * fabs(w2l.z);
+  const float3 fx2 =
+      bsdf_eval_both(&f2.bsdf, to_local(wo2, f2.t, f2.b, f2.n), w2l, &pdf2, &pdf2_rev) *
+      fabs(w2l.z);
   *g_dst = fabs(dot(h2.ng, w1)) / d2;
+  // T's density over L's here: the light tracer's of x_1 from x_2 against the camera's.
+  const float t = (r->kind & PR_RS_CAMERA) ? eye_paths_camera_ratio(x->cam, pdf2_rev, d2) : 0.0f;
   const float w = rs_weight2(r->kind, r->pdf_light, pdf2) *
-                  rs_eye_share(r->kind, r->rn, r->rh, pdf1 * *g_dst, pdf2);
+                  rs_eye_share(r->kind, r->rn, r->rh, pdf1 * *g_dst, pdf2, t);
   *seg = surface_segment(s, &x->h, &h2);
   return f1 * fx2 * make_float3(r->rest_r, r->rest_g, r->rest_b) * w;
 }
@@ -167,12 +182,12 @@ PR_INLINE void rs_candidate(PathReservoir* c, PR_GLOBAL const PathTrack* t, floa
   float w = rs_weight2(kind, pdf_light, pdf_bsdf);
   c->rn = c->rh = 0.0f;
   if (ew->l > 0.0f) {
-    w *= 1.0f - mis_power_share(ew->n / ew->l, ew->h / ew->l);
+    w *= eye_paths_eye_share(ew->n / ew->l, ew->h / ew->l, ew->t);
     const float pdf2 = last2 ? pdf_bsdf : t->pdf2;
     const float base = ew->l * t->p2;
     c->rn = ew->n / (last2 ? base : base * pdf2);
     c->rh = ew->h > 0.0f ? ew->h / (base * pdf2) : 0.0f;
-    kind |= PR_RS_JOINED | (last2 ? PR_RS_LAST2 : 0u);
+    kind |= PR_RS_JOINED | (last2 ? PR_RS_LAST2 : 0u) | (ew->t_len ? PR_RS_CAMERA : 0u);
   }
   const float3 f = make_float3(t->f1_r, t->f1_g, t->f1_b) * f2 * rest * w;
   c->f_r = f.x;
@@ -314,20 +329,6 @@ PR_INLINE int rs_temporal_ok(const SceneData* s, PR_GLOBAL const MovedInstance* 
     a = p;
   }
   return 1;
-}
-
-// The pixel of camera c that sees world point p (PR_INVALID_INDEX: behind it or outside).
-PR_INLINE u32 rs_project(const CameraParams* c, float3 p) {
-  const float3 v = p - make_float3(c->px, c->py, c->pz);
-  const float z = dot(v, make_float3(c->fx, c->fy, c->fz));
-  if (!(z > 0.0f)) return PR_INVALID_INDEX;
-  const float nx = dot(v, make_float3(c->rx, c->ry, c->rz)) / (z * c->tan_half_fov * c->aspect);
-  const float ny = dot(v, make_float3(c->ux, c->uy, c->uz)) / (z * c->tan_half_fov);
-  const float sx = 0.5f * (nx + 1.0f) * (float)c->width;
-  const float sy = 0.5f * (1.0f - ny) * (float)c->height;
-  if (!(sx >= 0.0f && sy >= 0.0f && sx < (float)c->width && sy < (float)c->height))
-    return PR_INVALID_INDEX;
-  return (u32)sy * c->width + (u32)sx;
 }
 
 PR_NAMESPACE_END

@@ -28,7 +28,8 @@ typedef struct {
                         // 0 = every candidate
   u32 eye_paths;        // 1: connections weighted against the path tracer's (--eye-paths)
   float eye_count;      // the samples an eye path counts as in those weights (1; --resample-mis)
-  u32 pad1, pad2;
+  float lt_scale;       // strategy T (--light-tracing): N_L A / (spp C W H); 0 = off
+  u32 pad2;
 } ReuseParams;
 
 // Most resampled connections per eye vertex (ReuseParams.resample; reservoir slots in connect).
@@ -69,6 +70,7 @@ PR_INLINE void connect_record_apply(float3* L, float3* g, float3 v, u32 op) {
   X(INVALID_RAYS, rays, "invalidation") /* DSG rays of invalidation */                 \
   X(LIGHT_RAYS, rays, "light")                                                         \
   X(CAMERA_RAYS, rays, "camera")                                                       \
+  X(SPLAT_RAYS, rays, "splat")   /* strategy T: light vertices to the camera */        \
   X(SHADOW_RAYS, rays, "shadow") /* next-event estimation */                           \
   X(CONNECT_RAYS, rays, "connection")                                                  \
   X(BOUNCE_RAYS, rays, "bounce")               /* eye rays after the first hit */      \
@@ -134,6 +136,43 @@ PR_INLINE float3 vertex_dir(PR_GLOBAL const LightVertex* v) {
 PR_INLINE float shading_normal_correction(float3 wo, float3 wi, float3 ns, float3 ng) {
   const float den = fabs(dot(wo, ng)) * fabs(dot(wi, ns));
   return den > 0.0f ? fabs(dot(wo, ns)) * fabs(dot(wi, ng)) / den : 0.0f;
+}
+
+// A stored light vertex k >= 1 rebuilt as a shaded surface.
+typedef struct {
+  SurfaceHit h;
+  ShadingFrame f;
+  float3 wprev;   // towards the previous light vertex
+  float3 wprevl;  // the same in the shading frame
+  int delta;
+} LightPoint;
+
+PR_INLINE LightPoint light_point(const SceneData* s, PR_GLOBAL const LightVertex* v) {
+  LightPoint y;
+  y.h = surface_interp(&s->sd, v->prim, v->inst, v->b1, v->b2, 0);  // ns as stored
+  y.h.p = vertex_pos(v);
+  y.h.ng = oct_decode(v->ng_oct);
+  y.h.ns = oct_decode(v->ns_oct);
+  y.wprev = -vertex_dir(v);
+  y.f = shading_frame(s, &y.h, y.wprev);
+  y.wprevl = to_local(y.wprev, y.f.t, y.f.b, y.f.n);
+  y.delta = bsdf_is_delta(&y.f.bsdf);
+  return y;
+}
+
+// The light side of a connection reached along dir (unit, from the eye side): its BSDF towards
+// -dir with the pdf of leaving along it (and that of arriving from it, pdf_rev), |cos| at its
+// shading normal and the shading-normal correction of light paths. 0 where it faces away from
+// the eye side.
+PR_INLINE int light_point_eval(const SceneData* s, const LightPoint* y, float3 dir, float3* f,
+                               float* pdf, float* pdf_rev, float* cos_t, float* corr) {
+  if (dot(-dir, y->f.ng) <= 0.0f && !surface_lifted(s, &y->h, &y->f)) return 0;
+  // The light path's BSDF: the view is towards the eye side (the adjoint of wprev's).
+  *f = bsdf_eval_mode(&y->f.bsdf, y->wprevl, to_local(-dir, y->f.t, y->f.b, y->f.n), PR_IMPORTANCE,
+                      pdf, pdf_rev);
+  *cos_t = fabs(dot(y->f.n, dir));
+  *corr = shading_normal_correction(y->wprev, -dir, y->f.n, y->f.ng);
+  return 1;
 }
 
 PR_NAMESPACE_END
