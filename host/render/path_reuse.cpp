@@ -183,9 +183,11 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
     ctx_.launch1D(lightTrace_, toTrace, "light_trace", &timer);
   }
 
-  if (!tracePasses(frame, camera, rp, sceneArgs, frameStamp, &timer)) return;
-  // Once per frame, by the device with the first pass (several devices add their films).
+  // Once per frame, by the device with the first pass (several devices add their films), before
+  // the passes: the film's sum is then the splats and the samples in pass order, as one device
+  // adds them, wherever the passes after the first device's run.
   if (settings_.lightTracing && passBegin_ == 0) splatToCamera(camera, rp, sceneArgs, &timer);
+  if (!tracePasses(frame, camera, rp, sceneArgs, frameStamp, &timer)) return;
   if (eyePaths_) eyePaths_->reportRays(stats);
   report(&timer, toTrace, stats);
 }

@@ -67,6 +67,10 @@ run "cornell-dynamic-pathtrace-resample" scenes/cornell-dynamic.gltf --frames 0-
 # path moves to another x_1.
 run "cornell-dynamic-reuse-resample" scenes/cornell-dynamic.gltf --frames 0-1 --mode reuse \
   --resample-neighbors 1
+# Strategy T: camera_splat's atomics into the fixed-point sums, splat_film, and T's ratio in
+# connect, pt_shade and the paths moved to another x_1 (a moving camera, a neighbour).
+run "cornell-orbit-reuse-light-tracing" scenes/cornell-orbit.gltf --frames 0-1 --mode reuse \
+  --light-tracing --resample-neighbors 1
 # Resampled connections (two shadow rays per eye vertex).
 run "cornell-dynamic-reuse-ris" scenes/cornell-dynamic.gltf --frames 0-1 --mode reuse --connections 2 \
   --no-eye-paths
