@@ -284,11 +284,11 @@ void addReuseOptions(CLI::App* render, RenderArgs& a) {
       "where they sample a path better, and eye paths elsewhere (dark corners, occluded rooms). "
       "On by default; --no-eye-paths: the connections alone at the first eye vertex, with "
       "next-event estimation, strategy E and the delta-chain extension there");
-  render->add_flag(
-      "--light-tracing,!--no-light-tracing", ro.lightTracing,
+  render->add_flag_function(
+      "--light-tracing,!--no-light-tracing", [&ro](int64_t n) { ro.lightTracing = n > 0; },
       "Reuse/retrace with eye paths: also join every stored light vertex to the camera (light "
       "tracing, strategy T), weighted against the eye paths and the connections over whole "
-      "paths: the technique for caustics seen on diffuse surfaces");
+      "paths: the technique for caustics seen on diffuse surfaces. On by default there");
 }
 
 void addMaterialOptions(CLI::App* render, RenderArgs& a) {
@@ -384,7 +384,7 @@ pr::RenderOptions toRenderOptions(const RenderArgs& a) {
   if (ro.eyePaths && a.connectionMis->count() > 0 && !ro.quiet)
     std::cerr << "note: --connection-mis is used with --no-eye-paths only; eye paths weigh "
                  "whole paths by MIS instead\n";
-  if (ro.lightTracing && ro.mode == pr::RenderMode::PathTrace && !ro.quiet)
+  if (ro.lightTracing.value_or(false) && ro.mode == pr::RenderMode::PathTrace && !ro.quiet)
     std::cerr << "note: --light-tracing joins stored light paths to the camera in --mode reuse or "
                  "retrace; the path tracer has none\n";
   ro.connections = a.connections == "auto"  ? -1

@@ -2,6 +2,7 @@
 // frame; camera motion invalidates nothing; reuse converges to the path tracer.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -473,6 +474,34 @@ TEST(Reuse, EyePathsAreTheDefault) {
   EXPECT_NE(test::frameImage(byDefault, 0).rgba, test::frameImage(without, 0).rgba);
 }
 
+// Strategy T is on by default with eye paths (reuse, retrace), off without them and in the path
+// tracer; asked for where eye paths are off, it is a one-line error (exit 2), and in the path
+// tracer a note.
+TEST(Reuse, LightTracingIsTheDefaultWithEyePaths) {
+  const std::string scene = test::sourcePath("scenes/cornell-dynamic.gltf");
+  const std::string args = "--width 32 --height 24 --spp 1";
+  const auto stages = [&](const std::string& extra, const std::string& tag) {
+    const std::string dir = test::renderFrames(scene, "0", args + " " + extra, tag);
+    return nlohmann::json::parse(test::statsLines(dir).at(0))["stages_s"];
+  };
+  EXPECT_TRUE(stages("--mode reuse", "lt-default").contains("camera_splat"));
+  EXPECT_TRUE(stages("--mode retrace", "lt-retrace").contains("camera_splat"));
+  EXPECT_FALSE(stages("--mode reuse --no-light-tracing", "lt-no").contains("camera_splat"));
+  EXPECT_FALSE(stages("--mode reuse --no-eye-paths", "lt-no-eye").contains("camera_splat"));
+  EXPECT_FALSE(stages("--mode pathtrace", "lt-pt").contains("camera_splat"));
+  const auto bad = test::runPathreuse("render '" + scene + "' --quiet --frames 0 " + args +
+                                      " --no-eye-paths --light-tracing --out '" +
+                                      test::tempDir("lt-bad") + "/f_%04d.exr'");
+  EXPECT_EQ(bad.exitCode, 2);
+  EXPECT_NE(bad.err.find("--light-tracing"), std::string::npos) << bad.err;
+  EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
+  const auto pt = test::runPathreuse("render '" + scene + "' --frames 0 " + args +
+                                     " --mode pathtrace --light-tracing --out '" +
+                                     test::tempDir("lt-pt-note") + "/f_%04d.exr'");
+  EXPECT_EQ(pt.exitCode, 0) << pt.err;
+  EXPECT_NE(pt.err.find("note: --light-tracing"), std::string::npos) << pt.err;
+}
+
 TEST(Reuse, ConvergesToThePathTracerOnCornellNvpro) {
   const std::string scene = test::sharedScene("cornell-nvpro/cornellBox.gltf");
   ASSERT_FALSE(scene.empty())
@@ -551,7 +580,8 @@ void expectLightTracingAgrees(const std::string& scene, const std::string& args,
   const std::string frames = "0-" + std::to_string(frame);
   const Image a = test::frameImage(
       renderReuse(scene, frames, base + " --light-tracing --seed 3", "lt-on"), frame);
-  Image d = test::frameImage(renderReuse(scene, frames, base + " --seed 9", "lt-off"), frame);
+  Image d = test::frameImage(
+      renderReuse(scene, frames, base + " --no-light-tracing --seed 9", "lt-off"), frame);
   ASSERT_EQ(a.rgba.size(), d.rgba.size());
   for (size_t i = 0; i < d.rgba.size(); ++i) d.rgba[i] = a.rgba[i] - d.rgba[i];
   const Moments lit = regionMean(a, 0, 0, w, h, 1);

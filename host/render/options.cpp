@@ -31,6 +31,10 @@ ResampleSettings resolveResample(const RenderOptions& o) {
   return r;
 }
 
+bool resolveLightTracing(const RenderOptions& o) {
+  return o.lightTracing.value_or(o.mode != RenderMode::PathTrace && o.eyePaths);
+}
+
 const char* renderModeName(RenderMode m) {
   switch (m) {
     case RenderMode::Reuse:

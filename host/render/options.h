@@ -105,7 +105,8 @@ struct RenderOptions {
   bool eyePaths = true;  // full eye paths, weighted against the connections over whole paths
   // Strategy T: the stored light paths' vertices joined to the camera (light tracing), weighted
   // against the eye paths and the connections (kernels/shared/eye_paths.h). Needs eye paths.
-  bool lightTracing = false;
+  // --light-tracing / --no-light-tracing where given (resolveLightTracing).
+  std::optional<bool> lightTracing;
   ResampleSettings resample;
   // The environment light (scene/environment.h): a map file, "none", or "" (a uniform one of
   // envColor where --env-color is given, else white where the scene has no lights, else none).
@@ -120,6 +121,11 @@ struct RenderOptions {
 // soon, with a third or less of the flicker: docs/design.md section 5) and off in pathtrace
 // mode, which stays the plain path tracer, and with --no-eye-paths, which it needs.
 ResampleSettings resolveResample(const RenderOptions& o);
+
+// Strategy T: --light-tracing / --no-light-tracing where given; else on in --mode reuse/retrace
+// with eye paths (it lowered the Cornell boxes' error per sample by 10-18% for 2-3% more time,
+// the atrium's neither way: docs/design.md section 5) and off in pathtrace mode.
+bool resolveLightTracing(const RenderOptions& o);
 
 // "R,G,B": three finite non-negative numbers. Throws InputError naming --env-color.
 void parseColor(const std::string& text, float rgb[3]);

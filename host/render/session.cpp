@@ -118,7 +118,7 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
   ResampleSettings resample = resolveResample(o);
   if (resample.enabled && o.mode != RenderMode::PathTrace && !o.eyePaths)
     throw InputError("--resample: resamples the eye paths, which --no-eye-paths turns off");
-  if (o.lightTracing && o.mode != RenderMode::PathTrace && !o.eyePaths)
+  if (o.lightTracing.value_or(false) && o.mode != RenderMode::PathTrace && !o.eyePaths)
     throw InputError(
         "--light-tracing: weighs its paths against the eye paths, which --no-eye-paths "
         "turns off");
@@ -148,7 +148,7 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
     r.historyCap = static_cast<uint32_t>(o.connectionHistory);
     r.historyPeriod = static_cast<uint32_t>(o.connectionHistoryPeriod);
     r.eyePaths = o.eyePaths;
-    r.lightTracing = o.lightTracing;
+    r.lightTracing = resolveLightTracing(o);
     r.retraceAll = o.mode == RenderMode::Retrace;
     r.fixedNoise = o.fixedNoise;
     r.resamplePaths = resample;

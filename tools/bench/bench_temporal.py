@@ -52,7 +52,7 @@ SETTINGS = {
     "reuse": ("reuse", ()),  # resampled, no neighbours: the default
     "reuse, 1 neighbour": ("reuse", ("--resample-neighbors", "1")),
     "reuse, connection history": ("reuse", ("--connection-history", "20")),
-    "reuse, light tracing": ("reuse", ("--light-tracing",)),
+    "reuse, no light tracing": ("reuse", ("--no-light-tracing",)),
 }
 
 
