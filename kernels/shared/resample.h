@@ -118,12 +118,16 @@ PR_INLINE float3 rs_shift(const SceneData* s, const RsPrimary* x, PR_GLOBAL cons
   const float3 w1l = to_local(w1, x->f.t, x->f.b, x->f.n);
   const float3 f1 = bsdf_eval(&x->f.bsdf, x->wol, w1l, &pdf1) * fabs(w1l.z);
   const float3 w2l = to_local(w2, f2.t, f2.b, f2.n);
-  const float3 fx2 =
-      bsdf_eval_both(&f2.bsdf, to_local(wo2, f2.t, f2.b, f2.n), w2l, &pdf2, &pdf2_rev) *
-      fabs(w2l.z);
+  // T's density over L's here, where T can make the path: the light tracer's of x_1 from x_2
+  // (x_2's reverse pdf, evaluated only then) against the camera's.
+  const int camera = (r->kind & PR_RS_CAMERA) && x->cam > 0.0f;
+  const float3 wo2l = to_local(wo2, f2.t, f2.b, f2.n);
+  pdf2_rev = 0.0f;
+  const float3 fx2 = (camera ? bsdf_eval_both(&f2.bsdf, wo2l, w2l, &pdf2, &pdf2_rev)
+                             : bsdf_eval(&f2.bsdf, wo2l, w2l, &pdf2)) *
+                     fabs(w2l.z);
   *g_dst = fabs(dot(h2.ng, w1)) / d2;
-  // T's density over L's here: the light tracer's of x_1 from x_2 against the camera's.
-  const float t = (r->kind & PR_RS_CAMERA) ? eye_paths_camera_ratio(x->cam, pdf2_rev, d2) : 0.0f;
+  const float t = camera ? eye_paths_camera_ratio(x->cam, pdf2_rev, d2) : 0.0f;
   const float w = rs_weight2(r->kind, r->pdf_light, pdf2) *
                   rs_eye_share(r->kind, r->rn, r->rh, pdf1 * *g_dst, pdf2, t);
   *seg = surface_segment(s, &x->h, &h2);
