@@ -223,15 +223,28 @@ TEST(EyePathShare, KeptRatiosGiveTheWeightOfTheWholePathsDensities) {
   EXPECT_GT(checked, 500);
 }
 
+// Densities for the weights' tests: three in ten a special value (0, tiny, huge, infinite, NaN),
+// the others log-uniform between e^-12 and e^12.
+class DensityDraw {
+ public:
+  explicit DensityDraw(unsigned seed) : gen_(seed) {}
+  float operator()() {
+    static const float inf = std::numeric_limits<float>::infinity();
+    static const std::vector<float> special = {0.0f, 1e-30f, 1e-3f, 1.0f,
+                                               1e3f, 1e30f,  inf,   std::nanf("")};
+    return u_(gen_) < 0.3f ? special[gen_() % special.size()] : std::exp(logu_(gen_));
+  }
+
+ private:
+  std::mt19937 gen_;
+  std::uniform_real_distribution<float> logu_{-12.0f, 12.0f}, u_{0.0f, 1.0f};
+};
+
 // Strategy T's share, L's and the eye path's add to 1 for any densities (0, tiny, huge, infinite,
 // NaN), and T off (t = 0) leaves L's and the eye path's shares as they were, bit for bit.
 TEST(EyePathShare, TheSharesOfTAndLAndTheEyePathAddToOne) {
   const float inf = std::numeric_limits<float>::infinity();
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  const std::vector<float> special = {0.0f, 1e-30f, 1e-3f, 1.0f, 1e3f, 1e30f, inf, nan};
-  std::mt19937 gen(29);
-  std::uniform_real_distribution<float> logu(-12.0f, 12.0f), u(0.0f, 1.0f);
-  auto draw = [&] { return u(gen) < 0.3f ? special[gen() % special.size()] : std::exp(logu(gen)); };
+  DensityDraw draw(29);
   for (int trial = 0; trial < 20000; ++trial) {
     const float t = draw(), n = draw(), h = draw();
     const float w_t = eye_paths_camera_share(t, n, h);
@@ -257,14 +270,11 @@ TEST(EyePathShare, TheSharesOfTAndLAndTheEyePathAddToOne) {
 // kernel's 0 / 0 is); mis_power_share is mis_power_share_n for two others.
 TEST(PowerShare, WeightsOfAllStrategiesAddToOne) {
   const float inf = std::numeric_limits<float>::infinity();
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  const std::vector<float> special = {0.0f, 1e-30f, 1e-3f, 1.0f, 1e3f, 1e30f, inf, nan};
-  std::mt19937 gen(23);
-  std::uniform_real_distribution<float> logu(-12.0f, 12.0f), u(0.0f, 1.0f);
+  DensityDraw draw(23);
   for (int trial = 0; trial < 20000; ++trial) {
     const int n = 2 + trial % 5;
     std::vector<float> d(n);
-    for (float& x : d) x = u(gen) < 0.3f ? special[gen() % special.size()] : std::exp(logu(gen));
+    for (float& x : d) x = draw();
     int usable = 0, infinite = 0;
     for (float x : d) usable += x > 0.0f, infinite += x == inf;
     if (usable == 0 || infinite > 1) continue;  // no strategy makes the path; inf / inf

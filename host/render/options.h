@@ -123,8 +123,9 @@ struct RenderOptions {
 ResampleSettings resolveResample(const RenderOptions& o);
 
 // Strategy T: --light-tracing / --no-light-tracing where given; else on in --mode reuse/retrace
-// with eye paths (it lowered the Cornell boxes' error per sample by 10-18% for 2-3% more time,
-// the atrium's neither way: docs/design.md section 5) and off in pathtrace mode.
+// with eye paths (it lowered the Cornell boxes' error per sample by 4-19%, the atrium's neither
+// way, for splats of 2-3 ms in frames of 0.15-0.3 s: docs/design.md section 5) and off in
+// pathtrace mode.
 bool resolveLightTracing(const RenderOptions& o);
 
 // "R,G,B": three finite non-negative numbers. Throws InputError naming --env-color.

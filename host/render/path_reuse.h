@@ -72,11 +72,11 @@ class PathReuse : public Integrator {
   // The slot offset of the light paths each pixel sample connects to, this frame.
   cl_uint historySlotOffset(const dev::ReuseParams& rp) const;
   dev::ReuseParams frameParams(int frame) const;
-  // The frame's sample passes: first hits (or the eye paths), connections, the film. False when
-  // interrupted.
   // Strategy T: the arena's vertices joined to the camera, into the film.
   void splatToCamera(const dev::CameraParams& camera, const dev::ReuseParams& rp,
                      const kargs::SceneArgs& sceneArgs, StageTimer* timer);
+  // The frame's sample passes: first hits (or the eye paths), connections, the film. False when
+  // interrupted.
   bool tracePasses(int frame, const dev::CameraParams& camera, const dev::ReuseParams& rp,
                    const kargs::SceneArgs& sceneArgs, cl_uint frameStamp, StageTimer* timer);
   // Reads the counters and adds them and the stage times to stats.

@@ -12,13 +12,13 @@
 #include "shared/eye_paths.h"
 #include "shared/splat.h"
 
-// z_k's splat, seen from camera point c by `dir` (unit, camera to z_k) at squared distance d2,
-// where the path before it is z_{k-1} (yp, ratios rp_prev) and z_k's arrival record is vk: its
-// value at the pixel before T's share, and the share; 0 where the camera cannot see it so.
+// z_k's splat (light point y, arrival record vk), seen from the camera along `dir` (unit, camera
+// to z_k), the path before it z_{k-1} (light point yp, whose ratios are r_prev): its value at the
+// pixel times T's share of the path; 0 where the camera cannot see it so or T takes no share.
 PR_INLINE float3 camera_splat_value(const SceneData* s, const ReuseParams* rp,
                                     const CameraParams* cam, const LightPoint* y,
                                     const LightPoint* yp, PR_GLOBAL const LightVertex* vk,
-                                    EyePathRatio r_prev, uint k, float3 dir, float d2) {
+                                    EyePathRatio r_prev, uint k, float3 dir) {
   const float3 zero = make_float3(0.0f, 0.0f, 0.0f);
   float3 f;
   float pdf_cam, pdf_x, cos_y, corr;
@@ -67,7 +67,7 @@ PR_KERNEL void camera_splat(PR_PARAMS(PR_ARGS_CAMERA_SPLAT)) {
       const float d2 = dot(dc, dc);
       const float3 dir = dc * (1.0f / sqrt(d2));
       const float3 val =
-          camera_splat_value(&s, &rp, &cam, &y, &yp, v + k, r[k - 1u], k, dir, d2) * film_scale;
+          camera_splat_value(&s, &rp, &cam, &y, &yp, v + k, r[k - 1u], k, dir) * film_scale;
       if (max3(val) > 0.0f) {
         ++rays;
         const Ray ray = surface_ray(&s, &y.h, -dir, sqrt(d2) * (1.0f - 1e-4f));
