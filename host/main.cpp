@@ -129,6 +129,9 @@ void addOutputOptions(CLI::App* render, RenderArgs& a) {
       ->capture_default_str();
   render->add_flag("--exr-float", ro.exrFloat, "Write 32-bit float EXR (default: half)");
   render->add_flag("--png", ro.png, "Also write an sRGB PNG beside each EXR");
+  render->add_option("--aov", ro.aov,
+                     "Auxiliary images as extra channels of each EXR, a comma-separated list of "
+                     "albedo, normal, depth, motion, object, material, or all");
   render->add_option("--exposure", ro.exposure, "Exposure in stops for the PNG")
       ->check(finiteIn(-64, 64))
       ->capture_default_str();

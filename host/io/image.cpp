@@ -105,6 +105,25 @@ void writeExr(const std::string& path, const Image& image, ExrPixels pixels) {
                        const_cast<char*>(reinterpret_cast<const char*>(image.rgba.data() + c)),
                        sizeof(float) * 4, sizeof(float) * 4 * image.width));
     }
+    // Extra channels: each in its own array, converted where it is written as half.
+    std::vector<std::vector<half>> channelHalves(image.channels.size());
+    for (size_t k = 0; k < image.channels.size(); ++k) {
+      const ImageChannel& c = image.channels[k];
+      if (c.values.size() != image.rgba.size() / 4)
+        throw std::runtime_error("channel " + c.name + " has the wrong size");
+      const Imf::PixelType ct = c.fullFloat ? Imf::FLOAT : type;
+      header.channels().insert(c.name, Imf::Channel(ct));
+      if (ct == Imf::HALF) {
+        channelHalves[k].assign(c.values.begin(), c.values.end());
+        fb.insert(c.name, Imf::Slice(Imf::HALF, reinterpret_cast<char*>(channelHalves[k].data()),
+                                     sizeof(half), sizeof(half) * image.width));
+      } else {
+        fb.insert(c.name,
+                  Imf::Slice(Imf::FLOAT,
+                             const_cast<char*>(reinterpret_cast<const char*>(c.values.data())),
+                             sizeof(float), sizeof(float) * image.width));
+      }
+    }
     Imf::OutputFile file(encoded, header);
     file.setFrameBuffer(fb);
     file.writePixels(image.height);
@@ -133,7 +152,12 @@ void writePng(const std::string& path, const Image& image, float exposure) {
   writeFileAtomic(path, encoded);
 }
 
-Image readExr(const std::string& path) {
+namespace {
+
+// Opens an OpenEXR file and calls read(file, data window, width, height); every failure is an
+// InputError naming the file.
+template <class Read>
+auto readExrWith(const std::string& path, Read&& read) {
   MemoryIStream stream(path, readInputFile(path, kMaxImageFileBytes));
   try {
     Imf::InputFile file(stream);
@@ -141,20 +165,8 @@ Image readExr(const std::string& path) {
     const int w = dw.max.x - dw.min.x + 1, h = dw.max.y - dw.min.y + 1;
     if (w <= 0 || h <= 0 || static_cast<long long>(w) * h > (1ll << 28))
       throw InputError(path + ": unreasonable OpenEXR data window");
-    Image img(w, h);
-    Imf::FrameBuffer fb;
-    const char* names[4] = {"R", "G", "B", "A"};
-    for (int c = 0; c < 4; ++c) {
-      char* base = reinterpret_cast<char*>(img.rgba.data() + c) -
-                   (static_cast<ptrdiff_t>(dw.min.x) + static_cast<ptrdiff_t>(dw.min.y) * w) *
-                       static_cast<ptrdiff_t>(sizeof(float) * 4);
-      fb.insert(names[c], Imf::Slice(Imf::FLOAT, base, sizeof(float) * 4, sizeof(float) * 4 * w, 1,
-                                     1, c == 3 ? 1.0 : 0.0));
-    }
-    file.setFrameBuffer(fb);
     if (!file.isComplete()) throw InputError(path + ": OpenEXR file is incomplete");
-    file.readPixels(dw.min.y, dw.max.y);
-    return img;
+    return read(file, dw, w, h);
   } catch (const InputError&) {
     throw;
   } catch (const std::exception& e) {
@@ -162,6 +174,43 @@ Image readExr(const std::string& path) {
     std::replace(msg.begin(), msg.end(), '\n', ' ');
     throw InputError(path + ": not a readable OpenEXR file (" + msg + ")");
   }
+}
+
+// Where a frame buffer's slice starts for pixel (0, 0) of a data window at `dw`, w wide, whose
+// first pixel is at `first` and pixels `stride` bytes apart.
+char* sliceBase(float* first, const Imath::Box2i& dw, int w, size_t stride) {
+  return reinterpret_cast<char*>(first) -
+         (static_cast<ptrdiff_t>(dw.min.x) + static_cast<ptrdiff_t>(dw.min.y) * w) *
+             static_cast<ptrdiff_t>(stride);
+}
+
+}  // namespace
+
+Image readExr(const std::string& path) {
+  return readExrWith(path, [&](Imf::InputFile& file, const Imath::Box2i& dw, int w, int h) {
+    Image img(w, h);
+    Imf::FrameBuffer fb;
+    const char* names[4] = {"R", "G", "B", "A"};
+    for (int c = 0; c < 4; ++c)
+      fb.insert(names[c], Imf::Slice(Imf::FLOAT, sliceBase(img.rgba.data() + c, dw, w, 16), 16,
+                                     size_t(16) * w, 1, 1, c == 3 ? 1.0 : 0.0));
+    file.setFrameBuffer(fb);
+    file.readPixels(dw.min.y, dw.max.y);
+    return img;
+  });
+}
+
+std::vector<float> readExrChannel(const std::string& path, const std::string& name) {
+  return readExrWith(path, [&](Imf::InputFile& file, const Imath::Box2i& dw, int w, int h) {
+    if (!file.header().channels().findChannel(name))
+      throw InputError(path + ": no channel " + name);
+    std::vector<float> values(size_t(w) * h);
+    Imf::FrameBuffer fb;
+    fb.insert(name, Imf::Slice(Imf::FLOAT, sliceBase(values.data(), dw, w, 4), 4, size_t(4) * w));
+    file.setFrameBuffer(fb);
+    file.readPixels(dw.min.y, dw.max.y);
+    return values;
+  });
 }
 
 bool isCompleteExr(const std::string& path) {

@@ -7,10 +7,18 @@
 
 namespace pr {
 
+// An extra channel of an image (--aov), named as OpenEXR names channels ("albedo.R", "Z").
+struct ImageChannel {
+  std::string name;
+  std::vector<float> values;  // one per pixel, row-major
+  bool fullFloat = false;     // 32-bit in every EXR (depth, ids), else as the image's pixels
+};
+
 struct Image {
   int width = 0;
   int height = 0;
-  std::vector<float> rgba;  // row-major, top row first, 4 floats per pixel
+  std::vector<float> rgba;             // row-major, top row first, 4 floats per pixel
+  std::vector<ImageChannel> channels;  // written after R, G, B, A
 
   Image() = default;
   Image(int w, int h) : width(w), height(h), rgba(static_cast<size_t>(w) * h * 4, 0.0f) {}
@@ -29,6 +37,10 @@ void writePng(const std::string& path, const Image& image, float exposure = 0.0f
 // Reads an OpenEXR file's RGBA channels (missing alpha = 1). Throws InputError naming the file
 // when it is missing, truncated or not OpenEXR.
 Image readExr(const std::string& path);
+
+// One channel of an OpenEXR file, as floats. Throws InputError naming the file where it is
+// missing or unreadable.
+std::vector<float> readExrChannel(const std::string& path, const std::string& name);
 
 // True when `path` is a complete, readable OpenEXR file.
 bool isCompleteExr(const std::string& path);

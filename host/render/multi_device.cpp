@@ -198,6 +198,10 @@ Image MultiDeviceSession::renderFrame(int frame, FrameStats* total,
     });
   }
 
+  // Auxiliary images on the first device, for the whole image whatever the split.
+  if (sessions_[0]->hasAovs() && !interrupted())
+    p[0].stats.stageSeconds["aov"] += sessions_[0]->renderAovs(frame, &img);
+
   if (total) {
     FrameStats& t = *total;
     t.frame = frame;

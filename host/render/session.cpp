@@ -1,5 +1,7 @@
 #include "render/session.h"
 
+#include "render/aov.h"
+
 #include <chrono>
 #include <cmath>
 
@@ -86,6 +88,7 @@ void validateRenderOptions(const RenderOptions& o) {
     throw InputError("--connection-history-period " + std::to_string(o.connectionHistoryPeriod) +
                      ": must be 1 to 1000");
   if (!std::isfinite(o.exposure)) throw InputError("--exposure: must be finite");
+  if (!o.aov.empty()) parseAovs(o.aov);
   if (!(o.envStrength >= 0.0f) || !std::isfinite(o.envStrength))
     throw InputError("--env-strength: must be 0 or positive");
   if (!std::isfinite(o.envRotate)) throw InputError("--env-rotate: must be finite");
@@ -156,6 +159,20 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
     pathTracer_ = reuse->eyePaths();
     integrator_ = std::move(reuse);
   }
+  if (!o.aov.empty()) {
+    AovSampling a;
+    a.seed = o.seed;
+    a.jitterFromFrame0 = resample.enabled || o.fixedNoise;
+    a.spp = o.spp;
+    a.maxDepth = o.maxDepth;
+    aov_ = std::make_unique<AovRenderer>(ctx_, scene, *gpu_, parseAovs(o.aov), a);
+  }
+}
+
+RenderSession::~RenderSession() = default;
+
+double RenderSession::renderAovs(int frame, Image* image) {
+  return aov_->render(frame, options_.fps, camera_, image);
 }
 
 bool RenderSession::hasHistory() const {

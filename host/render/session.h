@@ -18,6 +18,7 @@
 namespace pr {
 
 class PathTracer;
+class AovRenderer;
 
 // Checks the options that do not need the scene; throws InputError naming the option.
 void validateRenderOptions(const RenderOptions& o);
@@ -35,12 +36,17 @@ class RenderSession {
   // `scene` must outlive the session. Picks the camera and image size, builds the device scene
   // and the integrator. Throws InputError for a camera that does not exist or is orthographic.
   RenderSession(const Scene& scene, const DeviceEntry& device, const RenderOptions& options);
+  ~RenderSession();
 
   // Renders frame f (time f / fps). Frames must come in increasing order for reuse to apply;
   // any order gives correct images.
   Image renderFrame(int frame, FrameStats* stats);
   // The same, writing only the rows setRows() chose into `image` (of the session's size).
   void renderRows(int frame, Image* image, FrameStats* stats);
+  // --aov: whether the session makes auxiliary images, and adding frame f's to `image` (the
+  // whole image, after the frame's colour: render/aov.h). Returns the seconds taken.
+  bool hasAovs() const { return aov_ != nullptr; }
+  double renderAovs(int frame, Image* image);
   // Rows [rowBegin, rowEnd) of each frame are rendered (default: all). The light paths of
   // path reuse cover every slot whatever the rows (render/multi_device.h).
   void setRows(int rowBegin, int rowEnd) { film_->setRows(rowBegin, rowEnd); }
@@ -82,6 +88,7 @@ class RenderSession {
   std::unique_ptr<GpuScene> gpu_;
   std::unique_ptr<Film> film_;
   std::unique_ptr<Integrator> integrator_;
+  std::unique_ptr<AovRenderer> aov_;  // --aov
   // The path tracer whose --resample history is the run's: integrator_ itself, or reuse's eye
   // paths.
   PathTracer* pathTracer_ = nullptr;

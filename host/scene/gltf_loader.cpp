@@ -794,6 +794,8 @@ class Converter : Stage {
           scene_.instances.push_back({index, int(i), node.name});
         } else {
           flatten(mesh, node.restWorld);
+          scene_.staticTriangleNodes.insert(scene_.staticTriangleNodes.end(), mesh.triangleCount(),
+                                            uint32_t(i));
           if (staticMeshes.insert(node.mesh).second)
             scene_.staticMeshTriangles += mesh.triangleCount();
         }

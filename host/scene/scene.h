@@ -247,11 +247,12 @@ struct Instance {
 struct Scene {
   std::string path;  // the file it was loaded from
 
-  TriangleMesh staticMesh;                  // SSG, world space
-  std::vector<TriangleMesh> dynamicMeshes;  // DSG, object space, one per glTF mesh used
-  std::vector<Instance> instances;          // DSG instances
-  std::vector<Bounds> dynamicMeshBounds;    // object-space bounds of each dynamic mesh
-  std::vector<Deformer> deformers;          // one per dynamic mesh
+  TriangleMesh staticMesh;                    // SSG, world space
+  std::vector<uint32_t> staticTriangleNodes;  // per SSG triangle, the glTF node placing it
+  std::vector<TriangleMesh> dynamicMeshes;    // DSG, object space, one per glTF mesh used
+  std::vector<Instance> instances;            // DSG instances
+  std::vector<Bounds> dynamicMeshBounds;      // object-space bounds of each dynamic mesh
+  std::vector<Deformer> deformers;            // one per dynamic mesh
   std::vector<Skin> skins;
 
   std::vector<Material> materials;

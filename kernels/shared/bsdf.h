@@ -236,6 +236,20 @@ PR_INLINE BsdfLayers bsdf_layers(const BsdfParams* m, float3 w) {
   return l;
 }
 
+// The reflectance an auxiliary albedo image shows (--aov albedo): the layers' directional albedos
+// at w, tinted as they reflect. The glTF model keeps no albedos: its base colour stands in.
+PR_INLINE float3 bsdf_albedo(const BsdfParams* m, float3 w) {
+  const float3 one = make_float3(1.0f, 1.0f, 1.0f);
+  if (m->kind == PR_BSDF_LAMBERT || bsdf_gltf(m)) return m->base;
+  const BsdfLayers l = bsdf_layers(m, w);
+  const float3 dielectric =
+      l.spec_albedo + m->base * fmax(one - l.spec_albedo, make_float3(0.0f, 0.0f, 0.0f));
+  const float3 base = l.metal_albedo * m->metallic + dielectric * (1.0f - m->metallic);
+  const float3 sheen = m->sheen * (l.sheen_albedo > 0.0f ? l.sheen_albedo / max3(m->sheen) : 0.0f);
+  const float3 below = sheen + base * (1.0f - l.sheen_albedo);
+  return clamp(one * l.coat_albedo + below * (1.0f - l.coat_albedo), 0.0f, 1.0f);
+}
+
 // ---- The lobe table. A microfacet material is a mixture of lobes, each with one function set:
 //
 //   float  lobe_<name>_weight(m, wo, l)        its weight for lobe choice at wo (the model's:

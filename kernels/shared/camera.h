@@ -39,18 +39,26 @@ PR_INLINE Ray camera_ray(const CameraParams* c, u32 pixel, float2 jitter) {
   return r;
 }
 
-// The pixel of camera c that sees world point p (PR_INVALID_INDEX: behind it or outside).
-PR_INLINE u32 camera_pixel(const CameraParams* c, float3 p) {
+// The film point (in pixels, as camera_direction takes it) where camera c sees world point p;
+// 0 where p is not in front of it.
+PR_INLINE int camera_project(const CameraParams* c, float3 p, float2* s) {
   const float3 v = p - make_float3(c->px, c->py, c->pz);
   const float z = dot(v, make_float3(c->fx, c->fy, c->fz));
-  if (!(z > 0.0f)) return PR_INVALID_INDEX;
+  if (!(z > 0.0f)) return 0;
   const float nx = dot(v, make_float3(c->rx, c->ry, c->rz)) / (z * c->tan_half_fov * c->aspect);
   const float ny = dot(v, make_float3(c->ux, c->uy, c->uz)) / (z * c->tan_half_fov);
-  const float sx = 0.5f * (nx + 1.0f) * (float)c->width;
-  const float sy = 0.5f * (1.0f - ny) * (float)c->height;
-  if (!(sx >= 0.0f && sy >= 0.0f && sx < (float)c->width && sy < (float)c->height))
+  s->x = 0.5f * (nx + 1.0f) * (float)c->width;
+  s->y = 0.5f * (1.0f - ny) * (float)c->height;
+  return 1;
+}
+
+// The pixel of camera c that sees world point p (PR_INVALID_INDEX: behind it or outside).
+PR_INLINE u32 camera_pixel(const CameraParams* c, float3 p) {
+  float2 s;
+  if (!camera_project(c, p, &s)) return PR_INVALID_INDEX;
+  if (!(s.x >= 0.0f && s.y >= 0.0f && s.x < (float)c->width && s.y < (float)c->height))
     return PR_INVALID_INDEX;
-  return (u32)sy * c->width + (u32)sx;
+  return (u32)s.y * c->width + (u32)s.x;
 }
 
 // The area A of the image plane at distance 1 (both tangents of the field of view).

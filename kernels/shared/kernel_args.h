@@ -243,6 +243,24 @@
   X(FRAME, VAL, uint, first)  \
   X(FRAME, VAL, uint, end)
 
+// aov (--aov): one work-item per pixel, every sample pass in one launch (kernels/aov.cl).
+#define PR_ARGS_AOV(X)                  \
+  PR_ARGS_SCENE(X)                      \
+  X(FRAME, VAL, CameraParams, cam)      \
+  X(FRAME, VAL, CameraParams, prev_cam) \
+  X(FRAME, IN, float, prev_inst)        \
+  X(FRAME, IN, float4, prev_pos)        \
+  X(FRAME, IN, uint, tri_object)        \
+  X(FRAME, IN, uint, inst_object)       \
+  X(FRAME, OUT, float, aov)             \
+  X(FRAME, VAL, uint, static_vertices)  \
+  X(FRAME, VAL, uint, static_triangles) \
+  X(FRAME, VAL, uint, seed)             \
+  X(FRAME, VAL, uint, jitter_frame)     \
+  X(FRAME, VAL, uint, spp)              \
+  X(FRAME, VAL, uint, max_depth)        \
+  X(FRAME, VAL, uint, end)
+
 // Every kernel with a table: K(kernel name, the host's argument struct, its table).
 #define PR_KERNEL_TABLES(K)                                    \
   K(invalidate, InvalidateArgs, PR_ARGS_INVALIDATE)            \
@@ -257,7 +275,8 @@
   K(pt_shadow, PtShadowArgs, PR_ARGS_PT_SHADOW)                \
   K(pt_resample, PtResampleArgs, PR_ARGS_PT_RESAMPLE_SPATIAL)  \
   K(accumulate, AccumulateArgs, PR_ARGS_ACCUMULATE)            \
-  K(splat_film, SplatFilmArgs, PR_ARGS_SPLAT_FILM)
+  K(splat_film, SplatFilmArgs, PR_ARGS_SPLAT_FILM)             \
+  K(aov, AovArgs, PR_ARGS_AOV)
 
 // A parameter's name: scene entries carry their group's prefix (geometry and shading both have
 // `instances`), the others their own name.

@@ -71,6 +71,9 @@ run "cornell-dynamic-reuse-resample" scenes/cornell-dynamic.gltf --frames 0-1 --
 # connect, pt_shade and the paths moved to another x_1 (a moving camera, a neighbour).
 run "cornell-orbit-reuse-light-tracing" scenes/cornell-orbit.gltf --frames 0-1 --mode reuse \
   --light-tracing --resample-neighbors 1
+# Auxiliary images (kernels/aov.cl): a skinned mesh's previous shape for the motion, and below,
+# through an environment map.
+run "cornell-skinned-reuse-aov" scenes/cornell-skinned.gltf --frames 0-1 --mode reuse --aov all
 # Resampled connections (two shadow rays per eye vertex).
 run "cornell-dynamic-reuse-ris" scenes/cornell-dynamic.gltf --frames 0-1 --mode reuse --connections 2 \
   --no-eye-paths
@@ -105,7 +108,7 @@ with open(sys.argv[1], "wb") as f:
             f.write(bytes([200, 160, 120, 134] if (x, y) == (5, 1) else [100, 120, 160, 128]))
 PY
 run "atrium-normal-maps-env-pathtrace" "$work/bumps/atrium.gltf" --frames 0-1 --mode pathtrace \
-  --camera 1 --env "$work/bumps/sky.hdr" --env-rotate 40
+  --camera 1 --env "$work/bumps/sky.hdr" --env-rotate 40 --aov all
 run "atrium-normal-maps-env-reuse-connections" "$work/bumps/atrium.gltf" --frames 0-1 --mode reuse \
   --camera 1 --env "$work/bumps/sky.hdr" --env-rotate 40 --no-eye-paths
 run "atrium-normal-maps-env-eye" "$work/bumps/atrium.gltf" --frames 0-1 --mode reuse \

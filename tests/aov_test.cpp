@@ -1,0 +1,163 @@
+// --aov: auxiliary images as extra EXR channels (host/render/aov.h, kernels/aov.cl), checked
+// against what the scene makes exact: a wall's albedo, normal and depth, the motion of a
+// translated box and of a morphed one, and the ids of the objects and materials seen.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "io/image.h"
+#include "support/gltf_builder.h"
+#include "support/render_helpers.h"
+#include "support/test_env.h"
+
+namespace pr::test {
+namespace {
+
+constexpr int kSize = 64;
+constexpr float kFov = 0.8f;
+
+struct AovScene {
+  std::string path;
+  int wallNode = -1, movingNode = -1, morphNode = -1;
+};
+
+// A wall at z = -2 facing a camera at z = 5 along -z; before it a box (material 1) that moves
+// +1 in x per second, and one (material 2) that a morph target lifts by 1 per second. Lit by a
+// point light, so the background is empty.
+AovScene aovScene(const std::string& tag) {
+  GltfBuilder b;
+  const int wallMat = b.addMaterial({glm::vec4(0.2f, 0.4f, 0.6f, 1.0f)});
+  const int boxMat = b.addMaterial({glm::vec4(0.8f, 0.8f, 0.8f, 1.0f)});
+  const int morphMat = b.addMaterial({glm::vec4(0.5f, 0.5f, 0.5f, 1.0f)});
+  AovScene s;
+  s.wallNode = b.addNode(b.addQuad({-3, -3, -2}, {3, -3, -2}, {3, 3, -2}, {-3, 3, -2}, wallMat));
+  s.movingNode = b.addNode(b.addBox({-1.6f, -0.4f, -0.4f}, {-0.8f, 0.4f, 0.4f}, boxMat));
+  b.animateTranslation(s.movingNode, {0.0f, 4.0f}, {glm::vec3(0.0f), glm::vec3(4.0f, 0, 0)});
+  s.morphNode = b.addNode(
+      b.addBox({0.8f, -1.2f, -0.4f}, {1.6f, -0.4f, 0.4f}, morphMat, false, {0.0f, 1.0f, 0.0f}));
+  b.animateWeights(s.morphNode, {0.0f, 1.0f}, {{0.0f}, {1.0f}});
+  b.addCamera({0, 0, 5}, {0, 0, 0}, kFov, 1.0f);
+  b.addPointLight({0, 2, 3}, {1, 1, 1}, 50.0f);
+  s.path = b.write(tempDir(tag), "aov");
+  return s;
+}
+
+float at(const std::vector<float>& c, int x, int y) {
+  return c[size_t(y) * kSize + x];
+}
+
+// Film x of world point p for the test's camera (at z = 5, looking along -z).
+float filmX(glm::vec3 p) {
+  const float d = 5.0f - p.z;
+  return 0.5f * (p.x / (d * std::tan(0.5f * kFov)) + 1.0f) * kSize;
+}
+
+std::string args() {
+  return "--width " + std::to_string(kSize) + " --height " + std::to_string(kSize) +
+         " --fps 1 --spp 2 ";
+}
+
+TEST(Aov, ChannelsAreWrittenOnlyWhenAskedForInEveryMode) {
+  const AovScene s = aovScene("aov_modes");
+  const std::vector<std::string> names = {"albedo.R", "albedo.G",  "albedo.B",   "normal.X",
+                                          "normal.Y", "normal.Z",  "Z",          "motion.X",
+                                          "motion.Y", "object.ID", "material.ID"};
+  for (const std::string mode : {"reuse", "retrace", "pathtrace", "reuse --no-eye-paths"}) {
+    SCOPED_TRACE(mode);
+    const std::string dir =
+        renderFrames(s.path, "1", args() + "--aov all --mode " + mode, "aov_mode");
+    for (const std::string& n : names) {
+      const std::vector<float> c = readExrChannel(dir + "/f_0001.exr", n);
+      EXPECT_EQ(c.size(), size_t(kSize * kSize)) << n;
+    }
+    // The wall's depth where nothing stands before it (the top row's middle).
+    EXPECT_NEAR(at(readExrChannel(dir + "/f_0001.exr", "Z"), kSize / 2, 2), 7.0f, 1e-3f);
+  }
+  const std::string plain = renderFrames(s.path, "1", args(), "aov_none");
+  EXPECT_THROW(readExrChannel(plain + "/f_0001.exr", "albedo.R"), InputError);
+  // Half EXR: depth and ids stay 32-bit, the rest as the colour.
+  const std::string half = tempDir("aov_half");
+  const auto r = runPathreuse("render '" + s.path + "' --quiet --frames 1 --out '" + half +
+                              "/f_%04d.exr' --aov depth,object " + args());
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NEAR(at(readExrChannel(half + "/f_0001.exr", "Z"), kSize / 2, 2), 7.0f, 1e-4f);
+  EXPECT_THROW(readExrChannel(half + "/f_0001.exr", "normal.X"), InputError);
+}
+
+TEST(Aov, AWallsAlbedoNormalDepthAndIdsAreItsOwn) {
+  const AovScene s = aovScene("aov_wall");
+  const std::string dir = renderFrames(s.path, "0", args() + "--aov all --force-diffuse", "aov_w");
+  const std::string f = dir + "/f_0000.exr";
+  const auto r = readExrChannel(f, "albedo.R"), g = readExrChannel(f, "albedo.G"),
+             bl = readExrChannel(f, "albedo.B");
+  const auto nx = readExrChannel(f, "normal.X"), ny = readExrChannel(f, "normal.Y"),
+             nz = readExrChannel(f, "normal.Z");
+  const auto z = readExrChannel(f, "Z"), obj = readExrChannel(f, "object.ID"),
+             mat = readExrChannel(f, "material.ID");
+  int wall = 0;
+  for (int y = 0; y < 8; ++y)
+    for (int x = 8; x < kSize - 8; ++x) {  // the wall's top band: nothing before it
+      ++wall;
+      EXPECT_NEAR(at(r, x, y), 0.2f, 1e-5f);
+      EXPECT_NEAR(at(g, x, y), 0.4f, 1e-5f);
+      EXPECT_NEAR(at(bl, x, y), 0.6f, 1e-5f);
+      EXPECT_NEAR(at(nx, x, y), 0.0f, 1e-5f);
+      EXPECT_NEAR(at(ny, x, y), 0.0f, 1e-5f);
+      EXPECT_NEAR(at(nz, x, y), 1.0f, 1e-5f);
+      EXPECT_NEAR(at(z, x, y), 7.0f, 1e-4f);  // along the axis, not the ray
+      EXPECT_EQ(at(obj, x, y), float(s.wallNode));
+      EXPECT_EQ(at(mat, x, y), 0.0f);
+    }
+  EXPECT_GT(wall, 0);
+  // The moving box's front face at frame 0 (x from -1.6 to -0.8) and the morphed box's.
+  const int bx = int(filmX({-1.2f, 0, 0.4f})), mx = int(filmX({1.2f, 0, 0.4f}));
+  const int by = kSize / 2, my = kSize / 2 + 10;
+  EXPECT_EQ(at(obj, bx, by), float(s.movingNode));
+  EXPECT_EQ(at(mat, bx, by), 1.0f);
+  EXPECT_NEAR(at(z, bx, by), 4.6f, 1e-4f);
+  EXPECT_EQ(at(obj, mx, my), float(s.morphNode));
+  EXPECT_EQ(at(mat, mx, my), 2.0f);
+  // The default materials' albedo: the base under a little specular reflection.
+  const std::string full = renderFrames(s.path, "0", args() + "--aov albedo", "aov_full");
+  const auto fr = readExrChannel(full + "/f_0000.exr", "albedo.R");
+  EXPECT_GT(at(fr, kSize / 2, 2), 0.2f);
+  EXPECT_LT(at(fr, kSize / 2, 2), 0.3f);
+}
+
+TEST(Aov, MotionIsWhereThePreviousFrameSawTheSamePoint) {
+  const AovScene s = aovScene("aov_motion");
+  const std::string dir = renderFrames(s.path, "0-1", args() + "--aov motion", "aov_m");
+  // One unit at the boxes' front faces (z = 0.4, 4.6 from the camera), in pixels.
+  const float unit = filmX({1.0f, 0, 0.4f}) - filmX({0.0f, 0, 0.4f});
+  for (int frame : {0, 1}) {
+    char name[32];
+    std::snprintf(name, sizeof name, "/f_%04d.exr", frame);
+    const auto mx = readExrChannel(dir + name, "motion.X"),
+               my = readExrChannel(dir + name, "motion.Y");
+    // The wall stood still: exactly none; before frame 0 nothing moved either.
+    EXPECT_EQ(at(mx, kSize / 2, 2), 0.0f);
+    EXPECT_EQ(at(my, kSize / 2, 2), 0.0f);
+    // The translated box (at frame 1, x from -0.6 to 0.2): it was 1 unit to the left.
+    const int bx = int(filmX({-0.2f, 0, 0.4f})), by = kSize / 2;
+    EXPECT_NEAR(at(mx, bx, by), frame == 1 ? -unit : 0.0f, 1e-3f * unit) << frame;
+    EXPECT_NEAR(at(my, bx, by), 0.0f, 1e-3f * unit) << frame;
+    // The morphed box, lifted 1 unit since frame 0: it was lower (film y grows downwards).
+    const int mx0 = int(filmX({1.2f, 0, 0.4f})), my0 = kSize / 2 + 2;
+    EXPECT_NEAR(at(mx, mx0, my0), 0.0f, 1e-3f * unit) << frame;
+    EXPECT_NEAR(at(my, mx0, my0), frame == 1 ? unit : 0.0f, 1e-3f * unit) << frame;
+  }
+}
+
+TEST(Aov, AnUnknownImageIsAnInputError) {
+  const AovScene s = aovScene("aov_bad");
+  const auto r = runPathreuse("render '" + s.path + "' --quiet --frames 0 --out '" +
+                              tempDir("aov_bad_out") + "/f_%04d.exr' --aov albedo,shadow");
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_NE(r.err.find("--aov albedo,shadow: unknown image 'shadow'"), std::string::npos) << r.err;
+  EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+}
+
+}  // namespace
+}  // namespace pr::test
