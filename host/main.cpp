@@ -132,6 +132,10 @@ void addOutputOptions(CLI::App* render, RenderArgs& a) {
   render->add_option("--aov", ro.aov,
                      "Auxiliary images as extra channels of each EXR, a comma-separated list of "
                      "albedo, normal, depth, motion, object, material, or all");
+  render->add_flag("--denoise", ro.denoise,
+                   "Denoise each frame with Intel Open Image Denoise (installed by "
+                   "tools/setup/oidn.sh), guided by the albedo and normals; the noisy image "
+                   "stays in the EXR as noisy.R/G/B");
   render->add_option("--exposure", ro.exposure, "Exposure in stops for the PNG")
       ->check(finiteIn(-64, 64))
       ->capture_default_str();

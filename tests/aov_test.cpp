@@ -4,10 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <string>
 #include <vector>
 
 #include "io/image.h"
+#include "portability/compare.h"
 #include "support/gltf_builder.h"
 #include "support/render_helpers.h"
 #include "support/test_env.h"
@@ -157,6 +159,43 @@ TEST(Aov, AnUnknownImageIsAnInputError) {
   EXPECT_EQ(r.exitCode, 2);
   EXPECT_NE(r.err.find("--aov albedo,shadow: unknown image 'shadow'"), std::string::npos) << r.err;
   EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+}
+
+// --denoise (render/denoise.h, Open Image Denoise from tools/setup/oidn.sh, which the install
+// script runs): the colour becomes the denoised image, closer to a converged one than the noisy
+// one it keeps as noisy.R/G/B, which is the render without --denoise.
+TEST(Denoise, TheColourIsDenoisedAndTheNoisyOneKept) {
+  const std::string scene = sourcePath("scenes/cornell-dynamic.gltf");
+  const std::string size = "--width 96 --height 72 --spp 2 ";
+  const std::string noisy = renderFrames(scene, "3", size, "denoise_off");
+  const std::string denoised = renderFrames(scene, "3", size + "--denoise", "denoise_on");
+  const std::string ref =
+      renderFrames(scene, "3", "--width 96 --height 72 --spp 512 --seed 9", "denoise_ref");
+  const Image n = frameImage(noisy, 3), d = frameImage(denoised, 3), r = frameImage(ref, 3);
+  const char* names[3] = {"noisy.R", "noisy.G", "noisy.B"};
+  for (int c = 0; c < 3; ++c) {
+    const std::vector<float> kept = readExrChannel(denoised + "/f_0003.exr", names[c]);
+    for (size_t p = 0; p < kept.size(); ++p)
+      ASSERT_EQ(kept[p], n.rgba[p * 4 + c]) << names[c] << " pixel " << p;
+  }
+  const double before = compareImages(n, r).relMse, after = compareImages(d, r).relMse;
+  EXPECT_LT(after, 0.25 * before) << "noisy " << before << ", denoised " << after;
+  EXPECT_EQ(compareImages(d, r).nonFinite, 0u);
+  // Without --denoise there is nothing but the colour.
+  EXPECT_THROW(readExrChannel(noisy + "/f_0003.exr", "noisy.R"), InputError);
+}
+
+TEST(Denoise, WithoutTheLibraryItIsAnInputErrorThatSaysHowToInstallIt) {
+  const std::string out = tempDir("denoise_missing");
+  const auto r =
+      runPathreuse("render '" + sourcePath("scenes/cornell-dynamic.gltf") +
+                       "' --quiet --frames 0 --width 32 --denoise --out '" + out + "/f_%04d.exr'",
+                   "PATHREUSE_OIDN=/nonexistent/libOpenImageDenoise.so.2");
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_NE(r.err.find("--denoise: Open Image Denoise 2 not found"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("bash tools/setup/oidn.sh"), std::string::npos) << r.err;
+  EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+  EXPECT_FALSE(std::ifstream(out + "/f_0000.exr").good());
 }
 
 }  // namespace

@@ -49,8 +49,9 @@ uint32_t parseAovs(const std::string& list) {
 }
 
 AovRenderer::AovRenderer(Context& ctx, const Scene& scene, GpuScene& gpu, uint32_t aovs,
-                         const AovSampling& sampling)
+                         const AovSampling& sampling, bool denoise)
     : ctx_(ctx), scene_(scene), gpu_(gpu), aovs_(aovs), sampling_(sampling) {
+  if (denoise) denoiser_ = std::make_unique<Denoiser>();
   kernel_ = kargs::kernel<kargs::AovArgs>(ctx_, "aov.cl", gpu_.buildOptions());
   // Objects are glTF nodes: the SSG's triangles keep theirs, an instance is its node's.
   std::vector<uint32_t> tri(scene_.staticTriangleNodes.begin(), scene_.staticTriangleNodes.end());
@@ -91,7 +92,7 @@ void AovRenderer::uploadPrevious(double t) {
   restUploaded_ = true;
 }
 
-double AovRenderer::render(int frame, double fps, int camera, Image* image) {
+std::pair<double, double> AovRenderer::render(int frame, double fps, int camera, Image* image) {
   const auto t0 = std::chrono::steady_clock::now();
   const int w = image->width, h = image->height;
   const uint32_t n = uint32_t(w) * uint32_t(h);
@@ -149,7 +150,35 @@ double AovRenderer::render(int frame, double fps, int camera, Image* image) {
   }
   if (aovs_ & kAovObject) channel("object.ID", 9, false, true);
   if (aovs_ & kAovMaterial) channel("material.ID", 10, false, true);
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const auto t1 = std::chrono::steady_clock::now();
+  if (denoiser_) denoise(v, image);
+  return {std::chrono::duration<double>(t1 - t0).count(),
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count()};
+}
+
+void AovRenderer::denoise(const std::vector<float>& v, Image* image) {
+  const size_t n = size_t(image->width) * image->height;
+  std::vector<float> color(n * 3), albedo(n * 3), normal(n * 3);
+  for (size_t p = 0; p < n; ++p) {
+    const float* px = &v[p * kAovFloats];
+    for (int k = 0; k < 3; ++k) {
+      color[p * 3 + k] = image->rgba[p * 4 + k];
+      albedo[p * 3 + k] = px[k] / px[11];
+      normal[p * 3 + k] = px[3 + k] / px[11];
+    }
+  }
+  denoiser_->denoise(image->width, image->height, color.data(), albedo.data(), normal.data());
+  for (int k = 0; k < 3; ++k) {
+    ImageChannel c{k == 0   ? "noisy.R"
+                   : k == 1 ? "noisy.G"
+                            : "noisy.B",
+                   std::vector<float>(n), false};
+    for (size_t p = 0; p < n; ++p) {
+      c.values[p] = image->rgba[p * 4 + k];
+      image->rgba[p * 4 + k] = color[p * 3 + k];
+    }
+    image->channels.push_back(std::move(c));
+  }
 }
 
 }  // namespace pr

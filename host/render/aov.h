@@ -5,10 +5,13 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
+#include <utility>
 #include <string>
 #include <vector>
 
 #include "cl/context.h"
+#include "render/denoise.h"
 #include "io/image.h"
 #include "render/gpu_scene.h"
 #include "scene/scene.h"
@@ -40,22 +43,30 @@ struct AovSampling {
 
 class AovRenderer {
  public:
-  // `scene` and `gpu` must outlive this.
+  // `scene` and `gpu` must outlive this. With `denoise`, loads Open Image Denoise (throws
+  // InputError where it is missing) and computes albedo and normal for it, written only where
+  // `aovs` asks for them.
   AovRenderer(Context& ctx, const Scene& scene, GpuScene& gpu, uint32_t aovs,
-              const AovSampling& sampling);
-  // Adds the channels of frame f (at time f / fps, the GpuScene set to it) to `image`.
-  // Returns the kernel's seconds.
-  double render(int frame, double fps, int camera, Image* image);
+              const AovSampling& sampling, bool denoise);
+  // Adds the channels of frame f (at time f / fps, the GpuScene set to it) to `image`; with
+  // denoising, the image's colour becomes the denoised one and the noisy one the channels
+  // noisy.R/G/B. Returns the seconds of the auxiliary images and of the denoising.
+  std::pair<double, double> render(int frame, double fps, int camera, Image* image);
+  // OIDN's device type once a frame was denoised ("" before, or without --denoise).
+  std::string denoiseDevice() const { return denoiser_ ? denoiser_->deviceType() : ""; }
 
  private:
   // The dynamic meshes' vertices at time t, in object space, as the device's vertex array
   // orders them after the SSG's (deformed meshes at their shapes then).
   void uploadPrevious(double t);
+  // The colour denoised with the pixels' albedo and normal (v: the kernel's output).
+  void denoise(const std::vector<float>& v, Image* image);
 
   Context& ctx_;
   const Scene& scene_;
   GpuScene& gpu_;
   uint32_t aovs_;
+  std::unique_ptr<Denoiser> denoiser_;
   AovSampling sampling_;
   cl::Kernel kernel_;
   cl::Buffer out_, prevInst_, prevPos_, triObject_, instObject_;

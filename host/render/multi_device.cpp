@@ -96,6 +96,7 @@ MultiDeviceSession::MultiDeviceSession(const Scene& scene,
   // The first frame: an even split.
   const std::vector<double> even(devices.size(), 1.0);
   spp_ = options.spp;
+  denoise_ = options.denoise;
   if (resolveResample(options).enabled && devices.size() > 1) {
     passes_ = splitRows(spp_, even);
     int begin = 0;
@@ -198,9 +199,12 @@ Image MultiDeviceSession::renderFrame(int frame, FrameStats* total,
     });
   }
 
-  // Auxiliary images on the first device, for the whole image whatever the split.
-  if (sessions_[0]->hasAovs() && !interrupted())
-    p[0].stats.stageSeconds["aov"] += sessions_[0]->renderAovs(frame, &img);
+  // Auxiliary images (and denoising) on the first device, for the whole image whatever the split.
+  if (sessions_[0]->hasAovs() && !interrupted()) {
+    const auto [aov, denoise] = sessions_[0]->renderAovs(frame, &img);
+    p[0].stats.stageSeconds["aov"] += aov;
+    if (denoise_) p[0].stats.stageSeconds["denoise"] += denoise;
+  }
 
   if (total) {
     FrameStats& t = *total;

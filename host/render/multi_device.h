@@ -91,6 +91,7 @@ class MultiDeviceSession {
   std::vector<double> throughput_;  // rows per second of the last frame each device rendered
   std::vector<int> passes_;         // with --resample and several devices, passes per device
   int spp_ = 0;                     // samples per pixel of a frame
+  bool denoise_ = false;            // --denoise
 };
 
 }  // namespace pr

@@ -78,7 +78,8 @@ struct RenderOptions {
   std::string outPattern = "out/frame_%04d.exr";
   bool exrFloat = false;
   bool png = false;
-  std::string aov;  // --aov: auxiliary images as extra EXR channels (render/aov.h); "" = none
+  std::string aov;       // --aov: auxiliary images as extra EXR channels (render/aov.h); "" = none
+  bool denoise = false;  // --denoise: Open Image Denoise (render/denoise.h)
   float exposure = 0.0f;
   bool quiet = false;
   bool forceDiffuse = false;

@@ -159,19 +159,20 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
     pathTracer_ = reuse->eyePaths();
     integrator_ = std::move(reuse);
   }
-  if (!o.aov.empty()) {
+  if (!o.aov.empty() || o.denoise) {
     AovSampling a;
     a.seed = o.seed;
     a.jitterFromFrame0 = resample.enabled || o.fixedNoise;
     a.spp = o.spp;
     a.maxDepth = o.maxDepth;
-    aov_ = std::make_unique<AovRenderer>(ctx_, scene, *gpu_, parseAovs(o.aov), a);
+    aov_ = std::make_unique<AovRenderer>(ctx_, scene, *gpu_, o.aov.empty() ? 0u : parseAovs(o.aov),
+                                         a, o.denoise);
   }
 }
 
 RenderSession::~RenderSession() = default;
 
-double RenderSession::renderAovs(int frame, Image* image) {
+std::pair<double, double> RenderSession::renderAovs(int frame, Image* image) {
   return aov_->render(frame, options_.fps, camera_, image);
 }
 

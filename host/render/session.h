@@ -5,6 +5,7 @@
 
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "cl/context.h"
 #include "cl/device.h"
@@ -43,10 +44,11 @@ class RenderSession {
   Image renderFrame(int frame, FrameStats* stats);
   // The same, writing only the rows setRows() chose into `image` (of the session's size).
   void renderRows(int frame, Image* image, FrameStats* stats);
-  // --aov: whether the session makes auxiliary images, and adding frame f's to `image` (the
-  // whole image, after the frame's colour: render/aov.h). Returns the seconds taken.
+  // --aov, --denoise: whether the session makes auxiliary images, and adding frame f's to
+  // `image` (the whole image, after the frame's colour), denoising it where asked
+  // (render/aov.h). Returns the seconds of each.
   bool hasAovs() const { return aov_ != nullptr; }
-  double renderAovs(int frame, Image* image);
+  std::pair<double, double> renderAovs(int frame, Image* image);
   // Rows [rowBegin, rowEnd) of each frame are rendered (default: all). The light paths of
   // path reuse cover every slot whatever the rows (render/multi_device.h).
   void setRows(int rowBegin, int rowEnd) { film_->setRows(rowBegin, rowEnd); }

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian packages that pathreuse's build, tests and PoCL need (python3-venv for
-# tools/setup/intel-opencl.sh, the second platform of the tests; oclgrind for
+# tools/setup/intel-opencl.sh, the second platform of the tests, and for tools/setup/oidn.sh,
+# Open Image Denoise, which it then installs; oclgrind for
 # tools/ci/oclgrind-check.sh; clang-format for tools/ci/format-check.sh; ccache, through which
 # CMakeLists.txt compiles where it is present; Slurm and munge for tools/slurm/'s single-node
 # test cluster).
@@ -27,12 +28,13 @@ done
 
 if [ ${#missing[@]} -eq 0 ]; then
   echo "install-deps: all ${#packages[@]} packages present"
-  exit 0
+else
+  echo "install-deps: installing ${missing[*]}"
+  SUDO=""
+  if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
-
-echo "install-deps: installing ${missing[*]}"
-SUDO=""
-if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -qq
-$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+# Open Image Denoise for --denoise, from PyPI into the user's cache (Debian 12 has none).
+bash "$(dirname "$0")/oidn.sh" >/dev/null
