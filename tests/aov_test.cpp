@@ -152,6 +152,35 @@ TEST(Aov, MotionIsWhereThePreviousFrameSawTheSamePoint) {
   }
 }
 
+// Under an orbiting camera every pixel moves: the previous frame's albedo fetched where the
+// motion points matches this frame's far better than the same pixel's does.
+TEST(Aov, MotionWarpsThePreviousFrameOntoThisOneUnderAMovingCamera) {
+  const int w = 80, h = 60;
+  const std::string dir = renderFrames(sourcePath("scenes/cornell-orbit.gltf"), "4-5",
+                                       "--width 80 --height 60 --spp 4 --fps 2 --force-diffuse "
+                                       "--aov albedo,motion",
+                                       "aov_orbit");
+  const std::vector<float> now = readExrChannel(dir + "/f_0005.exr", "albedo.G"),
+                           then = readExrChannel(dir + "/f_0004.exr", "albedo.G"),
+                           mx = readExrChannel(dir + "/f_0005.exr", "motion.X"),
+                           my = readExrChannel(dir + "/f_0005.exr", "motion.Y");
+  double warped = 0.0, still = 0.0, moved = 0.0;
+  int n = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const size_t p = size_t(y) * w + x;
+      const int qx = int(std::floor(x + 0.5f + mx[p])), qy = int(std::floor(y + 0.5f + my[p]));
+      if (qx < 0 || qy < 0 || qx >= w || qy >= h) continue;
+      ++n;
+      warped += std::fabs(now[p] - then[size_t(qy) * w + qx]);
+      still += std::fabs(now[p] - then[p]);
+      moved += std::hypot(mx[p], my[p]);
+    }
+  ASSERT_GT(n, w * h / 2);
+  EXPECT_GT(moved / n, 0.5) << "the camera should move the image by some pixels";
+  EXPECT_LT(warped, 0.5 * still) << "warped " << warped / n << ", unwarped " << still / n;
+}
+
 TEST(Aov, AnUnknownImageIsAnInputError) {
   const AovScene s = aovScene("aov_bad");
   const auto r = runPathreuse("render '" + s.path + "' --quiet --frames 0 --out '" +
