@@ -199,7 +199,7 @@ TEST(Denoise, TheColourIsDenoisedAndTheNoisyOneKept) {
   const std::string noisy = renderFrames(scene, "3", size, "denoise_off");
   const std::string denoised = renderFrames(scene, "3", size + "--denoise", "denoise_on");
   const std::string ref =
-      renderFrames(scene, "3", "--width 96 --height 72 --spp 512 --seed 9", "denoise_ref");
+      renderFrames(scene, "3", "--width 96 --height 72 --spp 256 --seed 9", "denoise_ref");
   const Image n = frameImage(noisy, 3), d = frameImage(denoised, 3), r = frameImage(ref, 3);
   const char* names[3] = {"noisy.R", "noisy.G", "noisy.B"};
   for (int c = 0; c < 3; ++c) {
