@@ -181,6 +181,25 @@ TEST(Aov, MotionWarpsThePreviousFrameOntoThisOneUnderAMovingCamera) {
   EXPECT_LT(warped, 0.5 * still) << "warped " << warped / n << ", unwarped " << still / n;
 }
 
+// Two devices split the colour, and the first makes the auxiliary images for the whole image:
+// they are one device's, bit for bit.
+TEST(Aov, TwoDevicesGiveOneDevicesImages) {
+  const AovScene s = aovScene("aov_devices");
+  const std::string two = twoPoclDevices(), one = two.substr(0, two.find(" --device", 1));
+  std::vector<std::string> dirs;
+  for (const std::string& devices : {one, two}) {
+    dirs.push_back(tempDir("aov_dev"));
+    const auto r = runPathreuse("render '" + s.path + "' --quiet --exr-float --frames 0-1 --out '" +
+                                    dirs.back() + "/f_%04d.exr' --aov all " + args() + devices,
+                                kTwoPoclDrivers);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+  }
+  for (const char* c : {"albedo.R", "normal.Z", "Z", "motion.X", "motion.Y", "object.ID"})
+    EXPECT_EQ(readExrChannel(dirs[0] + "/f_0001.exr", c),
+              readExrChannel(dirs[1] + "/f_0001.exr", c))
+        << c;
+}
+
 TEST(Aov, AnUnknownImageIsAnInputError) {
   const AovScene s = aovScene("aov_bad");
   const auto r = runPathreuse("render '" + s.path + "' --quiet --frames 0 --out '" +
