@@ -129,6 +129,11 @@ void addOutputOptions(CLI::App* render, RenderArgs& a) {
       ->capture_default_str();
   render->add_flag("--exr-float", ro.exrFloat, "Write 32-bit float EXR (default: half)");
   render->add_flag("--png", ro.png, "Also write an sRGB PNG beside each EXR");
+  render
+      ->add_option("--time-limit", ro.timeLimit,
+                   "Seconds per frame: no sample pass starts once they have run out (at least "
+                   "one; at most --spp); the stats line gives each frame's spp")
+      ->check(finiteIn(0, 1e9));
   render->add_option("--aov", ro.aov,
                      "Auxiliary images as extra channels of each EXR, a comma-separated list of "
                      "albedo, normal, depth, motion, object, material, or all");

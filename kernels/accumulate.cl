@@ -21,13 +21,15 @@ PR_KERNEL void accumulate(PR_PARAMS(PR_ARGS_ACCUMULATE)) {
 }
 
 // splat_film (strategy T): one work-item per pixel of the film's range (launched from its first
-// pixel, up to `end`). Adds the pixel's splats (shared/splat.h) to its film sum, not to its
-// count, and clears them for the next frame.
+// pixel, up to `end`). Adds the pixel's splats (shared/splat.h) times `scale` (1, or under
+// --time-limit what brings them from spp samples to the passes rendered) to its film sum, not
+// to its count, and clears them for the next frame where `clear`.
 PR_KERNEL void splat_film(PR_PARAMS(PR_ARGS_SPLAT_FILM)) {
   const uint i = (uint)get_global_id(0);
   if (i >= end) return;
   __global uint* w = splat + (size_t)i * PR_SPLAT_WORDS;
   const float r = splat_value(w[0], w[1]), g = splat_value(w[2], w[3]), b = splat_value(w[4], w[5]);
-  film[i] += (float4)(r, g, b, 0.0f);
-  for (uint k = 0u; k < PR_SPLAT_WORDS; ++k) w[k] = 0u;
+  film[i] += (float4)(r, g, b, 0.0f) * scale;
+  if (clear)
+    for (uint k = 0u; k < PR_SPLAT_WORDS; ++k) w[k] = 0u;
 }

@@ -38,10 +38,12 @@ void Film::accumulate(const cl::Buffer& radiance, StageTimer* timer) {
   ctx_.launch1D(accumulate_, first(), end(), "accumulate", timer);
 }
 
-void Film::addSplats(const cl::Buffer& splat, StageTimer* timer) {
+void Film::addSplats(const cl::Buffer& splat, StageTimer* timer, float scale, bool clear) {
   kargs::SplatFilmArgs a;
   a.splat = splat;
   a.film = film_;
+  a.scale = scale;
+  a.clear = clear ? 1u : 0u;
   a.end = end();
   a.set(splatFilm_);
   ctx_.launch1D(splatFilm_, first(), end(), "splat_film", timer);

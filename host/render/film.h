@@ -20,8 +20,8 @@ class Film {
   // Adds the radiance (float4 per pixel, indexed by pixel) of the range's pixels.
   void accumulate(const cl::Buffer& radiance, StageTimer* timer);
   // Adds the range's fixed-point splats (kernels/shared/splat.h, 6 words per pixel, indexed by
-  // pixel) to the sums, not to the counts, and clears them.
-  void addSplats(const cl::Buffer& splat, StageTimer* timer);
+  // pixel) times `scale` to the sums, not to the counts, and clears them where `clear`.
+  void addSplats(const cl::Buffer& splat, StageTimer* timer, float scale = 1.0f, bool clear = true);
   // The mean radiance per pixel (alpha 1), and how many samples were non-finite and dropped.
   Image read(uint64_t* badSamples = nullptr);
   // The same for the range's rows only, written into `image` (of the film's size).

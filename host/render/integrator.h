@@ -1,6 +1,7 @@
 // What every rendering mode provides to the frame loop.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <map>
 #include <set>
@@ -27,6 +28,7 @@ struct FrameStats {
   std::set<std::string> lightPathCounters;
   uint64_t deviceBytes = 0;
   uint64_t badSamples = 0;
+  int passes = 0;  // sample passes rendered (each pixel's samples; fewer under --time-limit)
 };
 
 class Integrator {
@@ -44,9 +46,20 @@ class Integrator {
     passEnd_ = end;
   }
 
+  // --time-limit: a frame renders no pass after the one during which `seconds`, counted from
+  // the start of renderFrame, ran out (at least one pass); 0: none.
+  void setTimeLimit(double seconds) { timeLimit_ = seconds; }
+
  protected:
+  using Clock = std::chrono::steady_clock;
   int passEnd(int spp) const { return passEnd_ < 0 ? spp : passEnd_; }
+  // Whether the frame begun at `start` is out of time.
+  bool outOfTime(Clock::time_point start) const {
+    return timeLimit_ > 0.0 &&
+           std::chrono::duration<double>(Clock::now() - start).count() >= timeLimit_;
+  }
   int passBegin_ = 0, passEnd_ = -1;
+  double timeLimit_ = 0.0;
 };
 
 }  // namespace pr

@@ -90,6 +90,10 @@ MultiDeviceSession::MultiDeviceSession(const Scene& scene,
                                        const RenderOptions& options)
     : devices_(devices), sessions_(devices.size()), throughput_(devices.size(), 0.0) {
   PR_CHECK(!devices.empty());
+  if (options.timeLimit > 0.0 && devices.size() > 1)
+    throw InputError(
+        "--time-limit: renders on one device (several split each frame's passes "
+        "or rows by measured speed already)");
   forEachDevice(devices.size(), [&](size_t i) {
     sessions_[i] = std::make_unique<RenderSession>(scene, *devices[i], options);
   });
@@ -209,6 +213,11 @@ Image MultiDeviceSession::renderFrame(int frame, FrameStats* total,
   if (total) {
     FrameStats& t = *total;
     t.frame = frame;
+    // Each pixel's samples: every device's passes where they split them, else one's.
+    t.passes = 0;
+    for (size_t i = 0; i < n; ++i)
+      t.passes =
+          passes_.empty() ? std::max(t.passes, p[i].stats.passes) : t.passes + p[i].stats.passes;
     for (size_t i = 0; i < n; ++i) {
       const FrameStats& s = p[i].stats;
       for (const auto& [k, v] : s.stageSeconds) t.stageSeconds[k] += v;

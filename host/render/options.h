@@ -69,6 +69,8 @@ struct RenderOptions {
   int width = 0;  // 0: the camera's aspect with height, else 640x480
   int height = 0;
   int spp = 4;
+  double timeLimit =
+      0.0;  // --time-limit: seconds of sampling per frame (render/integrator.h); 0 = none
   int maxDepth = 8;
   uint32_t seed = 1;
   // --device SPECs, repeatable; "all" for every device; none: the default device.

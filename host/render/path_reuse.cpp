@@ -131,6 +131,7 @@ dev::ReuseParams PathReuse::frameParams(int frame) const {
 }
 
 void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameStats* stats) {
+  const Clock::time_point start = Clock::now();
   StageTimer timer;
   ctx_.zero(counters_, dev::PR_C_COUNT * 4);
   dev::ReuseParams rp = frameParams(frame);
@@ -186,8 +187,18 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
   // Once per frame, by the device with the first pass (several devices add their films), before
   // the passes: the film's sum is then the splats and the samples in pass order, as one device
   // adds them, wherever the passes after the first device's run.
-  if (settings_.lightTracing && passBegin_ == 0) splatToCamera(camera, rp, sceneArgs, &timer);
-  if (!tracePasses(frame, camera, rp, sceneArgs, frameStamp, &timer)) return;
+  // With a time limit (one device) the splats are kept, to be scaled to the passes rendered.
+  const bool splat = settings_.lightTracing && passBegin_ == 0;
+  if (splat) splatToCamera(camera, rp, sceneArgs, &timer);
+  const int passes = tracePasses(frame, camera, rp, sceneArgs, frameStamp, start, &timer);
+  if (passes < 0) return;
+  if (splat && timeLimit_ > 0.0) {
+    // They were added for spp samples per pixel; the film's mean divides by `passes`.
+    const int spp = settings_.spp;
+    if (passes < spp) film_.addSplats(splat_, &timer, float(passes - spp) / float(spp));
+    ctx_.zero(splat_, uint64_t(film_.pixels()) * PR_SPLAT_WORDS * 4);
+  }
+  if (stats) stats->passes = passes;
   if (eyePaths_) eyePaths_->reportRays(stats);
   report(&timer, toTrace, stats);
 }
@@ -208,12 +219,12 @@ void PathReuse::splatToCamera(const dev::CameraParams& camera, const dev::ReuseP
   a.counters = counters_;
   a.set(cameraSplat_);
   ctx_.launch1D(cameraSplat_, slots_, "camera_splat", timer);
-  film_.addSplats(splat_, timer);
+  film_.addSplats(splat_, timer, 1.0f, timeLimit_ <= 0.0);
 }
 
-bool PathReuse::tracePasses(int frame, const dev::CameraParams& camera, const dev::ReuseParams& rp,
-                            const kargs::SceneArgs& sceneArgs, cl_uint frameStamp,
-                            StageTimer* timer) {
+int PathReuse::tracePasses(int frame, const dev::CameraParams& camera, const dev::ReuseParams& rp,
+                           const kargs::SceneArgs& sceneArgs, cl_uint frameStamp,
+                           Clock::time_point start, StageTimer* timer) {
   // 3. Per sample: first hits, then connections, then the film.
   // `sample` changes per pass.
   kargs::EyeHitArgs eh;
@@ -255,6 +266,7 @@ bool PathReuse::tracePasses(int frame, const dev::CameraParams& camera, const de
   }
   if (eyePaths_) eyePaths_->beginFrame(frame, camera, sceneArgs, radiance_, eye_);
   const cl_uint first = film_.first(), n = film_.end();
+  int passes = 0;
   for (int s = passBegin_; s < passEnd(settings_.spp); ++s) {
     // With eye paths, the path tracer's pass writes the sample's radiance and its first eye
     // vertex, where eye_hit would.
@@ -281,9 +293,11 @@ bool PathReuse::tracePasses(int frame, const dev::CameraParams& camera, const de
     film_.accumulate(radiance_, timer);
     // Wait for each pass, so that an interrupt stops a frame of many samples within one pass.
     ctx_.finish();
-    if (interrupted()) return false;
+    if (interrupted()) return -1;
+    ++passes;
+    if (outOfTime(start)) break;
   }
-  return true;
+  return passes;
 }
 
 void PathReuse::report(StageTimer* timer, cl_uint toTrace, FrameStats* stats) {

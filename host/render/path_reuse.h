@@ -75,10 +75,12 @@ class PathReuse : public Integrator {
   // Strategy T: the arena's vertices joined to the camera, into the film.
   void splatToCamera(const dev::CameraParams& camera, const dev::ReuseParams& rp,
                      const kargs::SceneArgs& sceneArgs, StageTimer* timer);
-  // The frame's sample passes: first hits (or the eye paths), connections, the film. False when
-  // interrupted.
-  bool tracePasses(int frame, const dev::CameraParams& camera, const dev::ReuseParams& rp,
-                   const kargs::SceneArgs& sceneArgs, cl_uint frameStamp, StageTimer* timer);
+  // The frame's sample passes: first hits (or the eye paths), connections, the film; no pass
+  // after the one during which the time limit (from `start`) ran out. Returns the passes
+  // rendered, -1 when interrupted.
+  int tracePasses(int frame, const dev::CameraParams& camera, const dev::ReuseParams& rp,
+                  const kargs::SceneArgs& sceneArgs, cl_uint frameStamp, Clock::time_point start,
+                  StageTimer* timer);
   // Reads the counters and adds them and the stage times to stats.
   void report(StageTimer* timer, cl_uint toTrace, FrameStats* stats);
 

@@ -397,15 +397,20 @@ void PathTracer::reportRays(FrameStats* stats) {
 }
 
 void PathTracer::renderFrame(int frame, const dev::CameraParams& camera, FrameStats* stats) {
+  const Clock::time_point start = Clock::now();
   StageTimer timer;
   beginFrame(frame, camera, scene_.kernelArgs(), radiance_, noEye_);
+  int passes = 0;
   for (int s = passBegin_; s < passEnd(settings_.spp); ++s) {
     tracePass(s, &timer);
     film_.accumulate(radiance_, &timer);
     // Wait for each pass, so that an interrupt stops a frame of many samples within one pass.
     ctx_.finish();
     if (interrupted()) return;
+    ++passes;
+    if (outOfTime(start)) break;
   }
+  if (stats) stats->passes = passes;
   reportRays(stats);
   if (stats) {
     for (const auto& [k, v] : timer.collect()) stats->stageSeconds[k] += v;

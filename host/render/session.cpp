@@ -89,6 +89,12 @@ void validateRenderOptions(const RenderOptions& o) {
                      ": must be 1 to 1000");
   if (!std::isfinite(o.exposure)) throw InputError("--exposure: must be finite");
   if (!o.aov.empty()) parseAovs(o.aov);
+  if (!(o.timeLimit >= 0.0) || !std::isfinite(o.timeLimit))
+    throw InputError("--time-limit: must be 0 (none) or positive seconds");
+  if (o.timeLimit > 0.0 && o.connectionHistory > 0)
+    throw InputError(
+        "--time-limit: cannot be combined with --connection-history, whose "
+        "reservoirs follow every pass of every frame");
   if (!(o.envStrength >= 0.0f) || !std::isfinite(o.envStrength))
     throw InputError("--env-strength: must be 0 or positive");
   if (!std::isfinite(o.envRotate)) throw InputError("--env-rotate: must be finite");
@@ -159,6 +165,7 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
     pathTracer_ = reuse->eyePaths();
     integrator_ = std::move(reuse);
   }
+  integrator_->setTimeLimit(o.timeLimit);
   if (!o.aov.empty() || o.denoise) {
     AovSampling a;
     a.seed = o.seed;

@@ -240,6 +240,8 @@
 #define PR_ARGS_SPLAT_FILM(X) \
   X(FRAME, OUT, uint, splat)  \
   X(FRAME, OUT, float4, film) \
+  X(FRAME, VAL, float, scale) \
+  X(FRAME, VAL, uint, clear)  \
   X(FRAME, VAL, uint, first)  \
   X(FRAME, VAL, uint, end)
 
