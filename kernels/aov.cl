@@ -25,7 +25,7 @@ PR_INLINE float3 aov_previous_point(const ShadingData* sd, __global const float*
   float3 p[3];
   const uint v[3] = {tri.v0, tri.v1, tri.v2};
   for (int k = 0; k < 3; ++k) {
-    if (inst == PR_INVALID_INDEX || v[k] < static_vertices) {
+    if (inst == PR_INVALID_INDEX) {
       const ShadingVertex sv = sd->vertices[v[k]];
       p[k] = make_float3(sv.px, sv.py, sv.pz);
     } else {

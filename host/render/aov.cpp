@@ -2,7 +2,6 @@
 
 #include <chrono>
 #include <cmath>
-#include <limits>
 #include <sstream>
 
 #include "cl/kernel_args.h"
@@ -14,35 +13,27 @@ namespace {
 
 constexpr int kAovFloats = 12;  // per pixel, kernels/aov.cl's PR_AOV_FLOATS
 
-void rows(const glm::mat4& m, float* out) {
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 4; ++c) out[r * 4 + c] = m[c][r];
-}
-
 }  // namespace
 
 uint32_t parseAovs(const std::string& list) {
+  static const std::pair<const char*, uint32_t> kNames[] = {{"albedo", kAovAlbedo},
+                                                            {"normal", kAovNormal},
+                                                            {"depth", kAovDepth},
+                                                            {"motion", kAovMotion},
+                                                            {"object", kAovObject},
+                                                            {"material", kAovMaterial},
+                                                            {"all", 63u}};
   uint32_t bits = 0;
   std::stringstream in(list);
   std::string name;
   while (std::getline(in, name, ',')) {
-    if (name == "albedo")
-      bits |= kAovAlbedo;
-    else if (name == "normal")
-      bits |= kAovNormal;
-    else if (name == "depth")
-      bits |= kAovDepth;
-    else if (name == "motion")
-      bits |= kAovMotion;
-    else if (name == "object")
-      bits |= kAovObject;
-    else if (name == "material")
-      bits |= kAovMaterial;
-    else if (name == "all")
-      bits |= 63u;
-    else
+    uint32_t bit = 0;
+    for (const auto& [n, b] : kNames)
+      if (name == n) bit = b;
+    if (!bit)
       throw InputError("--aov " + list + ": unknown image '" + name +
                        "' (albedo, normal, depth, motion, object, material, all)");
+    bits |= bit;
   }
   if (!bits) throw InputError("--aov: names no image");
   return bits;
@@ -51,7 +42,10 @@ uint32_t parseAovs(const std::string& list) {
 AovRenderer::AovRenderer(Context& ctx, const Scene& scene, GpuScene& gpu, uint32_t aovs,
                          const AovSampling& sampling, bool denoise)
     : ctx_(ctx), scene_(scene), gpu_(gpu), aovs_(aovs), sampling_(sampling) {
-  if (denoise) denoiser_ = std::make_unique<Denoiser>();
+  if (denoise) denoiser_ = std::make_unique<Denoiser>();  // a missing library: an error now
+}
+
+void AovRenderer::setUp() {
   kernel_ = kargs::kernel<kargs::AovArgs>(ctx_, "aov.cl", gpu_.buildOptions());
   // Objects are glTF nodes: the SSG's triangles keep theirs, an instance is its node's.
   std::vector<uint32_t> tri(scene_.staticTriangleNodes.begin(), scene_.staticTriangleNodes.end());
@@ -97,10 +91,11 @@ std::pair<double, double> AovRenderer::render(int frame, double fps, int camera,
   const int w = image->width, h = image->height;
   const uint32_t n = uint32_t(w) * uint32_t(h);
   const double then = (frame - 1) / fps;
+  if (!kernel_()) setUp();  // on the one device that renders them, at its first frame
   uploadPrevious(then);
   std::vector<float> inst(std::max<size_t>(scene_.instances.size(), 1) * 12, 0.0f);
   for (size_t i = 0; i < scene_.instances.size(); ++i)
-    rows(scene_.instanceTransform(i, then), &inst[i * 12]);
+    toRows(scene_.instanceTransform(i, then), &inst[i * 12]);
   CL_CHECK(ctx_.queue().enqueueWriteBuffer(prevInst_, CL_TRUE, 0, inst.size() * 4, inst.data()));
   if (n > outPixels_) {
     if (out_()) ctx_.release(uint64_t(outPixels_) * kAovFloats * 4);

@@ -56,6 +56,8 @@ class AovRenderer {
   std::string denoiseDevice() const { return denoiser_ ? denoiser_->deviceType() : ""; }
 
  private:
+  // The kernel and the scene's ids and previous-frame buffers on the device.
+  void setUp();
   // The dynamic meshes' vertices at time t, in object space, as the device's vertex array
   // orders them after the SSG's (deformed meshes at their shapes then).
   void uploadPrevious(double t);

@@ -60,6 +60,15 @@ struct Denoiser::Api {
     if (!*f)
       throw InputError("--denoise: " + path + " has no " + name + " (not Open Image Denoise 2)");
   }
+  // Filters and buffers are made once per image size (OIDN's set-up of a filter is the costly
+  // part): buffers colour, albedo, normal, output; filters albedo, normal, colour.
+  int width = 0, height = 0;
+  size_t bytes = 0;
+  Buffer buffers[4] = {};
+  Filter filters[3] = {};
+  void prepare(int w, int h);
+  void release();
+
   void check(const char* what) {
     const char* msg = nullptr;
     if (getDeviceError(device, &msg) != kErrorNone)
@@ -107,6 +116,7 @@ Denoiser::Denoiser() : api_(std::make_unique<Api>()) {
 }
 
 Denoiser::~Denoiser() {
+  api_->release();
   if (api_->device) api_->releaseDevice(api_->device);
   // The library stays loaded: OIDN's threads may outlive the device briefly.
 }
@@ -129,47 +139,57 @@ std::string Denoiser::deviceType() const {
   }
 }
 
+void Denoiser::Api::prepare(int w, int h) {
+  if (!device) {
+    device = newDevice(kDeviceDefault);
+    if (!device) throw RuntimeError("--denoise: Open Image Denoise has no device here");
+    commitDevice(device);
+    check("start its device");
+  }
+  if (w == width && h == height) return;
+  release();
+  width = w;
+  height = h;
+  bytes = size_t(w) * size_t(h) * 3 * sizeof(float);
+  for (Buffer& b : buffers) b = newBuffer(device, bytes);
+  check("allocate its buffers");
+  auto image = [&](Filter f, const char* name, Buffer b) {
+    setFilterImage(f, name, b, kFormatFloat3, size_t(w), size_t(h), 0, 0, 0);
+  };
+  // The auxiliary images alone first, each in place; then the colour with them.
+  for (int k = 0; k < 2; ++k) {
+    filters[k] = newFilter(device, "RT");
+    image(filters[k], k == 0 ? "albedo" : "normal", buffers[1 + k]);
+    image(filters[k], "output", buffers[1 + k]);
+  }
+  filters[2] = newFilter(device, "RT");
+  image(filters[2], "color", buffers[0]);
+  image(filters[2], "albedo", buffers[1]);
+  image(filters[2], "normal", buffers[2]);
+  image(filters[2], "output", buffers[3]);
+  setFilterBool(filters[2], "hdr", true);
+  setFilterBool(filters[2], "cleanAux", true);
+  for (Filter f : filters) commitFilter(f);
+  check("set up its filters");
+}
+
+void Denoiser::Api::release() {
+  for (Filter& f : filters)
+    if (f) releaseFilter(f), f = nullptr;
+  for (Buffer& b : buffers)
+    if (b) releaseBuffer(b), b = nullptr;
+  width = height = 0;
+}
+
 void Denoiser::denoise(int w, int h, float* color, const float* albedo, const float* normal) {
   Api& a = *api_;
-  if (!a.device) {
-    a.device = a.newDevice(kDeviceDefault);
-    if (!a.device) throw RuntimeError("--denoise: Open Image Denoise has no device here");
-    a.commitDevice(a.device);
-    a.check("start its device");
-  }
-  const size_t bytes = size_t(w) * size_t(h) * 3 * sizeof(float);
-  Buffer col = a.newBuffer(a.device, bytes), alb = a.newBuffer(a.device, bytes),
-         nrm = a.newBuffer(a.device, bytes), out = a.newBuffer(a.device, bytes);
-  a.check("allocate its buffers");
-  a.writeBuffer(col, 0, bytes, color);
-  a.writeBuffer(alb, 0, bytes, albedo);
-  a.writeBuffer(nrm, 0, bytes, normal);
-  auto image = [&](Filter f, const char* name, Buffer b) {
-    a.setFilterImage(f, name, b, kFormatFloat3, size_t(w), size_t(h), 0, 0, 0);
-  };
-  // The auxiliary images alone first, each in place.
-  for (const auto& [name, buf] : {std::pair<const char*, Buffer>{"albedo", alb}, {"normal", nrm}}) {
-    Filter f = a.newFilter(a.device, "RT");
-    image(f, name, buf);
-    image(f, "output", buf);
-    a.commitFilter(f);
-    a.executeFilter(f);
-    a.releaseFilter(f);
-    a.check(name[0] == 'a' ? "denoise the albedo" : "denoise the normals");
-  }
-  Filter f = a.newFilter(a.device, "RT");
-  image(f, "color", col);
-  image(f, "albedo", alb);
-  image(f, "normal", nrm);
-  image(f, "output", out);
-  a.setFilterBool(f, "hdr", true);
-  a.setFilterBool(f, "cleanAux", true);
-  a.commitFilter(f);
-  a.executeFilter(f);
-  a.releaseFilter(f);
-  a.check("denoise the colour");
-  a.readBuffer(out, 0, bytes, color);
-  for (Buffer b : {col, alb, nrm, out}) a.releaseBuffer(b);
+  a.prepare(w, h);
+  a.writeBuffer(a.buffers[0], 0, a.bytes, color);
+  a.writeBuffer(a.buffers[1], 0, a.bytes, albedo);
+  a.writeBuffer(a.buffers[2], 0, a.bytes, normal);
+  for (Filter f : a.filters) a.executeFilter(f);
+  a.check("denoise the frame");
+  a.readBuffer(a.buffers[3], 0, a.bytes, color);
   a.check("read its results");
 }
 

@@ -16,15 +16,11 @@
 
 namespace pr {
 
-namespace {
-
 void toRows(const glm::mat4& m, float out[12]) {
   // glm is column-major: m[col][row].
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 4; ++c) out[r * 4 + c] = m[c][r];
 }
-
-}  // namespace
 
 dev::CameraParams toCameraParams(const CameraPose& pose, int width, int height) {
   dev::CameraParams c{};

@@ -33,6 +33,8 @@ struct GpuSceneOptions {
   Environment environment;  // the environment light; none where !present()
 };
 
+// A transform as the kernels keep it: its top three rows, row-major (ShadingInstance).
+void toRows(const glm::mat4& m, float out[12]);
 // The camera as the kernels see it, exposed for tests (materials: render/device_materials.h).
 dev::CameraParams toCameraParams(const CameraPose& pose, int width, int height);
 

@@ -207,6 +207,9 @@ Image MultiDeviceSession::renderFrame(int frame, FrameStats* total,
   if (sessions_[0]->hasAovs() && !interrupted()) {
     const auto [aov, denoise] = sessions_[0]->renderAovs(frame, &img);
     p[0].stats.stageSeconds["aov"] += aov;
+    // Its kernel is built at the first frame that makes them: timed in that frame's line.
+    for (const auto& [k, v] : sessions_[0]->context().takeBuildSeconds())
+      p[0].stats.buildSeconds[k] += v;
     if (denoise_) p[0].stats.stageSeconds["denoise"] += denoise;
   }
 
