@@ -10,7 +10,6 @@
 
 #include <nlohmann/json.hpp>
 
-#include "support/gltf_builder.h"
 #include "support/render_helpers.h"
 #include "support/test_env.h"
 
@@ -45,17 +44,7 @@ TEST(TimeLimit, EachFrameStopsAfterThePassDuringWhichItRanOut) {
 // region by region, the mean of an uncut render. (Mutation checked: the splats left at --spp
 // samples' scale puts regions 2-3x too bright.)
 TEST(TimeLimit, ACutFrameConvergesToTheUncutOne) {
-  GltfBuilder b;
-  const int white = b.addMaterial({glm::vec4(0.8f, 0.8f, 0.8f, 1.0f)});
-  MaterialSpec chrome;
-  chrome.metallic = 1.0f;
-  chrome.roughness = 0.15f;
-  const int metal = b.addMaterial(chrome);
-  b.addNode(b.addQuad({-4, 0, 4}, {4, 0, 4}, {4, 0, -4}, {-4, 0, -4}, white));
-  b.addNode(b.addQuad({-4, 0, -2}, {4, 0, -2}, {4, 4, -2}, {-4, 4, -2}, metal));
-  b.addPointLight({0.0f, 1.5f, -1.0f}, {1, 1, 1}, 20.0f);
-  b.addCamera({0, 5, 5}, {0, 0, 0}, 0.9f, 4.0f / 3.0f);
-  const std::string scene = b.write(tempDir("tl_mirror"), "mirror");
+  const std::string scene = glossyReflectionScene("tl_mirror");
   const std::string size = " --width 96 --height 72 ";
   const std::string cut =
       renderFrames(scene, "0", size + "--spp 8 --time-limit 0.000001 --seed 3", "tl_conv");

@@ -16,13 +16,10 @@ constexpr int kAovFloats = 12;  // per pixel, kernels/aov.cl's PR_AOV_FLOATS
 }  // namespace
 
 uint32_t parseAovs(const std::string& list) {
-  static const std::pair<const char*, uint32_t> kNames[] = {{"albedo", kAovAlbedo},
-                                                            {"normal", kAovNormal},
-                                                            {"depth", kAovDepth},
-                                                            {"motion", kAovMotion},
-                                                            {"object", kAovObject},
-                                                            {"material", kAovMaterial},
-                                                            {"all", 63u}};
+  static const std::pair<const char*, uint32_t> kNames[] = {
+      {"albedo", kAovAlbedo},   {"normal", kAovNormal}, {"depth", kAovDepth},
+      {"motion", kAovMotion},   {"object", kAovObject}, {"material", kAovMaterial},
+      {"samples", kAovSamples}, {"all", 127u}};
   uint32_t bits = 0;
   std::stringstream in(list);
   std::string name;
@@ -32,7 +29,7 @@ uint32_t parseAovs(const std::string& list) {
       if (name == n) bit = b;
     if (!bit)
       throw InputError("--aov " + list + ": unknown image '" + name +
-                       "' (albedo, normal, depth, motion, object, material, all)");
+                       "' (albedo, normal, depth, motion, object, material, samples, all)");
     bits |= bit;
   }
   if (!bits) throw InputError("--aov: names no image");

@@ -26,9 +26,11 @@ enum AovBits : uint32_t {
   kAovMotion = 8u,
   kAovObject = 16u,
   kAovMaterial = 32u,
+  kAovSamples = 64u,  // each pixel's sample count, from the film (not kernels/aov.cl)
 };
 
-// --aov's comma-separated list (albedo, normal, depth, motion, object, material; "all") as bits.
+// --aov's comma-separated list (albedo, normal, depth, motion, object, material, samples; "all")
+// as bits.
 // Throws InputError naming the option and the name it does not know.
 uint32_t parseAovs(const std::string& list);
 

@@ -29,6 +29,9 @@ struct FrameStats {
   uint64_t deviceBytes = 0;
   uint64_t badSamples = 0;
   int passes = 0;  // sample passes rendered (each pixel's samples; fewer under --time-limit)
+  // Under --noise-threshold, the mean and maximum of the pixels' samples (-1: `passes` each).
+  double sppMean = -1.0;
+  int sppMax = 0;
 };
 
 class Integrator {

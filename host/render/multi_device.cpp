@@ -94,6 +94,10 @@ MultiDeviceSession::MultiDeviceSession(const Scene& scene,
     throw InputError(
         "--time-limit: renders on one device (several split each frame's passes "
         "or rows by measured speed already)");
+  if (options.noiseThreshold > 0.0f && devices.size() > 1)
+    throw InputError(
+        "--noise-threshold: renders on one device (each pixel's budget is planned from its "
+        "neighbours, which several devices would split)");
   forEachDevice(devices.size(), [&](size_t i) {
     sessions_[i] = std::make_unique<RenderSession>(scene, *devices[i], options);
   });
@@ -203,6 +207,15 @@ Image MultiDeviceSession::renderFrame(int frame, FrameStats* total,
     });
   }
 
+  // Each pixel's sample count: every device's, where they split rows or passes.
+  if (sessions_[0]->samplesAov() && !interrupted()) {
+    ImageChannel c{"samples", std::vector<float>(size_t(img.width) * img.height, 0.0f), true};
+    for (const auto& s : sessions_) {
+      const std::vector<float> counts = s->sampleCounts();
+      for (size_t k = 0; k < counts.size(); ++k) c.values[k] += counts[k];
+    }
+    img.channels.push_back(std::move(c));
+  }
   // Auxiliary images (and denoising) on the first device, for the whole image whatever the split.
   if (sessions_[0]->hasAovs() && !interrupted()) {
     const auto [aov, denoise] = sessions_[0]->renderAovs(frame, &img);
@@ -221,6 +234,10 @@ Image MultiDeviceSession::renderFrame(int frame, FrameStats* total,
     for (size_t i = 0; i < n; ++i)
       t.passes =
           passes_.empty() ? std::max(t.passes, p[i].stats.passes) : t.passes + p[i].stats.passes;
+    if (n == 1) {
+      t.sppMean = p[0].stats.sppMean;
+      t.sppMax = p[0].stats.sppMax;
+    }
     for (size_t i = 0; i < n; ++i) {
       const FrameStats& s = p[i].stats;
       for (const auto& [k, v] : s.stageSeconds) t.stageSeconds[k] += v;

@@ -71,6 +71,9 @@ struct RenderOptions {
   int spp = 4;
   double timeLimit =
       0.0;  // --time-limit: seconds of sampling per frame (render/integrator.h); 0 = none
+  // --noise-threshold: each pixel's target relative error (render/film.h); 0 = every pixel spp.
+  float noiseThreshold = 0.0f;
+  int adaptiveMinSpp = 0;  // --adaptive-min-spp: the pilot's passes; 0 = max(4, spp / 16)
   int maxDepth = 8;
   uint32_t seed = 1;
   // --device SPECs, repeatable; "all" for every device; none: the default device.

@@ -192,7 +192,10 @@ void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameSta
   if (splat) splatToCamera(camera, rp, sceneArgs, &timer);
   const int passes = tracePasses(frame, camera, rp, sceneArgs, frameStamp, start, &timer);
   if (passes < 0) return;
-  if (splat && timeLimit_ > 0.0) {
+  if (splat && film_.adaptive()) {
+    // Each pixel's count of samples times 1/spp of strategy T's estimate (kernels/accumulate.cl).
+    film_.addSplats(splat_, &timer, 1.0f / float(settings_.spp), true, true);
+  } else if (splat && timeLimit_ > 0.0) {
     // They were added for spp samples per pixel; the film's mean divides by `passes`.
     const int spp = settings_.spp;
     if (passes < spp) film_.addSplats(splat_, &timer, float(passes - spp) / float(spp));
@@ -219,7 +222,8 @@ void PathReuse::splatToCamera(const dev::CameraParams& camera, const dev::ReuseP
   a.counters = counters_;
   a.set(cameraSplat_);
   ctx_.launch1D(cameraSplat_, slots_, "camera_splat", timer);
-  film_.addSplats(splat_, timer, 1.0f, timeLimit_ <= 0.0);
+  // Under --noise-threshold they wait for the pixels' counts (renderFrame).
+  if (!film_.adaptive()) film_.addSplats(splat_, timer, 1.0f, timeLimit_ <= 0.0);
 }
 
 int PathReuse::tracePasses(int frame, const dev::CameraParams& camera, const dev::ReuseParams& rp,
@@ -234,6 +238,7 @@ int PathReuse::tracePasses(int frame, const dev::CameraParams& camera, const dev
   eh.eye = eye_;
   eh.radiance = radiance_;
   eh.counters = counters_;
+  eh.budget = film_.budget();
   eh.set(eyeHit_);
   kargs::ConnectArgs cn;
   kargs::setScene(&cn, sceneArgs);
@@ -266,37 +271,45 @@ int PathReuse::tracePasses(int frame, const dev::CameraParams& camera, const dev
   }
   if (eyePaths_) eyePaths_->beginFrame(frame, camera, sceneArgs, radiance_, eye_);
   const cl_uint first = film_.first(), n = film_.end();
-  int passes = 0;
-  for (int s = passBegin_; s < passEnd(settings_.spp); ++s) {
+  int passes = 0, s = passBegin_;
+  for (; s < passEnd(settings_.spp) && film_.passWanted(s); ++s) {
     // With eye paths, the path tracer's pass writes the sample's radiance and its first eye
     // vertex, where eye_hit would.
+    const cl_uint masked = film_.beginPass(s, timer);
     if (eyePaths_) {
-      eyePaths_->tracePass(s, timer);
+      eyePaths_->tracePass(s, masked, timer);
     } else {
       eh.sample = cl_uint(s);
+      eh.masked = masked;
       eh.set(eyeHit_, kargs::kPass);
       ctx_.launch1D(eyeHit_, first, n, "eye_hit", timer);
     }
     cn.sample = cl_uint(s);
+    // A masked pass connects its listed pixels alone.
+    cn.pixels = cs.pixels = film_.pixelList();
+    cn.listed = cs.listed = masked;
+    cn.list_count = cs.list_count = film_.listCount();
+    const cl_uint lo = masked ? 0 : first, hi = masked ? film_.listCount() : n;
     // Without eye paths connect traces its rays itself (one launch); with them, each launch's
     // terms are traced by connect_shadow before the next launch reuses the records.
-    const cl_uint chunk = eyePaths_ ? recordPixels_ : n - first;
-    for (cl_uint c0 = first; c0 < n; c0 += chunk) {
+    const cl_uint chunk = eyePaths_ ? recordPixels_ : hi - lo;
+    for (cl_uint c0 = lo; c0 < hi; c0 += chunk) {
       cn.record_first = cs.record_first = c0;
-      cn.record_end = cs.record_end = std::min(n, c0 + chunk);
+      cn.record_end = cs.record_end = std::min(hi, c0 + chunk);
       cn.set(connect_, kargs::kPass);
       ctx_.launch1D(connect_, c0, cn.record_end, "connect", timer);
       if (!eyePaths_) continue;
       cs.set(connectShadow_, kargs::kPass);
       ctx_.launch1D(connectShadow_, c0, cs.record_end, "connect_shadow", timer);
     }
-    film_.accumulate(radiance_, timer);
+    film_.accumulate(radiance_, s, timer);
     // Wait for each pass, so that an interrupt stops a frame of many samples within one pass.
     ctx_.finish();
     if (interrupted()) return -1;
     ++passes;
     if (outOfTime(start)) break;
   }
+  if (eyePaths_ && !film_.passWanted(s)) eyePaths_->skipPasses(s);
   return passes;
 }
 

@@ -244,25 +244,35 @@ void PathTracer::beginFrame(int frame, const dev::CameraParams& camera,
   generateArgs_.di_res = diRes_;
   generateArgs_.queue = queues_[0];
   generateArgs_.first = film_.first();
+  generateArgs_.queue_size = queueSizes_;
+  generateArgs_.budget = film_.budget();
   generateArgs_.set(generate_);
 }
 
-void PathTracer::tracePass(int sample, StageTimer* timer) {
+void PathTracer::tracePass(int sample, cl_uint masked, StageTimer* timer) {
   const cl_uint first = film_.first(), n = film_.end();
+  static const cl_uint kZero[dev::PR_QUEUE_COUNT] = {};
   generateArgs_.sample = shadeArgs_.sample = shadowArgs_.sample = cl_uint(sample);
+  generateArgs_.masked = masked;
   generateArgs_.set(generate_, kargs::kPass);
+  if (masked)
+    CL_CHECK(ctx_.queue().enqueueWriteBuffer(queueSizes_, CL_FALSE, 0, sizeof kZero, kZero));
   ctx_.launch1D(generate_, first, n, "generate", timer);
   // Each bounce runs over the paths still live (a queue pt_shade compacts), and traces the shadow
   // rays it wrote; the queues' sizes come back to size the next launches, and a pass ends once no
-  // path is live.
+  // path is live. A masked pass starts with the pixels that take it.
   cl_uint live = n - first;
+  if (masked) {
+    CL_CHECK(
+        ctx_.queue().enqueueReadBuffer(queueSizes_, CL_TRUE, dev::PR_QUEUE_LIVE * 4, 4, &live));
+    PR_CHECK(live <= n - first);
+  }
   for (int d = 0; d < settings_.maxDepth && live > 0; ++d) {
     const cl::Buffer& queue = queues_[d % 2];
     extendArgs_.queue = queue;
     extendArgs_.count = live;
     extendArgs_.set(extend_, kargs::kPass);
     ctx_.launch1D(extend_, 0, live, "extend", timer);
-    static const cl_uint kZero[dev::PR_QUEUE_COUNT] = {};
     CL_CHECK(ctx_.queue().enqueueWriteBuffer(queueSizes_, CL_FALSE, 0, sizeof kZero, kZero));
     shadeArgs_.queue = queue;
     shadeArgs_.count = live;
@@ -283,8 +293,11 @@ void PathTracer::tracePass(int sample, StageTimer* timer) {
     resampleArgs_.temporal = temporal_ && chained ? 1u : 0u;
     resampleArgs_.history = chained ? history_[size_t(sample)] : historyOut_;
     resampleArgs_.history_out = historyOut_;
+    resampleArgs_.pixels = film_.pixelList();
+    resampleArgs_.listed = masked;
+    resampleArgs_.list_count = film_.listCount();
     resampleArgs_.set(resample_, kargs::kPass);
-    ctx_.launch1D(resample_, 0, n - first, "resample", timer);
+    ctx_.launch1D(resample_, 0, masked ? film_.listCount() : n - first, "resample", timer);
     if (chained) {
       // The records just written become the chain, and the chain's old ones, all read, the next
       // pass's output (each pass writes every record of the film's rows): no copy.
@@ -400,16 +413,17 @@ void PathTracer::renderFrame(int frame, const dev::CameraParams& camera, FrameSt
   const Clock::time_point start = Clock::now();
   StageTimer timer;
   beginFrame(frame, camera, scene_.kernelArgs(), radiance_, noEye_);
-  int passes = 0;
-  for (int s = passBegin_; s < passEnd(settings_.spp); ++s) {
-    tracePass(s, &timer);
-    film_.accumulate(radiance_, &timer);
+  int passes = 0, s = passBegin_;
+  for (; s < passEnd(settings_.spp) && film_.passWanted(s); ++s) {
+    tracePass(s, film_.beginPass(s, &timer), &timer);
+    film_.accumulate(radiance_, s, &timer);
     // Wait for each pass, so that an interrupt stops a frame of many samples within one pass.
     ctx_.finish();
     if (interrupted()) return;
     ++passes;
     if (outOfTime(start)) break;
   }
+  if (!film_.passWanted(s)) skipPasses(s);
   if (stats) stats->passes = passes;
   reportRays(stats);
   if (stats) {

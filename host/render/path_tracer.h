@@ -50,7 +50,14 @@ class PathTracer : public Integrator {
   // sceneArgs: the scene's arguments for this frame (GpuScene::kernelArgs).
   void beginFrame(int frame, const dev::CameraParams& camera, const kargs::SceneArgs& sceneArgs,
                   const cl::Buffer& radiance, const cl::Buffer& eye);
-  void tracePass(int sample, StageTimer* timer);
+  // masked: Film::beginPass's answer for the pass.
+  void tracePass(int sample, cl_uint masked, StageTimer* timer);
+  // Passes [from, end) of this device that no pixel takes this frame (--noise-threshold): their
+  // chains keep an earlier frame's records, whose stamps the next frame does not take, so the
+  // history stays whole.
+  void skipPasses(int from) {
+    written_ += std::max(0, std::min(chains_, passEnd(settings_.spp)) - std::max(from, passBegin_));
+  }
   // The rays the passes since beginFrame traced, into stats.
   void reportRays(FrameStats* stats);
 

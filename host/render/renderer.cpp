@@ -152,8 +152,12 @@ std::string statsLine(int f, const RenderOptions& o, const FrameStats& fs,
   if (!fs.counters.empty()) j["counters"] = fs.counters;
   j["device_bytes"] = fs.deviceBytes;
   j["bad_samples"] = fs.badSamples;
-  // Samples per pixel: every pixel has the same (--time-limit cuts whole passes).
-  j["spp"] = {{"mean", fs.passes}, {"max", fs.passes}};
+  // Samples per pixel: each pixel's own under --noise-threshold, else every pixel the same
+  // (--time-limit cuts whole passes).
+  if (fs.sppMean >= 0.0)
+    j["spp"] = {{"mean", fs.sppMean}, {"max", fs.sppMax}};
+  else
+    j["spp"] = {{"mean", fs.passes}, {"max", fs.passes}};
   // Per device: its rows and sample passes, their share of the frame's pixel samples, its wall
   // and kernel times.
   nlohmann::ordered_json list = nlohmann::ordered_json::array();

@@ -2,12 +2,14 @@
 
 #include "render/aov.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
 #include "render/path_reuse.h"
 #include "render/path_tracer.h"
 #include "util/error.h"
+#include "util/interrupt.h"
 
 namespace pr {
 
@@ -95,6 +97,18 @@ void validateRenderOptions(const RenderOptions& o) {
     throw InputError(
         "--time-limit: cannot be combined with --connection-history, whose "
         "reservoirs follow every pass of every frame");
+  if (!(o.noiseThreshold >= 0.0f) || !std::isfinite(o.noiseThreshold))
+    throw InputError("--noise-threshold: must be 0 (off) or a positive relative error");
+  if (o.noiseThreshold > 0.0f) {
+    if (o.spp < 2) throw InputError("--noise-threshold: needs --spp of at least 2");
+    if (o.adaptiveMinSpp != 0 && (o.adaptiveMinSpp < 2 || o.adaptiveMinSpp > o.spp))
+      throw InputError("--adaptive-min-spp " + std::to_string(o.adaptiveMinSpp) +
+                       ": must be 2 to --spp (" + std::to_string(o.spp) + ")");
+    if (o.connectionHistory > 0)
+      throw InputError(
+          "--noise-threshold: cannot be combined with --connection-history, whose "
+          "reservoirs follow every pass of every pixel");
+  }
   if (!(o.envStrength >= 0.0f) || !std::isfinite(o.envStrength))
     throw InputError("--env-strength: must be 0 or positive");
   if (!std::isfinite(o.envRotate)) throw InputError("--env-rotate: must be finite");
@@ -166,14 +180,22 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
     integrator_ = std::move(reuse);
   }
   integrator_->setTimeLimit(o.timeLimit);
-  if (!o.aov.empty() || o.denoise) {
+  if (o.noiseThreshold > 0.0f) {
+    AdaptiveSettings a;
+    a.threshold = o.noiseThreshold;
+    a.spp = o.spp;
+    a.pilot = o.adaptiveMinSpp ? o.adaptiveMinSpp : std::min(o.spp, std::max(4, o.spp / 16));
+    film_->setAdaptive(a);
+  }
+  const uint32_t aovs = o.aov.empty() ? 0u : parseAovs(o.aov);
+  samplesAov_ = (aovs & kAovSamples) != 0;
+  if ((aovs & ~kAovSamples) || o.denoise) {
     AovSampling a;
     a.seed = o.seed;
     a.jitterFromFrame0 = resample.enabled || o.fixedNoise;
     a.spp = o.spp;
     a.maxDepth = o.maxDepth;
-    aov_ = std::make_unique<AovRenderer>(ctx_, scene, *gpu_, o.aov.empty() ? 0u : parseAovs(o.aov),
-                                         a, o.denoise);
+    aov_ = std::make_unique<AovRenderer>(ctx_, scene, *gpu_, aovs & ~kAovSamples, a, o.denoise);
   }
 }
 
@@ -181,6 +203,13 @@ RenderSession::~RenderSession() = default;
 
 std::pair<double, double> RenderSession::renderAovs(int frame, Image* image) {
   return aov_->render(frame, options_.fps, camera_, image);
+}
+
+std::vector<float> RenderSession::sampleCounts() {
+  std::vector<float> counts(size_t(width_) * height_, 0.0f);
+  const std::vector<float> sums = film_->readSums();
+  for (size_t k = 0; k < sums.size() / 4; ++k) counts[film_->first() + k] = sums[k * 4 + 3];
+  return counts;
 }
 
 bool RenderSession::hasHistory() const {
@@ -252,6 +281,7 @@ void RenderSession::render(int frame, FrameStats* fs) {
   fs->frame = frame;
   for (const auto& [k, v] : ctx_.takeBuildSeconds()) fs->buildSeconds[k] += v;
   integrator_->renderFrame(frame, gpu_->camera(camera_, time, width_, height_), fs);
+  if (film_->adaptive() && !interrupted()) film_->samplesPerPixel(&fs->sppMean, &fs->sppMax);
 }
 
 }  // namespace pr

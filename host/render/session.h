@@ -49,6 +49,10 @@ class RenderSession {
   // (render/aov.h). Returns the seconds of each.
   bool hasAovs() const { return aov_ != nullptr; }
   std::pair<double, double> renderAovs(int frame, Image* image);
+  // --aov samples: whether it was asked for, and each pixel's samples in the last frame from
+  // this session's film (0 outside its rows; several devices' counts add up).
+  bool samplesAov() const { return samplesAov_; }
+  std::vector<float> sampleCounts();
   // Rows [rowBegin, rowEnd) of each frame are rendered (default: all). The light paths of
   // path reuse cover every slot whatever the rows (render/multi_device.h).
   void setRows(int rowBegin, int rowEnd) { film_->setRows(rowBegin, rowEnd); }
@@ -91,6 +95,7 @@ class RenderSession {
   std::unique_ptr<Film> film_;
   std::unique_ptr<Integrator> integrator_;
   std::unique_ptr<AovRenderer> aov_;  // --aov
+  bool samplesAov_ = false;
   // The path tracer whose --resample history is the run's: integrator_ itself, or reuse's eye
   // paths.
   PathTracer* pathTracer_ = nullptr;

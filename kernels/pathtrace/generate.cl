@@ -2,7 +2,9 @@
 // camera ray through a jittered point of the pixel (random dimensions 0 and 1), and zero radiance;
 // with write_eye (--eye-paths, --resample), marks the sample's EyeVertex empty, and with
 // resample its reservoirs. Every path is live: the first
-// bounce's queue lists them all (pixel `first` on, in order).
+// bounce's queue lists them all (pixel `first` on, in order). Under --noise-threshold's mask
+// (`masked`) only the pixels that take the pass are live: they are appended to the queue, whose
+// length goes to queue_size[PR_QUEUE_LIVE]; the others' samples are left empty.
 #include "shared/arena.h"
 #include "shared/bvh.h"
 #include "shared/camera.h"
@@ -47,5 +49,8 @@ PR_KERNEL void pt_generate(PR_PARAMS(PR_ARGS_PT_GENERATE)) {
     di_res[i].light = PR_INVALID_INDEX;
     di_res[i].w_sum = 0.0f;
   }
-  queue[i - first] = i;
+  if (!masked)
+    queue[i - first] = i;
+  else if (pixel_takes_pass(budget, masked, i, sample))
+    queue[atomic_inc(queue_size + PR_QUEUE_LIVE)] = i;
 }

@@ -12,7 +12,10 @@
 // with x_1, to history_out for the next frame, stamped with `stamp` (the previous frame's record
 // counts only if its stamp is one less: a device's rows move between frames). Neighbours outside
 // [first, end) or without an x_1 are domains that make no samples here and are left out, which
-// keeps the weights a partition of unity.
+// keeps the weights a partition of unity. Under --noise-threshold only the pass's listed pixels
+// resample (PR_ARGS_PIXEL_LIST); pt_generate left the others without an x_1, so they are such
+// neighbours, and their records stay as an earlier frame left them, which the next one rejects
+// by their stamps.
 #include "shared/path_state.h"
 #include "shared/resample.h"
 #include "shared/resample_direct.h"
@@ -219,8 +222,9 @@ PR_INLINE uint rs_history_pixel(const CameraParams* prev_cam, float3 p, uint fir
 }
 
 PR_KERNEL void pt_resample(PR_PARAMS(PR_ARGS_PT_RESAMPLE_SPATIAL)) {
-  const uint j = (uint)get_global_id(0) + first;
-  if (j >= end) return;
+  const uint w = (uint)get_global_id(0);
+  if (listed ? w >= list_count : w + first >= end) return;
+  const uint j = listed ? pixels[w] : w + first;  // a listed launch has the list's length
   const EyeVertex e = eye[j];
   __global PathHistory* out = history_out + j;
   rs_history_start(out, &e, stamp);

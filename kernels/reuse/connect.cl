@@ -571,11 +571,12 @@ PR_INLINE float connect_camera_factor(const ReuseParams* rp, const CameraParams*
 }
 
 PR_KERNEL void connect(PR_PARAMS(PR_ARGS_CONNECT)) {
-  const uint i = (uint)get_global_id(0);
-  if (i >= rp.pixel_count || i >= record_end) return;
+  const uint q = (uint)get_global_id(0);  // the records' index; the pixel where not listed
+  if (q >= record_end || q >= (listed ? list_count : rp.pixel_count)) return;
+  const uint i = listed ? pixels[q] : q;
   const EyeVertex e = eye[i];
 #if PR_CONNECT_DEFERRED
-  record_counts[i - record_first] = 0u;  // until the terms are written
+  record_counts[q - record_first] = 0u;  // until the terms are written
 #endif
   if (e.prim == PR_INVALID_INDEX) return;
   const SceneData s = PR_SCENE();
@@ -593,7 +594,7 @@ PR_KERNEL void connect(PR_PARAMS(PR_ARGS_CONNECT)) {
   cn.history_cap = history_cap;
   cn.ratios = ratios;
   cn.slot_offset = slot_offset;  // 0 without a history (PathReuse::renderFrame)
-  cn.rec = records + (size_t)(i - record_first) * record_cap;
+  cn.rec = records + (size_t)(q - record_first) * record_cap;
   cn.cap = record_cap;
   connector_empty(&cn);
   EyePoint x = eye_point_at(&s, e.prim, e.inst, e.b1, e.b2, make_float3(e.wx, e.wy, e.wz),
@@ -680,7 +681,7 @@ PR_KERNEL void connect(PR_PARAMS(PR_ARGS_CONNECT)) {
   if (history_cap > 0u) history_resolve(&cn, &e, hist, changed, frame_stamp);
   reservoir_resolve(&cn);
 #if PR_CONNECT_DEFERRED
-  record_counts[i - record_first] = cn.n_rec;
+  record_counts[q - record_first] = cn.n_rec;
   if (cn.overflow) atomic_inc(counters + PR_C_RECORD_OVERFLOW);
 #else
   radiance[i] += (float4)(cn.L.x, cn.L.y, cn.L.z, 0.0f);

@@ -1,16 +1,17 @@
-// connect_shadow: one work-item per pixel sample of connect's launch (--eye-paths, where connect
-// traces no ray). Traces the shadow rays of the sample's records in the order connect wrote
-// them and adds the estimate they make, summed as the records say (shared/reuse.h), to the
-// sample's radiance; counts the unoccluded connections.
+// connect_shadow: one work-item per pixel sample of connect's launch (PR_ARGS_PIXEL_LIST)
+// (--eye-paths, where connect traces no ray). Traces the shadow rays of the sample's records in the
+// order connect wrote them and adds the estimate they make, summed as the records say
+// (shared/reuse.h), to the sample's radiance; counts the unoccluded connections.
 #include "shared/reuse.h"
 
 PR_KERNEL void connect_shadow(PR_PARAMS(PR_ARGS_CONNECT_SHADOW)) {
-  const uint i = (uint)get_global_id(0);
-  if (i >= record_end) return;
-  const uint n = record_counts[i - record_first];
+  const uint q = (uint)get_global_id(0);  // the records' index; the pixel where not listed
+  if (q >= record_end || (listed && q >= list_count)) return;
+  const uint n = record_counts[q - record_first];
   if (n == 0u) return;
+  const uint i = listed ? pixels[q] : q;
   const SceneData s = PR_SCENE();
-  __global const ShadowRay* r = records + (size_t)(i - record_first) * record_cap;
+  __global const ShadowRay* r = records + (size_t)(q - record_first) * record_cap;
   float3 L = make_float3(0.0f, 0.0f, 0.0f), g = L;
   uint unoccluded = 0u;
   for (uint k = 0u; k < n; ++k) {

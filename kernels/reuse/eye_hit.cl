@@ -2,6 +2,7 @@
 // jittered point of the pixel to its first non-delta surface, following mirror and glass
 // bounces, and counts the emission it sees on the way (no other technique can reach it).
 // Reads the camera and the scene; writes the pixel sample's EyeVertex and its radiance so far.
+// A pixel that --noise-threshold's mask leaves out of the pass gets an empty vertex, no ray.
 #include "shared/camera.h"
 #include "shared/reuse.h"
 
@@ -18,7 +19,8 @@ PR_KERNEL void eye_hit(PR_PARAMS(PR_ARGS_EYE_HIT)) {
   e.inst = PR_INVALID_INDEX;
   e.depth = 0u;
   uint bounces = 0u;
-  for (uint depth = 1u; depth <= rp.max_depth; ++depth) {
+  const uint max_depth = pixel_takes_pass(budget, masked, i, sample) ? rp.max_depth : 0u;
+  for (uint depth = 1u; depth <= max_depth; ++depth) {
     Hit hit;
     if (!trace_closest(&s, ray, &hit)) {
       L += tp * environment_radiance(&s, d);  // seen directly or through delta bounces
@@ -52,6 +54,6 @@ PR_KERNEL void eye_hit(PR_PARAMS(PR_ARGS_EYE_HIT)) {
   }
   eye[i] = e;
   radiance[i] = (float4)(L.x, L.y, L.z, 0.0f);
-  atomic_inc(counters + PR_C_CAMERA_RAYS);
+  if (max_depth) atomic_inc(counters + PR_C_CAMERA_RAYS);
   if (bounces) atomic_add(counters + PR_C_BOUNCE_RAYS, bounces);
 }

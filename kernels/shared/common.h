@@ -63,3 +63,10 @@ PR_NAMESPACE_END
                           __LINE__),                                                        \
              std::abort()))
 #endif
+
+#ifdef PR_DEVICE_CODE
+// --noise-threshold's mask (PR_ARGS_PIXEL_MASK): whether pixel px takes pass `sample`.
+PR_INLINE int pixel_takes_pass(__global const uint* budget, uint masked, uint px, uint sample) {
+  return !masked || sample < budget[px];
+}
+#endif

@@ -45,6 +45,19 @@
 
 #define PR_ARGS_SCENE(X) PR_ARGS_SCENE_GEOM(X) PR_ARGS_SHADING(X) PR_ARGS_LIGHTS(X)
 
+// --noise-threshold: the pass's samples are taken at pixels whose budget (total passes,
+// kernels/adaptive.cl) exceeds the sample index, where `masked`; at every pixel otherwise.
+#define PR_ARGS_PIXEL_MASK(X) \
+  X(FRAME, IN, uint, budget)  \
+  X(PASS, VAL, uint, masked)
+
+// The same pass's pixels as a list (Film::beginPass): where `listed`, a launch's work-item k
+// < list_count stands for pixel pixels[k] (in no particular order); otherwise for pixel k.
+#define PR_ARGS_PIXEL_LIST(X) \
+  X(PASS, IN, uint, pixels)   \
+  X(PASS, VAL, uint, listed)  \
+  X(PASS, VAL, uint, list_count)
+
 // ---- Path reuse (kernels/reuse/) ----
 
 #define PR_ARGS_INVALIDATE(X)         \
@@ -77,7 +90,8 @@
   X(PASS, VAL, uint, sample)       \
   X(FRAME, OUT, EyeVertex, eye)    \
   X(FRAME, OUT, float4, radiance)  \
-  X(FRAME, OUT, uint, counters)
+  X(FRAME, OUT, uint, counters)    \
+  PR_ARGS_PIXEL_MASK(X)
 
 #define PR_ARGS_CONNECT(X)                  \
   PR_ARGS_SCENE(X)                          \
@@ -104,7 +118,8 @@
   X(FRAME, kind, uint, record_counts)    \
   X(FRAME, VAL, uint, record_cap)        \
   X(PASS, VAL, uint, record_first)       \
-  X(PASS, VAL, uint, record_end)
+  X(PASS, VAL, uint, record_end)         \
+  PR_ARGS_PIXEL_LIST(X)
 
 // camera_splat (strategy T): the arena's vertices joined to the camera, into `splat` (fixed
 // point per pixel of [first, end), shared/splat.h) times film_scale.
@@ -132,21 +147,23 @@
 // `count` of them), which pt_shade compacts: the live paths into next_queue, the paths with a
 // shadow ray into shadow_queue, counted in queue_sizes (PR_QUEUE_*, shared/path_state.h).
 
-#define PR_ARGS_PT_GENERATE(X)         \
-  X(FRAME, VAL, CameraParams, cam)     \
-  X(FRAME, VAL, uint, seed)            \
-  X(FRAME, VAL, uint, frame)           \
-  X(PASS, VAL, uint, sample)           \
-  X(FRAME, OUT, PathState, states)     \
-  X(FRAME, OUT, float4, radiance)      \
-  X(FRAME, VAL, uint, count)           \
-  X(FRAME, OUT, EyeVertex, eye)        \
-  X(FRAME, VAL, uint, write_eye)       \
-  X(FRAME, OUT, uint, queue)           \
-  X(FRAME, VAL, uint, first)           \
-  X(FRAME, VAL, uint, resample)        \
-  X(FRAME, OUT, PathReservoir, rs_res) \
-  X(FRAME, OUT, DirectReservoir, di_res)
+#define PR_ARGS_PT_GENERATE(X)           \
+  X(FRAME, VAL, CameraParams, cam)       \
+  X(FRAME, VAL, uint, seed)              \
+  X(FRAME, VAL, uint, frame)             \
+  X(PASS, VAL, uint, sample)             \
+  X(FRAME, OUT, PathState, states)       \
+  X(FRAME, OUT, float4, radiance)        \
+  X(FRAME, VAL, uint, count)             \
+  X(FRAME, OUT, EyeVertex, eye)          \
+  X(FRAME, VAL, uint, write_eye)         \
+  X(FRAME, OUT, uint, queue)             \
+  X(FRAME, VAL, uint, first)             \
+  X(FRAME, VAL, uint, resample)          \
+  X(FRAME, OUT, PathReservoir, rs_res)   \
+  X(FRAME, OUT, DirectReservoir, di_res) \
+  X(FRAME, OUT, uint, queue_size)        \
+  PR_ARGS_PIXEL_MASK(X)
 
 #define PR_ARGS_PT_EXTEND(X)      \
   PR_ARGS_SCENE(X)                \
@@ -226,7 +243,8 @@
   X(FRAME, VAL, CameraParams, prev_cam)  \
   X(FRAME, VAL, CameraParams, cam)       \
   X(FRAME, IN, MovedInstance, moved)     \
-  X(FRAME, VAL, uint, stamp)
+  X(FRAME, VAL, uint, stamp)             \
+  PR_ARGS_PIXEL_LIST(X)
 
 // ---- The film (kernels/accumulate.cl) ----
 
@@ -235,15 +253,40 @@
   X(FRAME, OUT, float4, film)      \
   X(FRAME, OUT, uint, bad_samples) \
   X(FRAME, VAL, uint, count)       \
-  X(FRAME, VAL, uint, pixel_count)
+  X(FRAME, VAL, uint, pixel_count) \
+  PR_ARGS_PIXEL_LIST(X)
 
-#define PR_ARGS_SPLAT_FILM(X) \
-  X(FRAME, OUT, uint, splat)  \
-  X(FRAME, OUT, float4, film) \
-  X(FRAME, VAL, float, scale) \
-  X(FRAME, VAL, uint, clear)  \
-  X(FRAME, VAL, uint, first)  \
+#define PR_ARGS_SPLAT_FILM(X)   \
+  X(FRAME, OUT, uint, splat)    \
+  X(FRAME, OUT, float4, film)   \
+  X(FRAME, VAL, float, scale)   \
+  X(FRAME, VAL, uint, clear)    \
+  X(FRAME, VAL, uint, by_count) \
+  X(FRAME, VAL, uint, first)    \
   X(FRAME, VAL, uint, end)
+
+// adaptive_plan (--noise-threshold): one work-item per pixel of the film's range, after the
+// pilot passes (kernels/adaptive.cl).
+#define PR_ARGS_ADAPTIVE_PLAN(X) \
+  X(FRAME, IN, float4, film)     \
+  X(FRAME, IN, float4, odd)      \
+  X(FRAME, OUT, uint, budget)    \
+  X(FRAME, VAL, uint, width)     \
+  X(FRAME, VAL, uint, first)     \
+  X(FRAME, VAL, uint, end)       \
+  X(FRAME, VAL, uint, radius)    \
+  X(FRAME, VAL, uint, pilot)     \
+  X(FRAME, VAL, uint, spp)       \
+  X(FRAME, VAL, float, threshold)
+
+// adaptive_list: one work-item per pixel of the film's range; appends those that take pass
+// `sample` to `pixels`, their count to *count.
+#define PR_ARGS_ADAPTIVE_LIST(X) \
+  X(FRAME, IN, uint, budget)     \
+  X(PASS, VAL, uint, sample)     \
+  X(FRAME, VAL, uint, end)       \
+  X(FRAME, OUT, uint, pixels)    \
+  X(FRAME, OUT, uint, count)
 
 // aov (--aov): one work-item per pixel, every sample pass in one launch (kernels/aov.cl).
 #define PR_ARGS_AOV(X)                  \
@@ -278,6 +321,8 @@
   K(pt_resample, PtResampleArgs, PR_ARGS_PT_RESAMPLE_SPATIAL)  \
   K(accumulate, AccumulateArgs, PR_ARGS_ACCUMULATE)            \
   K(splat_film, SplatFilmArgs, PR_ARGS_SPLAT_FILM)             \
+  K(adaptive_plan, AdaptivePlanArgs, PR_ARGS_ADAPTIVE_PLAN)    \
+  K(adaptive_list, AdaptiveListArgs, PR_ARGS_ADAPTIVE_LIST)    \
   K(aov, AovArgs, PR_ARGS_AOV)
 
 // A parameter's name: scene entries carry their group's prefix (geometry and shading both have

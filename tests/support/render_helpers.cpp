@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <fstream>
 
+#include "support/gltf_builder.h"
 #include "support/test_env.h"
 
 namespace pr::test {
@@ -48,6 +49,20 @@ std::vector<std::string> statsLines(const std::string& dir) {
   std::string line;
   while (std::getline(in, line)) lines.push_back(line);
   return lines;
+}
+
+std::string glossyReflectionScene(const std::string& tag) {
+  GltfBuilder b;
+  const int white = b.addMaterial({glm::vec4(0.8f, 0.8f, 0.8f, 1.0f)});
+  MaterialSpec chrome;
+  chrome.metallic = 1.0f;
+  chrome.roughness = 0.15f;
+  const int metal = b.addMaterial(chrome);
+  b.addNode(b.addQuad({-4, 0, 4}, {4, 0, 4}, {4, 0, -4}, {-4, 0, -4}, white));
+  b.addNode(b.addQuad({-4, 0, -2}, {4, 0, -2}, {4, 4, -2}, {-4, 4, -2}, metal));
+  b.addPointLight({0.0f, 1.5f, -1.0f}, {1, 1, 1}, 20.0f);
+  b.addCamera({0, 5, 5}, {0, 0, 0}, 0.9f, 4.0f / 3.0f);
+  return b.write(tempDir(tag), "mirror");
 }
 
 }  // namespace pr::test

@@ -27,4 +27,9 @@ Image frameImage(const std::string& dir, int frame);
 // The JSON lines of dir/stats.jsonl.
 std::vector<std::string> statsLines(const std::string& dir);
 
+// A floor lit by a point light and by its glossy reflection in a metal wall (roughness 0.15):
+// strategy T (light tracing) takes most of the reflected light, as an eye path's next-event
+// estimation seldom finds the narrow lobe. Written into a fresh folder named after `tag`; 4:3.
+std::string glossyReflectionScene(const std::string& tag);
+
 }  // namespace pr::test

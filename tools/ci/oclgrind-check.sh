@@ -23,7 +23,7 @@ run() {
   local name=$1; shift
   local log="$work/$name.log"
   if ! oclgrind --check-api --data-races --log "$log" "$bin" render "$@" --quiet \
-      --width 16 --height 12 --spp 1 --out "$work/$name/f_%04d.exr" 2>"$work/$name.err"; then
+      --width 16 --height 12 --spp "${SPP:-1}" --out "$work/$name/f_%04d.exr" 2>"$work/$name.err"; then
     echo "oclgrind-check: $name: render failed: $(head -c 2000 "$work/$name.err")"
     fail=1
   elif [ -s "$log" ]; then
@@ -74,6 +74,16 @@ run "cornell-orbit-reuse-light-tracing" scenes/cornell-orbit.gltf --frames 0-1 -
 # Auxiliary images (kernels/aov.cl): a skinned mesh's previous shape for the motion, and below,
 # through an environment map.
 run "cornell-skinned-reuse-aov" scenes/cornell-skinned.gltf --frames 0-1 --mode reuse --aov all
+# Adaptive sampling (kernels/adaptive.cl): the plan after a pilot of two passes, then the masked
+# passes over listed pixels in pt_generate, pt_resample (with a neighbour that may skip the
+# pass, and the previous frame's records of skipped passes), connect, connect_shadow,
+# accumulate, strategy T's splats by each pixel's count; and eye_hit's mask without eye paths.
+SPP=6 run "cornell-dynamic-reuse-adaptive" scenes/cornell-dynamic.gltf --frames 0-2 --mode reuse \
+  --noise-threshold 0.3 --adaptive-min-spp 2 --resample-neighbors 1 --light-tracing --aov samples
+SPP=6 run "cornell-dynamic-pathtrace-adaptive" scenes/cornell-dynamic.gltf --frames 0-1 \
+  --mode pathtrace --resample --noise-threshold 0.3 --adaptive-min-spp 2
+SPP=6 run "cornell-dynamic-reuse-adaptive-connections" scenes/cornell-dynamic.gltf --frames 0-1 \
+  --mode reuse --no-eye-paths --noise-threshold 0.3 --adaptive-min-spp 2
 # Resampled connections (two shadow rays per eye vertex).
 run "cornell-dynamic-reuse-ris" scenes/cornell-dynamic.gltf --frames 0-1 --mode reuse --connections 2 \
   --no-eye-paths
