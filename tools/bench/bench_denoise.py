@@ -66,6 +66,7 @@ def main():
     ap.add_argument("--seeds", default="1,2")
     ap.add_argument("--settings", default="256:raw,16:raw,16:denoise,4:denoise",
                     help="spp:raw or spp:denoise, comma-separated")
+    ap.add_argument("--full-only", action="store_true", help="without the --force-diffuse runs")
     ap.add_argument("--exe", default=str(REPO / "build" / "pathreuse"))
     ap.add_argument("--cmp", default=str(REPO / "build" / "exr_compare"))
     ap.add_argument("--atrium", default=str(ATRIUM))
@@ -85,7 +86,7 @@ def main():
                 scene = ensure_atrium(args.atrium, python=sys.executable)
             else:
                 scene = REPO / "scenes" / f"{key}.gltf"
-            for extra in ([], ["--force-diffuse"]):
+            for extra in ([],) if args.full_only else ([], ["--force-diffuse"]):
                 results[(key, " ".join(extra))] = measure(runner, key, scene, extra, cache)
     print("\n| scene | materials | setting | relMSE | flicker | s/frame | relMSE x s |\n"
           "|---|---|---|---|---|---|---|")
