@@ -40,6 +40,7 @@ void Film::clear() {
 void Film::setAdaptive(const AdaptiveSettings& settings) {
   PR_CHECK(settings.threshold > 0.0f && settings.pilot >= 2 && settings.pilot <= settings.spp);
   adaptive_ = settings;
+  ctx_.release(8);  // the unread words budget_ and list_ were
   odd_ = ctx_.allocate("odd pass sums", uint64_t(pixels()) * 16);
   oddBad_ = ctx_.allocate("odd pass bad samples", 4);
   budget_ = ctx_.allocate("pixel budgets", uint64_t(pixels()) * 4);

@@ -75,12 +75,12 @@ class Film {
   uint32_t pixels() const { return static_cast<uint32_t>(width_) * height_; }
 
  private:
-  Context& ctx_;
-  int width_, height_;
-  int rowBegin_ = 0, rowEnd_ = 0;
   void launchAccumulate(const cl::Buffer& radiance, const cl::Buffer& film, const cl::Buffer& bad,
                         cl_uint listed, StageTimer* timer);
 
+  Context& ctx_;
+  int width_, height_;
+  int rowBegin_ = 0, rowEnd_ = 0;
   cl::Buffer film_, bad_;
   cl::Kernel accumulate_, splatFilm_;
   AdaptiveSettings adaptive_;
