@@ -182,7 +182,7 @@ TEST(Aov, MotionWarpsThePreviousFrameOntoThisOneUnderAMovingCamera) {
 }
 
 // Two devices split the colour, and the first makes the auxiliary images for the whole image:
-// they are one device's, bit for bit.
+// they are one device's, bit for bit; each pixel's sample count is the devices' together.
 TEST(Aov, TwoDevicesGiveOneDevicesImages) {
   const AovScene s = aovScene("aov_devices");
   const std::string two = twoPoclDevices(), one = two.substr(0, two.find(" --device", 1));
@@ -194,7 +194,8 @@ TEST(Aov, TwoDevicesGiveOneDevicesImages) {
                                 kTwoPoclDrivers);
     ASSERT_EQ(r.exitCode, 0) << r.err;
   }
-  for (const char* c : {"albedo.R", "normal.Z", "Z", "motion.X", "motion.Y", "object.ID"})
+  for (const char* c :
+       {"albedo.R", "normal.Z", "Z", "motion.X", "motion.Y", "object.ID", "samples"})
     EXPECT_EQ(readExrChannel(dirs[0] + "/f_0001.exr", c),
               readExrChannel(dirs[1] + "/f_0001.exr", c))
         << c;
