@@ -1,6 +1,7 @@
 // adaptive_plan (--noise-threshold): one work-item per pixel of the film's range [first, end),
 // after the `pilot` passes that every pixel takes. Reads the film's sums of those passes and
-// the sums of their odd passes; writes each pixel's budget, its passes in all (pilot to spp).
+// the sums of their odd passes; writes each pixel's budget, its passes in all (pilot to spp),
+// and the largest in *max_budget (atomic_max: the same whatever the order).
 // The budget is the sample count at which the pixel's estimated relative error would fall to
 // `threshold`. The variance comes from the two halves of the pilot (even and odd passes), as
 // Cycles estimates it, relative to the pixel's value plus relMSE's 0.01 so that dark pixels do
@@ -40,7 +41,9 @@ PR_KERNEL void adaptive_plan(PR_PARAMS(PR_ARGS_ADAPTIVE_PLAN)) {
     }
   // The samples N at which rel / N = threshold^2; all of them where that is unknown.
   const float want = count ? sum / (float)count / (threshold * threshold) : PR_INF_F;
-  budget[i] = want < (float)spp ? max(pilot, (uint)ceil(want)) : spp;
+  const uint b = want < (float)spp ? max(pilot, (uint)ceil(want)) : spp;
+  budget[i] = b;
+  atomic_max(max_budget, b);
 }
 
 // adaptive_list: one work-item per pixel of the film's range (launched from its first pixel, up

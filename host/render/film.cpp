@@ -69,14 +69,13 @@ cl_uint Film::beginPass(int sample, StageTimer* timer) {
     a.pilot = cl_uint(adaptive_.pilot);
     a.spp = cl_uint(adaptive_.spp);
     a.threshold = adaptive_.threshold;
+    a.max_budget = listSize_;
     a.set(plan_);
+    ctx_.zero(listSize_, 4);
     ctx_.launch1D(plan_, first(), end(), "adaptive_plan", timer);
-    std::vector<uint32_t> budgets(end() - first());
-    if (!budgets.empty())
-      CL_CHECK(ctx_.queue().enqueueReadBuffer(budget_, CL_TRUE, size_t(first()) * 4,
-                                              budgets.size() * 4, budgets.data()));
-    maxBudget_ = adaptive_.pilot;
-    for (uint32_t b : budgets) maxBudget_ = std::max(maxBudget_, int(b));
+    cl_uint most = 0;
+    CL_CHECK(ctx_.queue().enqueueReadBuffer(listSize_, CL_TRUE, 0, 4, &most));
+    maxBudget_ = std::max(adaptive_.pilot, int(most));
   }
   ctx_.zero(listSize_, 4);
   kargs::AdaptiveListArgs a;
@@ -90,18 +89,6 @@ cl_uint Film::beginPass(int sample, StageTimer* timer) {
   CL_CHECK(ctx_.queue().enqueueReadBuffer(listSize_, CL_TRUE, 0, 4, &listCount_));
   PR_CHECK(listCount_ <= end() - first());
   return 1u;
-}
-
-void Film::samplesPerPixel(double* mean, int* max) {
-  const std::vector<float> sums = readSums();
-  double total = 0.0;
-  float most = 0.0f;
-  for (size_t i = 3; i < sums.size(); i += 4) {
-    total += sums[i];
-    most = std::max(most, sums[i]);
-  }
-  *mean = sums.empty() ? 0.0 : total / double(sums.size() / 4);
-  *max = int(most);
 }
 
 void Film::launchAccumulate(const cl::Buffer& radiance, const cl::Buffer& film,
@@ -166,10 +153,11 @@ void Film::mean(const float* sums, size_t n, float* rgba) {
   }
 }
 
-void Film::readRows(Image* image, uint64_t* badSamples) {
+std::vector<float> Film::readRows(Image* image, uint64_t* badSamples) {
   PR_CHECK(image->width == width_ && image->height == height_);
-  const std::vector<float> sums = readSums(badSamples);
+  std::vector<float> sums = readSums(badSamples);
   mean(sums.data(), sums.size() / 4, image->rgba.data() + size_t(first()) * 4);
+  return sums;
 }
 
 }  // namespace pr

@@ -50,12 +50,11 @@ class Film {
   bool passWanted(int sample) const {
     return !adaptive() || sample <= adaptive_.pilot || sample < maxBudget_;
   }
-  // The range's samples per pixel in the frame so far: their mean and maximum.
-  void samplesPerPixel(double* mean, int* max);
   // The mean radiance per pixel (alpha 1), and how many samples were non-finite and dropped.
   Image read(uint64_t* badSamples = nullptr);
-  // The same for the range's rows only, written into `image` (of the film's size).
-  void readRows(Image* image, uint64_t* badSamples = nullptr);
+  // The same for the range's rows only, written into `image` (of the film's size); returns the
+  // sums it read (readSums).
+  std::vector<float> readRows(Image* image, uint64_t* badSamples = nullptr);
   // The range's sums as they stand (rgb sum and sample count per pixel, 4 floats), for films
   // of several devices that are added before the mean (render/multi_device.h).
   std::vector<float> readSums(uint64_t* badSamples = nullptr);

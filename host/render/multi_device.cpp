@@ -211,7 +211,7 @@ Image MultiDeviceSession::renderFrame(int frame, FrameStats* total,
   if (sessions_[0]->samplesAov() && !interrupted()) {
     ImageChannel c{"samples", std::vector<float>(size_t(img.width) * img.height, 0.0f), true};
     for (const auto& s : sessions_) {
-      const std::vector<float> counts = s->sampleCounts();
+      const std::vector<float>& counts = s->sampleCounts();
       for (size_t k = 0; k < counts.size(); ++k) c.values[k] += counts[k];
     }
     img.channels.push_back(std::move(c));

@@ -9,7 +9,6 @@
 #include "render/path_reuse.h"
 #include "render/path_tracer.h"
 #include "util/error.h"
-#include "util/interrupt.h"
 
 namespace pr {
 
@@ -205,13 +204,6 @@ std::pair<double, double> RenderSession::renderAovs(int frame, Image* image) {
   return aov_->render(frame, options_.fps, camera_, image);
 }
 
-std::vector<float> RenderSession::sampleCounts() {
-  std::vector<float> counts(size_t(width_) * height_, 0.0f);
-  const std::vector<float> sums = film_->readSums();
-  for (size_t k = 0; k < sums.size() / 4; ++k) counts[film_->first() + k] = sums[k * 4 + 3];
-  return counts;
-}
-
 bool RenderSession::hasHistory() const {
   return pathTracer_ && pathTracer_->hasHistory();
 }
@@ -257,7 +249,7 @@ void RenderSession::renderRows(int frame, Image* image, FrameStats* stats) {
   FrameStats local;
   FrameStats* fs = stats ? stats : &local;
   render(frame, fs);
-  film_->readRows(image, &fs->badSamples);
+  takeCounts(film_->readRows(image, &fs->badSamples), fs);
   fs->deviceBytes = ctx_.bytesInUse();
 }
 
@@ -266,8 +258,26 @@ std::vector<float> RenderSession::renderSums(int frame, FrameStats* stats) {
   FrameStats* fs = stats ? stats : &local;
   render(frame, fs);
   std::vector<float> sums = film_->readSums(&fs->badSamples);
+  takeCounts(sums, fs);
   fs->deviceBytes = ctx_.bytesInUse();
   return sums;
+}
+
+void RenderSession::takeCounts(const std::vector<float>& sums, FrameStats* fs) {
+  const size_t n = sums.size() / 4;
+  if (samplesAov_) {
+    counts_.assign(size_t(width_) * height_, 0.0f);
+    for (size_t k = 0; k < n; ++k) counts_[film_->first() + k] = sums[k * 4 + 3];
+  }
+  if (!film_->adaptive() || n == 0) return;
+  double total = 0.0;
+  float most = 0.0f;
+  for (size_t k = 0; k < n; ++k) {
+    total += sums[k * 4 + 3];
+    most = std::max(most, sums[k * 4 + 3]);
+  }
+  fs->sppMean = total / double(n);
+  fs->sppMax = int(most);
 }
 
 void RenderSession::render(int frame, FrameStats* fs) {
@@ -281,7 +291,6 @@ void RenderSession::render(int frame, FrameStats* fs) {
   fs->frame = frame;
   for (const auto& [k, v] : ctx_.takeBuildSeconds()) fs->buildSeconds[k] += v;
   integrator_->renderFrame(frame, gpu_->camera(camera_, time, width_, height_), fs);
-  if (film_->adaptive() && !interrupted()) film_->samplesPerPixel(&fs->sppMean, &fs->sppMax);
 }
 
 }  // namespace pr

@@ -6,6 +6,7 @@
 #include <memory>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "cl/context.h"
 #include "cl/device.h"
@@ -52,7 +53,7 @@ class RenderSession {
   // --aov samples: whether it was asked for, and each pixel's samples in the last frame from
   // this session's film (0 outside its rows; several devices' counts add up).
   bool samplesAov() const { return samplesAov_; }
-  std::vector<float> sampleCounts();
+  const std::vector<float>& sampleCounts() const { return counts_; }
   // Rows [rowBegin, rowEnd) of each frame are rendered (default: all). The light paths of
   // path reuse cover every slot whatever the rows (render/multi_device.h).
   void setRows(int rowBegin, int rowEnd) { film_->setRows(rowBegin, rowEnd); }
@@ -84,6 +85,9 @@ class RenderSession {
  private:
   // Frame f into the film (its stats into *fs).
   void render(int frame, FrameStats* fs);
+  // From the film's sums just read: the samples channel (--aov samples) and, under
+  // --noise-threshold, the stats' mean and maximum samples per pixel.
+  void takeCounts(const std::vector<float>& sums, FrameStats* fs);
 
   const Scene& scene_;
   RenderOptions options_;
@@ -96,6 +100,7 @@ class RenderSession {
   std::unique_ptr<Integrator> integrator_;
   std::unique_ptr<AovRenderer> aov_;  // --aov
   bool samplesAov_ = false;
+  std::vector<float> counts_;  // sampleCounts()
   // The path tracer whose --resample history is the run's: integrator_ itself, or reuse's eye
   // paths.
   PathTracer* pathTracer_ = nullptr;

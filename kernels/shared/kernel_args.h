@@ -267,17 +267,18 @@
 
 // adaptive_plan (--noise-threshold): one work-item per pixel of the film's range, after the
 // pilot passes (kernels/adaptive.cl).
-#define PR_ARGS_ADAPTIVE_PLAN(X) \
-  X(FRAME, IN, float4, film)     \
-  X(FRAME, IN, float4, odd)      \
-  X(FRAME, OUT, uint, budget)    \
-  X(FRAME, VAL, uint, width)     \
-  X(FRAME, VAL, uint, first)     \
-  X(FRAME, VAL, uint, end)       \
-  X(FRAME, VAL, uint, radius)    \
-  X(FRAME, VAL, uint, pilot)     \
-  X(FRAME, VAL, uint, spp)       \
-  X(FRAME, VAL, float, threshold)
+#define PR_ARGS_ADAPTIVE_PLAN(X)  \
+  X(FRAME, IN, float4, film)      \
+  X(FRAME, IN, float4, odd)       \
+  X(FRAME, OUT, uint, budget)     \
+  X(FRAME, VAL, uint, width)      \
+  X(FRAME, VAL, uint, first)      \
+  X(FRAME, VAL, uint, end)        \
+  X(FRAME, VAL, uint, radius)     \
+  X(FRAME, VAL, uint, pilot)      \
+  X(FRAME, VAL, uint, spp)        \
+  X(FRAME, VAL, float, threshold) \
+  X(FRAME, OUT, uint, max_budget)
 
 // adaptive_list: one work-item per pixel of the film's range; appends those that take pass
 // `sample` to `pixels`, their count to *count.

@@ -18,8 +18,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .bench_denoise import reference
-from .benchlib import ATRIUM, REPO, ensure_atrium, median
+from .bench_denoise import add_common_args, finish_common_args, reference, scene_path
+from .benchlib import median
 from .evaluation.run import Runner
 
 
@@ -89,32 +89,20 @@ def main():
     ap.add_argument("--scenes", default="atrium,cornell-dynamic")
     ap.add_argument("--diffuse", action="store_true", help="also with --force-diffuse")
     ap.add_argument("--mode", default="reuse")
-    ap.add_argument("--width", type=int, default=160)
-    ap.add_argument("--first", type=int, default=8)
-    ap.add_argument("--last", type=int, default=10)
-    ap.add_argument("--ref-spp", type=int, default=1024)
-    ap.add_argument("--seeds", default="1,2")
+    add_common_args(ap, last=10)
     ap.add_argument("--settings",
                     default="u:16,u:32,u:64,a:256:0.2,a:256:0.14,a:256:0.1,a:256:0.07,a:256:0.05")
     ap.add_argument("--min-spp", type=int, default=0, help="--adaptive-min-spp (0: default)")
     ap.add_argument("--oracle-seeds", type=int, default=0,
                     help="also the gain bound of any allocation, from this many uniform renders")
-    ap.add_argument("--exe", default=str(REPO / "build" / "pathreuse"))
-    ap.add_argument("--cmp", default=str(REPO / "build" / "exr_compare"))
-    ap.add_argument("--atrium", default=str(ATRIUM))
-    ap.add_argument("--cache", default=str(REPO / "out" / "bench-denoise-cache"))
     args = ap.parse_args()
-    args.max_depth, args.reuse_args, args.quiet = 8, "", False
-    args.seeds = [int(s) for s in args.seeds.split(",")]
+    cache = finish_common_args(args)
     args.settings = parse_settings(args.settings)
-    cache = Path(args.cache)
-    cache.mkdir(parents=True, exist_ok=True)
     results, oracles = {}, {}
     with tempfile.TemporaryDirectory() as t:
         runner = Runner(args, Path(t))
         for key in args.scenes.split(","):
-            scene = (ensure_atrium(args.atrium, python=sys.executable) if key == "atrium"
-                     else REPO / "scenes" / f"{key}.gltf")
+            scene = scene_path(key, args)
             for extra in ([], ["--force-diffuse"]) if args.diffuse else ([],):
                 results[(key, " ".join(extra))] = measure(runner, key, scene, extra, cache)
                 if args.oracle_seeds:

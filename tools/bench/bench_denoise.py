@@ -23,6 +23,35 @@ from .evaluation.metrics import flicker
 from .evaluation.run import Runner, file_sha
 
 
+def add_common_args(ap, last):
+    """The options bench_denoise and bench_adaptive share: image, frames, references, binaries."""
+    ap.add_argument("--width", type=int, default=160)
+    ap.add_argument("--first", type=int, default=8)
+    ap.add_argument("--last", type=int, default=last)
+    ap.add_argument("--ref-spp", type=int, default=1024)
+    ap.add_argument("--seeds", default="1,2")
+    ap.add_argument("--exe", default=str(REPO / "build" / "pathreuse"))
+    ap.add_argument("--cmp", default=str(REPO / "build" / "exr_compare"))
+    ap.add_argument("--atrium", default=str(ATRIUM))
+    ap.add_argument("--cache", default=str(REPO / "out" / "bench-denoise-cache"))
+
+
+def finish_common_args(args):
+    """What the evaluation's Runner expects beside them; returns the reference cache folder."""
+    args.max_depth, args.reuse_args, args.quiet = 8, "", False
+    args.seeds = [int(s) for s in args.seeds.split(",")]
+    cache = Path(args.cache)
+    cache.mkdir(parents=True, exist_ok=True)
+    return cache
+
+
+def scene_path(key, args):
+    """The scene file of a scene key: the atrium (fetched once), else one of scenes/."""
+    if key == "atrium":
+        return ensure_atrium(args.atrium, python=sys.executable)
+    return REPO / "scenes" / f"{key}.gltf"
+
+
 def reference(runner, key, scene, extra, cache):
     """The reference frames of one setting of materials, cached as float EXRs."""
     a = runner.args
@@ -59,33 +88,19 @@ def measure(runner, key, scene, extra, cache):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--scenes", default="cornell-dynamic,atrium")
-    ap.add_argument("--width", type=int, default=160)
-    ap.add_argument("--first", type=int, default=8)
-    ap.add_argument("--last", type=int, default=11)
-    ap.add_argument("--ref-spp", type=int, default=1024)
-    ap.add_argument("--seeds", default="1,2")
+    add_common_args(ap, last=11)
     ap.add_argument("--settings", default="256:raw,16:raw,16:denoise,4:denoise",
                     help="spp:raw or spp:denoise, comma-separated")
     ap.add_argument("--full-only", action="store_true", help="without the --force-diffuse runs")
-    ap.add_argument("--exe", default=str(REPO / "build" / "pathreuse"))
-    ap.add_argument("--cmp", default=str(REPO / "build" / "exr_compare"))
-    ap.add_argument("--atrium", default=str(ATRIUM))
-    ap.add_argument("--cache", default=str(REPO / "out" / "bench-denoise-cache"))
     args = ap.parse_args()
-    args.max_depth, args.reuse_args, args.quiet = 8, "", False
-    args.seeds = [int(s) for s in args.seeds.split(",")]
+    cache = finish_common_args(args)
     args.settings = [(int(s.split(":")[0]), s.split(":")[1] == "denoise")
                      for s in args.settings.split(",")]
-    cache = Path(args.cache)
-    cache.mkdir(parents=True, exist_ok=True)
     results = {}
     with tempfile.TemporaryDirectory() as t:
         runner = Runner(args, Path(t))
         for key in args.scenes.split(","):
-            if key == "atrium":
-                scene = ensure_atrium(args.atrium, python=sys.executable)
-            else:
-                scene = REPO / "scenes" / f"{key}.gltf"
+            scene = scene_path(key, args)
             for extra in ([],) if args.full_only else ([], ["--force-diffuse"]):
                 results[(key, " ".join(extra))] = measure(runner, key, scene, extra, cache)
     print("\n| scene | materials | setting | relMSE | flicker | s/frame | relMSE x s |\n"
