@@ -152,9 +152,7 @@ void expectSceneMatchesBruteForce(const std::string& path, const std::vector<dou
 }
 
 TEST(SceneAccel, CornellNvproMatchesBruteForce) {
-  const std::string path = test::sharedScene("cornell-nvpro/cornellBox.gltf");
-  ASSERT_FALSE(path.empty())
-      << "../shared/scenes/cornell-nvpro is absent: the tests need ../shared beside the project";
+  PR_SHARED_SCENE(path, "cornell-nvpro/cornellBox.gltf");
   expectSceneMatchesBruteForce(path, {0.0}, 1500);
 }
 
@@ -186,9 +184,7 @@ TEST(SceneAccel, EveryBvhWidthRendersTheDemoAlike) {
 }
 
 TEST(SceneAccel, BoxAnimatedMatchesBruteForceAtSeveralFrames) {
-  const std::string path = test::sharedScene("BoxAnimated/BoxAnimated.gltf");
-  ASSERT_FALSE(path.empty())
-      << "../shared/scenes/BoxAnimated is absent: the tests need ../shared beside the project";
+  PR_SHARED_SCENE(path, "BoxAnimated/BoxAnimated.gltf");
   expectSceneMatchesBruteForce(path, {0.0, 0.7, 1.5, 3.0}, 2000);
 }
 

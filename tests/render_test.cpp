@@ -233,9 +233,7 @@ TEST(PathTrace, NoNonFiniteSamplesOnTheDemoScenes) {
 }
 
 TEST(PathTrace, NoNonFiniteSamplesOnCornellNvpro) {
-  const std::string scene = test::sharedScene("cornell-nvpro/cornellBox.gltf");
-  ASSERT_FALSE(scene.empty())
-      << "../shared/scenes/cornell-nvpro is absent: the tests need ../shared beside the project";
+  PR_SHARED_SCENE(scene, "cornell-nvpro/cornellBox.gltf");
   const std::string dir = test::tempDir("nan-nvpro");
   const auto r = test::runPathreuse(
       "render '" + scene +

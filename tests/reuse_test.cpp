@@ -503,9 +503,7 @@ TEST(Reuse, LightTracingIsTheDefaultWithEyePaths) {
 }
 
 TEST(Reuse, ConvergesToThePathTracerOnCornellNvpro) {
-  const std::string scene = test::sharedScene("cornell-nvpro/cornellBox.gltf");
-  ASSERT_FALSE(scene.empty())
-      << "../shared/scenes/cornell-nvpro is absent: the tests need ../shared beside the project";
+  PR_SHARED_SCENE(scene, "cornell-nvpro/cornellBox.gltf");
   expectSameImage(scene, "--max-depth 6", 48, 36, 32, 2);
 }
 

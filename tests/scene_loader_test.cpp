@@ -52,9 +52,7 @@ void expectRefused(const std::string& path) {
 // Real scenes
 
 TEST(SceneLoader, CornellNvpro) {
-  const std::string path = test::sharedScene("cornell-nvpro/cornellBox.gltf");
-  ASSERT_FALSE(path.empty())
-      << "../shared/scenes is absent: the tests need ../shared beside the project";
+  PR_SHARED_SCENE(path, "cornell-nvpro/cornellBox.gltf");
   const auto start = std::chrono::steady_clock::now();
   const Scene s = loadScene(path, quiet());
   const double ms =
@@ -81,9 +79,7 @@ TEST(SceneLoader, CornellNvpro) {
 }
 
 TEST(SceneLoader, BoxAnimatedIsSplit) {
-  const std::string path = test::sharedScene("BoxAnimated/BoxAnimated.gltf");
-  ASSERT_FALSE(path.empty())
-      << "../shared/scenes is absent: the tests need ../shared beside the project";
+  PR_SHARED_SCENE(path, "BoxAnimated/BoxAnimated.gltf");
   const Scene s = loadScene(path, quiet());
   EXPECT_GT(s.dynamicTriangleCount(), 0u);
   EXPECT_EQ(s.dynamicTriangleCount(),
@@ -106,9 +102,7 @@ TEST(SceneLoader, BoxAnimatedIsSplit) {
 // Khronos validator test files: each report lists what is wrong. All of them but valid.glb have
 // at least one error (severity 0) in their report, so every one must be refused.
 TEST(SceneLoader, KhronosInvalidFilesAreRefused) {
-  const std::string dir = test::sharedScene("invalid");
-  ASSERT_FALSE(dir.empty())
-      << "../shared/scenes/invalid is absent: the tests need ../shared beside the project";
+  PR_SHARED_SCENE(dir, "invalid");
   int refused = 0;
   for (const auto& entry : fs::recursive_directory_iterator(dir)) {
     const std::string p = entry.path().string();

@@ -67,16 +67,16 @@ struct ArgSpec {
   to->PR_ARG_NAME(role, name) = from.PR_ARG_NAME(role, name);
 
 // struct ConnectArgs { cl::Buffer pr_g_static_nodes; ...; ReuseParams rp; uint sample; ... }
-#define PR_KARG_STRUCT_(kernelName, Struct, table)                            \
-  struct Struct {                                                             \
-    static constexpr const char* kKernel = #kernelName;                       \
-    static constexpr ArgSpec kSpecs[] = {table(PR_KARG_SPEC_)};               \
-    static constexpr size_t kCount = sizeof(kSpecs) / sizeof(kSpecs[0]);      \
-    table(PR_KARG_MEMBER_) /* Sets the arguments whose role is in `roles`. */ \
-        void set(cl::Kernel& kernel, unsigned roles = kAllRoles) const {      \
-      cl_uint index = 0;                                                      \
-      table(PR_KARG_SET_)                                                     \
-    }                                                                         \
+#define PR_KARG_STRUCT_(kernelName, Struct, table)                                             \
+  struct Struct {                                                                              \
+    static constexpr const char* kKernel = #kernelName;                                        \
+    static constexpr ArgSpec kSpecs[] = {table(PR_KARG_SPEC_, PR_KARG_SPEC_)};                 \
+    static constexpr size_t kCount = sizeof(kSpecs) / sizeof(kSpecs[0]);                       \
+    table(PR_KARG_MEMBER_, PR_KARG_MEMBER_) /* Sets the arguments whose role is in `roles`. */ \
+        void set(cl::Kernel& kernel, unsigned roles = kAllRoles) const {                       \
+      cl_uint index = 0;                                                                       \
+      table(PR_KARG_SET_, PR_KARG_SET_)                                                        \
+    }                                                                                          \
   };
 PR_KERNEL_TABLES(PR_KARG_STRUCT_)
 PR_KARG_STRUCT_(scene, SceneArgs, PR_ARGS_SCENE)
@@ -84,7 +84,7 @@ PR_KARG_STRUCT_(scene, SceneArgs, PR_ARGS_SCENE)
 // Copies the scene's members into a kernel's argument struct.
 template <class KernelArgs>
 void setScene(KernelArgs* to, const SceneArgs& from) {
-  PR_ARGS_SCENE(PR_KARG_COPY_)
+  PR_ARGS_SCENE(PR_KARG_COPY_, PR_KARG_COPY_)
 }
 
 // Every table, for tests: (kernel name, specs, count).

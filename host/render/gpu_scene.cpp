@@ -11,6 +11,7 @@
 
 #include "cl/kernel_args.h"
 #include "render/device_materials.h"
+#include "render/kernel_programs.h"
 #include "render/light_table.h"
 #include "util/error.h"
 
@@ -448,21 +449,18 @@ kargs::SceneArgs GpuScene::kernelArgs() {
 }
 
 std::string GpuScene::buildOptions() const {
-  std::string o = "-DPR_BVH_WIDTH=" + std::to_string(bvhWidth_) + " ";
-  if (hasAlpha_) o += "-DPR_HAS_ALPHA=1 ";
-  if (hasSheen_) o += "-DPR_HAS_SHEEN=1 ";
-  if (hasCoat_) o += "-DPR_HAS_COAT=1 ";
-  if (hasAnisotropy_) o += "-DPR_HAS_ANISOTROPY=1 ";
-  if (!options_.shadowTerminator) o += "-DPR_TERMINATOR_OFFSET=0 ";
-  if (options_.materialModel == MaterialModel::Gltf)
-    o += "-DPR_HAS_GLTF_MODEL=1 -DPR_HAS_ENERGY_MODEL=0 ";
-  // One value picks the receivers' light sampler; the kernels compile all three (shared/lights.h).
-  const int sampler = lightChoice_ == LightSampler::Power        ? PR_LIGHT_SAMPLER_POWER
-                      : lightChoice_ == LightSampler::Exhaustive ? PR_LIGHT_SAMPLER_EXHAUSTIVE
-                                                                 : PR_LIGHT_SAMPLER_BVH;
-  o += "-DPR_LIGHT_SAMPLER=" + std::to_string(sampler) + " ";
-  if (!o.empty()) o.pop_back();
-  return o;
+  KernelFeatures f;
+  f.bvhWidth = bvhWidth_;
+  f.alpha = hasAlpha_;
+  f.sheen = hasSheen_;
+  f.coat = hasCoat_;
+  f.anisotropy = hasAnisotropy_;
+  f.terminatorOffset = options_.shadowTerminator;
+  f.gltfModel = options_.materialModel == MaterialModel::Gltf;
+  f.lightSampler = lightChoice_ == LightSampler::Power        ? PR_LIGHT_SAMPLER_POWER
+                   : lightChoice_ == LightSampler::Exhaustive ? PR_LIGHT_SAMPLER_EXHAUSTIVE
+                                                              : PR_LIGHT_SAMPLER_BVH;
+  return kernelBuildOptions(f);
 }
 
 uint64_t GpuScene::deviceBytes() const {

@@ -5,6 +5,7 @@
 
 #include "cl/kernel_args.h"
 #include "util/check.h"
+#include "render/kernel_programs.h"
 #include "render/path_tracer.h"
 #include "shared/reuse.h"
 #include "shared/splat.h"
@@ -45,7 +46,7 @@ PathReuse::PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseS
   eyeHit_ = kargs::kernel<kargs::EyeHitArgs>(ctx, "reuse/eye_hit.cl", opts);
   // With eye paths, connect traces no ray: its terms go to connect_shadow (kernels/reuse).
   connect_ = kargs::kernel<kargs::ConnectArgs>(
-      ctx, "reuse/connect.cl", opts + (settings_.eyePaths ? " -DPR_CONNECT_DEFERRED=1" : ""));
+      ctx, "reuse/connect.cl", settings_.eyePaths ? opts + " " + kConnectDeferredOption : opts);
   if (settings_.eyePaths)
     connectShadow_ = kargs::kernel<kargs::ConnectShadowArgs>(ctx, "reuse/connect_shadow.cl", opts);
   // Strategy T's weights need the eye paths' ratios (kernels/shared/eye_paths.h).

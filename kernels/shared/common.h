@@ -20,7 +20,9 @@ typedef ulong u64;
 #define PR_CALLABLE static inline
 #define PR_NAMESPACE_BEGIN
 #define PR_NAMESPACE_END
-#define PR_STATIC_ASSERT(cond, msg)
+// The host checks the layouts; here the assertion is an empty declaration that takes its `;`
+// (C99 has no stray `;` at file scope).
+#define PR_STATIC_ASSERT(cond, msg) struct pr_static_assert_
 // Every kernel: one work-item's computation already uses float4 (BVH slabs, triangle packets),
 // so a compiler should not pack work-items into vector lanes (OpenCL 1.2 6.7.2). Intel's CPU
 // compiler heeds the hint: packing lanes made connect 8x and the whole reuse frame 4.4x slower

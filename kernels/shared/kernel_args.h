@@ -3,6 +3,12 @@
 // kernel against its table (clGetKernelArgInfo) all come from these lists, so that an argument
 // is named once and never counted by hand.
 //
+// A table is a macro of two entry macros, F for its first entry and X for every other, so that a
+// parameter list is made without a variadic macro (OpenCL C 1.2 has none; NVIDIA's compiler
+// refuses them): F(...) gives `param`, X(...) gives `, param`. A table that begins with another
+// passes it (F, X); one included after an entry passes it (X, X). Where the separator does not
+// matter (the host's structs, the gathers below) both are the same macro.
+//
 // An entry is X(role, kind, type, name):
 //   role  GEOM, SHADING, LIGHTS: the scene (GpuScene sets them; kernels get SceneData);
 //         FRAME: set once per frame; PASS: changes between the launches of one frame (the
@@ -13,8 +19,8 @@
 #pragma once
 
 // The scene's geometry: the two BVHs (SSG, and DSG's top level over instances of mesh BVHs).
-#define PR_ARGS_SCENE_GEOM(X)            \
-  X(GEOM, IN, BvhNode, static_nodes)     \
+#define PR_ARGS_SCENE_GEOM(F, X)         \
+  F(GEOM, IN, BvhNode, static_nodes)     \
   X(GEOM, IN, BvhTriPacket, static_tris) \
   X(GEOM, IN, BvhNode, tlas_nodes)       \
   X(GEOM, IN, BvhInstance, instances)    \
@@ -23,8 +29,8 @@
   X(GEOM, VAL, uint, instance_count)
 
 // What shading reads: vertices, triangles, per-instance records, materials, textures.
-#define PR_ARGS_SHADING(X)                   \
-  X(SHADING, IN, ShadingVertex, vertices)    \
+#define PR_ARGS_SHADING(F, X)                \
+  F(SHADING, IN, ShadingVertex, vertices)    \
   X(SHADING, IN, ShadingTriangle, triangles) \
   X(SHADING, IN, ShadingInstance, instances) \
   X(SHADING, IN, Material, materials)        \
@@ -32,8 +38,8 @@
   X(SHADING, IN, uint, texels)
 
 // The light table, its light BVH and the environment.
-#define PR_ARGS_LIGHTS(X)            \
-  X(LIGHTS, IN, Light, lights)       \
+#define PR_ARGS_LIGHTS(F, X)         \
+  F(LIGHTS, IN, Light, lights)       \
   X(LIGHTS, IN, float, cdf)          \
   X(LIGHTS, IN, LightNode, nodes)    \
   X(LIGHTS, IN, uint, prim_light)    \
@@ -43,25 +49,25 @@
   X(LIGHTS, VAL, float, total_power) \
   X(LIGHTS, VAL, uint, env_light)
 
-#define PR_ARGS_SCENE(X) PR_ARGS_SCENE_GEOM(X) PR_ARGS_SHADING(X) PR_ARGS_LIGHTS(X)
+#define PR_ARGS_SCENE(F, X) PR_ARGS_SCENE_GEOM(F, X) PR_ARGS_SHADING(X, X) PR_ARGS_LIGHTS(X, X)
 
 // --noise-threshold: the pass's samples are taken at pixels whose budget (total passes,
 // kernels/adaptive.cl) exceeds the sample index, where `masked`; at every pixel otherwise.
-#define PR_ARGS_PIXEL_MASK(X) \
-  X(FRAME, IN, uint, budget)  \
+#define PR_ARGS_PIXEL_MASK(F, X) \
+  F(FRAME, IN, uint, budget)     \
   X(PASS, VAL, uint, masked)
 
 // The same pass's pixels as a list (Film::beginPass): where `listed`, a launch's work-item k
 // < list_count stands for pixel pixels[k] (in no particular order); otherwise for pixel k.
-#define PR_ARGS_PIXEL_LIST(X) \
-  X(PASS, IN, uint, pixels)   \
-  X(PASS, VAL, uint, listed)  \
+#define PR_ARGS_PIXEL_LIST(F, X) \
+  F(PASS, IN, uint, pixels)      \
+  X(PASS, VAL, uint, listed)     \
   X(PASS, VAL, uint, list_count)
 
 // ---- Path reuse (kernels/reuse/) ----
 
-#define PR_ARGS_INVALIDATE(X)         \
-  PR_ARGS_SCENE(X)                    \
+#define PR_ARGS_INVALIDATE(F, X)      \
+  PR_ARGS_SCENE(F, X)                 \
   X(FRAME, VAL, ReuseParams, rp)      \
   X(FRAME, VAL, uint, test_segments)  \
   X(FRAME, OUT, PathHeader, headers)  \
@@ -72,8 +78,8 @@
   X(FRAME, VAL, uint, frame_stamp)    \
   X(FRAME, OUT, uint, changed)
 
-#define PR_ARGS_LIGHT_TRACE(X)         \
-  PR_ARGS_SCENE(X)                     \
+#define PR_ARGS_LIGHT_TRACE(F, X)      \
+  PR_ARGS_SCENE(F, X)                  \
   X(FRAME, VAL, ReuseParams, rp)       \
   X(FRAME, IN, float, trace_cdf)       \
   X(FRAME, OUT, PathHeader, headers)   \
@@ -83,18 +89,18 @@
   X(FRAME, VAL, uint, list_count)      \
   X(FRAME, OUT, uint, counters)
 
-#define PR_ARGS_EYE_HIT(X)         \
-  PR_ARGS_SCENE(X)                 \
+#define PR_ARGS_EYE_HIT(F, X)      \
+  PR_ARGS_SCENE(F, X)              \
   X(FRAME, VAL, ReuseParams, rp)   \
   X(FRAME, VAL, CameraParams, cam) \
   X(PASS, VAL, uint, sample)       \
   X(FRAME, OUT, EyeVertex, eye)    \
   X(FRAME, OUT, float4, radiance)  \
   X(FRAME, OUT, uint, counters)    \
-  PR_ARGS_PIXEL_MASK(X)
+  PR_ARGS_PIXEL_MASK(X, X)
 
-#define PR_ARGS_CONNECT(X)                  \
-  PR_ARGS_SCENE(X)                          \
+#define PR_ARGS_CONNECT(F, X)               \
+  PR_ARGS_SCENE(F, X)                       \
   X(FRAME, VAL, ReuseParams, rp)            \
   X(FRAME, VAL, CameraParams, cam)          \
   X(PASS, VAL, uint, sample)                \
@@ -109,22 +115,22 @@
   X(FRAME, IN, uint, changed)               \
   X(FRAME, OUT, ConnectionHistory, history) \
   X(FRAME, IN, EyePathRatio, ratios)        \
-  PR_ARGS_CONNECT_RECORDS(X, OUT)
+  PR_ARGS_CONNECT_RECORDS(X, X, OUT)
 
 // The pixel samples [record_first, record_end) of one launch of connect and connect_shadow, and
 // their terms, record_cap per sample (--eye-paths; ShadowRay with op, shared/reuse.h).
-#define PR_ARGS_CONNECT_RECORDS(X, kind) \
-  X(FRAME, kind, ShadowRay, records)     \
-  X(FRAME, kind, uint, record_counts)    \
-  X(FRAME, VAL, uint, record_cap)        \
-  X(PASS, VAL, uint, record_first)       \
-  X(PASS, VAL, uint, record_end)         \
-  PR_ARGS_PIXEL_LIST(X)
+#define PR_ARGS_CONNECT_RECORDS(F, X, kind) \
+  F(FRAME, kind, ShadowRay, records)        \
+  X(FRAME, kind, uint, record_counts)       \
+  X(FRAME, VAL, uint, record_cap)           \
+  X(PASS, VAL, uint, record_first)          \
+  X(PASS, VAL, uint, record_end)            \
+  PR_ARGS_PIXEL_LIST(X, X)
 
 // camera_splat (strategy T): the arena's vertices joined to the camera, into `splat` (fixed
 // point per pixel of [first, end), shared/splat.h) times film_scale.
-#define PR_ARGS_CAMERA_SPLAT(X)       \
-  PR_ARGS_SCENE(X)                    \
+#define PR_ARGS_CAMERA_SPLAT(F, X)    \
+  PR_ARGS_SCENE(F, X)                 \
   X(FRAME, VAL, ReuseParams, rp)      \
   X(FRAME, VAL, CameraParams, cam)    \
   X(FRAME, IN, PathHeader, headers)   \
@@ -136,10 +142,10 @@
   X(FRAME, VAL, float, film_scale)    \
   X(FRAME, OUT, uint, counters)
 
-#define PR_ARGS_CONNECT_SHADOW(X) \
-  PR_ARGS_SCENE(X)                \
-  PR_ARGS_CONNECT_RECORDS(X, IN)  \
-  X(FRAME, OUT, float4, radiance) \
+#define PR_ARGS_CONNECT_SHADOW(F, X) \
+  PR_ARGS_SCENE(F, X)                \
+  PR_ARGS_CONNECT_RECORDS(X, X, IN)  \
+  X(FRAME, OUT, float4, radiance)    \
   X(FRAME, OUT, uint, counters)
 
 // ---- The wavefront path tracer (kernels/pathtrace/) ----
@@ -147,8 +153,8 @@
 // `count` of them), which pt_shade compacts: the live paths into next_queue, the paths with a
 // shadow ray into shadow_queue, counted in queue_sizes (PR_QUEUE_*, shared/path_state.h).
 
-#define PR_ARGS_PT_GENERATE(X)           \
-  X(FRAME, VAL, CameraParams, cam)       \
+#define PR_ARGS_PT_GENERATE(F, X)        \
+  F(FRAME, VAL, CameraParams, cam)       \
   X(FRAME, VAL, uint, seed)              \
   X(FRAME, VAL, uint, frame)             \
   X(PASS, VAL, uint, sample)             \
@@ -163,18 +169,18 @@
   X(FRAME, OUT, PathReservoir, rs_res)   \
   X(FRAME, OUT, DirectReservoir, di_res) \
   X(FRAME, OUT, uint, queue_size)        \
-  PR_ARGS_PIXEL_MASK(X)
+  PR_ARGS_PIXEL_MASK(X, X)
 
-#define PR_ARGS_PT_EXTEND(X)      \
-  PR_ARGS_SCENE(X)                \
+#define PR_ARGS_PT_EXTEND(F, X)   \
+  PR_ARGS_SCENE(F, X)             \
   X(FRAME, IN, PathState, states) \
   X(FRAME, OUT, Hit, hits)        \
   X(FRAME, OUT, uint, rays)       \
   X(PASS, IN, uint, queue)        \
   X(PASS, VAL, uint, count)
 
-#define PR_ARGS_PT_SHADE(X)         \
-  PR_ARGS_SCENE(X)                  \
+#define PR_ARGS_PT_SHADE(F, X)      \
+  PR_ARGS_SCENE(F, X)               \
   X(FRAME, OUT, PathState, states)  \
   X(FRAME, IN, Hit, hits)           \
   X(FRAME, OUT, float4, radiance)   \
@@ -192,20 +198,20 @@
   X(FRAME, IN, float, trace_cdf)    \
   X(FRAME, VAL, float, trace_total) \
   X(FRAME, OUT, EyeVertex, eye)     \
-  PR_ARGS_PT_RESAMPLE(X)
+  PR_ARGS_PT_RESAMPLE(X, X)
 
 // --resample: the paths' candidates, offered by pt_shade and pt_shadow to their pixel's
 // reservoir (shared/resample.h).
-#define PR_ARGS_PT_RESAMPLE(X)             \
-  X(FRAME, VAL, ResampleParams, rsp)       \
+#define PR_ARGS_PT_RESAMPLE(F, X)          \
+  F(FRAME, VAL, ResampleParams, rsp)       \
   X(FRAME, OUT, PathTrack, rs_track)       \
   X(FRAME, OUT, PathReservoir, rs_res)     \
   X(FRAME, OUT, PathReservoir, rs_pending) \
   X(FRAME, OUT, DirectReservoir, di_res)   \
   X(FRAME, OUT, DirectReservoir, di_pending)
 
-#define PR_ARGS_PT_SHADOW(X)              \
-  PR_ARGS_SCENE(X)                        \
+#define PR_ARGS_PT_SHADOW(F, X)           \
+  PR_ARGS_SCENE(F, X)                     \
   X(FRAME, OUT, float4, radiance)         \
   X(FRAME, IN, ShadowRay, shadows)        \
   X(FRAME, OUT, uint, rays)               \
@@ -224,74 +230,74 @@
 // reconnection, into its radiance and history_out (one pass over the film's pixels [first, end)).
 // temporal: `history` holds this pass's reservoirs of the previous frame, seen by prev_cam, and
 // `moved` (rsp.moved_count boxes) where the scene changed since.
-#define PR_ARGS_PT_RESAMPLE_SPATIAL(X)   \
-  PR_ARGS_SCENE(X)                       \
-  X(FRAME, VAL, ResampleParams, rsp)     \
-  X(FRAME, IN, EyeVertex, eye)           \
-  X(FRAME, IN, PathReservoir, rs_res)    \
-  X(FRAME, IN, DirectReservoir, di_res)  \
-  X(FRAME, OUT, float4, radiance)        \
-  X(FRAME, VAL, uint, seed)              \
-  X(FRAME, VAL, uint, frame)             \
-  X(PASS, VAL, uint, sample)             \
-  X(FRAME, VAL, uint, first)             \
-  X(FRAME, VAL, uint, end)               \
-  X(FRAME, OUT, uint, rays)              \
-  X(PASS, VAL, uint, temporal)           \
-  X(PASS, IN, PathHistory, history)      \
-  X(PASS, OUT, PathHistory, history_out) \
-  X(FRAME, VAL, CameraParams, prev_cam)  \
-  X(FRAME, VAL, CameraParams, cam)       \
-  X(FRAME, IN, MovedInstance, moved)     \
-  X(FRAME, VAL, uint, stamp)             \
-  PR_ARGS_PIXEL_LIST(X)
+#define PR_ARGS_PT_RESAMPLE_SPATIAL(F, X) \
+  PR_ARGS_SCENE(F, X)                     \
+  X(FRAME, VAL, ResampleParams, rsp)      \
+  X(FRAME, IN, EyeVertex, eye)            \
+  X(FRAME, IN, PathReservoir, rs_res)     \
+  X(FRAME, IN, DirectReservoir, di_res)   \
+  X(FRAME, OUT, float4, radiance)         \
+  X(FRAME, VAL, uint, seed)               \
+  X(FRAME, VAL, uint, frame)              \
+  X(PASS, VAL, uint, sample)              \
+  X(FRAME, VAL, uint, first)              \
+  X(FRAME, VAL, uint, end)                \
+  X(FRAME, OUT, uint, rays)               \
+  X(PASS, VAL, uint, temporal)            \
+  X(PASS, IN, PathHistory, history)       \
+  X(PASS, OUT, PathHistory, history_out)  \
+  X(FRAME, VAL, CameraParams, prev_cam)   \
+  X(FRAME, VAL, CameraParams, cam)        \
+  X(FRAME, IN, MovedInstance, moved)      \
+  X(FRAME, VAL, uint, stamp)              \
+  PR_ARGS_PIXEL_LIST(X, X)
 
 // ---- The film (kernels/accumulate.cl) ----
 
-#define PR_ARGS_ACCUMULATE(X)      \
-  X(FRAME, IN, float4, radiance)   \
+#define PR_ARGS_ACCUMULATE(F, X)   \
+  F(FRAME, IN, float4, radiance)   \
   X(FRAME, OUT, float4, film)      \
   X(FRAME, OUT, uint, bad_samples) \
   X(FRAME, VAL, uint, count)       \
   X(FRAME, VAL, uint, pixel_count) \
-  PR_ARGS_PIXEL_LIST(X)
+  PR_ARGS_PIXEL_LIST(X, X)
 
-#define PR_ARGS_SPLAT_FILM(X)   \
-  X(FRAME, OUT, uint, splat)    \
-  X(FRAME, OUT, float4, film)   \
-  X(FRAME, VAL, float, scale)   \
-  X(FRAME, VAL, uint, clear)    \
-  X(FRAME, VAL, uint, by_count) \
-  X(FRAME, VAL, uint, first)    \
+#define PR_ARGS_SPLAT_FILM(F, X) \
+  F(FRAME, OUT, uint, splat)     \
+  X(FRAME, OUT, float4, film)    \
+  X(FRAME, VAL, float, scale)    \
+  X(FRAME, VAL, uint, clear)     \
+  X(FRAME, VAL, uint, by_count)  \
+  X(FRAME, VAL, uint, first)     \
   X(FRAME, VAL, uint, end)
 
 // adaptive_plan (--noise-threshold): one work-item per pixel of the film's range, after the
 // pilot passes (kernels/adaptive.cl).
-#define PR_ARGS_ADAPTIVE_PLAN(X)  \
-  X(FRAME, IN, float4, film)      \
-  X(FRAME, IN, float4, odd)       \
-  X(FRAME, OUT, uint, budget)     \
-  X(FRAME, VAL, uint, width)      \
-  X(FRAME, VAL, uint, first)      \
-  X(FRAME, VAL, uint, end)        \
-  X(FRAME, VAL, uint, radius)     \
-  X(FRAME, VAL, uint, pilot)      \
-  X(FRAME, VAL, uint, spp)        \
-  X(FRAME, VAL, float, threshold) \
+#define PR_ARGS_ADAPTIVE_PLAN(F, X) \
+  F(FRAME, IN, float4, film)        \
+  X(FRAME, IN, float4, odd)         \
+  X(FRAME, OUT, uint, budget)       \
+  X(FRAME, VAL, uint, width)        \
+  X(FRAME, VAL, uint, first)        \
+  X(FRAME, VAL, uint, end)          \
+  X(FRAME, VAL, uint, radius)       \
+  X(FRAME, VAL, uint, pilot)        \
+  X(FRAME, VAL, uint, spp)          \
+  X(FRAME, VAL, float, threshold)   \
   X(FRAME, OUT, uint, max_budget)
 
 // adaptive_list: one work-item per pixel of the film's range; appends those that take pass
 // `sample` to `pixels`, their count to *count.
-#define PR_ARGS_ADAPTIVE_LIST(X) \
-  X(FRAME, IN, uint, budget)     \
-  X(PASS, VAL, uint, sample)     \
-  X(FRAME, VAL, uint, end)       \
-  X(FRAME, OUT, uint, pixels)    \
+#define PR_ARGS_ADAPTIVE_LIST(F, X) \
+  F(FRAME, IN, uint, budget)        \
+  X(PASS, VAL, uint, sample)        \
+  X(FRAME, VAL, uint, end)          \
+  X(FRAME, OUT, uint, pixels)       \
   X(FRAME, OUT, uint, count)
 
 // aov (--aov): one work-item per pixel, every sample pass in one launch (kernels/aov.cl).
-#define PR_ARGS_AOV(X)                  \
-  PR_ARGS_SCENE(X)                      \
+#define PR_ARGS_AOV(F, X)               \
+  PR_ARGS_SCENE(F, X)                   \
   X(FRAME, VAL, CameraParams, cam)      \
   X(FRAME, VAL, CameraParams, prev_cam) \
   X(FRAME, IN, float, prev_inst)        \
@@ -335,26 +341,24 @@
 #define PR_ARG_NAME_FRAME(name) name
 #define PR_ARG_NAME_PASS(name) name
 
-// A list X(...) X(...) ... whose entries each begin with a comma, without its first comma.
-#define PR_ARG_DROP_FIRST_(first, ...) __VA_ARGS__
-#define PR_ARG_DROP_FIRST(...) PR_ARG_DROP_FIRST_(__VA_ARGS__)
-
 #ifdef PR_DEVICE_CODE
 #define PR_ARG_DECL_IN(type) __global const type*
 #define PR_ARG_DECL_OUT(type) __global type*
 #define PR_ARG_DECL_VAL(type) type
-#define PR_ARG_PARAM_(role, kind, type, name) , PR_ARG_DECL_##kind(type) PR_ARG_NAME(role, name)
+#define PR_ARG_PARAM_FIRST_(role, kind, type, name) PR_ARG_DECL_##kind(type) PR_ARG_NAME(role, name)
+#define PR_ARG_PARAM_(role, kind, type, name) , PR_ARG_PARAM_FIRST_(role, kind, type, name)
+#define PR_ARG_VALUE_FIRST_(role, kind, type, name) PR_ARG_NAME(role, name)
 #define PR_ARG_VALUE_(role, kind, type, name) , PR_ARG_NAME(role, name)
 #define PR_ARG_FIELD_(role, kind, type, name) d.name = PR_ARG_NAME(role, name);
 
 // The parameter list of a kernel (or helper) from its table, and the names to pass them on.
-#define PR_PARAMS(table) PR_ARG_DROP_FIRST(~table(PR_ARG_PARAM_))
-#define PR_ARG_VALUES(table) PR_ARG_DROP_FIRST(~table(PR_ARG_VALUE_))
+#define PR_PARAMS(table) table(PR_ARG_PARAM_FIRST_, PR_ARG_PARAM_)
+#define PR_ARG_VALUES(table) table(PR_ARG_VALUE_FIRST_, PR_ARG_VALUE_)
 
 // The scene's structs, filled from their parameters field by field (field name = entry name).
-#define PR_ARG_GATHER(Type, fn, table)  \
-  PR_INLINE Type fn(PR_PARAMS(table)) { \
-    Type d;                             \
-    table(PR_ARG_FIELD_) return d;      \
+#define PR_ARG_GATHER(Type, fn, table)            \
+  PR_INLINE Type fn(PR_PARAMS(table)) {           \
+    Type d;                                       \
+    table(PR_ARG_FIELD_, PR_ARG_FIELD_) return d; \
   }
 #endif

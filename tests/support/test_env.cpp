@@ -31,9 +31,25 @@ Context& testContext() {
   return *ctx;
 }
 
+std::string scenesDir() {
+  if (const char* dir = std::getenv("PATHREUSE_SCENES"); dir && *dir) return dir;
+  return (fs::path(PATHREUSE_SHARED_DIR) / "scenes").lexically_normal().string();
+}
+
+bool scenesRequired() {
+  const char* r = std::getenv("PATHREUSE_REQUIRE_SCENES");
+  return r && *r && std::string(r) != "0";
+}
+
 std::string sharedScene(const std::string& rel) {
-  const fs::path p = fs::path(PATHREUSE_SHARED_DIR) / "scenes" / rel;
+  const fs::path p = fs::path(scenesDir()) / rel;
   return fs::exists(p) ? p.lexically_normal().string() : "";
+}
+
+std::string missingSceneMessage(const std::string& rel) {
+  return "third-party scene " + rel + " is not in " + scenesDir() +
+         (scenesRequired() ? " and PATHREUSE_REQUIRE_SCENES is set"
+                           : "; put ../shared/scenes beside the clone or set PATHREUSE_SCENES");
 }
 
 std::string sourcePath(const std::string& rel) {

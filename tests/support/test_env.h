@@ -12,8 +12,15 @@ namespace pr::test {
 // default choice. Created once per test process.
 Context& testContext();
 
-// Path of ../shared/scenes/<rel> beside the project, or "" when that folder is absent.
+// The third-party scenes' folder: $PATHREUSE_SCENES, else ../shared/scenes beside the project.
+std::string scenesDir();
+// Whether a missing third-party scene fails its test ($PATHREUSE_REQUIRE_SCENES set, not 0; CI
+// sets it) rather than skipping it.
+bool scenesRequired();
+// Path of scenesDir()/<rel>, or "" when it is absent.
 std::string sharedScene(const std::string& rel);
+// Why a test that needs scenesDir()/<rel> did not run, and how to get it.
+std::string missingSceneMessage(const std::string& rel);
 
 // Path of a file in the source tree.
 std::string sourcePath(const std::string& rel);
@@ -46,3 +53,13 @@ extern const char* const kTwoPoclDrivers;
 std::string twoPoclDevices();
 
 }  // namespace pr::test
+
+// Declares `const std::string var`, the path of third-party scene `rel`. Where it is absent the
+// test fails under PATHREUSE_REQUIRE_SCENES and is skipped, saying why, otherwise (a user's clone
+// has no ../shared).
+#define PR_SHARED_SCENE(var, rel)                                                     \
+  const std::string var = ::pr::test::sharedScene(rel);                               \
+  if (var.empty()) {                                                                  \
+    if (::pr::test::scenesRequired()) FAIL() << ::pr::test::missingSceneMessage(rel); \
+    GTEST_SKIP() << ::pr::test::missingSceneMessage(rel);                             \
+  }

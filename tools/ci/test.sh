@@ -20,12 +20,19 @@ for device in pocl "intel(r) opencl"; do
   # The cross-platform portability test compares every platform already: once is enough. So
   # do the tests whose subject is host code, a Python tool or a script, whose kernels other
   # tests run on both platforms: the kernel-build notice (a fresh build of every kernel, 23 s on
-  # Intel's compiler), the evaluation tool's quick form and the Slurm chunks.
+  # Intel's compiler), the evaluation tool's quick form, the Slurm chunks and the kernels'
+  # conformance gate (clang's check, on no device).
   skip=()
-  [ "$device" = pocl ] || skip=(-E "PortabilityCli.EveryPlatformAgrees|Cli.KernelBuildsAreAnnouncedOnceAndTimedInTheFirstStatsLine|Evaluate.QuickFormWritesEveryOutputWithSaneNumbers|SlurmChunks.EqualOneProcess")
+  [ "$device" = pocl ] || skip=(-E "PortabilityCli.EveryPlatformAgrees|Cli.KernelBuildsAreAnnouncedOnceAndTimedInTheFirstStatsLine|Evaluate.QuickFormWritesEveryOutputWithSaneNumbers|SlurmChunks.EqualOneProcess|KernelConformance")
   (cd build && PATHREUSE_TEST_DEVICE="$device" \
     ctest --output-on-failure -j"$(nproc)" --timeout 900 "${skip[@]}") || status=1
+  # Each test skipped for want of a third-party scene says so once in ctest's log.
+  skipped=$(grep -c '^third-party scene .* is not in .*; put ' build/Testing/Temporary/LastTest.log || true)
+  [ "$skipped" -eq 0 ] || skips="${skips:+$skips, }$skipped on '$device'"
 done
 echo "== Oclgrind"
 bash tools/ci/oclgrind-check.sh || status=1
+if [ -n "${skips:-}" ]; then
+  echo "test.sh: tests skipped for want of the third-party scenes ($skips): they are not in ${PATHREUSE_SCENES:-../shared/scenes}; put that folder beside the clone, or set PATHREUSE_SCENES to it, to run them"
+fi
 exit $status

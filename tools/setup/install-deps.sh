@@ -2,7 +2,8 @@
 # Installs the Debian packages that pathreuse's build, tests and PoCL need (python3-venv for
 # tools/setup/intel-opencl.sh, the second platform of the tests, and for tools/setup/oidn.sh,
 # Open Image Denoise, which it then installs; oclgrind for
-# tools/ci/oclgrind-check.sh; clang-format for tools/ci/format-check.sh; ccache, through which
+# tools/ci/oclgrind-check.sh; clang-format for tools/ci/format-check.sh; clang for
+# tools/ci/kernel-conformance.sh, the kernels' strict OpenCL C 1.2 gate; ccache, through which
 # CMakeLists.txt compiles where it is present; Slurm and munge for tools/slurm/'s single-node
 # test cluster).
 # Idempotent: runs apt-get only when something is missing.
@@ -15,7 +16,7 @@ packages=(
   libopenexr-dev libcli11-dev libgtest-dev zlib1g-dev
   assimp-testmodels python3
   python3-matplotlib python3-numpy
-  python3-venv oclgrind clang-format ccache
+  python3-venv oclgrind clang-format clang ccache
   slurmctld slurmd slurm-client munge
 )
 

@@ -1,0 +1,37 @@
+// The OpenCL programs pathreuse builds and the -D options they are built with, in one place: the
+// renderer takes its options from here, and the conformance gate (tools/ci/kernel-conformance.sh)
+// checks every program in every variant listed here with a strict OpenCL C 1.2 compiler.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace pr {
+
+// What a scene's programs are compiled for (GpuScene::buildOptions).
+struct KernelFeatures {
+  int bvhWidth = 4;                                                     // 2, 4 or 8
+  bool alpha = false, sheen = false, coat = false, anisotropy = false;  // of any material
+  bool terminatorOffset = true;
+  bool gltfModel = false;  // --material-model gltf-reference
+  int lightSampler = 0;    // PR_LIGHT_SAMPLER_* (shared/lights.h)
+};
+
+// The -D options of a scene's programs.
+std::string kernelBuildOptions(const KernelFeatures& f);
+
+// connect.cl with eye paths: its terms go to connect_shadow, it traces no ray.
+inline constexpr const char* kConnectDeferredOption = "-DPR_CONNECT_DEFERRED=1";
+// Oclgrind's LLVM lacks llvm.bitreverse (tools/ci/oclgrind-check.sh sets it).
+inline constexpr const char* kBitreverseTableOption = "-DPR_BITREVERSE_TABLE";
+
+struct KernelProgram {
+  std::string file;     // under kernels/
+  std::string options;  // as passed to clBuildProgram, less -cl-std and -cl-kernel-arg-info
+};
+
+// Every program the renderer and the tests build, each in enough variants that every value of
+// every option is taken at least once and every feature both on and off.
+std::vector<KernelProgram> kernelProgramVariants();
+
+}  // namespace pr
