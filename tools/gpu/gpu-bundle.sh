@@ -3,6 +3,8 @@
 # built programs (stripped), the shared libraries they load except the C library (from ldd),
 # the portability suite's reference frames rendered here, on the CPU, and ../shared/scenes.
 # Usage: tools/gpu/gpu-bundle.sh DIR [--device SPEC]   (after tools/setup/build.sh; SPEC default pocl)
+#   e.g. GPU_BUNDLE_SCENES="cornell-nvpro BoxAnimated invalid FlightHelmet" for the tests and the
+#   asset step, packed with tar cJf to fit one call.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 dir="${1:?usage: tools/gpu/gpu-bundle.sh DIR [--device SPEC]}"
@@ -35,6 +37,10 @@ build/pathreuse portability --quiet --device "$device" --save-reference "$dir/re
   --out "$dir/reference-worst" >/dev/null
 rm -rf "$dir/reference-worst"
 pwd >"$dir/source_dir"  # where the tests look for the binary and the sources
-# The third-party test scenes (../shared/scenes), when they are beside the checkout.
-[ -d ../shared/scenes ] && cp -r ../shared/scenes "$dir/shared-scenes"
+# The third-party test scenes (../shared/scenes), when they are beside the checkout: all, or the
+# folders GPU_BUNDLE_SCENES names (a device call carries 64 MiB at most).
+if [ -d ../shared/scenes ]; then
+  mkdir -p "$dir/shared-scenes"
+  for s in ${GPU_BUNDLE_SCENES:-$(ls ../shared/scenes)}; do cp -r "../shared/scenes/$s" "$dir/shared-scenes/"; done
+fi
 du -sh "$dir"
