@@ -1,6 +1,8 @@
 // pathreuse: command-line entry. Parses arguments with CLI11, runs one subcommand, and turns
 // every exception into one line on stderr and an exit code (docs/design.md section 1).
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <cstdio>
 #include <exception>
 #include <iostream>
@@ -384,8 +386,32 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
   return render;
 }
 
-pr::RenderOptions toRenderOptions(const RenderArgs& a) {
+// The render options that cannot change a frame's pixels: where its files go and what else is
+// written, which frames, how the run reports, and the devices (named in the history's key by
+// what they are). Every other option, present or added later, is part of the estimator's key.
+const char* const kRunOnlyOptions[] = {
+    "--out",    "--exr-float", "--png",   "--exposure", "--aov",    "--denoise", "--stats",
+    "--resume", "--warm-up",   "--quiet", "--frames",   "--device", "--help"};
+
+// Each option of `render` but the run-only ones, with what was given for it ("" where nothing,
+// the default): two runs with the same key render the same frames from the same inputs.
+std::string estimatorKey(const CLI::App& render) {
+  std::string key;
+  for (const CLI::Option* opt : render.get_options()) {
+    const std::string name = opt->get_name();
+    if (std::find(std::begin(kRunOnlyOptions), std::end(kRunOnlyOptions), name) !=
+        std::end(kRunOnlyOptions))
+      continue;
+    key += name;
+    for (const std::string& r : opt->results()) key += " " + std::to_string(r.size()) + ":" + r;
+    key += "\n";
+  }
+  return key;
+}
+
+pr::RenderOptions toRenderOptions(const RenderArgs& a, const CLI::App& render) {
   pr::RenderOptions ro = a.ro;
+  ro.estimatorKey = estimatorKey(render);
   if (!a.frames.empty()) {
     ro.frames = pr::parseFrameRange(a.frames);
     ro.framesGiven = true;
@@ -557,7 +583,7 @@ int main(int argc, char** argv) {
     if (*devices) return runDevices(devicesJson);
     if (*info)
       return runInfo(infoArgs.scene, infoArgs.json, infoArgs.fps, infoArgs.allowOutsideUris);
-    if (*render) return pr::runRender(toRenderOptions(renderArgs));
+    if (*render) return pr::runRender(toRenderOptions(renderArgs, *render));
     if (*portability) {
       portabilityArgs.po.demoScenes = !portabilityArgs.noDemo;
       return pr::runPortability(portabilityArgs.po);

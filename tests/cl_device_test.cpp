@@ -13,6 +13,7 @@
 #include "shared/layout.h"
 #include "shared/types.h"
 #include "support/test_env.h"
+#include "util/hash.h"
 
 namespace pr {
 namespace {
@@ -213,6 +214,80 @@ TEST_F(ProgramTest, SecondBuildComesFromCacheAndCorruptEntryIsRebuilt) {
   std::ofstream(first.cacheFile, std::ios::trunc).close();
   EXPECT_FALSE(ctx.buildProgram("test/smoke.cl", "-DPR_CACHE_PROBE=1").fromCache);
   EXPECT_TRUE(ctx.buildProgram("test/smoke.cl", "-DPR_CACHE_PROBE=1").fromCache);
+}
+
+// A program whose kernel `scale` writes y[i] = factor * x[i].
+std::string scaleSource(int factor) {
+  return "__kernel void scale(__global const float* x, __global float* y) {\n"
+         "  y[get_global_id(0)] = " +
+         std::to_string(factor) + ".0f * x[get_global_id(0)];\n}\n";
+}
+
+// What kernel `scale` of `build` makes of x = 1.
+float scaleOfOne(const ProgramBuild& build) {
+  Context& ctx = test::testContext();
+  cl_int err = CL_SUCCESS;
+  cl::Kernel k(build.program, "scale", &err);
+  EXPECT_EQ(err, CL_SUCCESS);
+  const float one = 1.0f;
+  float y = -1.0f;
+  cl::Buffer x = ctx.allocate("x", sizeof one);
+  cl::Buffer out = ctx.allocate("y", sizeof y);
+  ctx.queue().enqueueWriteBuffer(x, CL_TRUE, 0, sizeof one, &one);
+  k.setArg(0, x);
+  k.setArg(1, out);
+  ctx.queue().enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(1));
+  ctx.queue().enqueueReadBuffer(out, CL_TRUE, 0, sizeof y, &y);
+  ctx.release(2 * sizeof y);
+  return y;
+}
+
+// Another program's valid cache file under this program's name (copied, or files rotated) is
+// never loaded: the file holds the key it was made for.
+TEST_F(ProgramTest, AnotherProgramsCacheFileIsRebuiltNotLoaded) {
+  Context& ctx = test::testContext();
+  const ProgramBuild two = ctx.buildProgramFromSource(scaleSource(2), "", "two");
+  const ProgramBuild three = ctx.buildProgramFromSource(scaleSource(3), "", "three");
+  ASSERT_FALSE(two.cacheFile.empty());
+  ASSERT_NE(two.cacheFile, three.cacheFile);
+  // Rotated: each file holds the other's binary.
+  const std::string aside = two.cacheFile + ".aside";
+  fs::rename(two.cacheFile, aside);
+  fs::rename(three.cacheFile, two.cacheFile);
+  fs::rename(aside, three.cacheFile);
+  const ProgramBuild twoAgain = ctx.buildProgramFromSource(scaleSource(2), "", "two");
+  EXPECT_FALSE(twoAgain.fromCache);
+  EXPECT_EQ(scaleOfOne(twoAgain), 2.0f);
+  const ProgramBuild threeAgain = ctx.buildProgramFromSource(scaleSource(3), "", "three");
+  EXPECT_FALSE(threeAgain.fromCache);
+  EXPECT_EQ(scaleOfOne(threeAgain), 3.0f);
+  // Rewritten right, each loads from its own file again.
+  EXPECT_TRUE(ctx.buildProgramFromSource(scaleSource(2), "", "two").fromCache);
+  EXPECT_EQ(scaleOfOne(ctx.buildProgramFromSource(scaleSource(2), "", "two")), 2.0f);
+}
+
+// A cache file with this program's key and a consistent checksum around a binary that lacks the
+// kernel asked for (the driver loads it): the kernel is built again from source, not refused.
+TEST_F(ProgramTest, CachedBinaryWithoutTheKernelIsRebuilt) {
+  Context& ctx = test::testContext();
+  const ProgramBuild smoke = ctx.buildProgram("test/smoke.cl");
+  const ProgramBuild other = ctx.buildProgramFromSource(scaleSource(2), "", "other");
+  std::string smokeFile = test::slurp(smoke.cacheFile), otherFile = test::slurp(other.cacheFile);
+  // Header: magic (8), key (32 hex), size (8), checksum (8); the binary follows.
+  ASSERT_GT(smokeFile.size(), 56u);
+  ASSERT_GT(otherFile.size(), 56u);
+  const std::string key = smokeFile.substr(8, 32), binary = otherFile.substr(56);
+  std::string forged = smokeFile.substr(0, 40);
+  const uint64_t size = binary.size(), check = Hash128().add(key).add(binary).low();
+  forged.append(reinterpret_cast<const char*>(&size), sizeof size);
+  forged.append(reinterpret_cast<const char*>(&check), sizeof check);
+  forged += binary;
+  std::ofstream(smoke.cacheFile, std::ios::binary | std::ios::trunc) << forged;
+  ASSERT_TRUE(ctx.buildProgram("test/smoke.cl").fromCache) << "the forged file was not loaded";
+  cl::Kernel k = ctx.kernel("test/smoke.cl", "saxpy");
+  EXPECT_TRUE(k());
+  EXPECT_NE(test::slurp(smoke.cacheFile), forged);
+  EXPECT_TRUE(ctx.buildProgram("test/smoke.cl").fromCache);
 }
 
 TEST(Layout, DeviceAgreesWithHostOnEverySharedStruct) {

@@ -359,5 +359,28 @@ TEST(MultiDeviceSession, HistoryFileKeepsTheSplitOfThePasses) {
   EXPECT_TRUE(a.rgba == b.rgba);
 }
 
+// A history file is used whole or not at all: where one device's part fails its checks (a bit
+// flipped in it, or a byte after the last part) no part is loaded and the split of the passes
+// stays, so the next frame equals a fresh start's.
+TEST(MultiDeviceSession, HistoryFileIsUsedWholeOrNotAtAll) {
+  const Scene scene = loadScene(kScene);
+  const RenderOptions ro = sessionOptions();
+  const DeviceEntry& d = test::testContext().device();
+  MultiDeviceSession first(scene, {&d, &d}, ro);
+  first.setPassSplit({3, 1});
+  for (int f = 0; f < 2; ++f) first.renderFrame(f, nullptr, nullptr);
+  const std::string file = packHistories(first, "key");
+  std::string flipped = file;
+  flipped[flipped.size() - 20] ^= 0x10;  // in device 1's records
+  for (const std::string& bad : {flipped, file + "x"}) {
+    MultiDeviceSession fresh(scene, {&d, &d}, ro), resumed(scene, {&d, &d}, ro);
+    EXPECT_FALSE(unpackHistories(bad, resumed, "key", 1));
+    EXPECT_EQ(resumed.passes(), fresh.passes());
+    const Image a = fresh.renderFrame(2, nullptr, nullptr);
+    const Image b = resumed.renderFrame(2, nullptr, nullptr);
+    EXPECT_TRUE(a.rgba == b.rgba) << "a part of a refused history was used";
+  }
+}
+
 }  // namespace
 }  // namespace pr

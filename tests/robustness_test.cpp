@@ -21,6 +21,8 @@
 #include <thread>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "io/image.h"
 #include "scene/gltf_loader.h"
 #include "support/background.h"
@@ -221,6 +223,88 @@ TEST(Resume, GoesOnFromTheResampledPathsOfTheLastFrame) {
   fs::resize_file(history6, fs::file_size(history6) / 2);
   refused(7, " --spp 2", "cut short");
   refused(8, " --spp 3", "another spp");
+  // Records whose numbers the kernels would sum into inf or negative pixels (checksums made
+  // right): a path's value f_r of 3e38, a negative radiance beyond x_2 (rest_r).
+  const auto forge = [&](int frame, size_t offset, float value) {
+    char name[64];
+    std::snprintf(name, sizeof name, "/cut/f_%04d.exr.history", frame);
+    std::string data;
+    ASSERT_TRUE(readFile(dir + name, &data));
+    const size_t n = 3 * 64 * 48;  // 3 chains
+    ASSERT_GT(data.size(), n * record + 8);
+    const size_t at = data.size() - 8 - n * record;
+    size_t j = 0;
+    while (j < n && data.compare(at + j * record, 4, std::string(4, '\xff')) == 0) ++j;
+    ASSERT_LT(j, n) << "no record keeps a path";
+    std::memcpy(&data[at + j * record + offset], &value, sizeof value);
+    const uint64_t check = Hash128().add(data.data() + at, n * record).low();
+    std::memcpy(&data[data.size() - 8], &check, sizeof check);
+    writeFileAtomic(dir + name, data);
+  };
+  forge(8, 48, 3e38f);  // PathReservoir::f_r
+  refused(9, " --spp 3", "a value of 3e38");
+  forge(9, 32, -7471.0f);  // PathReservoir::rest_r
+  refused(10, " --spp 3", "a negative radiance");
+}
+
+// A 1x1 image of one colour.
+Image plainImage(float r, float g, float b) {
+  Image img(1, 1);
+  float* p = img.pixel(0, 0);
+  p[0] = r, p[1] = g, p[2] = b, p[3] = 1.0f;
+  return img;
+}
+
+// The history is used only by a run that would have made it: of the same options that change a
+// frame, the same image size (not only the same pixel count), and files of the same content (an
+// edited texture or environment map under the same names). Otherwise the frame starts afresh and
+// says so. Each case resumes frame 2 from frame 1's history, kept aside and put back each time.
+TEST(Resume, AHistoryOfOtherInputsOrOptionsIsNotUsed) {
+  const std::string dir = test::tempDir("resume-inputs");
+  nlohmann::json g = nlohmann::json::parse(slurp(kScene));
+  g["images"] = {{{"uri", "tex.png"}}};
+  g["textures"] = {{{"source", 0}}};
+  g["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", 0}};
+  writeFileAtomic(dir + "/scene.gltf", g.dump());
+  writePng(dir + "/tex.png", plainImage(0.5f, 0.3f, 0.2f));
+  Image env(8, 4);
+  for (size_t i = 0; i < env.rgba.size(); ++i) env.rgba[i] = 0.2f;
+  writeExr(dir + "/env.exr", env);
+  const std::string common = "render '" + dir +
+                             "/scene.gltf' --exr-float --spp 2 --resume --env '" + dir +
+                             "/env.exr' --out '" + dir + "/f_%04d.exr'";
+  auto r = test::runPathreuse(common + " --quiet --width 32 --height 24 --frames 0-1");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const std::string history = dir + "/f_0001.exr.history";
+  std::string kept;
+  ASSERT_TRUE(readFile(history, &kept));
+  const auto resumeFrame2 = [&](const std::string& args) {
+    writeFileAtomic(history, kept);
+    fs::remove(dir + "/f_0002.exr");
+    fs::remove(dir + "/f_0002.exr.history");
+    r = test::runPathreuse(common + " --frames 2 " + args);
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    return r.err;
+  };
+  const std::string goesOn = "goes on from frame 1's resampled paths";
+  const std::string afresh = "history starts afresh at frame 2";
+  EXPECT_NE(resumeFrame2("--width 32 --height 24").find(goesOn), std::string::npos) << r.err;
+  EXPECT_NE(resumeFrame2("--width 24 --height 32").find(afresh), std::string::npos) << r.err;
+  EXPECT_NE(resumeFrame2("--width 32 --height 24 --no-light-tracing").find(afresh),
+            std::string::npos)
+      << r.err;
+  writePng(dir + "/tex.png", plainImage(0.2f, 0.5f, 0.3f));
+  EXPECT_NE(resumeFrame2("--width 32 --height 24").find(afresh), std::string::npos)
+      << "texture edited: " << r.err;
+  writePng(dir + "/tex.png", plainImage(0.5f, 0.3f, 0.2f));
+  for (size_t i = 0; i < env.rgba.size(); ++i) env.rgba[i] = 0.3f;
+  writeExr(dir + "/env.exr", env);
+  EXPECT_NE(resumeFrame2("--width 32 --height 24").find(afresh), std::string::npos)
+      << "environment edited: " << r.err;
+  for (size_t i = 0; i < env.rgba.size(); ++i) env.rgba[i] = 0.2f;
+  writeExr(dir + "/env.exr", env);
+  EXPECT_NE(resumeFrame2("--width 32 --height 24").find(goesOn), std::string::npos)
+      << "all as written: " << r.err;
 }
 
 // A chunk of frames that cannot read the history of the frame before it (rendered at the same

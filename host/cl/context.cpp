@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include "cl/kernel_sources.h"
+#include "util/check.h"
 #include "util/files.h"
 #include "util/hash.h"
 
@@ -15,13 +16,21 @@ namespace pr {
 
 namespace {
 
-constexpr char kCacheMagic[8] = {'P', 'R', 'K', 'B', 'I', 'N', '0', '1'};
+constexpr char kCacheMagic[8] = {'P', 'R', 'K', 'B', 'I', 'N', '0', '2'};
 
+// A cache file: this header, then the driver's binary. The file names its key, but a file can be
+// copied or renamed: the header holds the key it was made for, and the checksum covers key and
+// binary, so that another program's binary under this name is never loaded.
 struct CacheHeader {
   char magic[8];
+  char key[32];  // Hash128 hex of source, options, platform, device, driver and device version
   uint64_t size;
   uint64_t checksum;
 };
+
+uint64_t cacheChecksum(const std::string& key, const std::string& binary) {
+  return Hash128().add(key).add(binary).low();
+}
 
 double secondsSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -34,35 +43,43 @@ std::string buildLog(const cl::Program& program, const cl::Device& device) {
   return log;
 }
 
-// The cached binary for `key`, or empty if absent or corrupt (a corrupt file is removed).
-std::string loadCachedBinary(const std::string& file) {
+void removeCacheFile(const std::string& file) {
+  std::error_code ec;
+  std::filesystem::remove(file, ec);
+}
+
+// The cached binary of `key` in `file`, or empty where there is none or it is not this key's
+// whole binary (another format, key or size, a checksum that fails: the file is removed).
+std::string loadCachedBinary(const std::string& file, const std::string& key) {
   std::string data;
   if (!readFile(file, &data)) return {};
   CacheHeader h;
-  bool ok = data.size() >= sizeof h;
+  bool ok = data.size() >= sizeof h && key.size() == sizeof h.key;
   if (ok) {
     std::memcpy(&h, data.data(), sizeof h);
     ok = std::memcmp(h.magic, kCacheMagic, sizeof kCacheMagic) == 0 &&
-         h.size == data.size() - sizeof h && h.size > 0;
+         std::memcmp(h.key, key.data(), sizeof h.key) == 0 && h.size == data.size() - sizeof h &&
+         h.size > 0;
   }
   std::string binary;
   if (ok) {
     binary = data.substr(sizeof h);
-    ok = Hash128().add(binary.data(), binary.size()).low() == h.checksum;
+    ok = cacheChecksum(key, binary) == h.checksum;
   }
   if (!ok) {
-    std::error_code ec;
-    std::filesystem::remove(file, ec);
+    removeCacheFile(file);
     return {};
   }
   return binary;
 }
 
-void storeCachedBinary(const std::string& file, const std::string& binary) {
+void storeCachedBinary(const std::string& file, const std::string& key, const std::string& binary) {
   CacheHeader h;
+  PR_CHECK(key.size() == sizeof h.key);
   std::memcpy(h.magic, kCacheMagic, sizeof kCacheMagic);
+  std::memcpy(h.key, key.data(), sizeof h.key);
   h.size = binary.size();
-  h.checksum = Hash128().add(binary.data(), binary.size()).low();
+  h.checksum = cacheChecksum(key, binary);
   std::string data(reinterpret_cast<const char*>(&h), sizeof h);
   data += binary;
   try {
@@ -101,7 +118,14 @@ ProgramBuild Context::buildProgram(const std::string& mainFile, const std::strin
 
 cl::Kernel Context::kernel(const std::string& file, const char* name, const std::string& options) {
   cl_int err = CL_SUCCESS;
-  cl::Kernel k(buildProgram(file, options).program, name, &err);
+  ProgramBuild build = buildProgram(file, options);
+  cl::Kernel k(build.program, name, &err);
+  if (err != CL_SUCCESS && build.fromCache) {
+    // A cached binary that lacks the kernel is not this program's: built again from source.
+    removeCacheFile(build.cacheFile);
+    build = buildProgram(file, options);
+    k = cl::Kernel(build.program, name, &err);
+  }
   if (err != CL_SUCCESS)
     throw ClError(std::string("kernel ") + name + " of kernels/" + file, err, __FILE__, __LINE__);
   return k;
@@ -129,7 +153,7 @@ ProgramBuild Context::buildProgramFromSource(const std::string& source, const st
   ProgramBuild out;
   out.cacheFile = file;
   if (!file.empty()) {
-    const std::string binary = loadCachedBinary(file);
+    const std::string binary = loadCachedBinary(file, key);
     if (!binary.empty()) {
       cl::Program::Binaries bins{std::vector<unsigned char>(binary.begin(), binary.end())};
       std::vector<cl_int> status;
@@ -143,8 +167,7 @@ ProgramBuild Context::buildProgramFromSource(const std::string& source, const st
         return out;
       }
       // A binary the driver refuses (driver updated in place, truncated file): rebuild.
-      std::error_code ec;
-      std::filesystem::remove(file, ec);
+      removeCacheFile(file);
     }
   }
 
@@ -168,7 +191,7 @@ ProgramBuild Context::buildProgramFromSource(const std::string& source, const st
     std::vector<std::vector<unsigned char>> binaries;
     if (program.getInfo(CL_PROGRAM_BINARIES, &binaries) == CL_SUCCESS && binaries.size() == 1 &&
         !binaries[0].empty())
-      storeCachedBinary(file, std::string(binaries[0].begin(), binaries[0].end()));
+      storeCachedBinary(file, key, std::string(binaries[0].begin(), binaries[0].end()));
   }
   out.program = program;
   out.seconds = secondsSince(t0);

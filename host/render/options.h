@@ -121,6 +121,9 @@ struct RenderOptions {
   std::string envColor;  // "R,G,B"; "" = white
   float envStrength = 1.0f;
   float envRotate = 0.0f;  // degrees about +Y
+  // Every option that can change a frame's pixels, as given (the command line's, less those
+  // that cannot: host/main.cpp). The resume history is used only by a run of the same.
+  std::string estimatorKey;
 };
 
 // o.resample with `enabled` and `neighbors` resolved: --resample / --no-resample where given; else

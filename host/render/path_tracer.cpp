@@ -1,5 +1,7 @@
 #include "render/path_tracer.h"
 
+#include <initializer_list>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -320,24 +322,65 @@ struct HistoryHeader {
 
 constexpr char kHistoryMagic[8] = {'P', 'R', 'H', 'I', 'S', 'T', '1', '\0'};
 
-// A record the kernels can read safely: its surfaces in the scene, its numbers finite.
+// The largest number a record may hold: a product of two stays finite in float.
+constexpr float kMaxRecordValue = 1e18f;
+
+bool finiteIn(float x, float lo, float hi) {
+  return std::isfinite(x) && x >= lo && x <= hi;
+}
+
+// A reservoir's numbers: its path's value f (per channel), target p_hat, weight sum w_sum and
+// confidence m are non-negative and bounded, and so is what the kernels make of them, f w_sum /
+// p_hat (its unbiased contribution).
+bool validReservoir(const float f[3], float p_hat, float w_sum, float m) {
+  for (int c = 0; c < 3; ++c)
+    if (!finiteIn(f[c], 0.0f, kMaxRecordValue)) return false;
+  if (!finiteIn(p_hat, 0.0f, kMaxRecordValue) || !finiteIn(w_sum, 0.0f, kMaxRecordValue) ||
+      !finiteIn(m, 0.0f, kMaxRecordValue))
+    return false;
+  if (p_hat == 0.0f) return true;
+  const float weight = w_sum / p_hat;
+  for (int c = 0; c < 3; ++c)
+    if (!finiteIn(f[c] * weight, 0.0f, kMaxRecordValue)) return false;
+  return true;
+}
+
+// Barycentrics of a point on a triangle.
+bool validBarycentrics(float b1, float b2) {
+  const float slack = 1e-3f;
+  return finiteIn(b1, -slack, 1.0f + slack) && finiteIn(b2, -slack, 1.0f + slack) &&
+         b1 + b2 <= 1.0f + slack;
+}
+
+bool finiteAll(std::initializer_list<float> xs) {
+  for (float x : xs)
+    if (!std::isfinite(x)) return false;
+  return true;
+}
+
+// A record the kernels can read safely and sum into a frame without overflow: its surfaces in
+// the scene, its numbers finite, its values, weights and pdfs non-negative and bounded.
 bool validRecord(const dev::PathHistory& h, const GpuScene& scene) {
   const dev::DirectReservoir& d = h.d;
-  const float direct[] = {d.b1, d.b2, d.wx, d.wy, d.wz, d.f_r, d.f_g, d.f_b, d.p_hat, d.w_sum, d.m};
-  for (float x : direct)
-    if (!std::isfinite(x)) return false;
-  if (d.light != PR_INVALID_INDEX && d.light >= scene.lights().size()) return false;
+  const float df[3] = {d.f_r, d.f_g, d.f_b};
+  if (!finiteAll({d.wx, d.wy, d.wz}) || !validReservoir(df, d.p_hat, d.w_sum, d.m)) return false;
+  if (d.light != PR_INVALID_INDEX &&
+      (d.light >= scene.lights().size() || !validBarycentrics(d.b1, d.b2)))
+    return false;
   const dev::PathReservoir& r = h.r;
-  const float nums[] = {h.b1,        h.b2,  h.wx,  h.wy,    h.wz,     r.b1,     r.b2,
-                        r.wx,        r.wy,  r.wz,  r.g_src, r.rest_r, r.rest_g, r.rest_b,
-                        r.pdf_light, r.f_r, r.f_g, r.f_b,   r.p_hat,  r.w_sum,  r.m};
-  for (float x : nums)
-    if (!std::isfinite(x)) return false;
+  const float rf[3] = {r.f_r, r.f_g, r.f_b};
+  if (!validReservoir(rf, r.p_hat, r.w_sum, r.m)) return false;
+  if (!finiteAll({h.wx, h.wy, h.wz, r.wx, r.wy, r.wz, r.rn, r.rh})) return false;
+  for (float x : {r.g_src, r.rest_r, r.rest_g, r.rest_b, r.pdf_light})
+    if (!finiteIn(x, 0.0f, kMaxRecordValue)) return false;
   for (float x : r.sp)
     if (!std::isfinite(x)) return false;
   if ((r.suffix & PR_RS_COUNT_MASK) > PR_RS_SUFFIX) return false;
-  if (h.prim != PR_INVALID_INDEX && !scene.validSurface(h.prim, h.inst)) return false;
-  return r.prim == PR_INVALID_INDEX || scene.validSurface(r.prim, r.inst);
+  if (h.prim != PR_INVALID_INDEX &&
+      (!scene.validSurface(h.prim, h.inst) || !validBarycentrics(h.b1, h.b2)))
+    return false;
+  return r.prim == PR_INVALID_INDEX ||
+         (scene.validSurface(r.prim, r.inst) && validBarycentrics(r.b1, r.b2));
 }
 
 }  // namespace
@@ -369,7 +412,7 @@ std::string PathTracer::writeHistory(const std::string& key) {
   return out;
 }
 
-bool PathTracer::readHistory(const std::string& data, const std::string& key, int frame) {
+bool PathTracer::checkHistory(const std::string& data, const std::string& key, int frame) const {
   HistoryHeader h{};
   if (chainedPasses() == 0 || data.size() < sizeof h) return false;
   std::memcpy(&h, data.data(), sizeof h);
@@ -390,6 +433,14 @@ bool PathTracer::readHistory(const std::string& data, const std::string& key, in
     std::memcpy(&rec, data.data() + sizeof h + k, sizeof rec);
     if (!validRecord(rec, scene_)) return false;
   }
+  return true;
+}
+
+void PathTracer::applyHistory(const std::string& data) {
+  HistoryHeader h{};
+  PR_CHECK(data.size() >= sizeof h);
+  std::memcpy(&h, data.data(), sizeof h);
+  const size_t bytes = size_t(h.end - h.first) * h.record;
   syncChains();
   for (size_t c = 0; c < h.chains; ++c)
     writeChain(passBegin_ + int(c), data.data() + sizeof h + c * bytes);
@@ -397,7 +448,6 @@ bool PathTracer::readHistory(const std::string& data, const std::string& key, in
   stamp_ = h.stamp;
   camera_ = h.camera;
   written_ = chainedPasses();
-  return true;
 }
 
 void PathTracer::reportRays(FrameStats* stats) {

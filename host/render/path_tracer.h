@@ -65,11 +65,14 @@ class PathTracer : public Integrator {
   // on as the uninterrupted one would: whether the last frame left one whole, and its bytes
   // (a header, the chains' records of the film's rows, a checksum) or reading them back. `key`
   // names everything else it depends on (scene, options); a history of another key, size or frame
-  // is not read (returns false). readHistory's frame is the frame that wrote it; the caller sets
-  // the scene to that frame's time before the next frame.
+  // is not read. checkHistory says whether `data` is a whole history of `key`, this device's
+  // chains and film rows and frame `frame` (the frame that wrote it), every record in range;
+  // applyHistory then loads it. The caller sets the scene to that frame's time before checking
+  // (the records name its lights) and again before the next frame.
   bool hasHistory() const { return chainedPasses() > 0 && written_ >= chainedPasses(); }
   std::string writeHistory(const std::string& key);
-  bool readHistory(const std::string& data, const std::string& key, int frame);
+  bool checkHistory(const std::string& data, const std::string& key, int frame) const;
+  void applyHistory(const std::string& data);
 
   // Several devices: each holds the chains of its own passes alone, and a pass moving to another
   // device takes its chain along (render/multi_device.h): the records of pass `pass`'s chain

@@ -28,6 +28,7 @@
 #include "render/session.h"
 #include "scene/gltf_loader.h"
 #include "scene/image_decode.h"
+#include "util/check.h"
 #include "util/error.h"
 #include "util/files.h"
 #include "util/input_file.h"
@@ -237,42 +238,23 @@ bool keepsHistory(const RenderOptions& o) {
   return o.resume && r.enabled && r.history > 0;
 }
 
-// Everything a history depends on besides its frame and size: the scene file, the options that
-// change what a path is worth, the number of devices, and the kernels that made it. (The split of
-// the passes is in the file, and the run that reads it takes that split.)
-std::string historyKey(const RenderOptions& o, const MultiDeviceSession& session) {
-  std::string scene;
-  readFile(o.scene, &scene);
-  const ResampleSettings r = resolveResample(o);
-  nlohmann::json j = {o.scene,
-                      o.spp,
-                      o.maxDepth,
-                      o.seed,
-                      o.fps,
-                      o.camera,
-                      o.forceDiffuse,
-                      int(o.materialModel),
-                      o.shadowTerminator,
-                      int(o.lightSampler),
-                      o.bvhWidth,
-                      o.fixedNoise,
-                      o.env,
-                      o.envColor,
-                      o.envStrength,
-                      o.envRotate,
-                      r.neighbors,
-                      r.radius,
-                      r.roughness,
-                      r.distance,
-                      r.history,
-                      r.misCount,
-                      o.allowOutsideUris,
-                      int(o.mode),  // --mode reuse: the eye paths' share against the connections
-                      o.lightPaths,
-                      o.pathsPerPixel,
-                      session.deviceCount()};
-  return j.dump() + scene + expandKernelSource("pathtrace/shade.cl") +
-         expandKernelSource("pathtrace/resample.cl");
+// Everything a history depends on besides its frame: every option that can change a frame
+// (RenderOptions::estimatorKey), the image's size, the devices, the content of every file the
+// render reads (the scene and its files, the environment map) and the program itself, whose
+// kernels and defaults made it. (The split of the passes is in the file, and the run that reads
+// it takes that split.)
+std::string historyKey(const RenderOptions& o, MultiDeviceSession& session) {
+  PR_CHECK(!o.estimatorKey.empty());
+  std::string key = o.estimatorKey;
+  key += "size " + std::to_string(session.width()) + "x" + std::to_string(session.height()) + "\n";
+  for (size_t i = 0; i < session.deviceCount(); ++i) {
+    const DeviceEntry& d = session.device(i);
+    key += "device " + d.platformName + " / " + d.name + " / " + d.driverVersion + "\n";
+  }
+  key += "scene " + session.session(0).scene().inputDigest + "\n";
+  key += "environment " + session.session(0).environmentDigest() + "\n";
+  key += "program " + executableDigest() + "\n";
+  return key;
 }
 
 // Before a frame f > 0 whose previous frame this run did not render: whether the history frame
@@ -416,19 +398,31 @@ bool unpackHistories(const std::string& data, MultiDeviceSession& session, const
     if (!get(&v) || v < 0 || v > 1 << 20) return false;
     spp += p = v;
   }
-  if (!session.passes().empty()) {
-    if (spp != std::accumulate(session.passes().begin(), session.passes().end(), 0) ||
-        (size_t(spp) >= split.size() && std::count(split.begin(), split.end(), 0) > 0))
-      return false;
-    if (split != session.passes()) session.setPassSplit(split);  // the writing run's
-  }
-  for (size_t i = 0; i < session.deviceCount(); ++i) {
+  std::vector<std::string> parts(devices);
+  for (std::string& part : parts) {
     uint64_t n = 0;
     if (!get(&n) || n > data.size() - at) return false;
-    if (n > 0 && !session.session(i).readHistory(data.substr(at, n), key, frame)) return false;
+    part = data.substr(at, n);
     at += n;
   }
-  return at == data.size();
+  if (at != data.size()) return false;
+  const std::vector<int> before = session.passes();
+  if (!before.empty()) {
+    if (spp != std::accumulate(before.begin(), before.end(), 0) ||
+        (size_t(spp) >= split.size() && std::count(split.begin(), split.end(), 0) > 0))
+      return false;
+    if (split != before) session.setPassSplit(split);  // the writing run's
+  }
+  // All or nothing: every device's part is checked before any is loaded.
+  for (size_t i = 0; i < devices; ++i) {
+    if (!parts[i].empty() && !session.session(i).checkHistory(parts[i], key, frame)) {
+      if (!before.empty() && split != before) session.setPassSplit(before);
+      return false;
+    }
+  }
+  for (size_t i = 0; i < devices; ++i)
+    if (!parts[i].empty()) session.session(i).applyHistory(parts[i]);
+  return true;
 }
 
 int runRender(const RenderOptions& o) {

@@ -204,6 +204,10 @@ std::pair<double, double> RenderSession::renderAovs(int frame, Image* image) {
   return aov_->render(frame, options_.fps, camera_, image);
 }
 
+const std::string& RenderSession::environmentDigest() const {
+  return gpu_->environmentDigest();
+}
+
 bool RenderSession::hasHistory() const {
   return pathTracer_ && pathTracer_->hasHistory();
 }
@@ -212,12 +216,16 @@ std::string RenderSession::writeHistory(const std::string& key) {
   return pathTracer_->writeHistory(key);
 }
 
-bool RenderSession::readHistory(const std::string& data, const std::string& key, int frame) {
+bool RenderSession::checkHistory(const std::string& data, const std::string& key, int frame) {
   if (!pathTracer_) return false;
   // What moved between that frame and the next is measured from that frame's scene, whose light
   // table the records are checked against.
   gpu_->setTime(frame / options_.fps);
-  return pathTracer_->readHistory(data, key, frame);
+  return pathTracer_->checkHistory(data, key, frame);
+}
+
+void RenderSession::applyHistory(const std::string& data) {
+  pathTracer_->applyHistory(data);
 }
 
 int RenderSession::chains() const {

@@ -63,11 +63,14 @@ class RenderSession {
   std::vector<float> renderSums(int frame, FrameStats* stats);
 
   // --resample's history between frames (render/path_tracer.h): whether the last frame left
-  // one, its bytes, and reading the one frame `frame` wrote (which also sets the scene to
-  // that frame's time, so that the next frame finds what moved since, as it would have).
+  // one, its bytes, and checking then loading the one frame `frame` wrote (checking sets the
+  // scene to that frame's time, so that the next frame finds what moved since, as it would have).
+  const Scene& scene() const { return scene_; }
+  const std::string& environmentDigest() const;
   bool hasHistory() const;
   std::string writeHistory(const std::string& key);
-  bool readHistory(const std::string& data, const std::string& key, int frame);
+  bool checkHistory(const std::string& data, const std::string& key, int frame);
+  void applyHistory(const std::string& data);
   // The records of pass `pass`'s chain of that history, and writing them on the device the
   // pass moved to (render/multi_device.h); pass < the passes chained, this device's.
   int chains() const;

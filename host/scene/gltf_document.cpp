@@ -47,7 +47,7 @@ int jsonDepth(const uint8_t* json, size_t length, int limit) {
 // folder and below unless the options allow more. tinygltf tries the URI beside the scene, then
 // beside the working directory; only the first is a file of the scene.
 struct ExternalFiles {
-  const Document* doc;
+  Document* doc;
   std::string baseDir;
 };
 
@@ -77,6 +77,7 @@ bool readExternalFile(std::vector<unsigned char>* out, std::string*, const std::
   } catch (const InputError& e) {
     files->doc->fail(std::string("cannot load a file it names: ") + e.what());
   }
+  files->doc->inputs.add(path).add(out->data(), out->size());
   return true;
 }
 
@@ -104,6 +105,7 @@ class Parser : Stage {
     if (!inMemory_) readFileBytes();
     const std::vector<uint8_t>& bytes = bytes_;
     if (bytes.empty()) fail("file is empty");
+    doc_.inputs.add(doc_.path).add(bytes.data(), bytes.size());
 
     std::string ext = fs::path(doc_.path).extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(),

@@ -12,6 +12,7 @@
 #include <tiny_gltf.h>
 
 #include "scene/gltf_loader.h"
+#include "util/hash.h"
 
 namespace pr::gltf {
 
@@ -37,6 +38,9 @@ struct Document {
 
   std::string path;
   LoadOptions options;
+  // The content of every file read (the scene, its buffers and images), path by path: what a
+  // render's derived files (the resume history) must have been made from.
+  Hash128 inputs;
   tinygltf::Model model;
   ImageBytes images;
   std::vector<std::string> warnings;

@@ -853,7 +853,9 @@ class Converter : Stage {
 // A parsed document validated, then converted.
 Scene load(Document& doc) {
   Validated validated = validate(doc);
-  return Converter(doc, std::move(validated)).convert();
+  Scene scene = Converter(doc, std::move(validated)).convert();
+  scene.inputDigest = doc.inputs.hex();
+  return scene;
 }
 
 }  // namespace

@@ -246,6 +246,9 @@ struct Instance {
 
 struct Scene {
   std::string path;  // the file it was loaded from
+  // A hash of the content of every file it was loaded from (the glTF file, its buffers and
+  // images): an edited texture changes it where the names stay.
+  std::string inputDigest;
 
   TriangleMesh staticMesh;                    // SSG, world space
   std::vector<uint32_t> staticTriangleNodes;  // per SSG triangle, the glTF node placing it

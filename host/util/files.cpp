@@ -9,6 +9,7 @@
 #include <filesystem>
 
 #include "util/error.h"
+#include "util/hash.h"
 #include "util/input_file.h"
 #include "util/interrupt.h"
 
@@ -90,6 +91,14 @@ void writeFileAtomic(const std::string& path, const std::string& data) {
     std::remove(tmp.c_str());
     throw RuntimeError(path + ": cannot write: " + std::strerror(renameErr));
   }
+}
+
+const std::string& executableDigest() {
+  static const std::string digest = [] {
+    std::string bytes;
+    return readFile("/proc/self/exe", &bytes) ? Hash128().add(bytes).hex() : std::string("unknown");
+  }();
+  return digest;
 }
 
 }  // namespace pr

@@ -25,4 +25,8 @@ void checkWritable(const std::string& path);
 // A unique temporary name beside `path` (same folder, so rename is atomic).
 std::string temporaryNameFor(const std::string& path);
 
+// A hash of this program's executable file (hex; "unknown" where it cannot be read), so that a
+// file derived by one build is not taken for another's. Read once per process.
+const std::string& executableDigest();
+
 }  // namespace pr
