@@ -3,7 +3,11 @@
 // translated box and of a morphed one, and the ids of the objects and materials seen.
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -16,6 +20,8 @@
 
 namespace pr::test {
 namespace {
+
+namespace fs = std::filesystem;
 
 constexpr int kSize = 64;
 constexpr float kFov = 0.8f;
@@ -245,6 +251,45 @@ TEST(Denoise, WithoutTheLibraryItIsAnInputErrorThatSaysHowToInstallIt) {
   EXPECT_NE(r.err.find("bash tools/setup/oidn.sh"), std::string::npos) << r.err;
   EXPECT_EQ(lineCount(r.err), 1u) << r.err;
   EXPECT_FALSE(std::ifstream(out + "/f_0000.exr").good());
+}
+
+// The library tools/setup/oidn.sh installs (render/denoise.cpp looks there first).
+std::string installedOidn() {
+  const char* xdg = std::getenv("XDG_CACHE_HOME");
+  const std::string root = xdg && *xdg ? std::string(xdg) + "/pathreuse"
+                                       : std::string(std::getenv("HOME")) + "/.cache/pathreuse";
+  return root + "/oidn/libOpenImageDenoise.so.2";
+}
+
+// A library cut short (dlopen would map it and die of SIGBUS), a FIFO in its place (opening it
+// would wait for a writer) or a file that is no library: one line naming it, exit 2, no frame.
+TEST(Denoise, ADamagedLibraryIsOneLineExitTwoBeforeRendering) {
+  const std::string lib = installedOidn();
+  ASSERT_TRUE(fs::is_regular_file(lib)) << lib << " absent: tools/setup/oidn.sh installs it";
+  const std::string dir = tempDir("denoise_damaged");
+  const std::string cut = dir + "/cut/libOpenImageDenoise.so.2";
+  fs::create_directories(dir + "/cut");
+  fs::copy_file(lib, cut);
+  fs::resize_file(cut, 64 * 1024);
+  const std::string fifo = dir + "/fifo/libOpenImageDenoise.so.2";
+  fs::create_directories(dir + "/fifo");
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  const std::string text = dir + "/text/libOpenImageDenoise.so.2";
+  fs::create_directories(dir + "/text");
+  std::ofstream(text) << "not a library\n";
+  for (const auto& [path, why] : {std::pair<std::string, std::string>{cut, "is cut short"},
+                                  {fifo, "is not a regular file"},
+                                  {text, "is not a 64-bit ELF shared object"}}) {
+    SCOPED_TRACE(path);
+    const auto r = runPathreuse("render '" + sourcePath("scenes/cornell-dynamic.gltf") +
+                                    "' --quiet --frames 0 --width 32 --denoise --out '" + dir +
+                                    "/out/f_%04d.exr'",
+                                "timeout 60 env PATHREUSE_OIDN='" + path + "'");
+    EXPECT_EQ(r.exitCode, 2) << r.err;
+    EXPECT_NE(r.err.find(path + " " + why), std::string::npos) << r.err;
+    EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+    EXPECT_FALSE(fs::exists(dir + "/out/f_0000.exr"));
+  }
 }
 
 }  // namespace

@@ -1,8 +1,15 @@
 #include "render/denoise.h"
 
 #include <dlfcn.h>
+#include <elf.h>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
+#include <cerrno>
 #include <cstdlib>
+#include <cstring>
+#include <filesystem>
 #include <vector>
 
 #include "util/error.h"
@@ -31,6 +38,65 @@ std::string cacheLibrary() {
     return "";
   }
   return root + "/oidn/libOpenImageDenoise.so.2";
+}
+
+// Why the shared object at `path` cannot be loaded safely ("" where it can): it must be a regular
+// file (a FIFO is refused, never waited on) and an ELF shared object of this machine whose
+// headers and loaded segments lie within the file. dlopen maps a file cut short and dies of
+// SIGBUS on its first missing page, so a cut library must be refused before it.
+std::string whyNotLoadable(const std::string& path) {
+  const int fd = open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) return std::string("cannot be opened: ") + std::strerror(errno);
+  struct stat st {};
+  std::string why;
+  Elf64_Ehdr eh{};
+  const auto within = [&](uint64_t offset, uint64_t bytes) {
+    return offset <= uint64_t(st.st_size) && bytes <= uint64_t(st.st_size) - offset;
+  };
+  if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    why = "is not a regular file";
+  } else if (pread(fd, &eh, sizeof eh, 0) != ssize_t(sizeof eh) ||
+             std::memcmp(eh.e_ident, ELFMAG, SELFMAG) != 0 || eh.e_ident[EI_CLASS] != ELFCLASS64 ||
+             eh.e_type != ET_DYN || eh.e_phentsize != sizeof(Elf64_Phdr)) {
+    why = "is not a 64-bit ELF shared object";
+#if defined(__x86_64__)
+  } else if (eh.e_machine != EM_X86_64) {
+    why = "is built for another processor";
+#elif defined(__aarch64__)
+  } else if (eh.e_machine != EM_AARCH64) {
+    why = "is built for another processor";
+#endif
+  } else if (!within(eh.e_phoff, uint64_t(eh.e_phnum) * sizeof(Elf64_Phdr))) {
+    why = "is cut short (its program headers lie past its end)";
+  } else {
+    for (int i = 0; i < eh.e_phnum && why.empty(); ++i) {
+      Elf64_Phdr ph{};
+      const off_t at = off_t(eh.e_phoff + uint64_t(i) * sizeof ph);
+      if (pread(fd, &ph, sizeof ph, at) != ssize_t(sizeof ph))
+        why = "cannot be read";
+      else if (ph.p_type != PT_NULL && !within(ph.p_offset, ph.p_filesz))
+        why = "is cut short (a segment lies past its end)";
+    }
+  }
+  close(fd);
+  return why;
+}
+
+// The library and every shared object in its folder (the core and device modules OIDN loads
+// beside it, and TBB): checked before any is loaded. Throws InputError naming the file.
+void checkLibraryFolder(const std::string& library) {
+  std::vector<std::string> files = {library};
+  std::error_code ec;
+  const std::filesystem::path dir = std::filesystem::path(library).parent_path();
+  for (const auto& e : std::filesystem::directory_iterator(dir.empty() ? "." : dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (name.rfind("lib", 0) == 0 && name.find(".so") != std::string::npos)
+      files.push_back(e.path().string());
+  }
+  for (const std::string& f : files)
+    if (const std::string why = whyNotLoadable(f); !why.empty())
+      throw InputError("--denoise: " + f + " " + why +
+                       " (reinstall it with: bash tools/setup/oidn.sh)");
 }
 
 }  // namespace
@@ -87,6 +153,14 @@ Denoiser::Denoiser() : api_(std::make_unique<Api>()) {
   }
   std::string looked;
   for (const std::string& path : tried) {
+    // A path is checked first; a bare name is the system's, found by the dynamic loader.
+    const bool isPath = path.find('/') != std::string::npos;
+    std::error_code ec;
+    if (isPath && !std::filesystem::exists(std::filesystem::symlink_status(path, ec))) {
+      looked += (looked.empty() ? "" : ", ") + path;
+      continue;
+    }
+    if (isPath) checkLibraryFolder(path);
     api_->lib = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
     if (api_->lib) {
       looked = path;
