@@ -142,9 +142,11 @@ void addOutputOptions(CLI::App* render, RenderArgs& a) {
                    "error (from its neighbours' variance) is below this, at least "
                    "--adaptive-min-spp and at most --spp (e.g. 0.02; default 0: off)")
       ->check(finiteIn(0, 1e9));
-  render->add_option("--adaptive-min-spp", ro.adaptiveMinSpp,
-                     "Adaptive sampling's pilot: the samples every pixel takes before the noise "
-                     "is estimated (default: max(4, spp/16))");
+  render
+      ->add_option("--adaptive-min-spp", ro.adaptiveMinSpp,
+                   "Adaptive sampling's pilot: the samples every pixel takes before the noise "
+                   "is estimated (default: max(4, spp/16))")
+      ->check(CLI::Range(0, 1 << 20));
   render->add_option("--aov", ro.aov,
                      "Auxiliary images as extra channels of each EXR, a comma-separated list of "
                      "albedo, normal, depth, motion, object, material, or all");

@@ -466,6 +466,37 @@ TEST(DeviceMemory, AbsurdSizesAreBadInput) {
   }
 }
 
+// Ranges are checked whether or not the option's feature is on; frame numbers take the whole int
+// range and say the limit past it; a scene with a camera and nothing to render is one line, the
+// note about its missing lights left out.
+TEST(BadOptions, RangesAndEmptyScenesAreOneLineAndExitTwo) {
+  const std::string dir = test::tempDir("bad-options");
+  const std::string common =
+      " --frames 0 --width 8 --height 8 --spp 1 --out '" + dir + "/f_%04d.exr'";
+  auto r = test::runPathreuse("render '" + kScene + "'" + common + " --adaptive-min-spp -5");
+  EXPECT_EQ(r.exitCode, 2) << r.err;
+  EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+  EXPECT_NE(r.err.find("--adaptive-min-spp"), std::string::npos) << r.err;
+  r = test::runPathreuse("render '" + kScene +
+                         "' --quiet --frames 1234567890 --width 8 --height 8 "
+                         "--spp 1 --out '" +
+                         dir + "/big_%d.exr'");
+  EXPECT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir + "/big_1234567890.exr"));
+  r = test::runPathreuse("render '" + kScene + "' --frames 99999999999" + common.substr(11));
+  EXPECT_EQ(r.exitCode, 2) << r.err;
+  EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+  EXPECT_NE(r.err.find("2147483647"), std::string::npos) << r.err;
+  writeFileAtomic(dir + "/camera.gltf",
+                  R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],)"
+                  R"("nodes":[{"camera":0}],"cameras":[{"type":"perspective",)"
+                  R"("perspective":{"yfov":0.8,"znear":0.1}}]})");
+  r = test::runPathreuse("render '" + dir + "/camera.gltf'" + common);
+  EXPECT_EQ(r.exitCode, 2) << r.err;
+  EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+  EXPECT_NE(r.err.find("nothing to render"), std::string::npos) << r.err;
+}
+
 TEST(BadOptions, HistoryPeriodOutOfRangeIsOneLineAndExitTwo) {
   for (const char* period : {"0", "1001", "-3"}) {
     const std::string dir = test::tempDir("bad-period");

@@ -669,6 +669,13 @@ TEST(SceneLoader, BrokenQuadsAreRefused) {
              {{"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", -1}}}}}}};
        },
        "emissiveStrength"},
+      {"emission overflows",
+       [](Quad& q) {
+         q.doc["materials"] = {
+             {{"emissiveFactor", {1e38, 1, 1}},
+              {"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", 3e38}}}}}}};
+       },
+       "emitted radiance"},
       {"zero ior",
        [](Quad& q) {
          q.doc["materials"] = {{{"extensions", {{"KHR_materials_ior", {{"ior", 0}}}}}}};

@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 
 #include "util/error.h"
 
@@ -53,11 +54,14 @@ const char* materialModelName(MaterialModel m) {
 
 namespace {
 
+// A whole number 0 .. INT_MAX (a frame number: 2^31 - 1 frames are 2.8 years at 24 fps).
 bool parseInt(const std::string& s, int* out) {
-  if (s.empty() || s.size() > 9) return false;
+  if (s.empty() || s.size() > 10) return false;
   for (char c : s)
     if (!std::isdigit(static_cast<unsigned char>(c))) return false;
-  *out = std::stoi(s);
+  const long long v = std::stoll(s);
+  if (v > std::numeric_limits<int>::max()) return false;
+  *out = int(v);
   return true;
 }
 
@@ -107,7 +111,9 @@ FrameRange parseFrameRange(const std::string& text) {
   } else {
     ok = parseInt(text.substr(0, dash), &r.first) && parseInt(text.substr(dash + 1), &r.last);
   }
-  if (!ok) throw InputError("--frames " + text + ": expected A-B or A, with whole numbers >= 0");
+  if (!ok)
+    throw InputError("--frames " + text +
+                     ": expected A-B or A, with whole numbers from 0 to 2147483647");
   if (r.last < r.first)
     throw InputError("--frames " + text + ": the last frame is before the first");
   return r;

@@ -117,6 +117,8 @@ bool frameDone(const std::string& exr, const RenderOptions& o, int width, int he
 
 // A scene without lights: lit by a white environment unless asked otherwise, said once.
 void noteUnlitScene(const Scene& scene, const RenderOptions& o) {
+  // A scene with nothing to render is an error of one line (RenderSession), without this note.
+  if (scene.staticTriangleCount() + scene.dynamicTriangleCount() == 0) return;
   if (!sceneHasNoLights(scene) || o.quiet) return;
   if (o.env.empty() && o.envColor.empty())
     std::cerr << "note: " << o.scene

@@ -1,6 +1,7 @@
 #include "scene/gltf_validate.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <set>
 
 #include "scene/gltf_accessors.h"
@@ -9,6 +10,9 @@
 namespace pr::gltf {
 
 namespace {
+
+// The largest radiance a material may emit (README "What pathreuse reads").
+constexpr double kMaxEmission = 1e20;
 
 // What an attribute or animation accessor may be.
 struct AccessorRule {
@@ -234,6 +238,22 @@ class Validator : Stage {
            where);
   }
 
+  // The radiance a material emits, emissiveFactor x emissiveStrength, stays where the lights'
+  // power sums (radiance x area x pi, summed) are finite in float: at most kMaxEmission.
+  void checkEmission(const tinygltf::Material& m, const std::string& where) {
+    double strength = 1.0;
+    if (const Value* e = extension(m.extensions, "KHR_materials_emissive_strength"))
+      if (const Value* s = member(*e, "emissiveStrength")) strength = s->GetNumberAsDouble();
+    double largest = 0.0;
+    for (double c : m.emissiveFactor) largest = std::max(largest, c);
+    const double radiance = largest * strength;
+    if (!finite(radiance) || radiance > kMaxEmission) {
+      char text[96];
+      std::snprintf(text, sizeof text, "%.3g is above %.0e", radiance, kMaxEmission);
+      fail(std::string("emitted radiance (emissiveFactor x emissiveStrength) ") + text, where);
+    }
+  }
+
   void checkMaterials() {
     for (size_t i = 0; i < model_.materials.size(); ++i) {
       const auto& m = model_.materials[i];
@@ -260,6 +280,7 @@ class Validator : Stage {
         if (const Value* s = member(*e, "emissiveStrength"))
           if (!s->IsNumber() || !finite(s->GetNumberAsDouble()) || s->GetNumberAsDouble() < 0.0)
             fail("KHR_materials_emissive_strength emissiveStrength must be a number >= 0", where);
+      checkEmission(m, where);
       if (const Value* e = extension(m.extensions, "KHR_materials_ior"))
         if (const Value* s = member(*e, "ior"))
           if (!s->IsNumber() || !finite(s->GetNumberAsDouble()) || s->GetNumberAsDouble() <= 0.0)
