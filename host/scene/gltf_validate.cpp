@@ -243,7 +243,11 @@ class Validator : Stage {
   void checkEmission(const tinygltf::Material& m, const std::string& where) {
     double strength = 1.0;
     if (const Value* e = extension(m.extensions, "KHR_materials_emissive_strength"))
-      if (const Value* s = member(*e, "emissiveStrength")) strength = s->GetNumberAsDouble();
+      if (const Value* s = member(*e, "emissiveStrength")) {
+        if (!s->IsNumber() || !finite(s->GetNumberAsDouble()) || s->GetNumberAsDouble() < 0.0)
+          fail("KHR_materials_emissive_strength emissiveStrength must be a number >= 0", where);
+        strength = s->GetNumberAsDouble();
+      }
     double largest = 0.0;
     for (double c : m.emissiveFactor) largest = std::max(largest, c);
     const double radiance = largest * strength;
@@ -276,10 +280,6 @@ class Validator : Stage {
       checkTextureInfo(doc_, m.emissiveTexture.index, "emissiveTexture", where);
       checkTextureInfo(doc_, m.normalTexture.index, "normalTexture", where);
       checkTextureInfo(doc_, m.occlusionTexture.index, "occlusionTexture", where);
-      if (const Value* e = extension(m.extensions, "KHR_materials_emissive_strength"))
-        if (const Value* s = member(*e, "emissiveStrength"))
-          if (!s->IsNumber() || !finite(s->GetNumberAsDouble()) || s->GetNumberAsDouble() < 0.0)
-            fail("KHR_materials_emissive_strength emissiveStrength must be a number >= 0", where);
       checkEmission(m, where);
       if (const Value* e = extension(m.extensions, "KHR_materials_ior"))
         if (const Value* s = member(*e, "ior"))
