@@ -406,6 +406,33 @@ TEST(WriteErrors, FullDiskForTheStatsFileIsOneLineAndExitOne) {
       << r.err;
 }
 
+// A stats line that does not fit (a file-size limit: the write falls short mid-line, as on a full
+// disk) is cut back: the file holds whole lines only, each one JSON, and the run says why, exit 1.
+TEST(WriteErrors, AStatsLineIsWholeOrAbsent) {
+  const std::string dir = test::tempDir("stats-limit");
+  const std::string render = "render '" + kScene +
+                             "' --quiet --width 8 --height 8 --spp 1 --out '" + dir + "/f_%04d.exr'";
+  auto r = test::runPathreuse(render + " --frames 0");  // the kernels built before the limit
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  // 4 KiB (dash counts 512-byte blocks): a few frames' EXRs fit, the stats lines' sum does not.
+  // The limit set by the shell, and the device under test named after it (runPathreuse would put
+  // PATHREUSE_DEVICE before `trap`, where it would not reach the renderer).
+  const char* device = std::getenv("PATHREUSE_TEST_DEVICE");
+  const std::string limited = std::string("trap '' XFSZ; ulimit -f 8;") +
+                              (device && *device ? " PATHREUSE_DEVICE='" + std::string(device) + "'"
+                                                 : std::string());
+  r = test::runPathreuse(render + " --frames 0-20 --stats '" + dir + "/stats.jsonl'", limited);
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_NE(r.err.find(dir + "/stats.jsonl: cannot write the stats file"), std::string::npos)
+      << r.err;
+  const std::string text = slurp(dir + "/stats.jsonl");
+  ASSERT_FALSE(text.empty());
+  EXPECT_EQ(text.back(), '\n') << "a cut line was left";
+  std::istringstream lines(text);
+  std::string line;
+  while (std::getline(lines, line)) EXPECT_NO_THROW(nlohmann::json::parse(line)) << line;
+}
+
 // A file-size limit makes write() fail the way a full disk does (EFBIG instead of ENOSPC), for
 // this process only: the EXR write reports the file, and neither it nor its temporary remains.
 TEST(WriteErrors, FailingExrWriteLeavesNoFile) {

@@ -139,7 +139,9 @@ ProgramBuild Context::buildProgramFromSource(const std::string& source, const st
   // Extra options for diagnosing a platform, e.g. -cl-opt-disable (part of the cache key).
   if (const char* extra = std::getenv("PATHREUSE_CL_OPTIONS"); extra && *extra)
     fullOptions += std::string(" ") + extra;
+  // The file format is in the key too: another version's files have other names, not churn.
   const std::string key = Hash128()
+                              .add(std::string(kCacheMagic, sizeof kCacheMagic))
                               .add(source)
                               .add(fullOptions)
                               .add(device_.platformName)

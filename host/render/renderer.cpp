@@ -1,5 +1,7 @@
 #include "render/renderer.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -57,19 +59,35 @@ class StatsFile {
     std::error_code ec;
     if (!parent.empty()) std::filesystem::create_directories(parent, ec);
     if (append) dropPartialLine();
-    file_ = std::fopen(path.c_str(), append ? "a" : "w");
-    if (!file_) fail();
+    fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC | (append ? O_APPEND : O_TRUNC), 0644);
+    if (fd_ < 0) fail();
   }
   ~StatsFile() {
-    if (file_) std::fclose(file_);
+    if (fd_ >= 0) ::close(fd_);
   }
   StatsFile(const StatsFile&) = delete;
   StatsFile& operator=(const StatsFile&) = delete;
+  // The line whole or not at all: where a write falls short (a full disk) the file is cut back
+  // to where the line began, then the error is raised.
   void writeLine(const std::string& line) {
-    errno = 0;
-    if (std::fputs(line.c_str(), file_) < 0 || std::fputc('\n', file_) == EOF ||
-        std::fflush(file_) != 0)
-      fail();
+    const std::string text = line + "\n";
+    struct stat st {};
+    const bool regular = ::fstat(fd_, &st) == 0 && S_ISREG(st.st_mode);
+    size_t done = 0;
+    while (done < text.size()) {
+      errno = 0;
+      const ssize_t n = ::write(fd_, text.data() + done, text.size() - done);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) {
+        const int err = errno ? errno : ENOSPC;
+        if (regular && done > 0 && ::ftruncate(fd_, st.st_size) != 0) {
+          // The cut-back failed too: the next run's dropPartialLine removes the half line.
+        }
+        errno = err;
+        fail();
+      }
+      done += size_t(n);
+    }
   }
 
  private:
@@ -90,7 +108,7 @@ class StatsFile {
                        ": cannot write the stats file: " + std::strerror(errno ? errno : EIO));
   }
   std::string path_;
-  FILE* file_ = nullptr;
+  int fd_ = -1;
 };
 
 std::string frameSpan(int a, int b) {
