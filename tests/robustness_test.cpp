@@ -307,6 +307,38 @@ TEST(Resume, AHistoryOfOtherInputsOrOptionsIsNotUsed) {
       << "all as written: " << r.err;
 }
 
+// What runs that died or broke a history chain left beside the frames (a hidden temporary of a
+// process that no longer runs, the history of a frame whose next frame is done) is removed by
+// the next run over that output, and a note says so; the history a resumed run needs stays, and
+// so does a temporary of a running process.
+TEST(Resume, StaleHistoriesAndTemporariesAreRemoved) {
+  const std::string dir = test::tempDir("stale");
+  const std::string common = "render '" + kScene + "' --exr-float --width 32 --height 24 --spp 1 " +
+                             "--resume --out '" + dir + "/f_%04d.exr'";
+  auto r = test::runPathreuse(common + " --quiet --frames 0-3");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  ASSERT_TRUE(fs::exists(dir + "/f_0003.exr.history"));
+  fs::copy_file(dir + "/f_0003.exr.history", dir + "/f_0001.exr.history");
+  const pid_t dead = fork();
+  ASSERT_GE(dead, 0);
+  if (dead == 0) _exit(0);
+  waitpid(dead, nullptr, 0);
+  const std::string deadTemp = dir + "/.f_0002.exr.tmp" + std::to_string(dead) + "_0";
+  const std::string liveTemp = dir + "/.f_0004.exr.tmp" + std::to_string(getpid()) + "_0";
+  writeFileAtomic(deadTemp, "half a frame");
+  writeFileAtomic(liveTemp, "a frame being written");
+  r = test::runPathreuse(common + " --frames 0-3");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.err.find("removed 2 stale"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/f_0001.exr.history"));
+  EXPECT_FALSE(fs::exists(deadTemp));
+  EXPECT_TRUE(fs::exists(liveTemp));
+  EXPECT_TRUE(fs::exists(dir + "/f_0003.exr.history"));  // frame 4 resumes from it
+  r = test::runPathreuse(common + " --frames 0-4");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.err.find("goes on from frame 3's resampled paths"), std::string::npos) << r.err;
+}
+
 // A chunk of frames that cannot read the history of the frame before it (rendered at the same
 // time as the chunk before, say) warms up: --warm-up N renders the N frames before its first one
 // without writing them. From frame 0 on they are the uninterrupted run's frames, bit for bit;
@@ -406,21 +438,61 @@ TEST(WriteErrors, FullDiskForTheStatsFileIsOneLineAndExitOne) {
       << r.err;
 }
 
+// An output never replaces a file the render reads: the scene named by --out's pattern (for the
+// first frame or a later one) or by --stats, or the scene through a link. One line, exit 2, the
+// file intact.
+TEST(WriteErrors, AnOutputNeverReplacesAnInput) {
+  const std::string dir = test::tempDir("self");
+  const std::string scene = dir + "/1.gltf", original = slurp(kScene);
+  writeFileAtomic(scene, original);
+  fs::create_symlink(scene, dir + "/link0.exr");
+  const std::string render = "render '" + scene + "' --quiet --width 8 --height 8 --spp 1 ";
+  for (const std::string& args :
+       {std::string("--frames 1 --out '") + dir + "/%d.gltf'",
+        std::string("--frames 0-1 --out '") + dir + "/%d.gltf'",
+        std::string("--frames 0 --out '") + dir + "/o_%d.exr' --stats '" + scene + "'",
+        std::string("--frames 0 --out '") + dir + "/link%d.exr'"}) {
+    SCOPED_TRACE(args);
+    const auto r = test::runPathreuse(render + args);
+    EXPECT_EQ(r.exitCode, 2) << r.err;
+    EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find("a file this render reads"), std::string::npos) << r.err;
+    EXPECT_EQ(slurp(scene), original);
+  }
+}
+
+// Output names up to the file system's 255 bytes: the hidden temporary name each is written
+// under first is shortened to fit where the final name fits.
+TEST(WriteErrors, LongOutputNamesAreWritten) {
+  const std::string dir = test::tempDir("long-names");
+  const std::string stem(240, 'n');  // + "_0000.exr": 249 bytes, + ".png" the same
+  const auto r = test::runPathreuse("render '" + kScene +
+                                    "' --quiet --frames 0 --width 8 --height 8 --spp 1 --png "
+                                    "--out '" +
+                                    dir + "/" + stem + "_%04d.exr'");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir + "/" + stem + "_0000.exr"));
+  EXPECT_TRUE(fs::exists(dir + "/" + stem + "_0000.png"));
+  size_t files = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir)) ++files;
+  EXPECT_EQ(files, 2u) << "a temporary file was left";
+}
+
 // A stats line that does not fit (a file-size limit: the write falls short mid-line, as on a full
 // disk) is cut back: the file holds whole lines only, each one JSON, and the run says why, exit 1.
 TEST(WriteErrors, AStatsLineIsWholeOrAbsent) {
   const std::string dir = test::tempDir("stats-limit");
-  const std::string render = "render '" + kScene +
-                             "' --quiet --width 8 --height 8 --spp 1 --out '" + dir + "/f_%04d.exr'";
+  const std::string render =
+      "render '" + kScene + "' --quiet --width 8 --height 8 --spp 1 --out '" + dir + "/f_%04d.exr'";
   auto r = test::runPathreuse(render + " --frames 0");  // the kernels built before the limit
   ASSERT_EQ(r.exitCode, 0) << r.err;
   // 4 KiB (dash counts 512-byte blocks): a few frames' EXRs fit, the stats lines' sum does not.
   // The limit set by the shell, and the device under test named after it (runPathreuse would put
   // PATHREUSE_DEVICE before `trap`, where it would not reach the renderer).
   const char* device = std::getenv("PATHREUSE_TEST_DEVICE");
-  const std::string limited = std::string("trap '' XFSZ; ulimit -f 8;") +
-                              (device && *device ? " PATHREUSE_DEVICE='" + std::string(device) + "'"
-                                                 : std::string());
+  const std::string limited =
+      std::string("trap '' XFSZ; ulimit -f 8;") +
+      (device && *device ? " PATHREUSE_DEVICE='" + std::string(device) + "'" : std::string());
   r = test::runPathreuse(render + " --frames 0-20 --stats '" + dir + "/stats.jsonl'", limited);
   EXPECT_EQ(r.exitCode, 1) << r.err;
   EXPECT_NE(r.err.find(dir + "/stats.jsonl: cannot write the stats file"), std::string::npos)

@@ -59,7 +59,8 @@ class StatsFile {
     std::error_code ec;
     if (!parent.empty()) std::filesystem::create_directories(parent, ec);
     if (append) dropPartialLine();
-    fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC | (append ? O_APPEND : O_TRUNC), 0644);
+    fd_ =
+        ::open(path.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC | (append ? O_APPEND : O_TRUNC), 0644);
     if (fd_ < 0) fail();
   }
   ~StatsFile() {
@@ -109,6 +110,34 @@ class StatsFile {
   }
   std::string path_;
   int fd_ = -1;
+};
+
+// The files a render reads: none of its outputs may replace one (`--out out/%d.gltf` over the
+// scene, `--stats` naming a texture), by any name or link.
+class InputFiles {
+ public:
+  InputFiles(const Scene& scene, const RenderOptions& o) : files_(scene.inputFiles) {
+    if (!o.env.empty() && o.env != "none") files_.push_back(o.env);
+  }
+  // Throws InputError, naming `option` and the file, where `path` is one of them.
+  void refuse(const std::string& path, const char* option) const {
+    std::error_code ec;
+    for (const std::string& in : files_)
+      if (std::filesystem::equivalent(path, in, ec))
+        throw InputError(std::string(option) + " " + path + ": " +
+                         (path == in ? "" : "the same file as " + in + ", ") +
+                         "a file this render reads (an output never replaces an input)");
+  }
+  // Every file frame f writes.
+  void refuseFrame(const RenderOptions& o, int f, bool history) const {
+    const std::string exr = formatOutPath(o.outPattern, f);
+    refuse(exr, "--out");
+    if (o.png) refuse(withExtension(exr, ".png"), "--out");
+    if (history) refuse(exr + ".history", "--out");
+  }
+
+ private:
+  std::vector<std::string> files_;
 };
 
 std::string frameSpan(int a, int b) {
@@ -317,9 +346,58 @@ void writeHistory(const RenderOptions& o, MultiDeviceSession& session, const std
   std::filesystem::remove(historyPath(o, f - 1), ec);
 }
 
+// Whether process `pid` is running (a temporary file of a live run is not stale).
+bool processAlive(long pid) {
+  return pid > 0 && (::kill(pid_t(pid), 0) == 0 || errno != ESRCH);
+}
+
+// Files a run over this output pattern left that nothing will use: the hidden temporaries of
+// runs that died (SIGKILL, a crash) and resume histories that no resumed frame can need (frame
+// g's, where frame g + 1's EXR exists or g's does not, or g is the animation's last). Removed,
+// and counted in a note. Only where the frame number is in the file name, not in a folder.
+void removeStaleFiles(const RenderOptions& o, int frameCount) {
+  namespace fs = std::filesystem;
+  const fs::path a(formatOutPath(o.outPattern, 0)), b(formatOutPath(o.outPattern, 1));
+  if (a.parent_path() != b.parent_path()) return;
+  const std::string name = fs::path(o.outPattern).filename().string();
+  const std::string prefix = name.substr(0, name.find('%'));
+  const fs::path dir = a.parent_path().empty() ? fs::path(".") : a.parent_path();
+  std::error_code ec;
+  int removed = 0;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    const std::string file = e.path().filename().string();
+    bool stale = false;
+    const size_t tmp = file.rfind(".tmp");
+    if (file.size() > 1 && file[0] == '.' && tmp != std::string::npos &&
+        file.compare(1, prefix.size(), prefix) == 0) {
+      // .NAME.tmpPID_N (util/files.h)
+      const std::string tail = file.substr(tmp + 4);
+      const size_t bar = tail.find('_');
+      if (bar != std::string::npos && bar > 0 &&
+          tail.find_first_not_of("0123456789_") == std::string::npos)
+        stale = !processAlive(std::strtol(tail.substr(0, bar).c_str(), nullptr, 10));
+    } else if (file.size() > 8 && file.compare(file.size() - 8, 8, ".history") == 0 &&
+               file.compare(0, prefix.size(), prefix) == 0) {
+      const std::string exr = file.substr(0, file.size() - 8);
+      const size_t digits = exr.find_first_not_of("0123456789", prefix.size());
+      if (digits == prefix.size() || digits == std::string::npos || digits - prefix.size() > 9)
+        continue;
+      const int g = std::stoi(exr.substr(prefix.size(), digits - prefix.size()));
+      if (fs::path(formatOutPath(o.outPattern, g)).filename() != exr) continue;
+      stale = g >= frameCount - 1 || !fs::exists(dir / exr, ec) ||
+              fs::exists(formatOutPath(o.outPattern, g + 1), ec);
+    }
+    if (stale && fs::remove(e.path(), ec)) ++removed;
+  }
+  if (removed > 0 && !o.quiet)
+    std::cerr << "note: removed " << removed
+              << " stale resume histories and temporary files of earlier runs beside "
+              << formatOutPath(o.outPattern, 0) << "\n";
+}
+
 // Renders the session's frames in order, each written as soon as it is done.
 int renderFrames(const RenderOptions& o, MultiDeviceSession& session, const FrameRange& range,
-                 StatsFile* stats) {
+                 StatsFile* stats, const InputFiles& inputs) {
   const bool progress = !o.quiet && isatty(STDERR_FILENO);
   Tally t;
   int f = range.first;
@@ -328,9 +406,11 @@ int renderFrames(const RenderOptions& o, MultiDeviceSession& session, const Fram
   const bool resampled = rs.enabled && rs.history > 0;
   const std::string key = history ? historyKey(o, session) : std::string();
   int lastRendered = -2;
+  removeStaleFiles(o, session.session(0).frameCount());
   endLoadingPhase();  // a signal from here on finishes cleanly between launches
   for (; f <= range.last && !interrupted(); ++f) {
     const std::string exr = formatOutPath(o.outPattern, f);
+    inputs.refuseFrame(o, f, history);
     if (o.resume && frameDone(exr, o, session.width(), session.height())) {
       ++t.skipped;
       continue;
@@ -452,15 +532,19 @@ int runRender(const RenderOptions& o) {
   loadOptions.allowOutsideUris = o.allowOutsideUris;
   const Scene scene = loadScene(o.scene, loadOptions);
   noteUnlitScene(scene, o);
+  const InputFiles inputs(scene, o);
+  const int first = o.framesGiven ? o.frames.first : 0;
+  inputs.refuseFrame(o, first, keepsHistory(o));
+  if (!o.statsFile.empty()) inputs.refuse(o.statsFile, "--stats");
   // Unwritable output is found before the kernels are built, not after the first frame.
-  checkWritable(formatOutPath(o.outPattern, o.framesGiven ? o.frames.first : 0));
+  checkWritable(formatOutPath(o.outPattern, first));
   std::unique_ptr<StatsFile> stats;
   if (!o.statsFile.empty()) stats = std::make_unique<StatsFile>(o.statsFile, o.resume);
   const auto devices = enumerateDevices();
   MultiDeviceSession session(scene, selectDevices(devices, o.devices), o);
   const FrameRange range = session.frameRange();
   if (!o.quiet) printStart(o, session, range);
-  return renderFrames(o, session, range, stats.get());
+  return renderFrames(o, session, range, stats.get(), inputs);
 }
 
 }  // namespace pr

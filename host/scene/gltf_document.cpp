@@ -78,6 +78,7 @@ bool readExternalFile(std::vector<unsigned char>* out, std::string*, const std::
     files->doc->fail(std::string("cannot load a file it names: ") + e.what());
   }
   files->doc->inputs.add(path).add(out->data(), out->size());
+  files->doc->inputFiles.push_back(path);
   return true;
 }
 
@@ -106,6 +107,7 @@ class Parser : Stage {
     const std::vector<uint8_t>& bytes = bytes_;
     if (bytes.empty()) fail("file is empty");
     doc_.inputs.add(doc_.path).add(bytes.data(), bytes.size());
+    if (!inMemory_) doc_.inputFiles.push_back(doc_.path);
 
     std::string ext = fs::path(doc_.path).extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(),

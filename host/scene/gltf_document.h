@@ -41,6 +41,7 @@ struct Document {
   // The content of every file read (the scene, its buffers and images), path by path: what a
   // render's derived files (the resume history) must have been made from.
   Hash128 inputs;
+  std::vector<std::string> inputFiles;  // their paths
   tinygltf::Model model;
   ImageBytes images;
   std::vector<std::string> warnings;

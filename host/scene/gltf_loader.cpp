@@ -855,6 +855,7 @@ Scene load(Document& doc) {
   Validated validated = validate(doc);
   Scene scene = Converter(doc, std::move(validated)).convert();
   scene.inputDigest = doc.inputs.hex();
+  scene.inputFiles = doc.inputFiles;
   return scene;
 }
 

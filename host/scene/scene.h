@@ -249,6 +249,7 @@ struct Scene {
   // A hash of the content of every file it was loaded from (the glTF file, its buffers and
   // images): an edited texture changes it where the names stay.
   std::string inputDigest;
+  std::vector<std::string> inputFiles;  // those files' paths
 
   TriangleMesh staticMesh;                    // SSG, world space
   std::vector<uint32_t> staticTriangleNodes;  // per SSG triangle, the glTF node placing it

@@ -41,8 +41,16 @@ std::string temporaryNameFor(const std::string& path) {
   static std::atomic<unsigned> counter{0};
   namespace fs = std::filesystem;
   const fs::path p(path);
-  const std::string name = "." + p.filename().string() + ".tmp" + std::to_string(getpid()) + "_" +
-                           std::to_string(counter++);
+  const std::string tail = ".tmp" + std::to_string(getpid()) + "_" + std::to_string(counter++);
+  std::string name = "." + p.filename().string() + tail;
+  // A name the file system takes whenever it takes the final one (255 bytes on Linux): a long
+  // name is shortened, keeping its start and a hash of the whole.
+  constexpr size_t kNameMax = 255;
+  if (name.size() > kNameMax) {
+    const std::string hash = Hash128().add(p.filename().string()).hex().substr(0, 16);
+    name = "." + p.filename().string().substr(0, kNameMax - 2 - hash.size() - tail.size()) + "-" +
+           hash + tail;
+  }
   return (p.parent_path() / name).string();
 }
 
