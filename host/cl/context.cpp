@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 
+#include "cl/binary_cache.h"
 #include "cl/kernel_sources.h"
 #include "util/check.h"
 #include "util/files.h"
@@ -15,22 +16,6 @@
 namespace pr {
 
 namespace {
-
-constexpr char kCacheMagic[8] = {'P', 'R', 'K', 'B', 'I', 'N', '0', '2'};
-
-// A cache file: this header, then the driver's binary. The file names its key, but a file can be
-// copied or renamed: the header holds the key it was made for, and the checksum covers key and
-// binary, so that another program's binary under this name is never loaded.
-struct CacheHeader {
-  char magic[8];
-  char key[32];  // Hash128 hex of source, options, platform, device, driver and device version
-  uint64_t size;
-  uint64_t checksum;
-};
-
-uint64_t cacheChecksum(const std::string& key, const std::string& binary) {
-  return Hash128().add(key).add(binary).low();
-}
 
 double secondsSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -49,41 +34,18 @@ void removeCacheFile(const std::string& file) {
 }
 
 // The cached binary of `key` in `file`, or empty where there is none or it is not this key's
-// whole binary (another format, key or size, a checksum that fails: the file is removed).
+// whole binary (cl/binary_cache.h; such a file is removed).
 std::string loadCachedBinary(const std::string& file, const std::string& key) {
   std::string data;
   if (!readFile(file, &data)) return {};
-  CacheHeader h;
-  bool ok = data.size() >= sizeof h && key.size() == sizeof h.key;
-  if (ok) {
-    std::memcpy(&h, data.data(), sizeof h);
-    ok = std::memcmp(h.magic, kCacheMagic, sizeof kCacheMagic) == 0 &&
-         std::memcmp(h.key, key.data(), sizeof h.key) == 0 && h.size == data.size() - sizeof h &&
-         h.size > 0;
-  }
-  std::string binary;
-  if (ok) {
-    binary = data.substr(sizeof h);
-    ok = cacheChecksum(key, binary) == h.checksum;
-  }
-  if (!ok) {
-    removeCacheFile(file);
-    return {};
-  }
+  std::string binary = unpackCacheFile(data, key);
+  if (binary.empty()) removeCacheFile(file);
   return binary;
 }
 
 void storeCachedBinary(const std::string& file, const std::string& key, const std::string& binary) {
-  CacheHeader h;
-  PR_CHECK(key.size() == sizeof h.key);
-  std::memcpy(h.magic, kCacheMagic, sizeof kCacheMagic);
-  std::memcpy(h.key, key.data(), sizeof h.key);
-  h.size = binary.size();
-  h.checksum = cacheChecksum(key, binary);
-  std::string data(reinterpret_cast<const char*>(&h), sizeof h);
-  data += binary;
   try {
-    writeFileAtomic(file, data);
+    writeFileAtomic(file, packCacheFile(key, binary));
   } catch (const RuntimeError&) {
     // An unwritable cache costs only build time next run.
   }
@@ -141,7 +103,7 @@ ProgramBuild Context::buildProgramFromSource(const std::string& source, const st
     fullOptions += std::string(" ") + extra;
   // The file format is in the key too: another version's files have other names, not churn.
   const std::string key = Hash128()
-                              .add(std::string(kCacheMagic, sizeof kCacheMagic))
+                              .add(cacheFormatTag())
                               .add(source)
                               .add(fullOptions)
                               .add(device_.platformName)

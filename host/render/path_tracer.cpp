@@ -1,7 +1,5 @@
 #include "render/path_tracer.h"
 
-#include <initializer_list>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -10,6 +8,7 @@
 #include <vector>
 
 #include "cl/kernel_args.h"
+#include "render/history_format.h"
 #include "shared/path_state.h"
 #include "util/check.h"
 #include "util/hash.h"
@@ -309,86 +308,9 @@ void PathTracer::tracePass(int sample, cl_uint masked, StageTimer* timer) {
   }
 }
 
-namespace {
-
-// The history file's header; the chains' records of the film's rows follow, then a checksum.
-struct HistoryHeader {
-  char magic[8];
-  uint64_t key;  // Hash128 of the caller's key
-  int32_t frame;
-  uint32_t stamp, chains, first, end, record;
-  dev::CameraParams camera;
-};
-
-constexpr char kHistoryMagic[8] = {'P', 'R', 'H', 'I', 'S', 'T', '1', '\0'};
-
-// The largest number a record may hold: a product of two stays finite in float.
-constexpr float kMaxRecordValue = 1e18f;
-
-bool finiteIn(float x, float lo, float hi) {
-  return std::isfinite(x) && x >= lo && x <= hi;
-}
-
-// A reservoir's numbers: its path's value f (per channel), target p_hat, weight sum w_sum and
-// confidence m are non-negative and bounded, and so is what the kernels make of them, f w_sum /
-// p_hat (its unbiased contribution).
-bool validReservoir(const float f[3], float p_hat, float w_sum, float m) {
-  for (int c = 0; c < 3; ++c)
-    if (!finiteIn(f[c], 0.0f, kMaxRecordValue)) return false;
-  if (!finiteIn(p_hat, 0.0f, kMaxRecordValue) || !finiteIn(w_sum, 0.0f, kMaxRecordValue) ||
-      !finiteIn(m, 0.0f, kMaxRecordValue))
-    return false;
-  if (p_hat == 0.0f) return true;
-  const float weight = w_sum / p_hat;
-  for (int c = 0; c < 3; ++c)
-    if (!finiteIn(f[c] * weight, 0.0f, kMaxRecordValue)) return false;
-  return true;
-}
-
-// Barycentrics of a point on a triangle.
-bool validBarycentrics(float b1, float b2) {
-  const float slack = 1e-3f;
-  return finiteIn(b1, -slack, 1.0f + slack) && finiteIn(b2, -slack, 1.0f + slack) &&
-         b1 + b2 <= 1.0f + slack;
-}
-
-bool finiteAll(std::initializer_list<float> xs) {
-  for (float x : xs)
-    if (!std::isfinite(x)) return false;
-  return true;
-}
-
-// A record the kernels can read safely and sum into a frame without overflow: its surfaces in
-// the scene, its numbers finite, its values, weights and pdfs non-negative and bounded.
-bool validRecord(const dev::PathHistory& h, const GpuScene& scene) {
-  const dev::DirectReservoir& d = h.d;
-  const float df[3] = {d.f_r, d.f_g, d.f_b};
-  if (!finiteAll({d.wx, d.wy, d.wz}) || !validReservoir(df, d.p_hat, d.w_sum, d.m)) return false;
-  if (d.light != PR_INVALID_INDEX &&
-      (d.light >= scene.lights().size() || !validBarycentrics(d.b1, d.b2)))
-    return false;
-  const dev::PathReservoir& r = h.r;
-  const float rf[3] = {r.f_r, r.f_g, r.f_b};
-  if (!validReservoir(rf, r.p_hat, r.w_sum, r.m)) return false;
-  if (!finiteAll({h.wx, h.wy, h.wz, r.wx, r.wy, r.wz, r.rn, r.rh})) return false;
-  for (float x : {r.g_src, r.rest_r, r.rest_g, r.rest_b, r.pdf_light})
-    if (!finiteIn(x, 0.0f, kMaxRecordValue)) return false;
-  for (float x : r.sp)
-    if (!std::isfinite(x)) return false;
-  if ((r.suffix & PR_RS_COUNT_MASK) > PR_RS_SUFFIX) return false;
-  if (h.prim != PR_INVALID_INDEX &&
-      (!scene.validSurface(h.prim, h.inst) || !validBarycentrics(h.b1, h.b2)))
-    return false;
-  return r.prim == PR_INVALID_INDEX ||
-         (scene.validSurface(r.prim, r.inst) && validBarycentrics(r.b1, r.b2));
-}
-
-}  // namespace
-
 std::string PathTracer::writeHistory(const std::string& key) {
   PR_CHECK(hasHistory());
   HistoryHeader h{};
-  std::memcpy(h.magic, kHistoryMagic, sizeof h.magic);
   h.key = Hash128().add(key).low();
   h.frame = frame_;
   h.stamp = stamp_;
@@ -396,54 +318,36 @@ std::string PathTracer::writeHistory(const std::string& key) {
   h.chains = cl_uint(chainedPasses());
   h.first = film_.first();
   h.end = film_.end();
-  h.record = sizeof(dev::PathHistory);
   h.camera = camera_;
-  const size_t bytes = size_t(h.end - h.first) * h.record;
-  std::string out(sizeof h + bytes * h.chains + sizeof(uint64_t), '\0');
-  std::memcpy(&out[0], &h, sizeof h);
-  Hash128 sum;
-  for (size_t c = 0; c < h.chains; ++c) {
-    char* at = &out[sizeof h + c * bytes];
-    readChain(passBegin_ + int(c), at);
-    sum.add(at, bytes);
-  }
-  const uint64_t check = sum.low();
-  std::memcpy(&out[out.size() - sizeof check], &check, sizeof check);
+  std::string out = beginHistoryPart(h);
+  for (uint32_t c = 0; c < h.chains; ++c) readChain(passBegin_ + int(c), historyRecords(&out, c));
+  sealHistoryPart(&out);
   return out;
 }
 
 bool PathTracer::checkHistory(const std::string& data, const std::string& key, int frame) const {
+  if (chainedPasses() == 0) return false;
+  HistoryLayout want;
+  want.key = Hash128().add(key).low();
+  want.frame = frame;
+  want.chains = cl_uint(chainedPasses());
+  want.first = film_.first();
+  want.end = film_.end();
+  HistoryScene scene;
+  scene.lights = uint32_t(scene_.lights().size());
+  scene.validSurface = [this](uint32_t prim, uint32_t inst) {
+    return scene_.validSurface(prim, inst);
+  };
   HistoryHeader h{};
-  if (chainedPasses() == 0 || data.size() < sizeof h) return false;
-  std::memcpy(&h, data.data(), sizeof h);
-  if (std::memcmp(h.magic, kHistoryMagic, sizeof h.magic) != 0 ||
-      h.key != Hash128().add(key).low() || h.frame != frame ||
-      h.chains != cl_uint(chainedPasses()) || h.first != film_.first() || h.end != film_.end() ||
-      h.record != sizeof(dev::PathHistory))
-    return false;
-  const size_t bytes = size_t(h.end - h.first) * h.record;
-  if (data.size() != sizeof h + bytes * h.chains + sizeof(uint64_t)) return false;
-  Hash128 sum;
-  for (size_t c = 0; c < h.chains; ++c) sum.add(data.data() + sizeof h + c * bytes, bytes);
-  uint64_t check = 0;
-  std::memcpy(&check, data.data() + data.size() - sizeof check, sizeof check);
-  if (sum.low() != check) return false;
-  for (size_t k = 0; k < bytes * h.chains; k += h.record) {
-    dev::PathHistory rec;
-    std::memcpy(&rec, data.data() + sizeof h + k, sizeof rec);
-    if (!validRecord(rec, scene_)) return false;
-  }
-  return true;
+  return checkHistoryPart(data, want, scene, &h);
 }
 
 void PathTracer::applyHistory(const std::string& data) {
   HistoryHeader h{};
   PR_CHECK(data.size() >= sizeof h);
   std::memcpy(&h, data.data(), sizeof h);
-  const size_t bytes = size_t(h.end - h.first) * h.record;
   syncChains();
-  for (size_t c = 0; c < h.chains; ++c)
-    writeChain(passBegin_ + int(c), data.data() + sizeof h + c * bytes);
+  for (uint32_t c = 0; c < h.chains; ++c) writeChain(passBegin_ + int(c), historyRecords(data, c));
   frame_ = h.frame;
   stamp_ = h.stamp;
   camera_ = h.camera;

@@ -24,6 +24,7 @@
 #include "io/image.h"
 #include "render/film.h"
 #include "render/gpu_scene.h"
+#include "render/history_format.h"
 #include "render/multi_device.h"
 #include "render/path_reuse.h"
 #include "render/path_tracer.h"
@@ -464,48 +465,22 @@ int renderFrames(const RenderOptions& o, MultiDeviceSession& session, const Fram
 // each device's passes, 4 bytes each; 0 where the devices split rows), then per device its
 // history's size (8 bytes) and its history ("" where the device chains no passes).
 std::string packHistories(MultiDeviceSession& session, const std::string& key) {
-  std::string out;
-  const auto put = [&out](const auto& v) {
-    out.append(reinterpret_cast<const char*>(&v), sizeof v);
-  };
-  put(uint32_t(session.deviceCount()));
-  for (size_t i = 0; i < session.deviceCount(); ++i)
-    put(int32_t(session.passes().empty() ? 0 : session.passes()[i]));
+  std::vector<int> split(session.deviceCount(), 0);
+  std::vector<std::string> parts(session.deviceCount());
   for (size_t i = 0; i < session.deviceCount(); ++i) {
+    if (!session.passes().empty()) split[i] = session.passes()[i];
     RenderSession& s = session.session(i);
-    const std::string h = s.hasHistory() ? s.writeHistory(key) : std::string();
-    put(uint64_t(h.size()));
-    out += h;
+    if (s.hasHistory()) parts[i] = s.writeHistory(key);
   }
-  return out;
+  return packHistoryFile(split, parts);
 }
 
 bool unpackHistories(const std::string& data, MultiDeviceSession& session, const std::string& key,
                      int frame) {
-  size_t at = 0;
-  const auto get = [&](auto* v) {
-    if (data.size() - at < sizeof *v) return false;
-    std::memcpy(v, data.data() + at, sizeof *v);
-    at += sizeof *v;
-    return true;
-  };
-  uint32_t devices = 0;
-  if (!get(&devices) || devices != session.deviceCount()) return false;
-  std::vector<int> split(devices);
-  int spp = 0;
-  for (int& p : split) {
-    int32_t v = 0;
-    if (!get(&v) || v < 0 || v > 1 << 20) return false;
-    spp += p = v;
-  }
-  std::vector<std::string> parts(devices);
-  for (std::string& part : parts) {
-    uint64_t n = 0;
-    if (!get(&n) || n > data.size() - at) return false;
-    part = data.substr(at, n);
-    at += n;
-  }
-  if (at != data.size()) return false;
+  std::vector<int> split;
+  std::vector<std::string> parts;
+  if (!unpackHistoryFile(data, session.deviceCount(), &split, &parts)) return false;
+  const int spp = std::accumulate(split.begin(), split.end(), 0);
   const std::vector<int> before = session.passes();
   if (!before.empty()) {
     if (spp != std::accumulate(before.begin(), before.end(), 0) ||
@@ -514,13 +489,13 @@ bool unpackHistories(const std::string& data, MultiDeviceSession& session, const
     if (split != before) session.setPassSplit(split);  // the writing run's
   }
   // All or nothing: every device's part is checked before any is loaded.
-  for (size_t i = 0; i < devices; ++i) {
+  for (size_t i = 0; i < parts.size(); ++i) {
     if (!parts[i].empty() && !session.session(i).checkHistory(parts[i], key, frame)) {
       if (!before.empty() && split != before) session.setPassSplit(before);
       return false;
     }
   }
-  for (size_t i = 0; i < devices; ++i)
+  for (size_t i = 0; i < parts.size(); ++i)
     if (!parts[i].empty()) session.session(i).applyHistory(parts[i]);
   return true;
 }
