@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "cl/context.h"
+#include "render/kernel_programs.h"
 #include "render/light_bvh.h"
 #include "support/test_env.h"
 #include "test/shared_check.h"
@@ -60,9 +61,7 @@ bool close(float device, float host) {
 TEST(SharedHelpers, DeviceEqualsTheCpuReferenceInEveryLane) {
   Context& ctx = test::testContext();
   // Every BSDF feature, as the host code has them.
-  cl::Kernel k = ctx.kernel("test/shared_check.cl", "shared_check",
-                            "-DPR_HAS_SHEEN=1 -DPR_HAS_COAT=1 -DPR_HAS_ANISOTROPY=1 "
-                            "-DPR_HAS_GLTF_MODEL=1 -DPR_HAS_ENERGY_MODEL=1");
+  cl::Kernel k = ctx.kernel("test/shared_check.cl", "shared_check", kSharedCheckOptions);
   const std::vector<float> cdf = powerTable();
   cl::Buffer out = ctx.allocate("check output", uint64_t(kCases) * PR_CHECK_STRIDE * sizeof(float));
   cl::Buffer table = ctx.allocate("power table", cdf.size() * sizeof(float), CL_MEM_READ_ONLY);

@@ -14,6 +14,7 @@
 #include "render/kernel_programs.h"
 #include "render/light_table.h"
 #include "util/error.h"
+#include "util/hash.h"
 
 namespace pr {
 
@@ -446,6 +447,15 @@ kargs::SceneArgs GpuScene::kernelArgs() {
   a.pr_l_total_power = totalPower_;
   a.pr_l_env_light = static_cast<cl_uint>(environmentLight());
   return a;
+}
+
+std::string GpuScene::environmentDigest() const {
+  const Environment& e = options_.environment;
+  return Hash128()
+      .add(&e.width, sizeof e.width)
+      .add(&e.height, sizeof e.height)
+      .add(e.rgb.data(), e.rgb.size() * sizeof(float))
+      .hex();
 }
 
 std::string GpuScene::buildOptions() const {

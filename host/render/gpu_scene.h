@@ -53,8 +53,8 @@ class GpuScene {
   // The scene's kernel arguments (PR_ARGS_SCENE) as they are now; copy them into a kernel's
   // argument struct with kargs::setScene after each setTime.
   kargs::SceneArgs kernelArgs();
-  // A hash of the environment map's content ("" where there is none or it is constant).
-  const std::string& environmentDigest() const { return options_.environment.digest; }
+  // A hash of the environment's texels (its map's content) and size; computed when asked.
+  std::string environmentDigest() const;
   // Build options every kernel that takes the scene is compiled with.
   std::string buildOptions() const;
   // The light-tracing selection table: running sums of every light's power at time 0, fixed for

@@ -55,9 +55,7 @@ std::vector<KernelProgram> kernelProgramVariants() {
   for (int width : {2, 4, 8})
     out.push_back({"test/trace.cl", "-DPR_BVH_WIDTH=" + std::to_string(width)});
   for (const char* file : {"test/layout.cl", "test/math_check.cl"}) out.push_back({file, ""});
-  out.push_back({"test/shared_check.cl",
-                 "-DPR_HAS_SHEEN=1 -DPR_HAS_COAT=1 -DPR_HAS_ANISOTROPY=1 -DPR_HAS_GLTF_MODEL=1 "
-                 "-DPR_HAS_ENERGY_MODEL=1"});
+  out.push_back({"test/shared_check.cl", kSharedCheckOptions});
   out.push_back({"test/smoke.cl", ""});
   out.push_back({"test/smoke.cl", "-DPR_CACHE_PROBE=1"});
   return out;

@@ -22,6 +22,10 @@ std::string kernelBuildOptions(const KernelFeatures& f);
 
 // connect.cl with eye paths: its terms go to connect_shadow, it traces no ray.
 inline constexpr const char* kConnectDeferredOption = "-DPR_CONNECT_DEFERRED=1";
+// The shared helpers' device test (tests/shared_device_test.cpp): every BSDF feature.
+inline constexpr const char* kSharedCheckOptions =
+    "-DPR_HAS_SHEEN=1 -DPR_HAS_COAT=1 -DPR_HAS_ANISOTROPY=1 -DPR_HAS_GLTF_MODEL=1 "
+    "-DPR_HAS_ENERGY_MODEL=1";
 // Oclgrind's LLVM lacks llvm.bitreverse (tools/ci/oclgrind-check.sh sets it).
 inline constexpr const char* kBitreverseTableOption = "-DPR_BITREVERSE_TABLE";
 

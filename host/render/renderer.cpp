@@ -20,7 +20,6 @@
 
 #include "cl/context.h"
 #include "cl/device.h"
-#include "cl/kernel_sources.h"
 #include "io/image.h"
 #include "render/film.h"
 #include "render/gpu_scene.h"
@@ -294,7 +293,7 @@ bool keepsHistory(const RenderOptions& o) {
 // kernels and defaults made it. (The split of the passes is in the file, and the run that reads
 // it takes that split.)
 std::string historyKey(const RenderOptions& o, MultiDeviceSession& session) {
-  PR_CHECK(!o.estimatorKey.empty());
+  PR_CHECK(!o.estimatorKey.empty() && !session.session(0).scene().inputDigest.empty());
   std::string key = o.estimatorKey;
   key += "size " + std::to_string(session.width()) + "x" + std::to_string(session.height()) + "\n";
   for (size_t i = 0; i < session.deviceCount(); ++i) {
@@ -505,6 +504,7 @@ int runRender(const RenderOptions& o) {
   validateRenderOptions(o);
   LoadOptions loadOptions;
   loadOptions.allowOutsideUris = o.allowOutsideUris;
+  loadOptions.digestInputs = keepsHistory(o);
   const Scene scene = loadScene(o.scene, loadOptions);
   noteUnlitScene(scene, o);
   const InputFiles inputs(scene, o);

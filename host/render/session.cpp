@@ -204,7 +204,7 @@ std::pair<double, double> RenderSession::renderAovs(int frame, Image* image) {
   return aov_->render(frame, options_.fps, camera_, image);
 }
 
-const std::string& RenderSession::environmentDigest() const {
+std::string RenderSession::environmentDigest() const {
   return gpu_->environmentDigest();
 }
 

@@ -66,7 +66,7 @@ class RenderSession {
   // one, its bytes, and checking then loading the one frame `frame` wrote (checking sets the
   // scene to that frame's time, so that the next frame finds what moved since, as it would have).
   const Scene& scene() const { return scene_; }
-  const std::string& environmentDigest() const;
+  std::string environmentDigest() const;
   bool hasHistory() const;
   std::string writeHistory(const std::string& key);
   bool checkHistory(const std::string& data, const std::string& key, int frame);

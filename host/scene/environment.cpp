@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "util/hash.h"
 #include "io/image.h"
 #include "scene/image_decode.h"
 #include "util/error.h"
@@ -53,11 +52,6 @@ Environment loadEnvironment(const std::string& path) {
   for (float v : e.rgb)
     if (!std::isfinite(v) || v < 0.0f)
       throw InputError(path + ": the environment map holds a negative or non-finite value");
-  e.digest = Hash128()
-                 .add(&e.width, sizeof e.width)
-                 .add(&e.height, sizeof e.height)
-                 .add(e.rgb.data(), e.rgb.size() * sizeof(float))
-                 .hex();
   return e;
 }
 

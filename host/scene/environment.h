@@ -16,7 +16,6 @@ struct Environment {
   std::vector<float> rgb;  // width * height * 3, top row (+Y) first
   glm::vec3 scale{1.0f};   // strength times colour
   float rotation = 0.0f;   // radians about +Y
-  std::string digest;      // a hash of the map file's content ("" for a constant one)
 
   bool present() const { return width > 0; }
 };

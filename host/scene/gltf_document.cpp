@@ -77,7 +77,7 @@ bool readExternalFile(std::vector<unsigned char>* out, std::string*, const std::
   } catch (const InputError& e) {
     files->doc->fail(std::string("cannot load a file it names: ") + e.what());
   }
-  files->doc->inputs.add(path).add(out->data(), out->size());
+  if (files->doc->options.digestInputs) files->doc->inputs.add(path).add(out->data(), out->size());
   files->doc->inputFiles.push_back(path);
   return true;
 }
@@ -106,7 +106,7 @@ class Parser : Stage {
     if (!inMemory_) readFileBytes();
     const std::vector<uint8_t>& bytes = bytes_;
     if (bytes.empty()) fail("file is empty");
-    doc_.inputs.add(doc_.path).add(bytes.data(), bytes.size());
+    if (doc_.options.digestInputs) doc_.inputs.add(doc_.path).add(bytes.data(), bytes.size());
     if (!inMemory_) doc_.inputFiles.push_back(doc_.path);
 
     std::string ext = fs::path(doc_.path).extension().string();

@@ -854,7 +854,7 @@ class Converter : Stage {
 Scene load(Document& doc) {
   Validated validated = validate(doc);
   Scene scene = Converter(doc, std::move(validated)).convert();
-  scene.inputDigest = doc.inputs.hex();
+  if (doc.options.digestInputs) scene.inputDigest = doc.inputs.hex();
   scene.inputFiles = doc.inputFiles;
   return scene;
 }

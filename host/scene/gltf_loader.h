@@ -19,6 +19,9 @@ struct LoadOptions {
   // Buffers and images the file names are read from its folder and below only, unless this is
   // set (--allow-outside-uris): a scene from elsewhere must not read /etc/passwd into a frame.
   bool allowOutsideUris = false;
+  // Hash the content of every file read into Scene::inputDigest (what a resume history is keyed
+  // by); off, the cost of hashing a scene's textures is not paid.
+  bool digestInputs = false;
 };
 
 Scene loadScene(const std::string& path, const LoadOptions& options = {});

@@ -247,7 +247,8 @@ struct Instance {
 struct Scene {
   std::string path;  // the file it was loaded from
   // A hash of the content of every file it was loaded from (the glTF file, its buffers and
-  // images): an edited texture changes it where the names stay.
+  // images): an edited texture changes it where the names stay. "" unless
+  // LoadOptions::digestInputs.
   std::string inputDigest;
   std::vector<std::string> inputFiles;  // those files' paths
 
