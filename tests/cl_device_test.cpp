@@ -7,6 +7,7 @@
 #include <fstream>
 #include <vector>
 
+#include "cl/binary_cache.h"
 #include "cl/context.h"
 #include "cl/device.h"
 #include "cl/kernel_sources.h"
@@ -266,28 +267,110 @@ TEST_F(ProgramTest, AnotherProgramsCacheFileIsRebuiltNotLoaded) {
   EXPECT_EQ(scaleOfOne(ctx.buildProgramFromSource(scaleSource(2), "", "two")), 2.0f);
 }
 
-// A cache file with this program's key and a consistent checksum around a binary that lacks the
-// kernel asked for (the driver loads it): the kernel is built again from source, not refused.
+// Header: magic (8), key (32 hex), size (8), MAC (32); the binary follows.
+constexpr size_t kCacheHeaderBytes = 80;
+
+// A cache file of `key` around `binary` whose MAC is made under `secret`.
+std::string forgeCacheFile(const std::string& key, const std::string& binary,
+                           const std::string& secret) {
+  std::string forged = cacheFormatTag() + key;
+  const uint64_t size = binary.size();
+  forged.append(reinterpret_cast<const char*>(&size), sizeof size);
+  forged += cacheFileMac(secret, key, binary);
+  return forged + binary;
+}
+
+// A cache file with this program's key and a right MAC around a binary that lacks the kernel
+// asked for (the driver loads it): the kernel is built again from source, not refused.
 TEST_F(ProgramTest, CachedBinaryWithoutTheKernelIsRebuilt) {
   Context& ctx = test::testContext();
   const ProgramBuild smoke = ctx.buildProgram("test/smoke.cl");
   const ProgramBuild other = ctx.buildProgramFromSource(scaleSource(2), "", "other");
   std::string smokeFile = test::slurp(smoke.cacheFile), otherFile = test::slurp(other.cacheFile);
-  // Header: magic (8), key (32 hex), size (8), checksum (8); the binary follows.
-  ASSERT_GT(smokeFile.size(), 56u);
-  ASSERT_GT(otherFile.size(), 56u);
-  const std::string key = smokeFile.substr(8, 32), binary = otherFile.substr(56);
-  std::string forged = smokeFile.substr(0, 40);
-  const uint64_t size = binary.size(), check = Hash128().add(key).add(binary).low();
-  forged.append(reinterpret_cast<const char*>(&size), sizeof size);
-  forged.append(reinterpret_cast<const char*>(&check), sizeof check);
-  forged += binary;
+  ASSERT_GT(smokeFile.size(), kCacheHeaderBytes);
+  ASSERT_GT(otherFile.size(), kCacheHeaderBytes);
+  const std::string secret = test::slurp(cacheDir_ + "/kernels/secret");
+  ASSERT_EQ(secret.size(), kCacheSecretBytes);
+  const std::string forged =
+      forgeCacheFile(smokeFile.substr(8, 32), otherFile.substr(kCacheHeaderBytes), secret);
   std::ofstream(smoke.cacheFile, std::ios::binary | std::ios::trunc) << forged;
   ASSERT_TRUE(ctx.buildProgram("test/smoke.cl").fromCache) << "the forged file was not loaded";
   cl::Kernel k = ctx.kernel("test/smoke.cl", "saxpy");
   EXPECT_TRUE(k());
   EXPECT_NE(test::slurp(smoke.cacheFile), forged);
   EXPECT_TRUE(ctx.buildProgram("test/smoke.cl").fromCache);
+}
+
+// Files this user's pathreuse did not write never reach the driver, which may crash on a damaged
+// binary rather than refuse it: half a binary in a file whose header and checksum are consistent
+// but made without this cache's secret, and a whole one from another user's cache, are rebuilt.
+TEST_F(ProgramTest, CacheFileNotWrittenUnderThisCachesSecretIsRebuilt) {
+  Context& ctx = test::testContext();
+  const ProgramBuild first = ctx.buildProgramFromSource(scaleSource(5), "", "five");
+  ASSERT_FALSE(first.cacheFile.empty());
+  const std::string file = test::slurp(first.cacheFile);
+  ASSERT_GT(file.size(), kCacheHeaderBytes + 2);
+  const std::string key = file.substr(8, 32), binary = file.substr(kCacheHeaderBytes);
+  const std::string strangersSecret(kCacheSecretBytes, 'x');
+  for (const std::string& forged :
+       {forgeCacheFile(key, binary.substr(0, binary.size() / 2), strangersSecret),
+        forgeCacheFile(key, binary, strangersSecret)}) {
+    std::ofstream(first.cacheFile, std::ios::binary | std::ios::trunc) << forged;
+    const ProgramBuild again = ctx.buildProgramFromSource(scaleSource(5), "", "five");
+    EXPECT_FALSE(again.fromCache);
+    EXPECT_EQ(scaleOfOne(again), 5.0f);
+    // Stored again under this cache's secret: the next build loads it.
+    const ProgramBuild stored = ctx.buildProgramFromSource(scaleSource(5), "", "five");
+    EXPECT_TRUE(stored.fromCache);
+    EXPECT_EQ(scaleOfOne(stored), 5.0f);
+  }
+}
+
+// A secret others could read (or one another user owns) could sign anything: the cache is not
+// used at all, and the run goes on building from source.
+TEST_F(ProgramTest, CacheWhoseSecretOthersCanReadIsNotUsed) {
+  Context& ctx = test::testContext();
+  const std::string dir = test::tempDir("cache-open");
+  fs::create_directories(dir + "/kernels");
+  std::ofstream(dir + "/kernels/secret", std::ios::binary) << std::string(kCacheSecretBytes, 'k');
+  fs::permissions(dir + "/kernels/secret", fs::perms::owner_read | fs::perms::owner_write |
+                                               fs::perms::group_read | fs::perms::others_read);
+  setenv("PATHREUSE_CACHE_DIR", dir.c_str(), 1);
+  testing::internal::CaptureStderr();
+  const ProgramBuild first = ctx.buildProgramFromSource(scaleSource(7), "", "seven");
+  const ProgramBuild second = ctx.buildProgramFromSource(scaleSource(7), "", "seven");
+  const std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_TRUE(first.cacheFile.empty());
+  EXPECT_FALSE(second.fromCache);
+  EXPECT_EQ(scaleOfOne(second), 7.0f);
+  EXPECT_NE(err.find("kernel cache is not used this run: " + dir +
+                     "/kernels/secret is open to "
+                     "other users"),
+            std::string::npos)
+      << err;
+  EXPECT_EQ(err.find("kernel cache", err.find("kernel cache") + 1), std::string::npos)
+      << "said more than once: " << err;
+  // Nothing was written into it.
+  std::vector<std::string> bins;
+  for (const auto& e : fs::directory_iterator(dir + "/kernels"))
+    if (e.path().extension() == ".bin") bins.push_back(e.path());
+  EXPECT_TRUE(bins.empty());
+}
+
+// A fresh cache folder gets a private secret of the right size, made once.
+TEST_F(ProgramTest, CacheSecretIsPrivateAndKept) {
+  Context& ctx = test::testContext();
+  ctx.buildProgramFromSource(scaleSource(9), "", "nine");
+  const std::string secretFile = cacheDir_ + "/kernels/secret";
+  ASSERT_TRUE(fs::is_regular_file(secretFile));
+  EXPECT_EQ(fs::file_size(secretFile), kCacheSecretBytes);
+  const fs::perms p = fs::status(secretFile).permissions();
+  EXPECT_EQ(p & (fs::perms::group_all | fs::perms::others_all), fs::perms::none);
+  std::string why;
+  const std::string secret = cacheSecret(cacheDir_ + "/kernels", &why);
+  EXPECT_TRUE(why.empty()) << why;
+  EXPECT_EQ(secret, test::slurp(secretFile));
+  EXPECT_EQ(cacheSecret(cacheDir_ + "/kernels", &why), secret);
 }
 
 TEST(Layout, DeviceAgreesWithHostOnEverySharedStruct) {

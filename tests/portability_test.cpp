@@ -132,8 +132,12 @@ TEST(PortabilityCompare, DifferenceImageIsScaledAndFinite) {
 }
 
 TEST(PortabilityCompare, FrameLists) {
-  EXPECT_EQ(parseFrameList("0-2,24"), (std::vector<int>{0, 1, 2, 24}));
-  EXPECT_EQ(parseFrameList("5,1-2,2"), (std::vector<int>{1, 2, 5}));
+  EXPECT_EQ(parseFrameList("0-2,24"), (std::vector<int64_t>{0, 1, 2, 24}));
+  EXPECT_EQ(parseFrameList("5,1-2,2"), (std::vector<int64_t>{1, 2, 5}));
+  // The last frame numbers end the list rather than wrap around.
+  EXPECT_EQ(parseFrameList("9223372036854775805-9223372036854775806"),
+            (std::vector<int64_t>{9223372036854775805, 9223372036854775806}));
+  EXPECT_THROW(parseFrameList("9223372036854775807"), InputError);
   EXPECT_THROW(parseFrameList(""), InputError);
   EXPECT_THROW(parseFrameList("3-1"), InputError);
   EXPECT_THROW(parseFrameList("1,"), InputError);

@@ -11,7 +11,10 @@ TEST(RenderOptions, FrameRanges) {
   EXPECT_EQ(parseFrameRange("3").first, 3);
   EXPECT_EQ(parseFrameRange("3").last, 3);
   EXPECT_EQ(parseFrameRange("0-119").last, 119);
-  for (const char* bad : {"", "-", "a", "3-", "-3", "5-2", "1-2-3", "1.5", "99999999999"})
+  EXPECT_EQ(parseFrameRange("99999999999").first, 99999999999);
+  EXPECT_EQ(parseFrameRange("0-9223372036854775806").last, kMaxFrame);
+  for (const char* bad : {"", "-", "a", "3-", "-3", "5-2", "1-2-3", "1.5", "9223372036854775807",
+                          "18446744073709551616", "00000000000000000001"})
     EXPECT_THROW(parseFrameRange(bad), InputError) << bad;
 }
 
@@ -51,6 +54,7 @@ TEST(RenderOptions, ResamplingDefaultsByMode) {
 TEST(RenderOptions, OutPatterns) {
   EXPECT_EQ(formatOutPath("out/frame_%04d.exr", 7), "out/frame_0007.exr");
   EXPECT_EQ(formatOutPath("f%d.exr", 12), "f12.exr");
+  EXPECT_EQ(formatOutPath("f%05d.exr", kMaxFrame), "f9223372036854775806.exr");
   EXPECT_EQ(formatOutPath("100%%_%03i.exr", 5), "100%_005.exr");
   EXPECT_NO_THROW(validateOutPattern("a/b_%05d.exr"));
   for (const char* bad :

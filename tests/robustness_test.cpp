@@ -565,8 +565,8 @@ TEST(DeviceMemory, AbsurdSizesAreBadInput) {
   }
 }
 
-// Ranges are checked whether or not the option's feature is on; frame numbers take the whole int
-// range and say the limit past it; a scene with a camera and nothing to render is one line, the
+// Ranges are checked whether or not the option's feature is on; frame numbers are 64-bit and
+// say the limit past it; a scene with a camera and nothing to render is one line, the
 // note about its missing lights left out.
 TEST(BadOptions, RangesAndEmptyScenesAreOneLineAndExitTwo) {
   const std::string dir = test::tempDir("bad-options");
@@ -582,10 +582,23 @@ TEST(BadOptions, RangesAndEmptyScenesAreOneLineAndExitTwo) {
                          dir + "/big_%d.exr'");
   EXPECT_EQ(r.exitCode, 0) << r.err;
   EXPECT_TRUE(fs::exists(dir + "/big_1234567890.exr"));
-  r = test::runPathreuse("render '" + kScene + "' --frames 99999999999" + common.substr(11));
-  EXPECT_EQ(r.exitCode, 2) << r.err;
-  EXPECT_EQ(lineCount(r.err), 1u) << r.err;
-  EXPECT_NE(r.err.find("2147483647"), std::string::npos) << r.err;
+  // 64-bit frame numbers; the last two end the run (a 32-bit counter wrapped and rendered on).
+  r = test::runPathreuse("render '" + kScene +
+                         "' --quiet --frames 9223372036854775805-9223372036854775806 --width 8 "
+                         "--height 8 --spp 1 --out '" +
+                         dir + "/big_%d.exr'");
+  EXPECT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir + "/big_9223372036854775806.exr"));
+  size_t frames = 0;
+  for (const auto& e : fs::directory_iterator(dir))
+    frames += e.path().filename().string().rfind("big_", 0) == 0;
+  EXPECT_EQ(frames, 3u) << "frames outside the range were rendered";
+  for (const char* frames : {"9223372036854775807", "99999999999999999999"}) {
+    r = test::runPathreuse("render '" + kScene + "' --frames " + frames + common.substr(11));
+    EXPECT_EQ(r.exitCode, 2) << r.err;
+    EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find("9223372036854775806"), std::string::npos) << r.err;
+  }
   writeFileAtomic(dir + "/camera.gltf",
                   R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],)"
                   R"("nodes":[{"camera":0}],"cameras":[{"type":"perspective",)"

@@ -6,6 +6,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <map>
+#include <mutex>
 
 #include "cl/binary_cache.h"
 #include "cl/kernel_sources.h"
@@ -35,20 +37,40 @@ void removeCacheFile(const std::string& file) {
 
 // The cached binary of `key` in `file`, or empty where there is none or it is not this key's
 // whole binary (cl/binary_cache.h; such a file is removed).
-std::string loadCachedBinary(const std::string& file, const std::string& key) {
+std::string loadCachedBinary(const std::string& file, const std::string& key,
+                             const std::string& secret) {
   std::string data;
   if (!readFile(file, &data)) return {};
-  std::string binary = unpackCacheFile(data, key);
+  std::string binary = unpackCacheFile(data, key, secret);
   if (binary.empty()) removeCacheFile(file);
   return binary;
 }
 
-void storeCachedBinary(const std::string& file, const std::string& key, const std::string& binary) {
+void storeCachedBinary(const std::string& file, const std::string& key, const std::string& binary,
+                       const std::string& secret) {
   try {
-    writeFileAtomic(file, packCacheFile(key, binary));
+    writeFileAtomic(file, packCacheFile(key, binary, secret));
   } catch (const RuntimeError&) {
     // An unwritable cache costs only build time next run.
   }
+}
+
+// The secret of the cache under `dir` (cl/binary_cache.h), or empty where the cache is off or
+// cannot be trusted (said once per process and folder).
+std::string cacheSecretFor(const std::string& dir) {
+  if (dir.empty()) return {};
+  static std::mutex mutex;
+  static std::map<std::string, std::string> secrets;
+  std::lock_guard<std::mutex> lock(mutex);
+  if (auto it = secrets.find(dir); it != secrets.end()) return it->second;
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  std::string why;
+  std::string secret = cacheSecret(dir + "/kernels", &why);
+  if (secret.empty())
+    std::fprintf(stderr, "note: the kernel cache is not used this run: %s\n", why.c_str());
+  secrets[dir] = secret;
+  return secret;
 }
 
 }  // namespace
@@ -112,12 +134,13 @@ ProgramBuild Context::buildProgramFromSource(const std::string& source, const st
                               .add(device_.deviceVersion)
                               .hex();
   const std::string dir = programCacheDir();
-  const std::string file = dir.empty() ? "" : dir + "/kernels/" + key + ".bin";
+  const std::string secret = cacheSecretFor(dir);
+  const std::string file = secret.empty() ? "" : dir + "/kernels/" + key + ".bin";
 
   ProgramBuild out;
   out.cacheFile = file;
   if (!file.empty()) {
-    const std::string binary = loadCachedBinary(file, key);
+    const std::string binary = loadCachedBinary(file, key, secret);
     if (!binary.empty()) {
       cl::Program::Binaries bins{std::vector<unsigned char>(binary.begin(), binary.end())};
       std::vector<cl_int> status;
@@ -155,7 +178,7 @@ ProgramBuild Context::buildProgramFromSource(const std::string& source, const st
     std::vector<std::vector<unsigned char>> binaries;
     if (program.getInfo(CL_PROGRAM_BINARIES, &binaries) == CL_SUCCESS && binaries.size() == 1 &&
         !binaries[0].empty())
-      storeCachedBinary(file, key, std::string(binaries[0].begin(), binaries[0].end()));
+      storeCachedBinary(file, key, std::string(binaries[0].begin(), binaries[0].end()), secret);
   }
   out.program = program;
   out.seconds = secondsSince(t0);

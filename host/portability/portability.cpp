@@ -50,7 +50,7 @@ struct FrameSet {
 struct Row {
   size_t scene = 0;
   RenderMode mode = RenderMode::Reuse;
-  int frame = 0;
+  int64_t frame = 0;
   size_t device = 0;  // position in the compared devices (0 is the reference)
   ImageDiff diff;
   NoiseFloor floor;
@@ -98,13 +98,13 @@ void validate(const PortabilityOptions& o) {
 }
 
 FrameSet renderSet(const SuiteScene& s, const DeviceEntry& device, const RenderOptions& ro,
-                   const std::vector<int>& frames, bool quiet) {
+                   const std::vector<int64_t>& frames, bool quiet) {
   if (!quiet)
     std::cerr << "portability: " << s.label << " " << renderModeName(ro.mode) << " seed " << ro.seed
               << " on [" << device.index << "] " << device.name << "\n";
   RenderSession session(*s.scene, device, ro);
   FrameSet set;
-  for (int f : frames) {  // increasing, so reuse carries paths from frame to frame
+  for (int64_t f : frames) {  // increasing, so reuse carries paths from frame to frame
     FrameStats stats;
     set.images.push_back(session.renderFrame(f, &stats));
     set.dropped.push_back(stats.badSamples);
@@ -117,12 +117,12 @@ FrameSet renderSet(const SuiteScene& s, const DeviceEntry& device, const RenderO
 const char* const kManifest = "reference.json";
 constexpr uint64_t kMaxManifestBytes = 64 << 20;
 
-std::string referenceFile(const std::string& label, RenderMode mode, uint32_t seed, int frame) {
+std::string referenceFile(const std::string& label, RenderMode mode, uint32_t seed, int64_t frame) {
   return safeName(label) + "_" + renderModeName(mode) + "_s" + std::to_string(seed) + "_f" +
          std::to_string(frame) + ".exr";
 }
 
-nlohmann::json suiteSettings(const std::vector<int>& frames, int width, int height, int spp,
+nlohmann::json suiteSettings(const std::vector<int64_t>& frames, int width, int height, int spp,
                              uint32_t seed) {
   return {{"frames", frames}, {"width", width}, {"height", height},
           {"spp", spp},       {"seed", seed},   {"noise_floor_seeds", kFloorSeeds}};
@@ -164,9 +164,9 @@ class StoredReference {
   // Every frame of one scene is the size of the first loaded (and --width wide): a frame of
   // another size is a damaged reference, named.
   FrameSet load(const std::string& label, RenderMode mode, uint32_t seed,
-                const std::vector<int>& frames) {
+                const std::vector<int64_t>& frames) {
     FrameSet set;
-    for (int f : frames) {
+    for (int64_t f : frames) {
       const std::string name = referenceFile(label, mode, seed, f);
       const fs::path path = fs::path(dir_) / name;
       if (!fs::is_regular_file(path) || !json_["frames_dropped"].contains(name))
@@ -223,14 +223,14 @@ nlohmann::json number(double v) {
 
 }  // namespace
 
-std::vector<int> parseFrameList(const std::string& text) {
-  std::vector<int> frames;
+std::vector<int64_t> parseFrameList(const std::string& text) {
+  std::vector<int64_t> frames;
   std::stringstream ss(text);
   std::string part;
   while (std::getline(ss, part, ',')) {
     const FrameRange r = parseFrameRange(part);
     if (r.last - r.first > 1000) throw InputError("--frames " + text + ": at most 1000 frames");
-    for (int f = r.first; f <= r.last; ++f) frames.push_back(f);
+    for (int64_t f = r.first; f <= r.last; ++f) frames.push_back(f);
   }
   if (frames.empty() || text.back() == ',')
     throw InputError("--frames " + text + ": expected A, A-B or a list A,B-C");
@@ -265,7 +265,7 @@ namespace {
 struct Suite {
   explicit Suite(const PortabilityOptions& options) : o(options) {}
   const PortabilityOptions& o;
-  std::vector<int> frames;
+  std::vector<int64_t> frames;
   std::vector<RenderMode> modes;
   std::vector<SuiteScene> scenes;
   // --reference: the saved frames every device is compared with.
@@ -514,12 +514,13 @@ void printRows(const Suite& suite, const Results& res) {
     std::string verdict = r.verdict.agree ? "agree" : "DISAGREE";
     for (size_t i = 0; i < r.verdict.reasons.size(); ++i)
       verdict += (i ? "; " : ": ") + r.verdict.reasons[i];
-    std::snprintf(line, sizeof line, "%-18s %-9s %5d %4d %10s %10s %10s %6s %10s %6s %4s ",
-                  suite.scenes[r.scene].label.c_str(), renderModeName(r.mode), r.frame,
-                  suite.devices[r.device]->index, sci(r.diff.relMse).c_str(),
-                  sci(r.diff.relMseTrimmed).c_str(), sci(r.floor.relMseTrimmed).c_str(),
-                  fixed(r.verdict.relMseRatio, 2).c_str(), sci(r.diff.mad).c_str(),
-                  fixed(r.verdict.lumZ, 2).c_str(), r.diff.identical ? "yes" : "no");
+    std::snprintf(line, sizeof line, "%-18s %-9s %5lld %4d %10s %10s %10s %6s %10s %6s %4s ",
+                  suite.scenes[r.scene].label.c_str(), renderModeName(r.mode),
+                  static_cast<long long>(r.frame), suite.devices[r.device]->index,
+                  sci(r.diff.relMse).c_str(), sci(r.diff.relMseTrimmed).c_str(),
+                  sci(r.floor.relMseTrimmed).c_str(), fixed(r.verdict.relMseRatio, 2).c_str(),
+                  sci(r.diff.mad).c_str(), fixed(r.verdict.lumZ, 2).c_str(),
+                  r.diff.identical ? "yes" : "no");
     std::cout << line << verdict << "\n";
   }
 }

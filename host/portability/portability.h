@@ -35,7 +35,7 @@ struct PortabilityOptions {
 
 // "A", "A-B" and comma-separated lists of them ("0-2,24"), sorted, without repeats. Throws
 // InputError naming --frames.
-std::vector<int> parseFrameList(const std::string& text);
+std::vector<int64_t> parseFrameList(const std::string& text);
 
 // Where the demo scenes are: <executable dir>/../scenes, else the source tree's scenes/.
 // Throws InputError when neither holds them.

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "cl/kernel_args.h"
+#include "render/integrator.h"
 #include "util/error.h"
 
 namespace pr {
@@ -83,7 +84,7 @@ void AovRenderer::uploadPrevious(double t) {
   restUploaded_ = true;
 }
 
-std::pair<double, double> AovRenderer::render(int frame, double fps, int camera, Image* image) {
+std::pair<double, double> AovRenderer::render(int64_t frame, double fps, int camera, Image* image) {
   const auto t0 = std::chrono::steady_clock::now();
   const int w = image->width, h = image->height;
   const uint32_t n = uint32_t(w) * uint32_t(h);
@@ -112,7 +113,7 @@ std::pair<double, double> AovRenderer::render(int frame, double fps, int camera,
   a.static_vertices = uint32_t(scene_.staticMesh.vertexCount());
   a.static_triangles = uint32_t(scene_.staticTriangleNodes.size());
   a.seed = sampling_.seed;
-  a.jitter_frame = sampling_.jitterFromFrame0 ? 0u : uint32_t(frame);
+  a.jitter_frame = sampling_.jitterFromFrame0 ? 0u : rngFrameKey(frame);
   a.spp = uint32_t(sampling_.spp);
   a.max_depth = uint32_t(sampling_.maxDepth);
   a.end = n;

@@ -53,7 +53,7 @@ class AovRenderer {
   // Adds the channels of frame f (at time f / fps, the GpuScene set to it) to `image`; with
   // denoising, the image's colour becomes the denoised one and the noisy one the channels
   // noisy.R/G/B. Returns the seconds of the auxiliary images and of the denoising.
-  std::pair<double, double> render(int frame, double fps, int camera, Image* image);
+  std::pair<double, double> render(int64_t frame, double fps, int camera, Image* image);
   // OIDN's device type once a frame was denoised ("" before, or without --denoise).
   std::string denoiseDevice() const { return denoiser_ ? denoiser_->deviceType() : ""; }
 

@@ -11,7 +11,7 @@ namespace pr {
 
 namespace {
 
-constexpr char kHistoryMagic[8] = {'P', 'R', 'H', 'I', 'S', 'T', '1', '\0'};
+constexpr char kHistoryMagic[8] = {'P', 'R', 'H', 'I', 'S', 'T', '2', '\0'};
 
 size_t chainBytes(const HistoryHeader& h) {
   return size_t(h.end - h.first) * h.record;

@@ -18,7 +18,7 @@ namespace pr {
 struct HistoryHeader {
   char magic[8];
   uint64_t key;  // Hash128 of the caller's key
-  int32_t frame;
+  int64_t frame;
   uint32_t stamp, chains, first, end, record;
   dev::CameraParams camera;
 };
@@ -26,7 +26,7 @@ struct HistoryHeader {
 // What a reader expects of a part: its key, frame, chains and film rows.
 struct HistoryLayout {
   uint64_t key = 0;
-  int32_t frame = 0;
+  int64_t frame = 0;
   uint32_t chains = 0, first = 0, end = 0;
 };
 

@@ -11,8 +11,14 @@
 
 namespace pr {
 
+// A frame number as the kernels' 32-bit RNG key: the frame itself below 2^32, its halves
+// folded above.
+inline uint32_t rngFrameKey(int64_t frame) {
+  return static_cast<uint32_t>(static_cast<uint64_t>(frame) ^ (static_cast<uint64_t>(frame) >> 32));
+}
+
 struct FrameStats {
-  int frame = 0;
+  int64_t frame = 0;
   double wallSeconds = 0.0;
   std::map<std::string, double> stageSeconds;  // kernel time per stage
   // Host time: "scene" (animation, deformation, BVH builds, uploads), "deform" (its part
@@ -39,7 +45,7 @@ class Integrator {
   virtual ~Integrator() = default;
   // Renders frame `frame` (the scene already set to its time) into the film. Returns early,
   // leaving the film partial, once pr::interrupted(); the caller then drops the frame.
-  virtual void renderFrame(int frame, const dev::CameraParams& camera, FrameStats* stats) = 0;
+  virtual void renderFrame(int64_t frame, const dev::CameraParams& camera, FrameStats* stats) = 0;
   virtual uint64_t deviceBytes() const = 0;
   // Sample passes [begin, end) of each frame are rendered (default: all, end -1 for spp):
   // several devices split a frame's passes rather than its rows with --resample

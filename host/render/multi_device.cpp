@@ -140,7 +140,7 @@ void MultiDeviceSession::setPassSplit(const std::vector<int>& passes) {
   for (const auto& [s, records] : moving) sessions_[owner(passes_, s)]->setChain(s, records);
 }
 
-void MultiDeviceSession::renderPasses(int frame, Image* img, std::vector<DeviceFrame>* parts) {
+void MultiDeviceSession::renderPasses(int64_t frame, Image* img, std::vector<DeviceFrame>* parts) {
   const size_t n = sessions_.size();
   std::vector<std::vector<float>> sums(n);
   std::vector<DeviceFrame>& p = *parts;
@@ -173,7 +173,7 @@ void MultiDeviceSession::setRows(const std::vector<int>& rows) {
   PR_CHECK(begin == height());
 }
 
-Image MultiDeviceSession::renderFrame(int frame, FrameStats* total,
+Image MultiDeviceSession::renderFrame(int64_t frame, FrameStats* total,
                                       std::vector<DeviceFrame>* parts) {
   const size_t n = sessions_.size();
   Image img(width(), height());

@@ -63,7 +63,7 @@ class MultiDeviceSession {
   // Renders frame f on every device and merges the rows. `total` sums the devices' stats
   // (counters of the replicated light paths are every device's and counted once); `parts`
   // gets each device's. Then splits the next frame's rows by the measured throughput.
-  Image renderFrame(int frame, FrameStats* total, std::vector<DeviceFrame>* parts);
+  Image renderFrame(int64_t frame, FrameStats* total, std::vector<DeviceFrame>* parts);
 
   size_t deviceCount() const { return sessions_.size(); }
   RenderSession& session(size_t i) { return *sessions_[i]; }
@@ -83,7 +83,7 @@ class MultiDeviceSession {
  private:
   void setRows(const std::vector<int>& rows);
   // Frame f with the passes split (--resample): every device's film summed into `img`.
-  void renderPasses(int frame, Image* img, std::vector<DeviceFrame>* parts);
+  void renderPasses(int64_t frame, Image* img, std::vector<DeviceFrame>* parts);
 
   std::vector<const DeviceEntry*> devices_;
   std::vector<std::unique_ptr<RenderSession>> sessions_;

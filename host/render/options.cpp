@@ -55,13 +55,14 @@ const char* materialModelName(MaterialModel m) {
 namespace {
 
 // A whole number 0 .. INT_MAX (a frame number: 2^31 - 1 frames are 2.8 years at 24 fps).
-bool parseInt(const std::string& s, int* out) {
-  if (s.empty() || s.size() > 10) return false;
+// A frame number: decimal digits, from 0 to kMaxFrame.
+bool parseFrameNumber(const std::string& s, int64_t* out) {
+  if (s.empty() || s.size() > 19) return false;
   for (char c : s)
     if (!std::isdigit(static_cast<unsigned char>(c))) return false;
-  const long long v = std::stoll(s);
-  if (v > std::numeric_limits<int>::max()) return false;
-  *out = int(v);
+  const unsigned long long v = std::stoull(s);
+  if (v > static_cast<unsigned long long>(kMaxFrame)) return false;
+  *out = static_cast<int64_t>(v);
   return true;
 }
 
@@ -106,14 +107,15 @@ FrameRange parseFrameRange(const std::string& text) {
   const size_t dash = text.find('-');
   bool ok;
   if (dash == std::string::npos) {
-    ok = parseInt(text, &r.first);
+    ok = parseFrameNumber(text, &r.first);
     r.last = r.first;
   } else {
-    ok = parseInt(text.substr(0, dash), &r.first) && parseInt(text.substr(dash + 1), &r.last);
+    ok = parseFrameNumber(text.substr(0, dash), &r.first) &&
+         parseFrameNumber(text.substr(dash + 1), &r.last);
   }
   if (!ok)
-    throw InputError("--frames " + text +
-                     ": expected A-B or A, with whole numbers from 0 to 2147483647");
+    throw InputError("--frames " + text + ": expected A-B or A, with whole numbers from 0 to " +
+                     std::to_string(kMaxFrame));
   if (r.last < r.first)
     throw InputError("--frames " + text + ": the last frame is before the first");
   return r;
@@ -127,13 +129,13 @@ void validateOutPattern(const std::string& pattern) {
     throw InputError("--out " + pattern + ": names a folder, not a file");
 }
 
-std::string formatOutPath(const std::string& pattern, int frame) {
+std::string formatOutPath(const std::string& pattern, int64_t frame) {
   size_t pos = 0, len = 0;
   std::string why;
   if (!findConversion(pattern, &pos, &len, &why)) throw InputError("--out " + pattern + ": " + why);
   char buf[64];
-  const std::string conv = pattern.substr(pos, len - 1) + "d";
-  std::snprintf(buf, sizeof buf, conv.c_str(), frame);
+  const std::string conv = pattern.substr(pos, len - 1) + "lld";
+  std::snprintf(buf, sizeof buf, conv.c_str(), static_cast<long long>(frame));
   std::string out;
   // Unescape %% outside the conversion.
   auto unescape = [](const std::string& s) {

@@ -55,9 +55,12 @@ struct ResampleSettings {
   float misCount = 4.0f;
 };
 
+// The largest frame number: one more still fits, as does the count of frames from 0 to it.
+constexpr int64_t kMaxFrame = INT64_MAX - 1;
+
 struct FrameRange {
-  int first = 0;
-  int last = -1;  // -1: up to the end of the animation
+  int64_t first = 0;
+  int64_t last = -1;  // -1: up to the end of the animation
 };
 
 struct RenderOptions {
@@ -149,7 +152,7 @@ FrameRange parseFrameRange(const std::string& text);
 void validateOutPattern(const std::string& pattern);
 
 // The pattern with the frame number substituted.
-std::string formatOutPath(const std::string& pattern, int frame);
+std::string formatOutPath(const std::string& pattern, int64_t frame);
 
 // `path` with its extension replaced (".exr" -> ".png"), or the extension appended.
 std::string withExtension(const std::string& path, const std::string& ext);

@@ -106,7 +106,7 @@ PathReuse::PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseS
   }
 }
 
-dev::ReuseParams PathReuse::frameParams(int frame) const {
+dev::ReuseParams PathReuse::frameParams(int64_t frame) const {
   dev::ReuseParams rp{};
   rp.seed = settings_.seed;
   rp.slots = slots_;
@@ -115,7 +115,7 @@ dev::ReuseParams PathReuse::frameParams(int frame) const {
   rp.paths_per_pixel = settings_.pathsPerPixel;
   rp.spp = static_cast<uint32_t>(settings_.spp);
   rp.pixel_count = film_.end();  // the bound of the film's pixels [first, end)
-  rp.frame = settings_.fixedNoise ? 0u : static_cast<uint32_t>(frame);  // RNG key only
+  rp.frame = settings_.fixedNoise ? 0u : rngFrameKey(frame);  // RNG key only
   rp.clamp = settings_.clamp;
   // With eye paths, strategy E's paths are the path tracer's.
   rp.mis_threshold = settings_.eyePaths ? 0.0f : settings_.misThreshold;
@@ -131,7 +131,7 @@ dev::ReuseParams PathReuse::frameParams(int frame) const {
   return rp;
 }
 
-void PathReuse::renderFrame(int frame, const dev::CameraParams& camera, FrameStats* stats) {
+void PathReuse::renderFrame(int64_t frame, const dev::CameraParams& camera, FrameStats* stats) {
   const Clock::time_point start = Clock::now();
   StageTimer timer;
   ctx_.zero(counters_, dev::PR_C_COUNT * 4);
@@ -227,9 +227,9 @@ void PathReuse::splatToCamera(const dev::CameraParams& camera, const dev::ReuseP
   if (!film_.adaptive()) film_.addSplats(splat_, timer, 1.0f, timeLimit_ <= 0.0);
 }
 
-int PathReuse::tracePasses(int frame, const dev::CameraParams& camera, const dev::ReuseParams& rp,
-                           const kargs::SceneArgs& sceneArgs, cl_uint frameStamp,
-                           Clock::time_point start, StageTimer* timer) {
+int PathReuse::tracePasses(int64_t frame, const dev::CameraParams& camera,
+                           const dev::ReuseParams& rp, const kargs::SceneArgs& sceneArgs,
+                           cl_uint frameStamp, Clock::time_point start, StageTimer* timer) {
   // 3. Per sample: first hits, then connections, then the film.
   // `sample` changes per pass.
   kargs::EyeHitArgs eh;

@@ -46,7 +46,7 @@ struct PathReuseSettings {
 class PathReuse : public Integrator {
  public:
   PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseSettings& settings);
-  void renderFrame(int frame, const dev::CameraParams& camera, FrameStats* stats) override;
+  void renderFrame(int64_t frame, const dev::CameraParams& camera, FrameStats* stats) override;
   uint64_t deviceBytes() const override { return bytes_; }
   void setPasses(int begin, int end) override {
     Integrator::setPasses(begin, end);
@@ -71,14 +71,14 @@ class PathReuse : public Integrator {
  private:
   // The slot offset of the light paths each pixel sample connects to, this frame.
   cl_uint historySlotOffset(const dev::ReuseParams& rp) const;
-  dev::ReuseParams frameParams(int frame) const;
+  dev::ReuseParams frameParams(int64_t frame) const;
   // Strategy T: the arena's vertices joined to the camera, into the film.
   void splatToCamera(const dev::CameraParams& camera, const dev::ReuseParams& rp,
                      const kargs::SceneArgs& sceneArgs, StageTimer* timer);
   // The frame's sample passes: first hits (or the eye paths), connections, the film; no pass
   // after the one during which the time limit (from `start`) ran out. Returns the passes
   // rendered, -1 when interrupted.
-  int tracePasses(int frame, const dev::CameraParams& camera, const dev::ReuseParams& rp,
+  int tracePasses(int64_t frame, const dev::CameraParams& camera, const dev::ReuseParams& rp,
                   const kargs::SceneArgs& sceneArgs, cl_uint frameStamp, Clock::time_point start,
                   StageTimer* timer);
   // Reads the counters and adds them and the stage times to stats.

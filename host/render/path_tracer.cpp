@@ -137,12 +137,12 @@ dev::ResampleParams PathTracer::resampleParams() const {
   return p;
 }
 
-void PathTracer::beginFrame(int frame, const dev::CameraParams& camera,
+void PathTracer::beginFrame(int64_t frame, const dev::CameraParams& camera,
                             const kargs::SceneArgs& sceneArgs, const cl::Buffer& radiance,
                             const cl::Buffer& eye) {
   // The film's pixels [first, n) only; buffers are indexed by pixel over the whole image.
   const cl_uint n = film_.end();
-  const cl_uint rngFrame = settings_.fixedNoise ? 0 : cl_uint(frame);
+  const cl_uint rngFrame = settings_.fixedNoise ? 0 : rngFrameKey(frame);
   syncChains();
   ctx_.zero(rays_, dev::PR_PT_COUNT * 4);
   dev::ResampleParams rsp = resampleParams();
@@ -325,7 +325,8 @@ std::string PathTracer::writeHistory(const std::string& key) {
   return out;
 }
 
-bool PathTracer::checkHistory(const std::string& data, const std::string& key, int frame) const {
+bool PathTracer::checkHistory(const std::string& data, const std::string& key,
+                              int64_t frame) const {
   if (chainedPasses() == 0) return false;
   HistoryLayout want;
   want.key = Hash128().add(key).low();
@@ -363,7 +364,7 @@ void PathTracer::reportRays(FrameStats* stats) {
 #undef PR_PT_REPORT
 }
 
-void PathTracer::renderFrame(int frame, const dev::CameraParams& camera, FrameStats* stats) {
+void PathTracer::renderFrame(int64_t frame, const dev::CameraParams& camera, FrameStats* stats) {
   const Clock::time_point start = Clock::now();
   StageTimer timer;
   beginFrame(frame, camera, scene_.kernelArgs(), radiance_, noEye_);

@@ -41,14 +41,14 @@ float lightTracingScale(const dev::CameraParams& camera, uint32_t lightPaths, in
 class PathTracer : public Integrator {
  public:
   PathTracer(Context& ctx, GpuScene& scene, Film& film, const PathTracerSettings& settings);
-  void renderFrame(int frame, const dev::CameraParams& camera, FrameStats* stats) override;
+  void renderFrame(int64_t frame, const dev::CameraParams& camera, FrameStats* stats) override;
   uint64_t deviceBytes() const override { return bytes_; }
 
   // One frame's kernel arguments, with the samples' radiance written to `radiance` (one float4
   // per pixel) and, with lightPaths > 0, each sample's first non-delta vertex to `eye` (one
   // EyeVertex per pixel); then one pass per sample index, which leaves both for the caller.
   // sceneArgs: the scene's arguments for this frame (GpuScene::kernelArgs).
-  void beginFrame(int frame, const dev::CameraParams& camera, const kargs::SceneArgs& sceneArgs,
+  void beginFrame(int64_t frame, const dev::CameraParams& camera, const kargs::SceneArgs& sceneArgs,
                   const cl::Buffer& radiance, const cl::Buffer& eye);
   // masked: Film::beginPass's answer for the pass.
   void tracePass(int sample, cl_uint masked, StageTimer* timer);
@@ -71,7 +71,7 @@ class PathTracer : public Integrator {
   // (the records name its lights) and again before the next frame.
   bool hasHistory() const { return chainedPasses() > 0 && written_ >= chainedPasses(); }
   std::string writeHistory(const std::string& key);
-  bool checkHistory(const std::string& data, const std::string& key, int frame) const;
+  bool checkHistory(const std::string& data, const std::string& key, int64_t frame) const;
   void applyHistory(const std::string& data);
 
   // Several devices: each holds the chains of its own passes alone, and a pass moving to another
@@ -125,7 +125,7 @@ class PathTracer : public Integrator {
   int chains_ = 0;
   uint64_t chainBytes_ = 0;     // one chain: a record per pixel of the image
   int written_ = 0;             // passes of the frame since beginFrame whose chain is written
-  int frame_ = -2;              // the frame of the last beginFrame
+  int64_t frame_ = -2;          // the frame of the last beginFrame
   dev::CameraParams camera_{};  // and its camera
   bool temporal_ = false;       // this frame resamples with the previous frame's history
   // Counts beginFrame calls: the history's stamp (zeroed records' 0 never precedes one).

@@ -129,7 +129,7 @@ class InputFiles {
                          "a file this render reads (an output never replaces an input)");
   }
   // Every file frame f writes.
-  void refuseFrame(const RenderOptions& o, int f, bool history) const {
+  void refuseFrame(const RenderOptions& o, int64_t f, bool history) const {
     const std::string exr = formatOutPath(o.outPattern, f);
     refuse(exr, "--out");
     if (o.png) refuse(withExtension(exr, ".png"), "--out");
@@ -140,7 +140,7 @@ class InputFiles {
   std::vector<std::string> files_;
 };
 
-std::string frameSpan(int a, int b) {
+std::string frameSpan(int64_t a, int64_t b) {
   return a == b ? std::to_string(a) : std::to_string(a) + "-" + std::to_string(b);
 }
 
@@ -188,7 +188,7 @@ void printStart(const RenderOptions& o, MultiDeviceSession& session, const Frame
 }
 
 // The stats file's line for one frame.
-std::string statsLine(int f, const RenderOptions& o, const FrameStats& fs,
+std::string statsLine(int64_t f, const RenderOptions& o, const FrameStats& fs,
                       const std::vector<DeviceFrame>& parts) {
   nlohmann::ordered_json j;
   j["frame"] = f;
@@ -236,20 +236,21 @@ struct Tally {
   int rendered = 0, skipped = 0, badFrames = 0;
 };
 
-void printProgress(const FrameRange& range, const Tally& t, int f) {
-  const int total = range.last - range.first + 1;
-  const int done = f - range.first + 1;
+void printProgress(const FrameRange& range, const Tally& t, int64_t f) {
+  const int64_t total = range.last - range.first + 1;
+  const int64_t done = f - range.first + 1;
   const double elapsed =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t.start).count();
-  const double eta = t.rendered > 0 ? elapsed / t.rendered * (total - done) : 0.0;
-  std::fprintf(stderr, "\rframe %d of %d (#%d)  %.2f Mrays/s  elapsed %s  ETA %s   ", done, total,
-               f, elapsed > 0 ? t.raysSoFar / elapsed * 1e-6 : 0.0, clock(elapsed).c_str(),
-               clock(eta).c_str());
+  const double eta = t.rendered > 0 ? elapsed / t.rendered * double(total - done) : 0.0;
+  std::fprintf(stderr, "\rframe %lld of %lld (#%lld)  %.2f Mrays/s  elapsed %s  ETA %s   ",
+               static_cast<long long>(done), static_cast<long long>(total),
+               static_cast<long long>(f), elapsed > 0 ? t.raysSoFar / elapsed * 1e-6 : 0.0,
+               clock(elapsed).c_str(), clock(eta).c_str());
   std::fflush(stderr);
 }
 
 // Frames before f are complete (rendered now or found complete); f onwards are not.
-int reportInterrupt(const RenderOptions& o, const FrameRange& range, int f) {
+int reportInterrupt(const RenderOptions& o, const FrameRange& range, int64_t f) {
   const int sig = interruptSignal();
   std::cerr << "interrupted by "
             << (sig == SIGTERM  ? "SIGTERM"
@@ -264,7 +265,7 @@ int reportInterrupt(const RenderOptions& o, const FrameRange& range, int f) {
 }
 
 void printSummary(const RenderOptions& o, const FrameRange& range, const Tally& t) {
-  const int total = range.last - range.first + 1;
+  const int64_t total = range.last - range.first + 1;
   std::cerr << "rendered " << t.rendered << " frame(s) to "
             << formatOutPath(o.outPattern, range.first)
             << (total > 1 ? " ... " + formatOutPath(o.outPattern, range.last) : "");
@@ -278,7 +279,7 @@ void printSummary(const RenderOptions& o, const FrameRange& range, const Tally& 
 // --resume with --resample: the resampled paths' history of frame f, kept beside its EXR so that a
 // resumed run (or the next chunk of frames, where it starts after this one ended) goes on as one
 // uninterrupted run. With several devices each keeps the chains of its own sample passes.
-std::string historyPath(const RenderOptions& o, int f) {
+std::string historyPath(const RenderOptions& o, int64_t f) {
   return formatOutPath(o.outPattern, f) + ".history";
 }
 
@@ -309,7 +310,7 @@ std::string historyKey(const RenderOptions& o, MultiDeviceSession& session) {
 // Before a frame f > 0 whose previous frame this run did not render: whether the history frame
 // f - 1 left was read.
 bool readHistory(const RenderOptions& o, MultiDeviceSession& session, const std::string& key,
-                 int f) {
+                 int64_t f) {
   std::string data;
   const bool read =
       readFile(historyPath(o, f - 1), &data) && unpackHistories(data, session, key, f - 1);
@@ -320,8 +321,8 @@ bool readHistory(const RenderOptions& o, MultiDeviceSession& session, const std:
 
 // The same frame f without that history: frames f - --warm-up .. f - 1 rendered and not written,
 // or the history starts afresh (both said when `say`).
-void warmUp(const RenderOptions& o, MultiDeviceSession& session, int f, bool say) {
-  const int first = std::max(0, f - o.warmUp);
+void warmUp(const RenderOptions& o, MultiDeviceSession& session, int64_t f, bool say) {
+  const int64_t first = std::max<int64_t>(0, f - o.warmUp);
   if (say && !o.quiet) {
     if (first < f)
       std::cerr << "note: --warm-up: frames " << first << "-" << f - 1
@@ -331,7 +332,7 @@ void warmUp(const RenderOptions& o, MultiDeviceSession& session, int f, bool say
       std::cerr << "note: --resume: the resampled paths' history starts afresh at frame " << f
                 << " (frames from here differ from an uninterrupted run's, unbiased)\n";
   }
-  for (int w = first; w < f && !interrupted(); ++w) {
+  for (int64_t w = first; w < f && !interrupted(); ++w) {
     FrameStats fs;
     std::vector<DeviceFrame> parts;
     session.renderFrame(w, &fs, &parts);
@@ -340,7 +341,7 @@ void warmUp(const RenderOptions& o, MultiDeviceSession& session, int f, bool say
 
 // After frame f is written: its history replaces the previous frame's.
 void writeHistory(const RenderOptions& o, MultiDeviceSession& session, const std::string& key,
-                  int f) {
+                  int64_t f) {
   writeFileAtomic(historyPath(o, f), packHistories(session, key));
   std::error_code ec;
   std::filesystem::remove(historyPath(o, f - 1), ec);
@@ -400,12 +401,12 @@ int renderFrames(const RenderOptions& o, MultiDeviceSession& session, const Fram
                  StatsFile* stats, const InputFiles& inputs) {
   const bool progress = !o.quiet && isatty(STDERR_FILENO);
   Tally t;
-  int f = range.first;
+  int64_t f = range.first;
   const bool history = keepsHistory(o);
   const ResampleSettings rs = resolveResample(o);
   const bool resampled = rs.enabled && rs.history > 0;
   const std::string key = history ? historyKey(o, session) : std::string();
-  int lastRendered = -2;
+  int64_t lastRendered = -2;
   removeStaleFiles(o, session.session(0).frameCount());
   endLoadingPhase();  // a signal from here on finishes cleanly between launches
   for (; f <= range.last && !interrupted(); ++f) {
@@ -475,7 +476,7 @@ std::string packHistories(MultiDeviceSession& session, const std::string& key) {
 }
 
 bool unpackHistories(const std::string& data, MultiDeviceSession& session, const std::string& key,
-                     int frame) {
+                     int64_t frame) {
   std::vector<int> split;
   std::vector<std::string> parts;
   if (!unpackHistoryFile(data, session.deviceCount(), &split, &parts)) return false;
@@ -508,7 +509,7 @@ int runRender(const RenderOptions& o) {
   const Scene scene = loadScene(o.scene, loadOptions);
   noteUnlitScene(scene, o);
   const InputFiles inputs(scene, o);
-  const int first = o.framesGiven ? o.frames.first : 0;
+  const int64_t first = o.framesGiven ? o.frames.first : 0;
   inputs.refuseFrame(o, first, keepsHistory(o));
   if (!o.statsFile.empty()) inputs.refuse(o.statsFile, "--stats");
   // Unwritable output is found before the kernels are built, not after the first frame.

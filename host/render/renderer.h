@@ -17,6 +17,6 @@ class MultiDeviceSession;
 // key, frame, size or device count, or damaged).
 std::string packHistories(MultiDeviceSession& session, const std::string& key);
 bool unpackHistories(const std::string& data, MultiDeviceSession& session, const std::string& key,
-                     int frame);
+                     int64_t frame);
 
 }  // namespace pr

@@ -200,7 +200,7 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
 
 RenderSession::~RenderSession() = default;
 
-std::pair<double, double> RenderSession::renderAovs(int frame, Image* image) {
+std::pair<double, double> RenderSession::renderAovs(int64_t frame, Image* image) {
   return aov_->render(frame, options_.fps, camera_, image);
 }
 
@@ -216,7 +216,7 @@ std::string RenderSession::writeHistory(const std::string& key) {
   return pathTracer_->writeHistory(key);
 }
 
-bool RenderSession::checkHistory(const std::string& data, const std::string& key, int frame) {
+bool RenderSession::checkHistory(const std::string& data, const std::string& key, int64_t frame) {
   if (!pathTracer_) return false;
   // What moved between that frame and the next is measured from that frame's scene, whose light
   // table the records are checked against.
@@ -247,13 +247,13 @@ FrameRange RenderSession::frameRange() const {
   return range;
 }
 
-Image RenderSession::renderFrame(int frame, FrameStats* stats) {
+Image RenderSession::renderFrame(int64_t frame, FrameStats* stats) {
   Image img(width_, height_);
   renderRows(frame, &img, stats);
   return img;
 }
 
-void RenderSession::renderRows(int frame, Image* image, FrameStats* stats) {
+void RenderSession::renderRows(int64_t frame, Image* image, FrameStats* stats) {
   FrameStats local;
   FrameStats* fs = stats ? stats : &local;
   render(frame, fs);
@@ -261,7 +261,7 @@ void RenderSession::renderRows(int frame, Image* image, FrameStats* stats) {
   fs->deviceBytes = ctx_.bytesInUse();
 }
 
-std::vector<float> RenderSession::renderSums(int frame, FrameStats* stats) {
+std::vector<float> RenderSession::renderSums(int64_t frame, FrameStats* stats) {
   FrameStats local;
   FrameStats* fs = stats ? stats : &local;
   render(frame, fs);
@@ -288,7 +288,7 @@ void RenderSession::takeCounts(const std::vector<float>& sums, FrameStats* fs) {
   fs->sppMax = int(most);
 }
 
-void RenderSession::render(int frame, FrameStats* fs) {
+void RenderSession::render(int64_t frame, FrameStats* fs) {
   const double time = frame / options_.fps;
   const auto t0 = std::chrono::steady_clock::now();
   gpu_->setTime(time);

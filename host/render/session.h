@@ -42,14 +42,14 @@ class RenderSession {
 
   // Renders frame f (time f / fps). Frames must come in increasing order for reuse to apply;
   // any order gives correct images.
-  Image renderFrame(int frame, FrameStats* stats);
+  Image renderFrame(int64_t frame, FrameStats* stats);
   // The same, writing only the rows setRows() chose into `image` (of the session's size).
-  void renderRows(int frame, Image* image, FrameStats* stats);
+  void renderRows(int64_t frame, Image* image, FrameStats* stats);
   // --aov, --denoise: whether the session makes auxiliary images, and adding frame f's to
   // `image` (the whole image, after the frame's colour), denoising it where asked
   // (render/aov.h). Returns the seconds of each.
   bool hasAovs() const { return aov_ != nullptr; }
-  std::pair<double, double> renderAovs(int frame, Image* image);
+  std::pair<double, double> renderAovs(int64_t frame, Image* image);
   // --aov samples: whether it was asked for, and each pixel's samples in the last frame from
   // this session's film (0 outside its rows; several devices' counts add up).
   bool samplesAov() const { return samplesAov_; }
@@ -60,7 +60,7 @@ class RenderSession {
   // Sample passes [begin, end) of each frame are rendered (default: all; render/integrator.h),
   // and renderSums gives the film's sums (Film::readSums) for another device's to be added.
   void setPasses(int begin, int end) { integrator_->setPasses(begin, end); }
-  std::vector<float> renderSums(int frame, FrameStats* stats);
+  std::vector<float> renderSums(int64_t frame, FrameStats* stats);
 
   // --resample's history between frames (render/path_tracer.h): whether the last frame left
   // one, its bytes, and checking then loading the one frame `frame` wrote (checking sets the
@@ -69,7 +69,7 @@ class RenderSession {
   std::string environmentDigest() const;
   bool hasHistory() const;
   std::string writeHistory(const std::string& key);
-  bool checkHistory(const std::string& data, const std::string& key, int frame);
+  bool checkHistory(const std::string& data, const std::string& key, int64_t frame);
   void applyHistory(const std::string& data);
   // The records of pass `pass`'s chain of that history, and writing them on the device the
   // pass moved to (render/multi_device.h); pass < the passes chained, this device's.
@@ -87,7 +87,7 @@ class RenderSession {
 
  private:
   // Frame f into the film (its stats into *fs).
-  void render(int frame, FrameStats* fs);
+  void render(int64_t frame, FrameStats* fs);
   // From the film's sums just read: the samples channel (--aov samples) and, under
   // --noise-threshold, the stats' mean and maximum samples per pixel.
   void takeCounts(const std::vector<float>& sums, FrameStats* fs);

@@ -37,7 +37,7 @@ std::string renderFrames(const std::string& scene, const std::string& frames,
   return dir;
 }
 
-Image frameImage(const std::string& dir, int frame) {
+Image frameImage(const std::string& dir, int64_t frame) {
   char name[32];
   std::snprintf(name, sizeof name, "/f_%04d.exr", frame);
   return readExr(dir + name);

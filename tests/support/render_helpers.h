@@ -22,7 +22,7 @@ std::string renderFrames(const std::string& scene, const std::string& frames,
                          const std::string& args, const std::string& tag);
 
 // The float EXR of frame f in a folder made by renderFrames.
-Image frameImage(const std::string& dir, int frame);
+Image frameImage(const std::string& dir, int64_t frame);
 
 // The JSON lines of dir/stats.jsonl.
 std::vector<std::string> statsLines(const std::string& dir);

@@ -5,8 +5,9 @@
 // range, checked here again by what the kernels compute of it (finite, non-negative).
 // The first byte picks the target: 0 the cache file, 1 and 2 the history file for one and two
 // devices, 3 and 4 the same with each part's checksum made right first, so that the records'
-// checks are reached rather than the checksum's. Built by -DPATHREUSE_FUZZ=ON (clang); run by
-// tools/fuzz/fuzz.sh formats. FORMAT_FUZZER_SEEDS=DIR writes valid seeds there at start.
+// checks are reached rather than the checksum's; 5 the cache file with its MAC made right first.
+// Built by -DPATHREUSE_FUZZ=ON (clang); run by tools/fuzz/fuzz.sh (formats, cache or history).
+// FORMAT_FUZZER_SEEDS=DIR writes valid seeds there at start.
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -25,6 +26,7 @@ namespace {
 using namespace pr;
 
 const std::string kKey = "0123456789abcdef0123456789abcdef";
+const std::string kSecret(kCacheSecretBytes, 's');
 constexpr uint32_t kRows = 3, kChains = 2;
 
 HistoryLayout layout() {
@@ -114,11 +116,35 @@ void writeSeed(const std::string& dir, const std::string& name, char mode, const
   std::ofstream(dir + "/" + name, std::ios::binary) << mode << s;
 }
 
+// Mode 5: a cache file whose MAC is made right first, so the reader's checks past the MAC run.
+void checkCacheWithMac(std::string bytes) {
+  constexpr size_t kHeader = 8 + kCacheKeyChars + 8, kMac = 32;
+  if (bytes.size() < kHeader + kMac) return;
+  const std::string key = bytes.substr(8, kCacheKeyChars), binary = bytes.substr(kHeader + kMac);
+  bytes.replace(kHeader, kMac, cacheFileMac(kSecret, key, binary));
+  const std::string got = unpackCacheFile(bytes, key, kSecret);
+  uint64_t size = 0;
+  std::memcpy(&size, bytes.data() + 8 + kCacheKeyChars, sizeof size);
+  const bool whole =
+      bytes.compare(0, 8, cacheFormatTag()) == 0 && size == binary.size() && !binary.empty();
+  if (got != (whole ? binary : std::string())) std::abort();
+}
+
+// FORMAT_FUZZER_ONLY=cache or history keeps to one format's modes.
+int pickMode(uint8_t byte) {
+  static const char* env = std::getenv("FORMAT_FUZZER_ONLY");
+  static const std::string only = env ? env : "";
+  if (only == "cache") return byte % 2 ? 5 : 0;
+  if (only == "history") return 1 + (byte + 3) % 4;  // the seeds' bytes 1-4 keep their modes
+  return byte % 6;
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
   if (const char* dir = std::getenv("FORMAT_FUZZER_SEEDS"); dir && *dir) {
-    writeSeed(dir, "cache", 0, packCacheFile(kKey, std::string(300, 'b')));
+    writeSeed(dir, "cache", 0, packCacheFile(kKey, std::string(300, 'b'), kSecret));
+    writeSeed(dir, "cache-mac", 5, packCacheFile(kKey, std::string(300, 'b'), kSecret));
     const std::string part = seedPart();
     writeSeed(dir, "history-1", 1, packHistoryFile({2}, {part}));
     writeSeed(dir, "history-2", 2, packHistoryFile({1, 1}, {part, part}));
@@ -131,10 +157,10 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size < 1) return 0;
   const std::string bytes(reinterpret_cast<const char*>(data) + 1, size - 1);
-  switch (data[0] % 5) {
+  switch (pickMode(data[0])) {
     case 0: {
-      const std::string binary = unpackCacheFile(bytes, kKey);
-      if (!binary.empty() && packCacheFile(kKey, binary) != bytes) std::abort();
+      const std::string binary = unpackCacheFile(bytes, kKey, kSecret);
+      if (!binary.empty() && packCacheFile(kKey, binary, kSecret) != bytes) std::abort();
       break;
     }
     case 1:
@@ -146,8 +172,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     case 3:
       checkHistory(bytes, 1, true);
       break;
-    default:
+    case 4:
       checkHistory(bytes, 2, true);
+      break;
+    default:
+      checkCacheWithMac(bytes);
       break;
   }
   return 0;

@@ -2,8 +2,8 @@
 # Fuzzes the glTF loader with libFuzzer for SECONDS (default 600): builds build-fuzz/ with clang
 # (ASan + UBSan), gathers a seed corpus, and runs until the time is up or a finding. With
 # `formats`, fuzzes the files pathreuse derives and reads back instead: the kernel cache's and
-# the resume history's formats (tools/fuzz/format_fuzzer.cpp).
-#   bash tools/fuzz/fuzz.sh [SECONDS] [gltf|formats]
+# the resume history's formats (tools/fuzz/format_fuzzer.cpp); `cache` or `history`, one of them.
+#   bash tools/fuzz/fuzz.sh [SECONDS] [gltf|formats|cache|history]
 # Needs clang with libFuzzer (Debian 12: apt-get install clang libclang-rt-14-dev); not in
 # tools/setup/install-deps.sh, which installs what the build and the tests need, and nothing more.
 # The corpus grows in out/fuzz-corpus/ across runs; findings land in out/fuzz-findings/
@@ -20,17 +20,18 @@ fi
 
 CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPATHREUSE_FUZZ=ON \
   -DPATHREUSE_TESTS=OFF -DPATHREUSE_TOOLS=OFF >/dev/null
-if [ "$target" = formats ]; then
+if [ "$target" = formats ] || [ "$target" = cache ] || [ "$target" = history ]; then
   cmake --build build-fuzz --target format_fuzzer -j"$jobs"
-  seeds=out/fuzz-format-seeds corpus=out/fuzz-format-corpus findings=out/fuzz-format-findings
+  seeds=out/fuzz-format-seeds corpus=out/fuzz-$target-corpus findings=out/fuzz-format-findings
   mkdir -p "$seeds" "$corpus" "$findings"
-  FORMAT_FUZZER_SEEDS="$seeds" ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1}" \
+  only=$([ "$target" = formats ] || echo "$target")
+  FORMAT_FUZZER_ONLY="$only" FORMAT_FUZZER_SEEDS="$seeds" ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1}" \
     UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1}" \
     build-fuzz/format_fuzzer "$corpus" "$seeds" -max_total_time="$seconds" -max_len=16384 \
     -rss_limit_mb=2048 -timeout=10 -artifact_prefix="$findings/" -print_final_stats=1
   exit
 fi
-[ "$target" = gltf ] || { echo "fuzz.sh: no target '$target' (gltf, formats)" >&2; exit 2; }
+[ "$target" = gltf ] || { echo "fuzz.sh: no target '$target' (gltf, formats, cache, history)" >&2; exit 2; }
 cmake --build build-fuzz --target gltf_fuzzer -j"$jobs"
 
 # Seeds: our scenes, the shared real and broken files, Debian's assimp glTF models, each up to

@@ -13,7 +13,7 @@ packages=(
   build-essential cmake pkg-config git
   ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers pocl-opencl-icd
   libglm-dev libtinygltf-dev nlohmann-json3-dev libstb-dev
-  libopenexr-dev libcli11-dev libgtest-dev zlib1g-dev
+  libopenexr-dev libcli11-dev libgtest-dev zlib1g-dev libssl-dev
   assimp-testmodels python3
   python3-matplotlib python3-numpy
   python3-venv oclgrind clang-format clang ccache
