@@ -1,6 +1,6 @@
 // The baseline path tracer against known answers: a white furnace, a diffuse plane under a point
 // light, determinism by seed, and frames free of NaN and Inf; flat facets where a primitive has
-// no normals (in both modes).
+// no normals, and the camera's clipping planes (in both modes).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -195,6 +195,55 @@ TEST(FlatShading, PrimitivesWithoutNormals) {
       EXPECT_NEAR(lo, expected, 0.01 * expected);
       EXPECT_NEAR(hi, expected, 0.01 * expected);
     }
+}
+
+// A black metal wall at depth 5 that emits 1, seen past a white quad at depth 0.5 lit by a point
+// light behind the camera; camera clipping planes znear and zfar (glTF's).
+std::string clippedScene(float znear, float zfar, const std::string& tag) {
+  test::GltfBuilder b;
+  test::MaterialSpec wall;
+  wall.baseColor = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
+  wall.metallic = 1.0f;  // a black metal reflects nothing
+  wall.emissive = glm::vec3(1.0f);
+  const int w = b.addMaterial(wall);
+  b.addNode(b.addQuad({-4, -4, 0}, {4, -4, 0}, {4, 4, 0}, {-4, 4, 0}, w));
+  test::MaterialSpec white;
+  white.baseColor = glm::vec4(0.8f, 0.8f, 0.8f, 1.0f);
+  const int m = b.addMaterial(white);
+  // The left half of the view.
+  b.addNode(b.addQuad({-3, -3, 4.5f}, {0, -3, 4.5f}, {0, 3, 4.5f}, {-3, 3, 4.5f}, m));
+  // Behind the camera, a white wall that the light lights: light paths reach the quad's front by
+  // it, so that light tracing could splat the quad.
+  b.addNode(b.addQuad({-4, -4, 7}, {-4, 4, 7}, {4, 4, 7}, {4, -4, 7}, m));
+  // Most light paths start here (by power), not on the wall.
+  b.addPointLight({0, 0, 6}, {1, 1, 1}, 200.0f);
+  b.addCamera({0, 0, 5}, {0, 0, 0}, 0.6f, 1.0f, znear, zfar);
+  return b.write(test::tempDir(tag), "clipped");
+}
+
+// glTF's znear and zfar clip what the camera sees, in every mode and every strategy: nearer than
+// znear the quad is not seen (light tracing splats none of its light either), so every pixel sees
+// the wall's emission alone; past zfar the wall is not seen. Lights still light what is clipped.
+TEST(Camera, ClippingPlanesHideWhatIsNearerOrFarther) {
+  for (const char* mode : {"pathtrace", "reuse"}) {
+    SCOPED_TRACE(mode);
+    const std::string args =
+        std::string("--width 24 --height 24 --spp 4 --light-paths 16384 --env none --mode ") + mode;
+    const Image seen = test::frameImage(
+        test::renderFrames(clippedScene(0.1f, 0.0f, "clip-seen"), "0", args, "clip-seen"), 0);
+    const Image near = test::frameImage(
+        test::renderFrames(clippedScene(1.0f, 0.0f, "clip-near"), "0", args, "clip-near"), 0);
+    const Image far = test::frameImage(
+        test::renderFrames(clippedScene(1.0f, 3.0f, "clip-far"), "0", args, "clip-far"), 0);
+    // The quad is seen where nothing clips it: its left half differs from the wall's 1.
+    EXPECT_GT(std::fabs(regionMean(seen, 2, 2, 10, 22, 1).mean - 1.0), 0.05);
+    for (int y = 0; y < 24; ++y)
+      for (int x = 0; x < 24; ++x)
+        for (int c = 0; c < 3; ++c) {
+          ASSERT_NEAR(near.pixel(x, y)[c], 1.0f, 1e-4f) << x << "," << y;
+          ASSERT_EQ(far.pixel(x, y)[c], 0.0f) << x << "," << y;
+        }
+  }
 }
 
 uint64_t badSamplesIn(const std::string& statsFile, int* lines) {

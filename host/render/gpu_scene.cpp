@@ -11,6 +11,7 @@
 
 #include "cl/kernel_args.h"
 #include "render/device_materials.h"
+#include "scene/emission_power.h"
 #include "render/kernel_programs.h"
 #include "render/light_table.h"
 #include "util/error.h"
@@ -34,6 +35,8 @@ dev::CameraParams toCameraParams(const CameraPose& pose, int width, int height) 
   c.rx = r.x, c.ry = r.y, c.rz = r.z;
   c.ux = u.x, c.uy = u.y, c.uz = u.z;
   c.tan_half_fov = std::tan(0.5f * pose.yfov);
+  c.znear = pose.znear;
+  c.zfar = pose.zfar;
   c.aspect = float(width) / float(height);
   c.width = static_cast<uint32_t>(width);
   c.height = static_cast<uint32_t>(height);
@@ -74,6 +77,7 @@ GpuScene::GpuScene(Context& ctx, const Scene& scene, const GpuSceneOptions& opti
   // Static emitters, once; the light of each emissive triangle, for the pdf of a BSDF ray
   // that hits it.
   primLight_.assign(next, PR_INVALID_INDEX);
+  const EmissionShares shares(scene);
   for (size_t i = 0; i < sm.triangleCount(); ++i) {
     const uint32_t mat = sm.materials[i];
     const glm::vec3 le = scene.materials[mat].emission();
@@ -81,27 +85,32 @@ GpuScene::GpuScene(Context& ctx, const Scene& scene, const GpuSceneOptions& opti
     const glm::vec3 a = sm.positions[sm.indices[3 * i]], b = sm.positions[sm.indices[3 * i + 1]],
                     c = sm.positions[sm.indices[3 * i + 2]];
     dev::Light l = triangleLight(a, b, c, le, static_cast<uint32_t>(i), PR_INVALID_INDEX, mat);
+    l.power *= shares.share(sm, i);  // 0: its texels are black, no light
     if (l.area > 0.0f && std::isfinite(l.power) && l.power > 0.0f) {
       primLight_[i] = static_cast<uint32_t>(staticEmitters_.size());
       staticEmitters_.push_back(l);
     }
   }
+  // A dynamic mesh's emitters, with their shares: the same for each of its instances.
+  std::vector<std::vector<std::pair<uint32_t, float>>> meshEmitters(scene.dynamicMeshes.size());
   for (size_t mi = 0; mi < scene.dynamicMeshes.size(); ++mi) {
     const TriangleMesh& m = scene.dynamicMeshes[mi];
-    uint32_t rank = 0;
-    for (uint32_t k = 0; k < m.triangleCount(); ++k)
-      if (scene.materials[m.materials[k]].isEmissive())
-        primLight_[meshFirstTriangle_[mi] + k] = rank++;
+    for (uint32_t k = 0; k < m.triangleCount(); ++k) {
+      if (!scene.materials[m.materials[k]].isEmissive()) continue;
+      const float share = shares.share(m, k);
+      if (!(share > 0.0f)) continue;
+      primLight_[meshFirstTriangle_[mi] + k] = static_cast<uint32_t>(meshEmitters[mi].size());
+      meshEmitters[mi].push_back({k, share});
+    }
   }
   for (uint32_t i = 0; i < scene.instances.size(); ++i) {
     instanceFirstLight_.push_back(
         static_cast<uint32_t>(staticEmitters_.size() + dynamicEmitters_.size()));
-    const TriangleMesh& m = scene.dynamicMeshes[scene.instances[i].mesh];
-    for (uint32_t k = 0; k < m.triangleCount(); ++k)
-      if (scene.materials[m.materials[k]].isEmissive()) {
-        dynamicEmitters_.push_back({i, k, m.materials[k]});
-        lightsAnimated_ = true;
-      }
+    const uint32_t mesh = scene.instances[i].mesh;
+    for (const auto& [k, share] : meshEmitters[mesh]) {
+      dynamicEmitters_.push_back({i, k, scene.dynamicMeshes[mesh].materials[k], share});
+      lightsAnimated_ = true;
+    }
   }
   primLightBuffer_ = upload("light of each emissive triangle", primLight_.data(),
                             primLight_.size() * sizeof(uint32_t), &shadingBytes_);
@@ -356,6 +365,7 @@ std::vector<dev::Light> GpuScene::lightsAt(double t) const {
         w(m.indices[3 * e.triangle]), w(m.indices[3 * e.triangle + 1]),
         w(m.indices[3 * e.triangle + 2]), scene_.materials[e.material].emission(),
         meshFirstTriangle_[scene_.instances[e.instance].mesh] + e.triangle, e.instance, e.material);
+    l.power *= e.share;
     // A degenerate or non-finite placement keeps its slot in the table with no power.
     if (!(l.area > 0.0f) || !std::isfinite(l.power)) l.power = 0.0f, l.area = 0.0f;
     lights.push_back(l);

@@ -130,6 +130,7 @@ class GpuScene {
   // emissive triangles of each instance, then punctual lights.
   struct DynamicEmitter {
     uint32_t instance, triangle, material;
+    float share;  // of its power, from its emission texture (scene/emission_power.h)
   };
   std::vector<dev::Light> staticEmitters_;
   std::vector<DynamicEmitter> dynamicEmitters_;

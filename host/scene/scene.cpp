@@ -5,6 +5,8 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "scene/emission_power.h"
+
 namespace pr {
 
 Bounds Bounds::transformed(const glm::mat4& m) const {
@@ -265,20 +267,23 @@ size_t Scene::dynamicTriangleCount() const {
 }
 
 namespace {
-size_t emissiveCount(const TriangleMesh& m, const std::vector<Material>& materials) {
+// The triangles that emit: an emissive material, and texels that are not all black.
+size_t emissiveCount(const TriangleMesh& m, const Scene& scene) {
+  const EmissionShares shares(scene);
   size_t n = 0;
-  for (uint32_t mat : m.materials) n += materials[mat].isEmissive();
+  for (size_t k = 0; k < m.triangleCount(); ++k)
+    n += scene.materials[m.materials[k]].isEmissive() && shares.share(m, k) > 0.0f;
   return n;
 }
 }  // namespace
 
 size_t Scene::staticEmissiveTriangleCount() const {
-  return emissiveCount(staticMesh, materials);
+  return emissiveCount(staticMesh, *this);
 }
 
 size_t Scene::dynamicEmissiveTriangleCount() const {
   size_t n = 0;
-  for (const Instance& i : instances) n += emissiveCount(dynamicMeshes[i.mesh], materials);
+  for (const Instance& i : instances) n += emissiveCount(dynamicMeshes[i.mesh], *this);
   return n;
 }
 

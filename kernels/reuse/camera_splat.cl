@@ -70,7 +70,9 @@ PR_KERNEL void camera_splat(PR_PARAMS(PR_ARGS_CAMERA_SPLAT)) {
           camera_splat_value(&s, &rp, &cam, &y, &yp, v + k, r[k - 1u], k, dir) * film_scale;
       if (max3(val) > 0.0f) {
         ++rays;
-        const Ray ray = surface_ray(&s, &y.h, -dir, sqrt(d2) * (1.0f - 1e-4f));
+        // Towards the camera as far as its near plane: nothing nearer is seen.
+        const Ray ray = surface_ray(&s, &y.h, -dir,
+                                    sqrt(d2) * (1.0f - 1e-4f) - camera_near_distance(&cam, dir));
         if (!trace_occluded(&s, ray)) splat_add(splat + (size_t)px * PR_SPLAT_WORDS, val);
       }
     }

@@ -10,8 +10,8 @@ PR_NAMESPACE_BEGIN
 typedef struct {
   float px, py, pz, tan_half_fov;  // position; tan(yfov / 2)
   float fx, fy, fz, aspect;        // unit forward; width / height
-  float rx, ry, rz, pad0;          // unit right
-  float ux, uy, uz, pad1;          // unit up
+  float rx, ry, rz, znear;         // unit right; the near clipping plane's depth (> 0)
+  float ux, uy, uz, zfar;          // unit up; the far clipping plane's depth (0: none)
   u32 width, height, pad2, pad3;
 } CameraParams;
 
@@ -30,13 +30,27 @@ PR_INLINE float3 camera_position(const CameraParams* c) {
 
 // The camera ray of pixel `pixel` (row-major) through its point offset by `jitter` in [0, 1)^2:
 // the one generator of camera rays, for every mode.
+// Its segment lies between the clipping planes (glTF's znear and zfar): what is nearer or
+// farther is not seen.
 PR_INLINE Ray camera_ray(const CameraParams* c, u32 pixel, float2 jitter) {
   const u32 x = pixel % c->width, y = pixel / c->width;
   const float3 d = camera_direction(c, (float)x + jitter.x, (float)y + jitter.y);
+  const float cos_t = dot(d, make_float3(c->fx, c->fy, c->fz));
   Ray r;
-  r.ox = c->px, r.oy = c->py, r.oz = c->pz, r.tmin = 0.0f;
-  r.dx = d.x, r.dy = d.y, r.dz = d.z, r.tmax = PR_INF_F;
+  r.ox = c->px, r.oy = c->py, r.oz = c->pz, r.tmin = c->znear / cos_t;
+  r.dx = d.x, r.dy = d.y, r.dz = d.z, r.tmax = c->zfar > 0.0f ? c->zfar / cos_t : PR_INF_F;
   return r;
+}
+
+// Whether p's depth along the camera's axis lies between its clipping planes.
+PR_INLINE int camera_in_depth_range(const CameraParams* c, float3 p) {
+  const float z = dot(p - make_float3(c->px, c->py, c->pz), make_float3(c->fx, c->fy, c->fz));
+  return z >= c->znear && (!(c->zfar > 0.0f) || z <= c->zfar);
+}
+
+// The distance from the camera to its near plane along unit dir (dir in front of the camera).
+PR_INLINE float camera_near_distance(const CameraParams* c, float3 dir) {
+  return c->znear / dot(dir, make_float3(c->fx, c->fy, c->fz));
 }
 
 // The film point (in pixels, as camera_direction takes it) where camera c sees world point p;
@@ -52,10 +66,11 @@ PR_INLINE int camera_project(const CameraParams* c, float3 p, float2* s) {
   return 1;
 }
 
-// The pixel of camera c that sees world point p (PR_INVALID_INDEX: behind it or outside).
+// The pixel of camera c that sees world point p (PR_INVALID_INDEX: behind it, outside the
+// image or outside the clipping planes).
 PR_INLINE u32 camera_pixel(const CameraParams* c, float3 p) {
   float2 s;
-  if (!camera_project(c, p, &s)) return PR_INVALID_INDEX;
+  if (!camera_in_depth_range(c, p) || !camera_project(c, p, &s)) return PR_INVALID_INDEX;
   if (!(s.x >= 0.0f && s.y >= 0.0f && s.x < (float)c->width && s.y < (float)c->height))
     return PR_INVALID_INDEX;
   return (u32)s.y * c->width + (u32)s.x;

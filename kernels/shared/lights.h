@@ -392,7 +392,9 @@ PR_INLINE float light_triangle_power(const Light* l, float scene_radius) {
 // projected from the centroid, which is close to the solid angle there and costs a fraction of
 // it. Zero only behind the receiver's normal or in the triangle's plane.
 PR_INLINE float light_triangle_importance(PR_GLOBAL const Light* l, float3 p, float3 n) {
-  const float lum = luminance(make_float3(l->le_r, l->le_g, l->le_b));
+  // The mean radiance, its emission texture's included (the host's power: le x share x pi A).
+  if (!(l->area > 0.0f)) return 0.0f;
+  const float lum = l->power * PR_INV_PI / l->area;
   const int normal = has_normal(n);
   const float3 v0 = make_float3(l->p0x, l->p0y, l->p0z);
   const float3 e1 = make_float3(l->e1x, l->e1y, l->e1z), e2 = make_float3(l->e2x, l->e2y, l->e2z);

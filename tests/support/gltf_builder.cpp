@@ -168,9 +168,11 @@ int GltfBuilder::addNode(int mesh, glm::vec3 t, glm::quat r, glm::vec3 s) {
   return static_cast<int>(nodes_.size() - 1);
 }
 
-int GltfBuilder::addCamera(glm::vec3 eye, glm::vec3 target, float yfov, float aspect) {
-  json cam = {{"type", "perspective"}, {"perspective", {{"yfov", yfov}, {"znear", 0.01}}}};
+int GltfBuilder::addCamera(glm::vec3 eye, glm::vec3 target, float yfov, float aspect, float znear,
+                           float zfar) {
+  json cam = {{"type", "perspective"}, {"perspective", {{"yfov", yfov}, {"znear", znear}}}};
   if (aspect > 0.0f) cam["perspective"]["aspectRatio"] = aspect;
+  if (zfar > 0.0f) cam["perspective"]["zfar"] = zfar;
   cameras_.push_back(cam);
   // The camera looks down its local -Z: the inverse of a look-at view matrix places it.
   const glm::vec3 fwd = glm::normalize(target - eye);
@@ -187,6 +189,22 @@ int GltfBuilder::addPointLight(glm::vec3 position, glm::vec3 color, float intens
   lights_.push_back(
       {{"type", "point"}, {"color", {color.r, color.g, color.b}}, {"intensity", intensity}});
   nodes_.push_back({{"translation", {position.x, position.y, position.z}},
+                    {"extensions", {{"KHR_lights_punctual", {{"light", lights_.size() - 1}}}}}});
+  return static_cast<int>(nodes_.size() - 1);
+}
+
+int GltfBuilder::addSpotLight(glm::vec3 position, glm::vec3 target, glm::vec3 color,
+                              float intensity, float inner, float outer) {
+  lights_.push_back({{"type", "spot"},
+                     {"color", {color.r, color.g, color.b}},
+                     {"intensity", intensity},
+                     {"spot", {{"innerConeAngle", inner}, {"outerConeAngle", outer}}}});
+  // The light shines along its node's -Z, as a camera looks: placed as addCamera places one.
+  const glm::vec3 fwd = glm::normalize(target - position);
+  const glm::vec3 up = std::fabs(fwd.y) > 0.99f ? glm::vec3(0, 0, -1) : glm::vec3(0, 1, 0);
+  const glm::quat q = glm::quat_cast(glm::mat3(glm::inverse(glm::lookAt(position, target, up))));
+  nodes_.push_back({{"translation", {position.x, position.y, position.z}},
+                    {"rotation", {q.x, q.y, q.z, q.w}},
                     {"extensions", {{"KHR_lights_punctual", {{"light", lights_.size() - 1}}}}}});
   return static_cast<int>(nodes_.size() - 1);
 }

@@ -56,9 +56,13 @@ class GltfBuilder {
   int addQuad(glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, int material);
   int addNode(int mesh, glm::vec3 translation = glm::vec3(0.0f),
               glm::quat rotation = glm::quat(1, 0, 0, 0), glm::vec3 scale = glm::vec3(1.0f));
-  // A perspective camera at `eye` looking at `target`.
-  int addCamera(glm::vec3 eye, glm::vec3 target, float yfov, float aspect = 0.0f);
+  // A perspective camera at `eye` looking at `target`, with its clipping planes (zfar 0: none).
+  int addCamera(glm::vec3 eye, glm::vec3 target, float yfov, float aspect = 0.0f,
+                float znear = 0.01f, float zfar = 0.0f);
   int addPointLight(glm::vec3 position, glm::vec3 color, float intensity);
+  // A spot light at `position` aimed at `target`, its cone's half-angles inner and outer.
+  int addSpotLight(glm::vec3 position, glm::vec3 target, glm::vec3 color, float intensity,
+                   float inner, float outer);
   // A directional light shining along its node's -Z turned by `rotation`.
   int addDirectionalLight(glm::quat rotation, glm::vec3 color, float intensity);
   // A skin on mesh node `node` whose joints are these nodes (inverse bind matrices identity).
