@@ -236,8 +236,8 @@ TEST(LightTable, EveryTypeHasItsFlags) {
   } want[] = {
       {PR_LIGHT_TRIANGLE, PR_LIGHT_ON_TRIANGLE | PR_LIGHT_JOINS_VERTEX0 | PR_LIGHT_EYE_PATHS},
       {PR_LIGHT_POINT, PR_LIGHT_DELTA_POSITION | PR_LIGHT_JOINS_VERTEX0 | PR_LIGHT_EYE_PATHS},
-      {PR_LIGHT_SPOT, PR_LIGHT_DELTA_POSITION},
-      {PR_LIGHT_DIRECTIONAL, PR_LIGHT_DELTA_DIRECTION | PR_LIGHT_AT_INFINITY},
+      {PR_LIGHT_SPOT, PR_LIGHT_DELTA_POSITION | PR_LIGHT_JOINS_VERTEX0 | PR_LIGHT_EYE_PATHS},
+      {PR_LIGHT_DIRECTIONAL, PR_LIGHT_DELTA_DIRECTION | PR_LIGHT_AT_INFINITY | PR_LIGHT_EYE_PATHS},
       {PR_LIGHT_ENV, PR_LIGHT_AT_INFINITY},
   };
   for (const auto& w : want) EXPECT_EQ(dev::light_type_flags(w.type), w.flags) << w.type;
@@ -247,7 +247,10 @@ TEST(LightTable, EveryTypeHasItsFlags) {
     EXPECT_FALSE(dev::light_is_triangle(t) && dev::light_is_delta(t)) << t;
     EXPECT_FALSE(dev::light_is_triangle(t) && dev::light_at_infinity(t)) << t;
     EXPECT_FALSE(dev::light_joins_vertex0(t) && dev::light_at_infinity(t)) << t;
-    EXPECT_TRUE(!dev::light_in_eye_paths(t) || dev::light_joins_vertex0(t)) << t;
+    // The eye paths' first light density: the emission's pdf at vertex 0, or a disk's.
+    EXPECT_TRUE(!dev::light_in_eye_paths(t) || dev::light_joins_vertex0(t) ||
+                dev::light_at_infinity(t))
+        << t;
     const uint32_t f = dev::light_type_flags(t);
     EXPECT_FALSE((f & PR_LIGHT_DELTA_POSITION) && (f & PR_LIGHT_DELTA_DIRECTION)) << t;
   }

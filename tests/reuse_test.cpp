@@ -563,6 +563,101 @@ TEST(Reuse, LightTracingConvergesToThePathTracer) {
                   32, 2);
 }
 
+// A floor, a back wall and a glossy box under a spot light, their only light, whose cone (30
+// degrees, soft from 20) lights part of the floor and the wall: its light paths take part in
+// every strategy (L, T, and E where eye paths are off).
+std::string spotScene() {
+  static std::string path;
+  if (!path.empty()) return path;
+  test::GltfBuilder b;
+  const int white = b.addMaterial({glm::vec4(0.8f, 0.8f, 0.8f, 1), 0, 1});
+  const int glossy = b.addMaterial({glm::vec4(0.9f, 0.6f, 0.3f, 1), 0.5f, 0.3f});
+  b.addNode(b.addQuad({-3, 0, -3}, {-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, white));
+  b.addNode(b.addQuad({-3, 0, -3}, {3, 0, -3}, {3, 3, -3}, {-3, 3, -3}, white));
+  b.addNode(b.addBox(glm::vec3(-0.4f, 0.0f, -0.4f), glm::vec3(0.4f, 0.8f, 0.4f), glossy));
+  b.addSpotLight({1.5f, 2.5f, 1.0f}, {0.0f, 0.0f, -1.5f}, {1.0f, 0.9f, 0.8f}, 12.0f, 0.0f, 0.6f);
+  b.addCamera(glm::vec3(0.0f, 1.6f, 4.5f), glm::vec3(0.0f, 0.8f, 0.0f), 0.9f, 4.0f / 3.0f);
+  path = b.write(test::tempDir("spot"), "spot");
+  return path;
+}
+
+// The spot light's paths in every strategy: with eye paths (L and T against N and H) and
+// without (L and E, E joining vertex 0 on the spot, outside its cone no light), the images
+// converge to the path tracer's, and light tracing adds what it should.
+TEST(Reuse, SpotLightPathsConvergeToThePathTracer) {
+  // Its paths are stored, connected and splatted (a spot's took part in none before).
+  const auto stats = nlohmann::json::parse(test::statsLines(renderReuse(
+      spotScene(), "0", "--width 48 --height 36 --spp 2 --eye-paths --light-tracing --no-resample",
+      "spot-stats"))[0]);
+  EXPECT_GT(stats["rays"]["splat"].get<uint64_t>(), 100u) << stats.dump();
+  EXPECT_GT(stats["counters"]["connections_unoccluded"].get<uint64_t>(), 1000u) << stats.dump();
+  expectSameImage(spotScene(), "--max-depth 6 --eye-paths --light-tracing --no-resample", 48, 36,
+                  32, 2);
+  expectSameImage(spotScene(), "--max-depth 6 --no-eye-paths --no-resample", 48, 36, 32, 2);
+}
+
+// The same room under a low sun (a directional light): its light paths start on the disk that
+// covers the scene and take part in L and T.
+std::string sunScene() {
+  static std::string path;
+  if (!path.empty()) return path;
+  test::GltfBuilder b;
+  const int white = b.addMaterial({glm::vec4(0.8f, 0.8f, 0.8f, 1), 0, 1});
+  const int glossy = b.addMaterial({glm::vec4(0.9f, 0.6f, 0.3f, 1), 0.5f, 0.3f});
+  b.addNode(b.addQuad({-3, 0, -3}, {-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, white));
+  b.addNode(b.addQuad({-3, 0, -3}, {3, 0, -3}, {3, 3, -3}, {-3, 3, -3}, white));
+  b.addNode(b.addBox(glm::vec3(-0.4f, 0.0f, -0.4f), glm::vec3(0.4f, 0.8f, 0.4f), glossy));
+  // Shining down and towards the back wall, from the right.
+  const glm::quat q =
+      glm::angleAxis(-0.9f, glm::vec3(1, 0, 0)) * glm::angleAxis(0.5f, glm::vec3(0, 1, 0));
+  b.addDirectionalLight(q, {1.0f, 0.95f, 0.9f}, 2.0f);
+  b.addCamera(glm::vec3(0.0f, 1.6f, 4.5f), glm::vec3(0.0f, 0.8f, 0.0f), 0.9f, 4.0f / 3.0f);
+  path = b.write(test::tempDir("sun"), "sun");
+  return path;
+}
+
+TEST(Reuse, DirectionalLightPathsConvergeToThePathTracer) {
+  const auto stats = nlohmann::json::parse(test::statsLines(renderReuse(
+      sunScene(), "0", "--width 48 --height 36 --spp 2 --eye-paths --light-tracing --no-resample",
+      "sun-stats"))[0]);
+  EXPECT_GT(stats["rays"]["splat"].get<uint64_t>(), 100u) << stats.dump();
+  EXPECT_GT(stats["counters"]["connections_unoccluded"].get<uint64_t>(), 1000u) << stats.dump();
+  expectSameImage(sunScene(), "--max-depth 6 --eye-paths --light-tracing --no-resample", 48, 36, 32,
+                  2);
+  expectSameImage(sunScene(), "--max-depth 6 --eye-paths --light-tracing", 48, 36, 32, 2);
+}
+
+// A point light's caustic through a mirror onto the floor, which only the light paths make (the
+// eye path's BSDF sample never hits a point): with eye paths their L and T take the whole of it,
+// as the connections without eye paths do.
+TEST(Reuse, PointLightCausticThroughAMirrorIsWhole) {
+  test::GltfBuilder b;
+  const int white = b.addMaterial({glm::vec4(0.8f, 0.8f, 0.8f, 1), 0, 1});
+  const int mirror = b.addMaterial({glm::vec4(0.95f, 0.95f, 0.95f, 1), 1.0f, 0.0f});
+  b.addNode(b.addQuad({-3, 0, -3}, {-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, white));
+  // A mirror tilted towards the floor, the light above and in front of it.
+  b.addNode(b.addQuad({-1.5f, 0.5f, -2.0f}, {1.5f, 0.5f, -2.0f}, {1.5f, 2.5f, -1.2f},
+                      {-1.5f, 2.5f, -1.2f}, mirror));
+  b.addPointLight({0.0f, 1.2f, 0.5f}, {1, 1, 1}, 4.0f);
+  b.addCamera(glm::vec3(0.0f, 2.5f, 4.0f), glm::vec3(0.0f, 0.0f, -0.5f), 0.9f, 4.0f / 3.0f);
+  const std::string scene = b.write(test::tempDir("caustic"), "caustic");
+  const std::string args =
+      "--width 32 --height 24 --spp 16 --max-depth 4 --paths-per-pixel 2 "
+      "--light-paths 24576 --no-resample";
+  const Image eye = test::frameImage(
+      renderReuse(scene, "0", args + " --eye-paths --light-tracing --seed 5", "caustic-eye"), 0);
+  const Image conn =
+      test::frameImage(renderReuse(scene, "0", args + " --seed 8", "caustic-conn"), 0);
+  for (int ry = 0; ry < 2; ++ry)
+    for (int rx = 0; rx < 2; ++rx) {
+      const Moments a = regionMean(eye, 16 * rx, 12 * ry, 16 * rx + 16, 12 * ry + 12, 1);
+      const Moments c = regionMean(conn, 16 * rx, 12 * ry, 16 * rx + 16, 12 * ry + 12, 1);
+      EXPECT_GT(c.mean, 1e-3) << "region " << rx << "," << ry << " unlit";
+      EXPECT_NEAR(a.mean, c.mean, 4.5 * std::hypot(a.stderr_, c.stderr_))
+          << "region " << rx << "," << ry;
+    }
+}
+
 // The path tracer's error on the sphere's caustic is large; reuse without T is small there, and
 // converges to the path tracer (above). So T's image is held against it, pixel by pixel: the
 // mean of their differences over each of 4x4 regions is within its standard error (from the

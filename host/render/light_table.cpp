@@ -57,6 +57,8 @@ dev::Light punctualLight(const PunctualLight& p, float sceneRadius) {
       break;
     case LightType::Directional:
       l.type = PR_LIGHT_DIRECTIONAL;
+      // The disk its light paths start on (light_trace): their density per unit area there.
+      l.area = float(M_PI) * sceneRadius * sceneRadius;
       break;
   }
   l.power = dev::light_power(&l, sceneRadius);

@@ -163,7 +163,7 @@ PR_INLINE uint connector_slot(const Connector* c, uint path) {
 }
 
 // Solid-angle pdf with which the light tracer leaves vertex 0 along dir; 0 where strategy E does
-// not connect to vertex 0 (spot and directional lights).
+// not connect to vertex 0 (directional lights and the environment).
 PR_INLINE float light_emit_pdf(const SceneData* s, u32 light, __global const LightVertex* v0,
                                float3 dir) {
   const Light l = s->lights.lights[light];
@@ -484,11 +484,15 @@ PR_INLINE void strategy_sampled_vertex(Connector* cn, float3 xp, float pdf_x, co
         const u32 type = s->lights.lights[cn->headers[slot].light].type;
         if (!light_joins_vertex0(type)) continue;
         zng = oct_decode(v[0].ng_oct);
-        pdf_l = light_emit_pdf(s, cn->headers[slot].light, v, dir);
-        // The stored throughput is emission over (position pdf times pdf_l / cos).
+        // Along -dir the light sends its emission towards Y (a spot's cone).
+        pdf_l = light_emit_pdf(s, cn->headers[slot].light, v, -dir);
+        // The stored throughput is emission over (position pdf times pdf_l / cos), before a
+        // spot's falloff: times pdf_l and the falloff towards Y, emission over the position pdf.
         const int tri = light_is_triangle(type);
         cos_z = tri ? fabs(dot(zng, dir)) : 1.0f;
-        f_z = make_float3(1.0f, 1.0f, 1.0f) * (tri ? 0.5f * PR_INV_PI : 0.25f * PR_INV_PI);
+        const Light lz = s->lights.lights[cn->headers[slot].light];
+        f_z = make_float3(1.0f, 1.0f, 1.0f) *
+              (tri ? 0.5f * PR_INV_PI : pdf_l * light_falloff(&lz, -dir));
       } else {
         const LightPoint z = light_point(s, v + k);
         float pdf_rev_unused;

@@ -9,9 +9,11 @@
 #include "shared/eye_paths.h"
 
 // A light sub-path's first vertex: its point on light L (chosen with probability pmf), the
-// normal stored with it, the first direction and the throughput Le / (pmf x pdf).
+// normal stored with it, the first direction and the throughput Le / (pmf x pdf); tp0 the same
+// before a spot's falloff along dir, the vertex's own record (connect joins other directions
+// to it).
 typedef struct {
-  float3 p, n, dir, tp;
+  float3 p, n, dir, tp, tp0;
   uint prim, inst;  // the emitting triangle, where L is one
   float b1, b2;
 } LightEmission;
@@ -54,8 +56,11 @@ PR_INLINE LightEmission light_emit(const SceneData* s, const Light* L, const Reu
     e.p = make_float3(L->p0x, L->p0y, L->p0z);
     const float pdf_dir = light_sample_emit_dir(L, e.n, u4, u5, &e.dir);
     const float att = light_falloff(L, e.dir);
+    e.tp0 = make_float3(L->le_r, L->le_g, L->le_b) * (1.0f / (pmf * pdf_dir));
     e.tp = make_float3(L->le_r, L->le_g, L->le_b) * (att / (pmf * pdf_dir));
+    return e;
   }
+  e.tp0 = e.tp;
   return e;
 }
 
@@ -119,7 +124,7 @@ PR_KERNEL void light_trace(PR_PARAMS(PR_ARGS_LIGHT_TRACE)) {
     return;
   }
   const uint n0_oct = oct_encode(em.n);
-  LightVertex v = light_vertex(em.p, 0.0f, make_float3(0.0f, 0.0f, 0.0f), n0_oct, n0_oct, tp,
+  LightVertex v = light_vertex(em.p, 0.0f, make_float3(0.0f, 0.0f, 0.0f), n0_oct, n0_oct, em.tp0,
                                em.prim, em.inst, em.b1, em.b2);
   out[0] = v;
   uint count = 1u;

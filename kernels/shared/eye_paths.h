@@ -18,8 +18,8 @@
 
 PR_NAMESPACE_BEGIN
 
-// The lights whose stored paths take part: emissive triangles and point lights. The others'
-// paths are the path tracer's alone.
+// The lights whose stored paths take part: emissive triangles, point, spot and directional
+// lights. The environment's paths are the path tracer's alone.
 PR_INLINE int eye_paths_light(const Light* l) {
   return light_in_eye_paths(l->type);
 }
@@ -41,9 +41,12 @@ PR_INLINE float eye_paths_start_density(const Light* l, u32 li, PR_GLOBAL const 
 }
 
 // The density at a point (|cos| cos_x of its geometric normal with the segment, squared
-// distance d2) of the light tracer's first step from z0 along dir.
+// distance d2) of the light tracer's first step from z0 along dir. A directional light's paths
+// leave a disk of area l->area across its fixed direction: per unit area at the point, the
+// disk's density projected, cos_x / area.
 PR_INLINE float eye_paths_emit_density(const Light* l, float3 n_tri, float3 dir, float cos_x,
                                        float d2) {
+  if (light_at_infinity(l->type)) return cos_x / l->area;
   return solid_angle_to_area_pdf(light_pdf_emit_dir(l, n_tri, dir), cos_x, d2);
 }
 
@@ -116,7 +119,8 @@ PR_INLINE void eye_path_walk_leave(EyePathWalk* w, u32 k, int delta, float pdf_f
   const float rev = area_pdf_g(pdf_rev, w->g);
   if (k == 1u) {
     w->z1_delta = delta;
-    w->hit = mis_sampled(rev, delta);
+    // H reaches z_0 only on a triangle: a point, a spot or a direction it never hits.
+    w->hit = w->tri ? mis_sampled(rev, delta) : 0.0f;
   } else {
     mis_chain_leave(&w->chain, rev, delta);
   }

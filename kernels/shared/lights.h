@@ -32,8 +32,9 @@
 #define PR_LIGHT_TYPES(X)                                                                   \
   X(TRIANGLE, triangle, PR_LIGHT_ON_TRIANGLE | PR_LIGHT_JOINS_VERTEX0 | PR_LIGHT_EYE_PATHS) \
   X(POINT, point, PR_LIGHT_DELTA_POSITION | PR_LIGHT_JOINS_VERTEX0 | PR_LIGHT_EYE_PATHS)    \
-  X(SPOT, spot, PR_LIGHT_DELTA_POSITION)                                                    \
-  X(DIRECTIONAL, directional, PR_LIGHT_DELTA_DIRECTION | PR_LIGHT_AT_INFINITY)              \
+  X(SPOT, spot, PR_LIGHT_DELTA_POSITION | PR_LIGHT_JOINS_VERTEX0 | PR_LIGHT_EYE_PATHS)      \
+  X(DIRECTIONAL, directional,                                                               \
+    PR_LIGHT_DELTA_DIRECTION | PR_LIGHT_AT_INFINITY | PR_LIGHT_EYE_PATHS)                   \
   X(ENV, env, PR_LIGHT_AT_INFINITY) /* shared/environment.h; the last light of the table */
 
 // Outside the namespace, as the macros it replaced: host code names PR_LIGHT_POINT unqualified.
@@ -536,10 +537,11 @@ PR_INLINE float light_spot_sample_emit(const Light* l, PR_GLOBAL const float* da
   return 1.0f / (2.0f * PR_PI * (1.0f - l->cos_outer));
 }
 
-// 0: no strategy joins a spot light's vertex 0.
+// Uniform in the outer cone about the axis, 0 outside it; dir leaves the light.
 PR_INLINE float light_spot_pdf_emit(const Light* l, float3 n0, float3 dir) {
-  (void)l, (void)n0, (void)dir;
-  return 0.0f;
+  (void)n0;
+  if (!(dot(dir, make_float3(l->e1x, l->e1y, l->e1z)) >= l->cos_outer)) return 0.0f;
+  return 1.0f / (2.0f * PR_PI * (1.0f - l->cos_outer));
 }
 
 PR_INLINE float light_spot_falloff(const Light* l, float3 dir) {
