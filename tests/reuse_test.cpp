@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <functional>
 
 #include <nlohmann/json.hpp>
 
@@ -563,65 +564,62 @@ TEST(Reuse, LightTracingConvergesToThePathTracer) {
                   32, 2);
 }
 
-// A floor, a back wall and a glossy box under a spot light, their only light, whose cone (30
-// degrees, soft from 20) lights part of the floor and the wall: its light paths take part in
-// every strategy (L, T, and E where eye paths are off).
-std::string spotScene() {
-  static std::string path;
-  if (!path.empty()) return path;
+// A floor, a back wall and a glossy box, lit by what `light` adds alone; written once per tag.
+std::string litRoom(const std::string& tag, const std::function<void(test::GltfBuilder&)>& light) {
   test::GltfBuilder b;
   const int white = b.addMaterial({glm::vec4(0.8f, 0.8f, 0.8f, 1), 0, 1});
   const int glossy = b.addMaterial({glm::vec4(0.9f, 0.6f, 0.3f, 1), 0.5f, 0.3f});
   b.addNode(b.addQuad({-3, 0, -3}, {-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, white));
   b.addNode(b.addQuad({-3, 0, -3}, {3, 0, -3}, {3, 3, -3}, {-3, 3, -3}, white));
   b.addNode(b.addBox(glm::vec3(-0.4f, 0.0f, -0.4f), glm::vec3(0.4f, 0.8f, 0.4f), glossy));
-  b.addSpotLight({1.5f, 2.5f, 1.0f}, {0.0f, 0.0f, -1.5f}, {1.0f, 0.9f, 0.8f}, 12.0f, 0.0f, 0.6f);
+  light(b);
   b.addCamera(glm::vec3(0.0f, 1.6f, 4.5f), glm::vec3(0.0f, 0.8f, 0.0f), 0.9f, 4.0f / 3.0f);
-  path = b.write(test::tempDir("spot"), "spot");
+  return b.write(test::tempDir(tag), tag);
+}
+
+// The room under a spot light whose cone (35 degrees, its falloff all the way) lights part of
+// the floor and the wall: its light paths take part in every strategy (L, T, and E where eye
+// paths are off).
+std::string spotScene() {
+  static const std::string path = litRoom("spot", [](test::GltfBuilder& b) {
+    b.addSpotLight({1.5f, 2.5f, 1.0f}, {0.0f, 0.0f, -1.5f}, {1.0f, 0.9f, 0.8f}, 12.0f, 0.0f, 0.6f);
+  });
   return path;
+}
+
+// The room under a low sun (a directional light): its light paths start on the disk that covers
+// the scene and take part in L and T.
+std::string sunScene() {
+  static const std::string path = litRoom("sun", [](test::GltfBuilder& b) {
+    // Shining down and towards the back wall, from the right.
+    b.addDirectionalLight(
+        glm::angleAxis(-0.9f, glm::vec3(1, 0, 0)) * glm::angleAxis(0.5f, glm::vec3(0, 1, 0)),
+        {1.0f, 0.95f, 0.9f}, 2.0f);
+  });
+  return path;
+}
+
+// The light paths of `scene` (its only light) are stored, connected and splatted.
+void expectLightPathsUsed(const std::string& scene, const std::string& tag) {
+  const auto stats = nlohmann::json::parse(test::statsLines(renderReuse(
+      scene, "0", "--width 48 --height 36 --spp 2 --eye-paths --light-tracing --no-resample",
+      tag))[0]);
+  EXPECT_GT(stats["rays"]["splat"].get<uint64_t>(), 100u) << stats.dump();
+  EXPECT_GT(stats["counters"]["connections_unoccluded"].get<uint64_t>(), 1000u) << stats.dump();
 }
 
 // The spot light's paths in every strategy: with eye paths (L and T against N and H) and
 // without (L and E, E joining vertex 0 on the spot, outside its cone no light), the images
-// converge to the path tracer's, and light tracing adds what it should.
+// converge to the path tracer's.
 TEST(Reuse, SpotLightPathsConvergeToThePathTracer) {
-  // Its paths are stored, connected and splatted (a spot's took part in none before).
-  const auto stats = nlohmann::json::parse(test::statsLines(renderReuse(
-      spotScene(), "0", "--width 48 --height 36 --spp 2 --eye-paths --light-tracing --no-resample",
-      "spot-stats"))[0]);
-  EXPECT_GT(stats["rays"]["splat"].get<uint64_t>(), 100u) << stats.dump();
-  EXPECT_GT(stats["counters"]["connections_unoccluded"].get<uint64_t>(), 1000u) << stats.dump();
+  expectLightPathsUsed(spotScene(), "spot-stats");  // a spot's took part in none before
   expectSameImage(spotScene(), "--max-depth 6 --eye-paths --light-tracing --no-resample", 48, 36,
                   32, 2);
   expectSameImage(spotScene(), "--max-depth 6 --no-eye-paths --no-resample", 48, 36, 32, 2);
 }
 
-// The same room under a low sun (a directional light): its light paths start on the disk that
-// covers the scene and take part in L and T.
-std::string sunScene() {
-  static std::string path;
-  if (!path.empty()) return path;
-  test::GltfBuilder b;
-  const int white = b.addMaterial({glm::vec4(0.8f, 0.8f, 0.8f, 1), 0, 1});
-  const int glossy = b.addMaterial({glm::vec4(0.9f, 0.6f, 0.3f, 1), 0.5f, 0.3f});
-  b.addNode(b.addQuad({-3, 0, -3}, {-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, white));
-  b.addNode(b.addQuad({-3, 0, -3}, {3, 0, -3}, {3, 3, -3}, {-3, 3, -3}, white));
-  b.addNode(b.addBox(glm::vec3(-0.4f, 0.0f, -0.4f), glm::vec3(0.4f, 0.8f, 0.4f), glossy));
-  // Shining down and towards the back wall, from the right.
-  const glm::quat q =
-      glm::angleAxis(-0.9f, glm::vec3(1, 0, 0)) * glm::angleAxis(0.5f, glm::vec3(0, 1, 0));
-  b.addDirectionalLight(q, {1.0f, 0.95f, 0.9f}, 2.0f);
-  b.addCamera(glm::vec3(0.0f, 1.6f, 4.5f), glm::vec3(0.0f, 0.8f, 0.0f), 0.9f, 4.0f / 3.0f);
-  path = b.write(test::tempDir("sun"), "sun");
-  return path;
-}
-
 TEST(Reuse, DirectionalLightPathsConvergeToThePathTracer) {
-  const auto stats = nlohmann::json::parse(test::statsLines(renderReuse(
-      sunScene(), "0", "--width 48 --height 36 --spp 2 --eye-paths --light-tracing --no-resample",
-      "sun-stats"))[0]);
-  EXPECT_GT(stats["rays"]["splat"].get<uint64_t>(), 100u) << stats.dump();
-  EXPECT_GT(stats["counters"]["connections_unoccluded"].get<uint64_t>(), 1000u) << stats.dump();
+  expectLightPathsUsed(sunScene(), "sun-stats");
   expectSameImage(sunScene(), "--max-depth 6 --eye-paths --light-tracing --no-resample", 48, 36, 32,
                   2);
   expectSameImage(sunScene(), "--max-depth 6 --eye-paths --light-tracing", 48, 36, 32, 2);
