@@ -277,26 +277,6 @@ TEST(Environment, ConvexLambertBoxShowsItsAlbedoInAUniformEnvironment) {
   }
 }
 
-// With eye paths, the environment's light paths would take part in no strategy (its light is the
-// eye paths' alone): none is traced. Without them the connections use them.
-TEST(Environment, EyePathsTraceNoLightPathsThatNoStrategyUses) {
-  const std::string scene = boxScene("envtrace");
-  for (const bool eyePaths : {true, false}) {
-    SCOPED_TRACE(eyePaths ? "eye paths" : "connections");
-    const std::string dir =
-        test::renderFrames(scene, "0",
-                           std::string("--width 16 --height 16 --spp 2 --env-color 1,1,1 ") +
-                               (eyePaths ? "--eye-paths" : "--no-eye-paths"),
-                           "envtrace-r");
-    const auto stats = nlohmann::json::parse(test::statsLines(dir)[0]);
-    const uint64_t light = stats["rays"]["light"].get<uint64_t>();
-    if (eyePaths)
-      EXPECT_EQ(light, 0u) << stats.dump();
-    else
-      EXPECT_GT(light, 100u) << stats.dump();
-  }
-}
-
 // Under a map with a sun, with a floor and a moving box (light paths that the environment
 // starts bounce between them): reuse converges to the path tracer, region by region.
 // (With one light path per pixel, as by default, every sample of a frame shares the same few

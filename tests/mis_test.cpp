@@ -149,7 +149,7 @@ TEST(EyePathShare, WeightsAddToOneForEveryPath) {
 // The light side that light_trace keeps per vertex (eye_path_walk_*) and connect finishes
 // (eye_path_weight) gives the same weight as the strategies' densities multiplied out along the
 // whole path, vertex by vertex, on random paths with delta vertices, triangle, point, spot and
-// directional lights.
+// directional lights and the environment.
 TEST(EyePathShare, KeptRatiosGiveTheWeightOfTheWholePathsDensities) {
   std::mt19937 gen(5);
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
@@ -161,13 +161,18 @@ TEST(EyePathShare, KeptRatiosGiveTheWeightOfTheWholePathsDensities) {
   int checked = 0;
   for (int trial = 0; trial < 400; ++trial) {
     Light l{};
-    const u32 types[6] = {PR_LIGHT_TRIANGLE, PR_LIGHT_TRIANGLE,    PR_LIGHT_TRIANGLE,
-                          PR_LIGHT_POINT,    PR_LIGHT_DIRECTIONAL, PR_LIGHT_SPOT};
-    l.type = types[trial % 6];
-    l.area = 0.1f + u(gen);  // a triangle's area, or the disk a directional light's paths leave
+    const u32 types[7] = {PR_LIGHT_TRIANGLE, PR_LIGHT_TRIANGLE,    PR_LIGHT_TRIANGLE,
+                          PR_LIGHT_POINT,    PR_LIGHT_DIRECTIONAL, PR_LIGHT_SPOT,
+                          PR_LIGHT_ENV};
+    l.type = types[trial % 7];
+    l.area = 0.1f + u(gen);       // a triangle's
+    l.disk_area = 0.1f + u(gen);  // the disk a directional light's or the environment's paths leave
     const u32 li = trial % 2;
     const int tri = l.type == PR_LIGHT_TRIANGLE;
-    const int sun = l.type == PR_LIGHT_DIRECTIONAL;
+    const int env = l.type == PR_LIGHT_ENV;
+    const int sun = l.type == PR_LIGHT_DIRECTIONAL || env;
+    // The environment's density of z_0's direction (its map's pdf), 1 for the others.
+    const float dirpdf = env ? 0.05f + 2.0f * u(gen) : 1.0f;
     const float3 n_tri = tri ? unit() : make_float3(0.0f, 0.0f, 1.0f);
     const float C = float(1 + trial % 4);
     const float start = eye_paths_start_density(&l, li, trace_cdf, 1.0f);
@@ -188,7 +193,7 @@ TEST(EyePathShare, KeptRatiosGiveTheWeightOfTheWholePathsDensities) {
       l.e1x = dir[1].x, l.e1y = dir[1].y, l.e1z = dir[1].z;
       l.cos_outer = 0.5f;
     }
-    EyePathWalk w = eye_path_walk_start(&l, li, n_tri, trace_cdf, 1.0f);
+    EyePathWalk w = eye_path_walk_start(&l, li, n_tri, trace_cdf, 1.0f, dirpdf);
     for (int k = 1; k <= K; ++k) {
       const EyePathRatio r = eye_path_walk_arrive(&w, k, dir[k], t[k], ng[k]);
       if (!delta[k]) {
@@ -201,8 +206,8 @@ TEST(EyePathShare, KeptRatiosGiveTheWeightOfTheWholePathsDensities) {
         };
         // L: C paths, z_0 by the power table, then each step from the vertex before; a
         // directional light's z_1 from its disk, projected.
-        double dl = C * start *
-                    (sun ? std::fabs(dot(ng[1], dir[1])) / l.area
+        double dl = C * start * dirpdf *
+                    (sun ? std::fabs(dot(ng[1], dir[1])) / l.disk_area
                          : light_pdf_emit_dir(&l, n_tri, dir[1]) * std::fabs(dot(ng[1], dir[1])) /
                                (t[1] * t[1]));
         for (int m = 2; m <= k; ++m)
@@ -212,12 +217,14 @@ TEST(EyePathShare, KeptRatiosGiveTheWeightOfTheWholePathsDensities) {
         double de = pdf_x * cos_z / d2;
         for (int m = k; m >= 2; --m)
           if (!delta[m]) de *= area(m == k ? rev_join : rev[m], ng[m - 1], dir[m], t[m]);
-        // H meets only a triangle (through a delta z_1 too); a point, a spot or a direction
-        // never.
-        const double dn = delta[1] ? 0.0 : de * start;
-        const double dh = !tri       ? 0.0
-                          : delta[1] ? de
-                                     : de * area(k == 1 ? rev_join : rev[1], n_tri, dir[1], t[1]);
+        // H meets a triangle (per unit area) or the environment (per solid angle), through a
+        // delta z_1 too; a point, a spot or a direction never.
+        const double dn = delta[1] ? 0.0 : de * start * dirpdf;
+        const double rev1 = k == 1 ? rev_join : rev[1];
+        const double dh = !(tri || env) ? 0.0
+                          : delta[1]    ? de
+                          : env         ? de * rev1
+                                        : de * area(float(rev1), n_tri, dir[1], t[1]);
         const double expect = 1.0 / (1.0 + (dn / dl) * (dn / dl) + (dh / dl) * (dh / dl));
         const float got = eye_path_weight(r, k, pdf_x, cos_z, d2, rev_join, 1.0f / C, 0.0f);
         EXPECT_NEAR(got, expect, 1e-4 * std::max(1.0, expect)) << "trial " << trial << " k " << k;

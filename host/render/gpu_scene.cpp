@@ -145,10 +145,7 @@ GpuScene::GpuScene(Context& ctx, const Scene& scene, const GpuSceneOptions& opti
   envBuffer_ =
       upload("environment map", envData.data(), envData.size() * sizeof(float), &shadingBytes_);
   // The light-tracing selection table, at time 0 once and for all.
-  std::vector<dev::Light> atZero = lightsAt(0.0);
-  if (options_.traceEyePathLightsOnly)
-    for (dev::Light& l : atZero)
-      if (!dev::light_in_eye_paths(l.type)) l.power = 0.0f;
+  const std::vector<dev::Light> atZero = lightsAt(0.0);
   traceTotal_ = runningSums(atZero, &traceCdf_);
   const size_t n = std::max<size_t>(traceCdf_.size(), 1);
   traceCdfBuffer_ = ctx_.allocate("light tracing power table", n * sizeof(float), CL_MEM_READ_ONLY);

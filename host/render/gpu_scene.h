@@ -31,9 +31,6 @@ struct GpuSceneOptions {
   LightSampler lightSampler = LightSampler::Auto;
   int bvhWidth = 0;         // children per BVH node; 0: defaultBvhWidth of the device
   Environment environment;  // the environment light; none where !present()
-  // The light tracer's table weighs only the lights whose paths the eye paths use
-  // (light_in_eye_paths): with eye paths no strategy uses the others' (the environment's).
-  bool traceEyePathLightsOnly = false;
 };
 
 // A transform as the kernels keep it: its top three rows, row-major (ShadingInstance).

@@ -58,7 +58,7 @@ dev::Light punctualLight(const PunctualLight& p, float sceneRadius) {
     case LightType::Directional:
       l.type = PR_LIGHT_DIRECTIONAL;
       // The disk its light paths start on (light_trace): their density per unit area there.
-      l.area = float(M_PI) * sceneRadius * sceneRadius;
+      l.disk_area = float(M_PI) * sceneRadius * sceneRadius;
       break;
   }
   l.power = dev::light_power(&l, sceneRadius);
@@ -75,6 +75,7 @@ dev::Light environmentLight(const Environment& env, float meanLuminance, float s
   l.p0y = std::sin(env.rotation);
   l.le_r = env.scale.r, l.le_g = env.scale.g, l.le_b = env.scale.b;
   l.area = meanLuminance;
+  l.disk_area = float(M_PI) * sceneRadius * sceneRadius;
   l.leaf = PR_INVALID_INDEX;
   l.power = dev::light_power(&l, sceneRadius);
   if (!std::isfinite(l.power) || !(l.power > 0.0f)) l.power = 0.0f;

@@ -134,7 +134,6 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
   sceneOptions.lightSampler = options.lightSampler;
   sceneOptions.bvhWidth = options.bvhWidth;
   sceneOptions.environment = resolveEnvironment(options, scene);
-  sceneOptions.traceEyePathLightsOnly = options.mode != RenderMode::PathTrace && options.eyePaths;
   gpu_ = std::make_unique<GpuScene>(ctx_, scene, sceneOptions);
   film_ = std::make_unique<Film>(ctx_, width_, height_);
   const RenderOptions& o = options_;

@@ -36,21 +36,6 @@ PR_INLINE float pt_light_density(const ShadingFrame* f, const PathState* p, floa
   return solid_angle_to_area_pdf(eye_paths_bsdf_pdf(f, wi, wo), p->seg_cos, dist2);
 }
 
-// Escaped: the environment's light, MIS-weighted against next-event estimation, into *add;
-// 0 where it gives none.
-PR_INLINE int pt_escaped(const SceneData* s, const PathState* p, float3* add) {
-  const float3 d = make_float3(p->ray.dx, p->ray.dy, p->ray.dz);
-  const float3 le = environment_radiance(s, d);
-  if (!(max3(le) > 0.0f)) return 0;
-  float w = 1.0f;
-  if (!(p->flags & PR_PATH_SPECULAR))
-    w = power_heuristic(p->last_pdf,
-                        environment_pdf(s, make_float3(p->prev_x, p->prev_y, p->prev_z),
-                                        make_float3(p->prev_nx, p->prev_ny, p->prev_nz), d));
-  *add = make_float3(p->tp_r, p->tp_g, p->tp_b) * le * w;
-  return 1;
-}
-
 // The weight of emission found at h along d (dist2 from the previous vertex): against next-event
 // estimation, and where the connections can make the path too (joinable), times their share;
 // its parts into *ew.
@@ -107,10 +92,13 @@ PR_INLINE float pt_next_event_weight(const SceneData* s, const PathState* p, con
     const float3 dz = ch->pos - h->p;
     const float dz2 = dot(dz, dz);
     const float3 wi = dz * (1.0f / sqrt(dz2));
-    const float dens_n = eye_paths_start_density(&l, ch->light, trace_cdf, trace_total);
+    // The environment's direction is z_0: its densities per solid angle.
+    const float dens_n = eye_paths_start_density(&l, ch->light, trace_cdf, trace_total) *
+                         eye_paths_direction_density(&l, s->lights.env, ch->wi);
     const float dens_h = light_is_triangle(l.type)
                              ? solid_angle_to_area_pdf(ch->pdf_bsdf, fabs(dot(n_tri, wi)), dz2)
-                             : 0.0f;
+                         : eye_paths_light_hit(&l) ? ch->pdf_bsdf
+                                                   : 0.0f;
     const float rev = has_rev ? solid_angle_to_area_pdf(ch->pdf_bsdf_rev, p->seg_cos, dist2) : 1.0f;
     const float dens_l =
         eye_paths_light_side(&l, n_tri, dens_n, light_paths, eye_count, p->eye_ratio, ch->pos, h->p,
@@ -227,28 +215,65 @@ PR_INLINE float4 pt_rgb(float3 c) {
   return (float4)(c.x, c.y, c.z, 0.0f);
 }
 
-// The path escaped: the environment's light into the sample's radiance, or with --resample from
-// x_1 (rel 1) to the direct light's reservoir and from x_2 on (rel >= 2) to the paths'.
-PR_INLINE void pt_escape(const SceneData* s, const PathState* p, uint rel,
-                         __global const PathTrack* track, __global PathReservoir* res,
-                         __global DirectReservoir* di, const RsKey* key,
-                         __global float4* radiance) {
-  float3 add;
-  if (!pt_escaped(s, p, &add)) return;
+// The weight of the environment found along d (escaped), pdf_light next-event estimation's
+// density of d: against next-event estimation, and where the connections can make the path
+// (joinable), times their share (the environment's direction is z_0: N's density of it and
+// H's per solid angle, L's of z_1 from the disk); its parts into *ew.
+PR_INLINE float pt_escape_weight(const SceneData* s, const PathState* p, float3 d, float pdf_light,
+                                 int joinable, u32 light_paths, float eye_count,
+                                 __global const float* trace_cdf, float trace_total, u32 max_depth,
+                                 EyeWeight* ew) {
+  const int spec = (p->flags & PR_PATH_SPECULAR) != 0u;
+  float w = spec ? 1.0f : power_heuristic(p->last_pdf, pdf_light);
+  ew->pt = w;
+  ew->n = ew->h = ew->l = ew->t = 0.0f;
+  ew->t_len = eye_paths_camera_len(p->depth, max_depth);
+  const u32 li = s->lights.env_light;
+  if (joinable && li != PR_INVALID_INDEX) {
+    const Light l = s->lights.lights[li];
+    const float3 prev = make_float3(p->prev_x, p->prev_y, p->prev_z);
+    const float start = eye_paths_start_density(&l, li, trace_cdf, trace_total) *
+                        eye_paths_direction_density(&l, s->lights.env, d);
+    const float dens_h = spec ? 1.0f : p->last_pdf;
+    const float dens_l =
+        eye_paths_light_side(&l, make_float3(0.0f, 0.0f, 1.0f), start, light_paths, eye_count,
+                             p->eye_ratio, prev - d, prev, p->seg_cos, 1.0f);
+    const float dens_n = spec ? 0.0f : start;
+    ew->t = p->x1_depth == 1u && ew->t_len ? p->lt : 0.0f;
+    if (dens_l > 0.0f) w *= eye_paths_eye_share(dens_n / dens_l, dens_h / dens_l, ew->t);
+    ew->n = dens_n;
+    ew->h = dens_h;
+    ew->l = dens_l;
+  }
+  return w;
+}
+
+// The path escaped: the environment's light (weighted as pt_escape_weight says) into the
+// sample's radiance, or with --resample from x_1 (rel 1) to the direct light's reservoir and
+// from x_2 on (rel >= 2) to the paths'.
+PR_INLINE void pt_escape(const SceneData* s, const PathState* p, uint rel, int joinable,
+                         u32 light_paths, float eye_count, __global const float* trace_cdf,
+                         float trace_total, u32 max_depth, __global const PathTrack* track,
+                         __global PathReservoir* res, __global DirectReservoir* di,
+                         const RsKey* key, __global float4* radiance) {
   const float3 d = make_float3(p->ray.dx, p->ray.dy, p->ray.dz);
+  const float3 le = environment_radiance(s, d);
+  if (!(max3(le) > 0.0f)) return;
   const float3 prev = make_float3(p->prev_x, p->prev_y, p->prev_z);
   const float3 prev_n = make_float3(p->prev_nx, p->prev_ny, p->prev_nz);
-  const float pdf_light = rel ? environment_pdf(s, prev, prev_n, d) : 0.0f;
-  const float w = (p->flags & PR_PATH_SPECULAR) ? 1.0f : power_heuristic(p->last_pdf, pdf_light);
-  if (rel == 1u && di_offer_hit(s, p, track, s->lights.env_light, 0.0f, 0.0f, d,
-                                environment_radiance(s, d), 1.0f, w, di, key))
+  const float pdf_light =
+      (p->flags & PR_PATH_SPECULAR) && !rel ? 0.0f : environment_pdf(s, prev, prev_n, d);
+  EyeWeight ew;
+  const float w = pt_escape_weight(s, p, d, pdf_light, joinable, light_paths, eye_count, trace_cdf,
+                                   trace_total, max_depth, &ew);
+  if (rel == 1u &&
+      di_offer_hit(s, p, track, s->lights.env_light, 0.0f, 0.0f, d, le, 1.0f, w, di, key))
     return;
   if (rel < 2u) {
-    *radiance += pt_rgb(add);
+    *radiance += pt_rgb(make_float3(p->tp_r, p->tp_g, p->tp_b) * le * w);
     return;
   }
-  const EyeWeight ew = {w, 0.0f, 0.0f, 0.0f, 0.0f, 0};  // the connections make no path to the sky
-  rs_offer_emission(track, res, p, rel, environment_radiance(s, d), &ew, pdf_light, 1, d, key);
+  rs_offer_emission(track, res, p, rel, le, &ew, pdf_light, 1, d, key);
 }
 
 // Emission at h (reached along d at squared distance dist2), weighted w by the path tracer (ew:
@@ -360,7 +385,11 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
   const RsKey key = {seed, frame, p.pixel, sample};
   const Hit hit = hits[i];
   if (hit.prim == PR_INVALID_INDEX) {
-    pt_escape(&s, &p, rel, track, rs_res + i, di_res + i, &key, radiance + i);
+    // As at a hit: the connections can make the paths that leave x_t, t >= 2.
+    const int joinable =
+        light_paths > 0u && (p.eye_flags & PR_EYE_JOINABLE) && p.depth >= p.x1_depth + 1u;
+    pt_escape(&s, &p, rel, joinable, light_paths, rsp.eye_count, trace_cdf, trace_total, max_depth,
+              track, rs_res + i, di_res + i, &key, radiance + i);
     p.alive = 0u;
     states[i] = p;
     return 0u;

@@ -138,7 +138,7 @@ PR_KERNEL void light_trace(PR_PARAMS(PR_ARGS_LIGHT_TRACE)) {
     walk = eye_path_walk_start(
         &L, li,
         light_is_triangle(L.type) ? eye_paths_light_normal(&s, &L) : make_float3(0.0f, 0.0f, 1.0f),
-        trace_cdf, rp.trace_total);
+        trace_cdf, rp.trace_total, eye_paths_direction_density(&L, s.lights.env, -em.dir));
   __global EyePathRatio* ratio_out = ratios + (size_t)slot * rp.stride;
   const float tp0 = max3(tp);  // Russian roulette weighs the throughput against this
 

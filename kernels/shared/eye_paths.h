@@ -18,8 +18,7 @@
 
 PR_NAMESPACE_BEGIN
 
-// The lights whose stored paths take part: emissive triangles, point, spot and directional
-// lights. The environment's paths are the path tracer's alone.
+// The lights whose stored paths take part: all (light_in_eye_paths).
 PR_INLINE int eye_paths_light(const Light* l) {
   return light_in_eye_paths(l->type);
 }
@@ -40,13 +39,28 @@ PR_INLINE float eye_paths_start_density(const Light* l, u32 li, PR_GLOBAL const 
   return light_is_triangle(l->type) ? pmf / l->area : pmf;
 }
 
+// The environment's density of z_0, the direction wi towards it, as next-event estimation and
+// the light tracer sample it (its map's pdf; the choice of the light is eye_paths_start_density);
+// 1 for the other lights.
+PR_INLINE float eye_paths_direction_density(const Light* l, PR_GLOBAL const float* env, float3 wi) {
+  if (!light_at_infinity(l->type) || light_is_delta(l->type)) return 1.0f;
+  return env_pdf(l, env, wi);
+}
+
+// Whether the eye path's BSDF sample can meet the light (strategy H): a triangle or the
+// environment; a point, a spot or a direction never.
+PR_INLINE int eye_paths_light_hit(const Light* l) {
+  return !light_is_delta(l->type);
+}
+
 // The density at a point (|cos| cos_x of its geometric normal with the segment, squared
 // distance d2) of the light tracer's first step from z0 along dir. A directional light's paths
-// leave a disk of area l->area across its fixed direction: per unit area at the point, the
-// disk's density projected, cos_x / area.
+// and the environment's leave a disk of area l->disk_area across their direction: per unit area
+// at the point, the disk's density projected, cos_x / disk_area (the environment's density of
+// the direction is z_0's: eye_paths_direction_density).
 PR_INLINE float eye_paths_emit_density(const Light* l, float3 n_tri, float3 dir, float cos_x,
                                        float d2) {
-  if (light_at_infinity(l->type)) return cos_x / l->area;
+  if (light_at_infinity(l->type)) return cos_x / l->disk_area;
   return solid_angle_to_area_pdf(light_pdf_emit_dir(l, n_tri, dir), cos_x, d2);
 }
 
@@ -64,7 +78,8 @@ PR_INLINE float eye_paths_bsdf_pdf(const ShadingFrame* f, float3 wo, float3 wi) 
 // (eye_path_weight).
 typedef struct {
   Light light;
-  int tri;          // a triangle light (H can reach z_0)
+  int tri;          // a triangle light
+  int hits;         // H can reach z_0 (a triangle or the environment)
   float inv_start;  // 1 / the light tracer's density of z_0
   MisChain chain;   // fwd: its densities of z_1 .. z_k; rev: the eye's of z_1 .. z_{k-2}
   float hit;        // the eye's density of z_0 sampled from z_1 arriving from z_2 (1: z_1 delta)
@@ -75,13 +90,16 @@ typedef struct {
   float3 ng_prev;  // geometric normal of z_{k-1}, then (after arriving) of z_k
 } EyePathWalk;
 
-// The walk of a path that starts on light l (index li, triangle normal n_tri).
+// The walk of a path that starts on light l (index li, triangle normal n_tri), z_0's direction
+// density dir_density (eye_paths_direction_density; 1 but for the environment).
 PR_INLINE EyePathWalk eye_path_walk_start(const Light* l, u32 li, float3 n_tri,
-                                          PR_GLOBAL const float* trace_cdf, float trace_total) {
+                                          PR_GLOBAL const float* trace_cdf, float trace_total,
+                                          float dir_density) {
   EyePathWalk w;
   w.light = *l;
   w.tri = light_is_triangle(l->type);
-  w.inv_start = 1.0f / eye_paths_start_density(l, li, trace_cdf, trace_total);
+  w.hits = eye_paths_light_hit(l);
+  w.inv_start = 1.0f / (eye_paths_start_density(l, li, trace_cdf, trace_total) * dir_density);
   w.chain = mis_chain_start();
   w.hit = 1.0f;
   w.pdf_next = w.g = 0.0f;
@@ -98,7 +116,9 @@ PR_INLINE EyePathRatio eye_path_walk_arrive(EyePathWalk* w, u32 k, float3 dir, f
   const float fwd = k == 1u ? eye_paths_emit_density(&w->light, w->n_tri, dir, cos_k, t2)
                             : solid_angle_to_area_pdf(w->pdf_next, cos_k, t2);
   mis_chain_arrive(&w->chain, fwd, w->delta_k);
-  w->g = (k > 1u || w->tri) ? fabs(dot(w->ng_prev, dir)) / t2 : 0.0f;
+  // H's density of z_0 from z_1 per unit area on a triangle, per solid angle for the
+  // environment (its direction is z_0).
+  w->g = (k > 1u || w->tri) ? fabs(dot(w->ng_prev, dir)) / t2 : w->hits ? 1.0f : 0.0f;
   w->ng_prev = ng;
   EyePathRatio r;
   if (k == 1u) {
@@ -119,8 +139,8 @@ PR_INLINE void eye_path_walk_leave(EyePathWalk* w, u32 k, int delta, float pdf_f
   const float rev = area_pdf_g(pdf_rev, w->g);
   if (k == 1u) {
     w->z1_delta = delta;
-    // H reaches z_0 only on a triangle: a point, a spot or a direction it never hits.
-    w->hit = w->tri ? mis_sampled(rev, delta) : 0.0f;
+    // H never hits a point, a spot or a direction.
+    w->hit = w->hits ? mis_sampled(rev, delta) : 0.0f;
   } else {
     mis_chain_leave(&w->chain, rev, delta);
   }

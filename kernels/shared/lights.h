@@ -35,7 +35,7 @@
   X(SPOT, spot, PR_LIGHT_DELTA_POSITION | PR_LIGHT_JOINS_VERTEX0 | PR_LIGHT_EYE_PATHS)      \
   X(DIRECTIONAL, directional,                                                               \
     PR_LIGHT_DELTA_DIRECTION | PR_LIGHT_AT_INFINITY | PR_LIGHT_EYE_PATHS)                   \
-  X(ENV, env, PR_LIGHT_AT_INFINITY) /* shared/environment.h; the last light of the table */
+  X(ENV, env, PR_LIGHT_AT_INFINITY | PR_LIGHT_EYE_PATHS) /* shared/environment.h; last */
 
 // Outside the namespace, as the macros it replaced: host code names PR_LIGHT_POINT unqualified.
 #define PR_LIGHT_ENUM_ENTRY(name, fn, flags) PR_LIGHT_##name,
@@ -67,10 +67,11 @@ typedef struct {
   float cos_inner, cos_outer;  // spot cone
   float power;                 // selection weight by power: light_power()
   u32 material;
-  u32 moved;  // changed since the previous frame (for invalidation)
-  u32 leaf;   // the light's node in the light BVH; PR_INVALID_INDEX for directional lights
-              // and the environment
-  float pad2, pad3;
+  u32 moved;        // changed since the previous frame (for invalidation)
+  u32 leaf;         // the light's node in the light BVH; PR_INVALID_INDEX for directional lights
+                    // and the environment
+  float disk_area;  // lights at infinity: the disk pi R^2 their light paths start on
+  float pad3;
 } Light;
 
 // A sampled point on a light, as seen from a reference point.

@@ -6,6 +6,7 @@ resampling (`--no-resample`), as it is by default (resampled, no neighbours) and
 
   /usr/bin/python3 -m tools.bench.bench_temporal                     # ~10-15 min on 2 cores
   /usr/bin/python3 -m tools.bench.bench_temporal --scenes atrium --seeds 1
+  /usr/bin/python3 -m tools.bench.bench_temporal --scenes atrium --scene-args "--env sky.exr"
   /usr/bin/python3 -m tools.bench.bench_temporal --cycles VENV/bin/python   # and Cycles 5.2
   /usr/bin/python3 -m tools.bench.bench_temporal --cycles VENV/bin/python --luxcore LUXVENV/bin/python
 
@@ -80,6 +81,9 @@ def parse_args():
                     help="LuxCore's reference spp (its 4-spp frame takes 7x ours)")
     ap.add_argument("--settings", default=";".join(SETTINGS),
                     help="the settings measured, by name, separated by ';'")
+    ap.add_argument("--scene-args", default="",
+                    help="options every render of ours takes, references too (e.g. '--env FILE'; "
+                    "part of the references' key); the peers do not see them")
     ap.add_argument("--quiet", action="store_true")
     args = ap.parse_args()
     args.settings = [n.strip() for n in args.settings.split(";")]

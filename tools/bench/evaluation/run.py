@@ -89,6 +89,7 @@ class Runner:
                "--max-depth", str(self.args.max_depth), "--seed", str(seed), "--mode", mode,
                "--out", str(out / "f_%04d.exr"), "--stats", str(stats), "--quiet", "--exr-float",
                *extra]  # float EXRs in every run, so that runs pay the same for writing
+        cmd += getattr(self.args, "scene_args", "").split()  # every render, references too
         if mode != "pathtrace":
             cmd += self.args.reuse_args.split()
         if fixed:
@@ -162,8 +163,10 @@ def references(runner, sc, cache):
     """Reference frames of a scene: pathtrace at ref spp, seed REF_SEED, cached per frame as
     float EXRs (what exr_compare measures against). Returns (their paths, their images, key)."""
     a = runner.args
+    scene_args = getattr(a, "scene_args", "")
     key = hashlib.sha1(json.dumps([file_sha(sc.path), a.width, sc.ref_spp, a.max_depth,
-                                   REF_SEED, "pathtrace"]).encode()).hexdigest()[:16]
+                                   REF_SEED, "pathtrace"] + ([scene_args] if scene_args else []))
+                       .encode()).hexdigest()[:16]
     path = {f: cache / f"{sc.key}_{key}_f{f:04d}.exr" for f in sc.frames}
     missing = [f for f in sc.frames if not path[f].is_file()]
     if missing:
