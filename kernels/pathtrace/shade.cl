@@ -36,6 +36,25 @@ PR_INLINE float pt_light_density(const ShadingFrame* f, const PathState* p, floa
   return solid_angle_to_area_pdf(eye_paths_bsdf_pdf(f, wi, wo), p->seg_cos, dist2);
 }
 
+// A path that the connections make too, ending on a light after x_t, t = p->depth: T's ratio
+// (fixed at x_2) and the eye path's share of it from N's, H's and L's densities, times w; the
+// parts into *ew.
+PR_INLINE float pt_eye_share(const PathState* p, float w, float dens_n, float dens_h, float dens_l,
+                             EyeWeight* ew) {
+  ew->t = p->x1_depth == 1u && ew->t_len ? p->lt : 0.0f;
+  if (dens_l > 0.0f) w *= eye_paths_eye_share(dens_n / dens_l, dens_h / dens_l, ew->t);
+  ew->n = dens_n;
+  ew->h = dens_h;
+  ew->l = dens_l;
+  return w;
+}
+
+// Whether the connections can make the paths that end after this path's last vertex x_t: x_2 is
+// non-delta and t >= x_1's depth + beyond.
+PR_INLINE int pt_joinable(const PathState* p, u32 light_paths, u32 beyond) {
+  return light_paths > 0u && (p->eye_flags & PR_EYE_JOINABLE) && p->depth >= p->x1_depth + beyond;
+}
+
 // The weight of emission found at h along d (dist2 from the previous vertex): against next-event
 // estimation, and where the connections can make the path too (joinable), times their share;
 // its parts into *ew.
@@ -63,12 +82,7 @@ PR_INLINE float pt_emission_weight(const SceneData* s, const PathState* p, const
         spec ? 1.0f : solid_angle_to_area_pdf(p->last_pdf, fabs(dot(n_tri, d)), dist2);
     const float dens_l = eye_paths_light_side(&l, n_tri, start, light_paths, eye_count,
                                               p->eye_ratio, h->p, prev, p->seg_cos, 1.0f);
-    const float dens_n = spec ? 0.0f : start;
-    ew->t = p->x1_depth == 1u && ew->t_len ? p->lt : 0.0f;
-    if (dens_l > 0.0f) w *= eye_paths_eye_share(dens_n / dens_l, dens_h / dens_l, ew->t);
-    ew->n = dens_n;
-    ew->h = dens_h;
-    ew->l = dens_l;
+    w = pt_eye_share(p, w, spec ? 0.0f : start, dens_h, dens_l, ew);
   }
   return w;
 }
@@ -238,12 +252,7 @@ PR_INLINE float pt_escape_weight(const SceneData* s, const PathState* p, float3 
     const float dens_l =
         eye_paths_light_side(&l, make_float3(0.0f, 0.0f, 1.0f), start, light_paths, eye_count,
                              p->eye_ratio, prev - d, prev, p->seg_cos, 1.0f);
-    const float dens_n = spec ? 0.0f : start;
-    ew->t = p->x1_depth == 1u && ew->t_len ? p->lt : 0.0f;
-    if (dens_l > 0.0f) w *= eye_paths_eye_share(dens_n / dens_l, dens_h / dens_l, ew->t);
-    ew->n = dens_n;
-    ew->h = dens_h;
-    ew->l = dens_l;
+    w = pt_eye_share(p, w, spec ? 0.0f : start, dens_h, dens_l, ew);
   }
   return w;
 }
@@ -385,11 +394,8 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
   const RsKey key = {seed, frame, p.pixel, sample};
   const Hit hit = hits[i];
   if (hit.prim == PR_INVALID_INDEX) {
-    // As at a hit: the connections can make the paths that leave x_t, t >= 2.
-    const int joinable =
-        light_paths > 0u && (p.eye_flags & PR_EYE_JOINABLE) && p.depth >= p.x1_depth + 1u;
-    pt_escape(&s, &p, rel, joinable, light_paths, rsp.eye_count, trace_cdf, trace_total, max_depth,
-              track, rs_res + i, di_res + i, &key, radiance + i);
+    pt_escape(&s, &p, rel, pt_joinable(&p, light_paths, 1u), light_paths, rsp.eye_count, trace_cdf,
+              trace_total, max_depth, track, rs_res + i, di_res + i, &key, radiance + i);
     p.alive = 0u;
     states[i] = p;
     return 0u;
@@ -406,8 +412,7 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
     rs_track_hit(track, rel, &hit, h.p, tr,
                  solid_angle_to_area_pdf(p.last_pdf, fabs(dot(h.ng, d)), dist2));
   // Connections can make the paths that end after x_t, t >= 2 (x_t: the vertex `ray` left).
-  const int joinable =
-      light_paths > 0u && (p.eye_flags & PR_EYE_JOINABLE) && p.depth >= p.x1_depth + 1u;
+  const int joinable = pt_joinable(&p, light_paths, 1u);
 
   if (s.sd.materials[h.material].flags & PR_MAT_EMISSIVE) {
     EyeWeight ew;
@@ -434,8 +439,7 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
     }
   }
   // x_t with t >= 3: the light tracer's density of x_{t-1}, reached from this vertex.
-  const int has_rev =
-      light_paths > 0u && (p.eye_flags & PR_EYE_JOINABLE) && p.depth >= p.x1_depth + 2u;
+  const int has_rev = pt_joinable(&p, light_paths, 2u);
   if (p.depth >= max_depth) {
     p.alive = 0u;
   } else {
@@ -443,8 +447,7 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
       Ray shadow;
       float3 c;
       NextEventChoice ch;
-      const int here_joinable =
-          light_paths > 0u && (p.eye_flags & PR_EYE_JOINABLE) && p.depth >= p.x1_depth + 1u;
+      const int here_joinable = pt_joinable(&p, light_paths, 1u);
       if (next_event(&s, &h, &f, wo, !here_joinable, &rng, &shadow, &c, &ch)) {
         EyeWeight ew;
         const float w =
