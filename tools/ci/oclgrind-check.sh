@@ -123,6 +123,10 @@ run "atrium-normal-maps-env-reuse-connections" "$work/bumps/atrium.gltf" --frame
   --camera 1 --env "$work/bumps/sky.hdr" --env-rotate 40 --no-eye-paths
 run "atrium-normal-maps-env-eye" "$work/bumps/atrium.gltf" --frames 0-1 --mode reuse \
   --camera 1 --env "$work/bumps/sky.hdr" --env-rotate 40
+# A sun and a sky: their light paths from the disk across their direction, in every strategy.
+python3 -m tools.scenes.gen_atrium --size 0.02 --light sun --out "$work/sun/atrium.gltf" >/dev/null
+run "atrium-sun-sky-eye" "$work/sun/atrium.gltf" --frames 0-1 --mode reuse \
+  --env-color 0.5,0.6,0.8
 # Every BSDF lobe and texture (sheen, a coat with its own normal map, anisotropy with a direction
 # texture) in both integrators, and the glTF specification's model.
 for mode in pathtrace reuse; do
