@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
+#include <cstdlib>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -53,6 +54,13 @@ std::string deviceTypeName(cl_device_type type) {
 }
 
 std::vector<DeviceEntry> enumerateDevices() {
+  // PoCL compiles a work-group function for each launch's local size, global offset (zero or
+  // not) and grid width (below 65,535 or not) the first time it meets them, outside any
+  // program binary: a new image size cost up to a minute of compiling (the demo: 42 s at a
+  // first size, 33 s at a second, with PoCL's own cache empty). Its generic functions, which
+  // the program binaries in our kernel cache hold, ran no slower here (docs/design.md section
+  // 7). Before the first OpenCL call, and where the user has not chosen.
+  setenv("POCL_WORK_GROUP_SPECIALIZATION", "0", 0);
   std::vector<cl::Platform> platforms;
   cl_int err = cl::Platform::get(&platforms);
   // The ICD loader reports "no platform" as CL_PLATFORM_NOT_FOUND_KHR: an empty list, not a
