@@ -576,17 +576,15 @@ TEST(BadOptions, RangesAndEmptyScenesAreOneLineAndExitTwo) {
   EXPECT_EQ(r.exitCode, 2) << r.err;
   EXPECT_EQ(lineCount(r.err), 1u) << r.err;
   EXPECT_NE(r.err.find("--adaptive-min-spp"), std::string::npos) << r.err;
-  r = test::runPathreuse("render '" + kScene +
-                         "' --quiet --frames 1234567890 --width 8 --height 8 "
-                         "--spp 1 --out '" +
-                         dir + "/big_%d.exr'");
+  auto renderBig = [&](const std::string& frames) {
+    return test::runPathreuse("render '" + kScene + "' --quiet --frames " + frames +
+                              " --width 8 --height 8 --spp 1 --out '" + dir + "/big_%d.exr'");
+  };
+  r = renderBig("1234567890");
   EXPECT_EQ(r.exitCode, 0) << r.err;
   EXPECT_TRUE(fs::exists(dir + "/big_1234567890.exr"));
   // 64-bit frame numbers; the last two end the run (a 32-bit counter wrapped and rendered on).
-  r = test::runPathreuse("render '" + kScene +
-                         "' --quiet --frames 9223372036854775805-9223372036854775806 --width 8 "
-                         "--height 8 --spp 1 --out '" +
-                         dir + "/big_%d.exr'");
+  r = renderBig("9223372036854775805-9223372036854775806");
   EXPECT_EQ(r.exitCode, 0) << r.err;
   EXPECT_TRUE(fs::exists(dir + "/big_9223372036854775806.exr"));
   size_t frames = 0;

@@ -11,9 +11,9 @@
 
 #include "cl/kernel_args.h"
 #include "render/device_materials.h"
-#include "scene/emission_power.h"
 #include "render/kernel_programs.h"
 #include "render/light_table.h"
+#include "scene/emission_power.h"
 #include "util/error.h"
 #include "util/hash.h"
 
