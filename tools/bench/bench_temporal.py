@@ -136,7 +136,22 @@ LUXCORE = "LuxCore 2.11 BIDIR (its own reference)"
 BENCH = REPO / "tools" / "bench"
 
 
-def peer_frames(args, cmd, name, key, spp, seed):
+def measured(args, sc):
+    """The first and last measured frame of a scene: its frames after the --warm ones."""
+    return sc.frames[args.warm], sc.frames[-1]
+
+
+def peer_view(sc):
+    """What a peer is told of the view: the camera by name, the world's colour."""
+    out = []
+    if getattr(sc, "camera_name", None):
+        out += ["--camera", sc.camera_name]
+    if getattr(sc, "world", None):
+        out += ["--world", sc.world]
+    return out
+
+
+def peer_frames(args, cmd, name, sc, spp, seed):
     """Runs a peer's frame script; the render seconds of the measured frames."""
     env = None
     if name == "luxcore":
@@ -149,17 +164,19 @@ def peer_frames(args, cmd, name, key, spp, seed):
     if proc.returncode != 0:
         die(f"{name} failed ({proc.returncode}): {' '.join(cmd)}\n{proc.stderr.strip()[-2000:]}", 1)
     recs = [json.loads(line) for line in proc.stdout.splitlines() if line.startswith("{")]
-    if len(recs) != args.frames - args.warm:
-        die(f"expected {args.frames - args.warm} frames from: {' '.join(cmd)}", 1)
+    first, last = measured(args, sc)
+    if len(recs) != last - first + 1:
+        die(f"expected {last - first + 1} frames from: {' '.join(cmd)}", 1)
     if not args.quiet:
-        print(f"  {key:16s} {name:9s} spp {spp:3d} seed {seed}       frames "
-              f"{args.warm}-{args.frames - 1}: median {median([r['render_s'] for r in recs]):.3f} "
+        print(f"  {sc.key:16s} {name:9s} spp {spp:3d} seed {seed}       frames "
+              f"{first}-{last}: median {median([r['render_s'] for r in recs]):.3f} "
               "s/frame", flush=True)
     return [r["render_s"] for r in recs]
 
 
-def frame_args(args, spp, seed, size):
-    return ["--frames", f"{args.warm}-{args.frames - 1}", "--spp", str(spp), "--width",
+def frame_args(args, sc, spp, seed, size):
+    first, last = measured(args, sc)
+    return ["--frames", f"{first}-{last}", "--spp", str(spp), "--width",
             str(size[1]), "--height", str(size[0]), "--max-depth", str(args.max_depth), "--seed",
             str(seed)]
 
@@ -168,18 +185,21 @@ def cycles_render(args, sc, spp, seed, size, out):
     """Cycles' measured frames at spp into out/f_%04d.exr; their render seconds."""
     out.mkdir(parents=True, exist_ok=True)
     cmd = [args.cycles, str(BENCH / "cycles_frames.py"), str(sc.path), str(out)]
-    return peer_frames(args, cmd + frame_args(args, spp, seed, size), "cycles", sc.key, spp, seed)
+    return peer_frames(args, cmd + frame_args(args, sc, spp, seed, size) + peer_view(sc), "cycles",
+                       sc, spp, seed)
 
 
 def luxcore_export(args, sc, size, cache):
     """The measured frames as triangles (tools/bench/scene_export.py), kept in the cache."""
-    key = hashlib.sha1(json.dumps([file_sha(sc.path), list(size), args.warm, args.frames,
+    first, last = measured(args, sc)
+    key = hashlib.sha1(json.dumps([file_sha(sc.path), list(size), first, last, peer_view(sc),
                                    file_sha(BENCH / "scene_export.py")]).encode()).hexdigest()[:16]
     out = cache / f"{sc.key}_export_{key}"
     if not (out / "scene.json").is_file():
         out.mkdir(parents=True, exist_ok=True)
         cmd = [args.cycles, str(BENCH / "scene_export.py"), str(sc.path), str(out), "--frames",
-               f"{args.warm}-{args.frames - 1}", "--width", str(size[1]), "--height", str(size[0])]
+               f"{first}-{last}", "--width", str(size[1]), "--height", str(size[0]),
+               *peer_view(sc)]
         proc = subprocess.run(cmd, capture_output=True, text=True)
         if proc.returncode != 0 or not (out / "scene.json").is_file():
             die(f"export failed ({proc.returncode}): {' '.join(cmd)}\n{proc.stderr[-2000:]}", 1)
@@ -190,15 +210,16 @@ def luxcore_render(args, export, sc, spp, seed, size, out):
     """LuxCore's measured frames at spp into out/f_%04d.exr; their render seconds."""
     out.mkdir(parents=True, exist_ok=True)
     cmd = [args.luxcore, str(BENCH / "luxcore_frames.py"), str(export), str(out)]
-    return peer_frames(args, cmd + frame_args(args, spp, seed, size), "luxcore", sc.key, spp, seed)
+    return peer_frames(args, cmd + frame_args(args, sc, spp, seed, size), "luxcore", sc, spp, seed)
 
 
 def peer_measure(runner, sc, size, args, cache, tmp, name, ref_spp, render):
     """A peer's row, {spp: (relMSE, s/frame, flicker)}, against its own reference frames;
     render(spp, seed, out) renders the measured frames."""
-    key = hashlib.sha1(json.dumps([file_sha(sc.path), list(size), ref_spp,
-                                   args.max_depth, name]).encode()).hexdigest()[:16]
-    frames = range(args.warm, args.frames)
+    first, last = measured(args, sc)
+    key = hashlib.sha1(json.dumps([file_sha(sc.path), list(size), ref_spp, args.max_depth, name,
+                                   first, last, peer_view(sc)]).encode()).hexdigest()[:16]
+    frames = range(first, last + 1)
     ref_dir = cache / f"{sc.key}_{name.split('-')[0]}_{key}"
     ref_exrs = [ref_dir / f"f_{f:04d}.exr" for f in frames]
     if not all(p.is_file() for p in ref_exrs):
@@ -224,8 +245,9 @@ def report(sc, fig, args):
     tracer at --spp."""
     pt = fig["pathtrace"][args.spp]
     target = pt[0]
-    lines = [f"### {sc.key} ({args.width} px wide, frames {args.warm}-{args.frames - 1} of "
-             f"0-{args.frames - 1} measured, seeds {','.join(map(str, args.seeds))})", "",
+    first, last = measured(args, sc)
+    lines = [f"### {sc.key} ({args.width} px wide, frames {first}-{last} of "
+             f"{sc.frames[0]}-{last} measured, seeds {','.join(map(str, args.seeds))})", "",
              "| setting | " + " | ".join(f"spp {s}: relMSE, s/frame" for s in args.sweep_spp)
              + f" | equal-error speed-up (target: path tracer at {args.spp} spp) "
              f"| relMSE x s at {args.spp} spp: the path tracer's over this "

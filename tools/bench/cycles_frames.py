@@ -3,10 +3,12 @@
 (PyPI's wheel, Python 3.13, in a virtual environment of its own):
 
   VENV/bin/python tools/bench/cycles_frames.py SCENE.gltf OUTDIR --frames A-B --spp N \\
-      --width W --height H --max-depth D [--seed S] [--threads T]
+      --width W --height H --max-depth D [--seed S] [--threads T] [--camera NAME] [--world R,G,B]
 
 The scene goes through Blender's own glTF importer with its materials as imported (Principled
-BSDF), a black world, the first camera, frame f at time f / 24 s (pathreuse's default --fps).
+BSDF; colour textures read as sRGB), lights unconverted (a sun's intensity is its irradiance, as
+pathreuse reads it), a black world or one of --world R,G,B, the first camera or the one --camera
+names, frame f at time f / 24 s (pathreuse's default --fps).
 Cycles on the CPU: a box pixel filter one pixel wide, no adaptive sampling, denoising, clamping or
 path guiding, light tree on, max bounces = D - 2 (pathreuse counts the camera's hit and the light's
 vertex in --max-depth), a fixed seed per run (Cycles' seed is not animated: each frame's noise
@@ -27,14 +29,49 @@ def parse_args():
     return peer_args("cycles_frames.py", "scene")
 
 
-def first_camera(path, scene):
+def first_camera(path, scene, name=None):
+    """The camera named `name` (its glTF node's or camera's name), else the file's first."""
     with open(path, encoding="utf-8") as f:
         doc = json.load(f)
-    want = doc.get("cameras", [{}])[0].get("name") if doc.get("cameras") else None
+    want = name or (doc.get("cameras", [{}])[0].get("name") if doc.get("cameras") else None)
     cams = [o for o in scene.objects if o.type == "CAMERA"]
     if not cams:
         raise SystemExit("cycles_frames: the scene has no camera")
-    return next((o for o in cams if want and o.data.name == want), cams[0])
+    found = next((o for o in cams if want and want in (o.name, o.data.name)), None)
+    if name and found is None:
+        raise SystemExit(f"cycles_frames: no camera named {name}")
+    return found or cams[0]
+
+
+def colour_textures_srgb():
+    """Blender's importer reads a texture that is both base colour and occlusion as Non-Color;
+    as colour (base or emission) glTF says it is sRGB."""
+    for mat in bpy.data.materials:
+        if not mat.use_nodes:
+            continue
+        for node in mat.node_tree.nodes:
+            if node.type != "BSDF_PRINCIPLED":
+                continue
+            todo = [node.inputs[n] for n in ("Base Color", "Emission Color")]
+            while todo:
+                for link in todo.pop().links:
+                    up = link.from_node
+                    if up.type == "TEX_IMAGE" and up.image is not None:
+                        up.image.colorspace_settings.name = "sRGB"
+                    todo += [i for i in up.inputs if i.is_linked]
+
+
+def world(scene, rgb):
+    """A uniform world of radiance rgb ("R,G,B"), or black."""
+    w = bpy.data.worlds.new("world")
+    w.use_nodes = True
+    bg = w.node_tree.nodes["Background"]
+    if rgb:
+        bg.inputs["Color"].default_value = [float(x) for x in rgb.split(",")] + [1.0]
+        bg.inputs["Strength"].default_value = 1.0
+    else:
+        bg.inputs["Strength"].default_value = 0.0
+    scene.world = w
 
 
 def setup(a):
@@ -42,12 +79,14 @@ def setup(a):
     scene = bpy.context.scene
     scene.render.fps = 24
     scene.render.fps_base = 1.0
-    bpy.ops.import_scene.gltf(filepath=a.scene)
-    world = bpy.data.worlds.new("black")
-    world.use_nodes = True
-    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
-    scene.world = world
-    scene.camera = first_camera(a.scene, scene)
+    # RAW: a sun's intensity is its irradiance, as pathreuse reads it
+    bpy.ops.import_scene.gltf(filepath=a.scene, export_import_convert_lighting_mode="RAW")
+    colour_textures_srgb()
+    for light in bpy.data.lights:
+        if light.type == "SUN":
+            light.angle = 0.0  # glTF's directional light is a delta light
+    world(scene, a.world)
+    scene.camera = first_camera(a.scene, scene, a.camera)
     scene.render.engine = "CYCLES"
     c = scene.cycles
     c.device = "CPU"

@@ -8,7 +8,8 @@ LD_PRELOAD naming the wheel's libtbbmalloc and libtbbmalloc_proxy (else PoCL abo
 
 Bidirectional path tracing on the CPU, Sobol samples, Russian roulette off (its default biases
 the mean), eye and light paths of at most D - 1 segments (pathreuse's --max-depth D counts the
-camera's hit and the light's vertex), a box pixel filter one pixel wide, a black world. Materials
+camera's hit and the light's vertex), a box pixel filter one pixel wide, the exported suns as
+distant lights, a black world or the exported uniform one. Materials
 from the exported Principled inputs, as near as LuxCore's own come: glass where transmission > 0.5,
 metal (metal2 with the base colour's Fresnel) where metallic > 0.5, else matte where roughness is
 at least 0.95, else glossy2 (diffuse base colour under a specular coat of reflectance 0.04), GGX
@@ -92,6 +93,15 @@ def build_scene(info, frame, arrays, a):
         f"scene.camera.up = {vec(cam['up'])}",
         f"scene.camera.fieldofview = {long_fov(cam['vfov_deg'], a)}",
     ]
+    for k, sun in enumerate(info.get("suns", [])):
+        props += [f"scene.lights.sun{k}.type = sharpdistant",
+                  f"scene.lights.sun{k}.direction = {vec(sun['direction'])}",
+                  f"scene.lights.sun{k}.color = {vec(sun['irradiance'])}",
+                  f"scene.lights.sun{k}.gain = 1 1 1"]
+    if info.get("world"):
+        props += ["scene.lights.world.type = constantinfinite",
+                  f"scene.lights.world.color = {vec(info['world'])}",
+                  "scene.lights.world.gain = 1 1 1"]
     used = sorted({int(k[1:]) for k in arrays.files if k.startswith("p")})
     for k in used:
         props += material_props(k, info["materials"][k])
@@ -148,6 +158,10 @@ def main():
     pyluxcore.Init(lambda msg: print(msg, file=sys.stderr) if a.verbose else None)
     with open(f"{a.export}/scene.json", encoding="utf-8") as f:
         info = json.load(f)
+    if info.get("textured"):
+        print(f"luxcore_frames: {a.export}: the scene has image textures, which the export "
+              "leaves out", file=sys.stderr)
+        return 2
     for frame in range(a.first, a.last + 1):
         arrays = np.load(f"{a.export}/f_{frame:04d}.npz")
         scene = build_scene(info, frame, arrays, a)

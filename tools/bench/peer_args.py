@@ -6,7 +6,8 @@ import sys
 
 
 def peer_args(prog, source, render=True, extra=None):
-    """Parses SOURCE OUTDIR --frames A-B --width W --height H and, with `render`, --spp N
+    """Parses SOURCE OUTDIR --frames A-B --width W --height H [--camera NAME] [--world R,G,B]
+    and, with `render`, --spp N
     --max-depth D --seed S --threads T; `extra(ap)` adds a script's own. Sets a.first, a.last."""
     ap = argparse.ArgumentParser(prog=prog)
     ap.add_argument(source)
@@ -19,6 +20,8 @@ def peer_args(prog, source, render=True, extra=None):
         ap.add_argument("--max-depth", type=int, required=True)
         ap.add_argument("--seed", type=int, default=1)
         ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--camera", help="the camera's name (default: the file's first)")
+    ap.add_argument("--world", help="R,G,B: a uniform world of this radiance (default: black)")
     if extra:
         extra(ap)
     a = ap.parse_args(sys.argv[1:])

@@ -6,10 +6,12 @@ that has no glTF importer (tools/bench/luxcore_frames.py). Run by a Python that 
 
 The scene goes through Blender's glTF importer, as for Cycles (tools/bench/cycles_frames.py),
 and frame f is evaluated at f / 24 s (skins, morph targets and transforms applied). Writes
-OUTDIR/scene.json (each material's Principled BSDF inputs; per frame the first camera's eye,
-target, up and vertical field of view for a W x H image) and OUTDIR/f_%04d.npz (per material
+OUTDIR/scene.json (each material's Principled BSDF inputs; the suns and the world colour of
+--world; whether any image texture was imported; per frame the camera's eye, target, up and
+vertical field of view for a W x H image) and OUTDIR/f_%04d.npz (per material
 index k, triangle corners p<k> and their shading normals n<k>, float32, 3 rows per triangle).
-Image textures are not exported: the benchmark scenes have none.
+Image textures are not exported: a scene that has them is marked "textured" and
+luxcore_frames.py refuses it.
 """
 
 import json
@@ -48,6 +50,17 @@ def principled(mat):
     return out
 
 
+def suns(scene):
+    """Each sun's direction of travel and irradiance (RGB)."""
+    out = []
+    for obj in scene.objects:
+        if obj.type == "LIGHT" and obj.data.type == "SUN":
+            d = (obj.matrix_world.to_3x3() @ Vector((0.0, 0.0, -1.0))).normalized()
+            out.append({"direction": list(d),
+                        "irradiance": [c * obj.data.energy for c in obj.data.color]})
+    return out
+
+
 def camera_at(cam, a):
     m = cam.matrix_world
     eye = m.translation
@@ -69,11 +82,13 @@ def main():
     scene = bpy.context.scene
     scene.render.fps = 24
     scene.render.fps_base = 1.0
-    bpy.ops.import_scene.gltf(filepath=a.scene)
-    cam = first_camera(a.scene, scene)
+    bpy.ops.import_scene.gltf(filepath=a.scene, export_import_convert_lighting_mode="RAW")
+    cam = first_camera(a.scene, scene, a.camera)
     mats = list(bpy.data.materials)
     index = {m.name: k for k, m in enumerate(mats)}
-    info = {"materials": [principled(m) for m in mats] + [principled(None)], "frames": {}}
+    info = {"materials": [principled(m) for m in mats] + [principled(None)], "frames": {},
+            "world": [float(x) for x in a.world.split(",")] if a.world else None,
+            "suns": suns(scene), "textured": any(i.source == "FILE" for i in bpy.data.images)}
     fallback = len(mats)
     for f in range(a.first, a.last + 1):
         scene.frame_set(f)

@@ -1,7 +1,7 @@
 """Generates a large atrium test scene (not committed): a courtyard surrounded by two
 storeys of columns and arches, galleries, outer walls, curtains, an opening in the roof
 lit by an emissive sky quad (or a directional sun, or at night by several hundred small
-lanterns), and three moving objects.
+lanterns), three moving objects, two still cameras and one walking through the courtyard.
 
   python3 -m tools.scenes.gen_atrium --size 1 --out /tmp/atrium/atrium.gltf   # ~300k triangles
   python3 -m tools.scenes.gen_atrium --size 0.1 --out /tmp/atrium-small.gltf  # quick test scene
@@ -243,6 +243,17 @@ def build_static(c, normal_maps=False):
 
 
 # ---------------------------------------------------------------- moving parts
+
+def walkthrough(t):
+    """The moving camera at time t: it walks from the courtyard camera's place towards the
+    far corner of the courtyard, rising a little, and pans 60 degrees to its left over the
+    animation: about 1.1 m and 6 degrees a second, a handheld walk."""
+    u = t / DURATION
+    eye = (COURTYARD_EYE[0] - 10.0 * u, COURTYARD_EYE[1] + 0.8 * u, COURTYARD_EYE[2] - 4.0 * u)
+    yaw = math.radians(-100.0 + 60.0 * u)
+    look = (math.cos(yaw), -0.12, math.sin(yaw))
+    return eye, gw.quat_look(look)
+
 
 def key_times():
     n = int(round(DURATION / KEY_STEP))
@@ -570,6 +581,8 @@ def build(size, light, normal_maps=False):
                             extensions={"KHR_lights_punctual": {"light": sun}}))
 
     times = key_times()
+    walk = g.node("walkthrough", camera=g.camera("walkthrough", 0.9, 16.0 / 9.0, 0.05, 200.0),
+                  translation=walkthrough(0)[0], rotation=walkthrough(0)[1])
     white = g.material("ball_white", (0.8, 0.8, 0.78), roughness=0.4)
     red = g.material("ball_red", (0.7, 0.1, 0.08), roughness=0.4)
     wa, wb = ball_meshes(c)
@@ -602,7 +615,9 @@ def build(size, light, normal_maps=False):
         (ball, "translation", times, [ball_pose(t)[0] for t in times]),
         (ball, "rotation", times, [ball_pose(t)[1] for t in times]),
         (pivot, "rotation", times, [lantern_swing(t) for t in times]),
-        (crate, "translation", times, [crate_position(t) for t in times])])
+        (crate, "translation", times, [crate_position(t) for t in times]),
+        (walk, "translation", times, [walkthrough(t)[0] for t in times]),
+        (walk, "rotation", times, [walkthrough(t)[1] for t in times])])
 
     # cameras: in the corner arch of the upper gallery looking across the courtyard, and
     # one standing in the courtyard
@@ -612,6 +627,7 @@ def build(size, light, normal_maps=False):
         cam = g.camera(name, 0.9, 16.0 / 9.0, 0.05, 200.0)
         roots.append(g.node(name, camera=cam, translation=eye,
                             rotation=gw.quat_look(gw.sub(at, eye))))
+    roots.append(walk)  # the third camera, after the still ones
     return g, roots, emitters
 
 
