@@ -13,6 +13,7 @@
 #include "render/device_materials.h"
 #include "render/kernel_programs.h"
 #include "render/light_table.h"
+#include "render/moved_tree.h"
 #include "scene/emission_power.h"
 #include "util/error.h"
 #include "util/hash.h"
@@ -323,6 +324,7 @@ void GpuScene::collectMoved(const std::vector<accel::Aabb>& before,
     }
     moved_.push_back(m);
   }
+  moved_ = movedTree(std::move(moved_));
 }
 
 bool GpuScene::validSurface(uint32_t prim, uint32_t inst) const {

@@ -136,6 +136,8 @@
   F(DirectReservoir, m)               \
   F(MovedInstance, root)              \
   F(MovedInstance, root_before)       \
+  F(MovedInstance, skip)              \
+  F(MovedInstance, node)              \
   F(MovedInstance, before)            \
   F(MovedInstance, after)             \
   F(PathTrack, x1_ok)                 \

@@ -154,12 +154,15 @@ typedef struct {
 // then and now (the same where it moved rigidly; the previous shape's where it deformed) and its
 // world-to-object transforms then and now (3 x 4 rows), against which a segment is tested
 // exactly. Where no shape of the previous frame is known (the first frame), it is its boxes
-// alone. 160 bytes.
+// alone. The records are a bounding-box tree in preorder (host/render/moved_tree.h): a `node`
+// record stands for no instance, both its boxes bound the records of its subtree, and `skip` is
+// the first record after that subtree, where a test that misses the boxes goes on. 160 bytes.
 typedef struct {
   float box[12];
   u32 root;         // now (PR_INVALID_INDEX: its boxes alone)
   u32 root_before;  // then
-  u32 pad1, pad2;
+  u32 skip;         // the next record outside this one's subtree (the next one, for an instance)
+  u32 node;         // 1: an inner node of the tree; 0: an instance
   float before[12], after[12];
 } MovedInstance;
 

@@ -282,20 +282,33 @@ PR_INLINE int rs_meets(const SceneData* s, PR_GLOBAL const MovedInstance* m, flo
   return 0;
 }
 
+// The record after moved[k] for a test that does (hit) or does not meet its boxes: into a node's
+// subtree, or past it. Never backwards, whatever the records say.
+PR_INLINE u32 rs_moved_next(PR_GLOBAL const MovedInstance* m, u32 k, int hit) {
+  return hit || !m->node ? k + 1u : max(m->skip, k + 1u);
+}
+
 // Whether the ray (segment: tmax 1 and d the far end minus o) meets none of the moved instances.
 PR_INLINE int rs_clear(const SceneData* s, PR_GLOBAL const MovedInstance* moved, u32 count,
                        float3 o, float3 d, float tmax) {
-  for (u32 k = 0u; k < count; ++k)
-    if (rs_meets(s, moved + k, o, d, tmax)) return 0;
+  for (u32 k = 0u; k < count;) {
+    PR_GLOBAL const MovedInstance* m = moved + k;
+    if (!m->node && rs_meets(s, m, o, d, tmax)) return 0;
+    k = rs_moved_next(m, k, m->node && rs_box_hit(m->box, o, d, tmax));
+  }
   return 1;
 }
 
 // Whether point p lies outside every moved instance's boxes (a path's point known by position
 // alone, which may have been on one).
 PR_INLINE int rs_apart(PR_GLOBAL const MovedInstance* moved, u32 count, float3 p) {
-  for (u32 k = 0u; k < count; ++k)
-    for (int b = 0; b < 2; ++b)
-      if (rs_box_hit(moved[k].box + 6 * b, p, make_float3(0.0f, 0.0f, 0.0f), 0.0f)) return 0;
+  const float3 z = make_float3(0.0f, 0.0f, 0.0f);
+  for (u32 k = 0u; k < count;) {
+    PR_GLOBAL const MovedInstance* m = moved + k;
+    const int in = rs_box_hit(m->box, p, z, 0.0f) || rs_box_hit(m->box + 6, p, z, 0.0f);
+    if (in && !m->node) return 0;
+    k = rs_moved_next(m, k, in);
+  }
   return 1;
 }
 
