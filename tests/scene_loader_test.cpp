@@ -322,6 +322,31 @@ TEST(SceneLoader, UnsupportedOptionalExtensionsAreNamedOnce) {
       << s.warnings[1];
 }
 
+// A transmission texture is not applied (the factor alone is): the user is told, once per
+// material, rather than seeing opaque parts of a window rendered as clear glass unexplained.
+TEST(SceneLoader, TransmissionTextureIsNamedInAWarning) {
+  Quad q;
+  q.doc["extensionsUsed"] = {"KHR_materials_transmission"};
+  q.doc["images"] = {{{"uri",
+                       "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAIAAAACCAIAAAD91JpzAAAAEkl"
+                       "EQVR4nGP4z8DAAMIM/4EAAB/uBfsL2WiLAAAAAElFTkSuQmCC"}}};
+  q.doc["textures"] = {{{"source", 0}}};
+  q.doc["materials"] = {
+      {{"name", "window"},
+       {"extensions",
+        {{"KHR_materials_transmission",
+          {{"transmissionFactor", 1.0}, {"transmissionTexture", {{"index", 0}}}}}}}}};
+  q.doc["meshes"][0]["primitives"][0]["material"] = 0;
+  Scene s;
+  ASSERT_EQ(tryLoad(q.write(), &s), "");
+  ASSERT_EQ(s.materials.size(), 1u);
+  EXPECT_FLOAT_EQ(s.materials[0].transmission, 1.0f);
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_NE(s.warnings[0].find("transmissionTexture is not applied"), std::string::npos)
+      << s.warnings[0];
+  EXPECT_NE(s.warnings[0].find("window"), std::string::npos) << s.warnings[0];
+}
+
 TEST(SceneLoader, InstancingAndMirroring) {
   Quad q;
   q.addNormals();

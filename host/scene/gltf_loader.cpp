@@ -492,9 +492,11 @@ class Converter : Stage {
       if (const Value* e = extension(src.extensions, "KHR_materials_emissive_strength"))
         if (const Value* s = member(*e, "emissiveStrength"))
           m.emissiveStrength = float(s->GetNumberAsDouble());
-      if (const Value* e = extension(src.extensions, "KHR_materials_transmission"))
+      if (const Value* e = extension(src.extensions, "KHR_materials_transmission")) {
         if (const Value* s = member(*e, "transmissionFactor"))
           m.transmission = float(s->GetNumberAsDouble());
+        warnTextures(*e, {"transmissionTexture"}, where);
+      }
       if (const Value* e = extension(src.extensions, "KHR_materials_ior"))
         if (const Value* s = member(*e, "ior")) m.ior = float(s->GetNumberAsDouble());
       if (const Value* e = extension(src.extensions, "KHR_materials_specular")) {
