@@ -22,6 +22,7 @@
 #include "cl/device.h"
 #include "io/image.h"
 #include "render/film.h"
+#include "render/frame_writer.h"
 #include "render/gpu_scene.h"
 #include "render/history_format.h"
 #include "render/multi_device.h"
@@ -339,10 +340,9 @@ void warmUp(const RenderOptions& o, MultiDeviceSession& session, int64_t f, bool
   }
 }
 
-// After frame f is written: its history replaces the previous frame's.
-void writeHistory(const RenderOptions& o, MultiDeviceSession& session, const std::string& key,
-                  int64_t f) {
-  writeFileAtomic(historyPath(o, f), packHistories(session, key));
+// After frame f is written: its history (packHistories's bytes) replaces the previous frame's.
+void writeHistory(const RenderOptions& o, const std::string& packed, int64_t f) {
+  writeFileAtomic(historyPath(o, f), packed);
   std::error_code ec;
   std::filesystem::remove(historyPath(o, f - 1), ec);
 }
@@ -396,9 +396,11 @@ void removeStaleFiles(const RenderOptions& o, int frameCount) {
               << formatOutPath(o.outPattern, 0) << "\n";
 }
 
-// Renders the session's frames in order, each written as soon as it is done.
+// Renders the session's frames in order, each written (render/frame_writer.h) while the next
+// one renders.
 int renderFrames(const RenderOptions& o, MultiDeviceSession& session, const FrameRange& range,
                  StatsFile* stats, const InputFiles& inputs) {
+  FrameWriter writer;
   const bool progress = !o.quiet && isatty(STDERR_FILENO);
   Tally t;
   int64_t f = range.first;
@@ -428,16 +430,24 @@ int renderFrames(const RenderOptions& o, MultiDeviceSession& session, const Fram
     const auto t0 = std::chrono::steady_clock::now();
     FrameStats fs;
     std::vector<DeviceFrame> parts;
-    const Image img = session.renderFrame(f, &fs, &parts);
+    Image img = session.renderFrame(f, &fs, &parts);
     if (interrupted()) break;  // the film may be partial: drop the frame
-    writeExr(exr, img, o.exrFloat ? ExrPixels::Float : ExrPixels::Half);
-    if (o.png) writePng(withExtension(exr, ".png"), img, o.exposure);
-    if (history) writeHistory(o, session, key, f);
+    // The devices' state is read now, before the next frame changes it; the files are written
+    // on the writer's thread, the frame before this one's first (its wall time counts here).
+    std::string packed = history ? packHistories(session, key) : std::string();
+    writer.wait();
     lastRendered = f;
     ++t.rendered;
     fs.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     for (const auto& [k, v] : fs.rays) t.raysSoFar += v;
-    if (stats) stats->writeLine(statsLine(f, o, fs, parts));
+    std::string line = stats ? statsLine(f, o, fs, parts) : std::string();
+    writer.submit([&o, stats, history, f, exr, img = std::move(img), packed = std::move(packed),
+                   line = std::move(line)] {
+      writeExr(exr, img, o.exrFloat ? ExrPixels::Float : ExrPixels::Half);
+      if (o.png) writePng(withExtension(exr, ".png"), img, o.exposure);
+      if (history) writeHistory(o, packed, f);
+      if (stats) stats->writeLine(line);
+    });
     if (fs.badSamples > 0) {
       t.badSamples += fs.badSamples;
       ++t.badFrames;
@@ -447,6 +457,7 @@ int renderFrames(const RenderOptions& o, MultiDeviceSession& session, const Fram
     }
     if (progress) printProgress(range, t, f);
   }
+  writer.wait();
   if (progress) std::fprintf(stderr, "\n");
   // The animation's last frame has no next one to take its history.
   if (history && f > range.last && range.last >= session.session(0).frameCount() - 1) {
