@@ -581,8 +581,6 @@ def build(size, light, normal_maps=False):
                             extensions={"KHR_lights_punctual": {"light": sun}}))
 
     times = key_times()
-    walk = g.node("walkthrough", camera=g.camera("walkthrough", 0.9, 16.0 / 9.0, 0.05, 200.0),
-                  translation=walkthrough(0)[0], rotation=walkthrough(0)[1])
     white = g.material("ball_white", (0.8, 0.8, 0.78), roughness=0.4)
     red = g.material("ball_red", (0.7, 0.1, 0.08), roughness=0.4)
     wa, wb = ball_meshes(c)
@@ -611,13 +609,11 @@ def build(size, light, normal_maps=False):
     crate = g.node("sliding_crate", mesh=g.mesh("crate", [(gw.box((-h, -h, -h), (h, h, h)), wood)]),
                    translation=crate_position(0), extras={"dynamic": True})
     roots += [ball, pivot, crate]
-    g.animation("motion", [
+    motion = g.animation("motion", [
         (ball, "translation", times, [ball_pose(t)[0] for t in times]),
         (ball, "rotation", times, [ball_pose(t)[1] for t in times]),
         (pivot, "rotation", times, [lantern_swing(t) for t in times]),
-        (crate, "translation", times, [crate_position(t) for t in times]),
-        (walk, "translation", times, [walkthrough(t)[0] for t in times]),
-        (walk, "rotation", times, [walkthrough(t)[1] for t in times])])
+        (crate, "translation", times, [crate_position(t) for t in times])])
 
     # cameras: in the corner arch of the upper gallery looking across the courtyard, and
     # one standing in the courtyard
@@ -627,7 +623,19 @@ def build(size, light, normal_maps=False):
         cam = g.camera(name, 0.9, 16.0 / 9.0, 0.05, 200.0)
         roots.append(g.node(name, camera=cam, translation=eye,
                             rotation=gw.quat_look(gw.sub(at, eye))))
-    roots.append(walk)  # the third camera, after the still ones
+    # The third camera walks; made last, so that the other nodes, cameras and accessors keep
+    # their indices (and the first camera, the default, its view).
+    walk = g.node("walkthrough", camera=g.camera("walkthrough", 0.9, 16.0 / 9.0, 0.05, 200.0),
+                  translation=walkthrough(0)[0], rotation=walkthrough(0)[1])
+    roots.append(walk)
+    moves = g.doc["animations"].pop(g.animation("walk", [
+        (walk, "translation", times, [walkthrough(t)[0] for t in times]),
+        (walk, "rotation", times, [walkthrough(t)[1] for t in times])]))
+    one = g.doc["animations"][motion]
+    for ch in moves["channels"]:
+        ch["sampler"] += len(one["samplers"])
+    one["samplers"] += moves["samplers"]
+    one["channels"] += moves["channels"]
     return g, roots, emitters
 
 
