@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <vector>
 
@@ -51,6 +52,47 @@ TEST(SceneCli, InfoBoxAnimated) {
   ASSERT_EQ(r.exitCode, 0) << r.err;
   EXPECT_NE(r.out.find("62 dynamic"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("89 frames at 24 fps"), std::string::npos) << r.out;
+}
+
+// The benchmark's lit wrappers of shared assets (tools/scenes/gen_real_scenes.py) load as the
+// generator says: the city's dome walls emit (its roof cut away), a sun and a held camera added;
+// BrainStem gains a stage and two cameras. They name the assets' files outside their own folder,
+// which a render allows only when asked.
+TEST(SceneCli, LitWrappersOfSharedAssetsLoadAsTheirGeneratorSays) {
+  PR_SHARED_SCENE(vc, "VC/VC.gltf");
+  PR_SHARED_SCENE(brainstem, "BrainStem/BrainStem.gltf");
+  const std::string dir = test::tempDir("lit-wrappers");
+  auto make = [&](const char* kind, const std::string& src) {
+    const std::string out = dir + "/" + kind + "-lit.gltf";
+    const std::string cmd = "cd '" + test::sourcePath("") +
+                            "' && python3 -m tools.scenes.gen_real_scenes " + kind + " '" + src +
+                            "' --out '" + out + "' >/dev/null";
+    EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
+    return out;
+  };
+  auto info = [&](const std::string& path) {
+    const auto r = test::runPathreuse("info --json --allow-outside-uris '" + path + "'");
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    return nlohmann::json::parse(r.out);
+  };
+  const std::string city = make("vc", vc);
+  const auto a = info(vc), c = info(city);
+  EXPECT_EQ(c["triangles"]["static"].get<int>(), a["triangles"]["static"].get<int>() - 40);
+  EXPECT_EQ(c["triangles"]["dynamic"], a["triangles"]["dynamic"]);
+  EXPECT_EQ(a["lights"]["emissive_triangles"], 0);
+  EXPECT_EQ(c["lights"]["emissive_triangles"], 16);  // 8 walls, 2 triangles each
+  EXPECT_EQ(c["lights"]["punctual"], 1);
+  EXPECT_EQ(c["cameras"].get<int>(), a["cameras"].get<int>() + 1);
+  EXPECT_EQ(c["animation"]["frames"], a["animation"]["frames"]);
+  const auto refused = test::runPathreuse("info '" + city + "'");
+  EXPECT_EQ(refused.exitCode, 2) << refused.err;
+  EXPECT_NE(refused.err.find("--allow-outside-uris"), std::string::npos) << refused.err;
+
+  const auto b = info(brainstem), s = info(make("brainstem", brainstem));
+  EXPECT_EQ(s["triangles"]["static"], 4);  // the floor and the wall
+  EXPECT_EQ(s["triangles"]["dynamic"], b["triangles"]["dynamic"]);
+  EXPECT_EQ(s["cameras"], 2);
+  EXPECT_EQ(s["animation"]["frames"], b["animation"]["frames"]);
 }
 
 TEST(SceneCli, BrokenFileIsOneLineExitTwo) {
