@@ -37,6 +37,16 @@ bool sameGeometry(const dev::Light& a, const dev::Light& b) {
   return std::memcmp(&a, &b, offsetof(dev::Light, moved)) == 0;
 }
 
+namespace {
+
+// The disk a light at infinity's paths start on, across their direction over the scene's sphere
+// (light_trace): their density per unit area there is its inverse.
+float diskArea(float sceneRadius) {
+  return float(M_PI) * sceneRadius * sceneRadius;
+}
+
+}  // namespace
+
 dev::Light punctualLight(const PunctualLight& p, float sceneRadius) {
   dev::Light l{};
   const glm::vec3 c = p.color * p.intensity;
@@ -57,8 +67,7 @@ dev::Light punctualLight(const PunctualLight& p, float sceneRadius) {
       break;
     case LightType::Directional:
       l.type = PR_LIGHT_DIRECTIONAL;
-      // The disk its light paths start on (light_trace): their density per unit area there.
-      l.disk_area = float(M_PI) * sceneRadius * sceneRadius;
+      l.disk_area = diskArea(sceneRadius);
       break;
   }
   l.power = dev::light_power(&l, sceneRadius);
@@ -75,7 +84,7 @@ dev::Light environmentLight(const Environment& env, float meanLuminance, float s
   l.p0y = std::sin(env.rotation);
   l.le_r = env.scale.r, l.le_g = env.scale.g, l.le_b = env.scale.b;
   l.area = meanLuminance;
-  l.disk_area = float(M_PI) * sceneRadius * sceneRadius;
+  l.disk_area = diskArea(sceneRadius);
   l.leaf = PR_INVALID_INDEX;
   l.power = dev::light_power(&l, sceneRadius);
   if (!std::isfinite(l.power) || !(l.power > 0.0f)) l.power = 0.0f;

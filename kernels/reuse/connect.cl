@@ -481,16 +481,15 @@ PR_INLINE void strategy_sampled_vertex(Connector* cn, float3 xp, float pdf_x, co
       float pdf_l, cos_z, corr = 1.0f;
       if (k == 0u) {
         // Vertex 0: the point on the light; f_z * tpz is its emission over the position pdf.
-        const u32 type = s->lights.lights[cn->headers[slot].light].type;
-        if (!light_joins_vertex0(type)) continue;
+        const Light lz = s->lights.lights[cn->headers[slot].light];
+        if (!light_joins_vertex0(lz.type)) continue;
         zng = oct_decode(v[0].ng_oct);
         // Along -dir the light sends its emission towards Y (a spot's cone).
-        pdf_l = light_emit_pdf(s, cn->headers[slot].light, v, -dir);
+        pdf_l = light_pdf_emit_dir(&lz, zng, -dir);
         // The stored throughput is emission over (position pdf times pdf_l / cos), before a
         // spot's falloff: times pdf_l and the falloff towards Y, emission over the position pdf.
-        const int tri = light_is_triangle(type);
+        const int tri = light_is_triangle(lz.type);
         cos_z = tri ? fabs(dot(zng, dir)) : 1.0f;
-        const Light lz = s->lights.lights[cn->headers[slot].light];
         f_z = make_float3(1.0f, 1.0f, 1.0f) *
               (tri ? 0.5f * PR_INV_PI : pdf_l * light_falloff(&lz, -dir));
       } else {
