@@ -37,20 +37,19 @@ void FrameWriter::run() {
   }
 }
 
-void FrameWriter::rethrow() {
+void FrameWriter::idle(std::unique_lock<std::mutex>& lock) {
+  cv_.wait(lock, [this] { return !busy_ && !next_; });
   if (error_) std::rethrow_exception(error_);
 }
 
 void FrameWriter::wait() {
   std::unique_lock<std::mutex> lock(mutex_);
-  cv_.wait(lock, [this] { return !busy_ && !next_; });
-  rethrow();
+  idle(lock);
 }
 
 void FrameWriter::submit(std::function<void()> write) {
   std::unique_lock<std::mutex> lock(mutex_);
-  cv_.wait(lock, [this] { return !busy_ && !next_; });
-  rethrow();
+  idle(lock);
   next_ = std::move(write);
   cv_.notify_all();
 }

@@ -15,7 +15,7 @@ namespace pr {
 class FrameWriter {
  public:
   FrameWriter();
-  // Waits for the frame being written; an error it met is dropped (call finish() to see it).
+  // Waits for the frame being written; an error it met is dropped (call wait() to see it).
   ~FrameWriter();
   FrameWriter(const FrameWriter&) = delete;
   FrameWriter& operator=(const FrameWriter&) = delete;
@@ -28,7 +28,8 @@ class FrameWriter {
 
  private:
   void run();
-  void rethrow();
+  // Waits, holding `lock`, until nothing is being written or waiting; throws a write's error.
+  void idle(std::unique_lock<std::mutex>& lock);
 
   std::mutex mutex_;
   std::condition_variable cv_;
