@@ -50,49 +50,17 @@ LUXCORE_SKIPS = {"vc": "its textures are not exported to LuxCore"}
 def parse_args():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--scenes", default=",".join(SCENES))
-    ap.add_argument("--width", type=int, default=160)
-    ap.add_argument("--frames", type=int, default=10, help="frames per run, --warm included")
-    ap.add_argument("--warm", type=int, default=4, help="first frames rendered, not measured")
-    ap.add_argument("--spp", type=int, default=4, help="the spp the gains are compared at")
-    ap.add_argument("--sweep-spp", default="2,4,8")
-    ap.add_argument("--seeds", default="1,2")
-    ap.add_argument("--ref-spp", type=int, default=512)
-    ap.add_argument("--max-depth", type=int, default=8)
-    ap.add_argument("--settings", default="pathtrace;reuse",
-                    help="our settings, by bench_temporal's names, separated by ';'")
-    ap.add_argument("--build", default="build", help="folder holding pathreuse and exr_compare")
+    bt.add_run_args(ap, frames=10, sweep="2,4,8", seeds="1,2", settings="pathtrace;reuse")
     ap.add_argument("--work", default=str(REPO / "out" / "bench-animations"),
                     help="the generated scenes, the references and the images")
-    ap.add_argument("--json", help="write the figures here too")
-    ap.add_argument("--cycles", help="a Python with bpy 5.2: measure Cycles too")
-    ap.add_argument("--luxcore", help="a Python with pyluxcore 2.11: measure LuxCore BIDIR too "
-                    "(needs --cycles's Python to export the frames)")
-    ap.add_argument("--luxcore-ref-spp", type=int, default=128)
-    ap.add_argument("--quiet", action="store_true")
     args = ap.parse_args()
     keys = [k.strip() for k in args.scenes.split(",")]
     for k in keys:
         if k not in SCENES:
             die(f"--scenes: no scene {k!r} (there are: {', '.join(SCENES)})")
     args.scenes = keys
-    args.settings = [n.strip() for n in args.settings.split(";")]
-    for n in args.settings:
-        if n not in bt.SETTINGS:
-            die(f"--settings: no setting {n!r} (there are: {'; '.join(bt.SETTINGS)})")
-    if "pathtrace" not in args.settings:
-        die("--settings: the gains are over 'pathtrace', which must be one of them")
-    if args.luxcore and not args.cycles:
-        die("--luxcore: give --cycles too (its bpy exports the frames LuxCore renders)")
-    if args.frames - args.warm < 2 or args.warm < 0:
-        die("--frames must exceed --warm by at least 2 (flicker needs frame pairs)")
-    args.sweep_spp = sorted({int(s) for s in args.sweep_spp.split(",")} | {args.spp})
-    args.seeds = [int(s) for s in args.seeds.split(",")]
-    args.reuse_args, args.scene_args = "", ""
-    build = Path(args.build) if Path(args.build).is_absolute() else REPO / args.build
-    args.exe, args.cmp = build / "pathreuse", build / "exr_compare"
-    for f in (args.exe, args.cmp):
-        if not f.is_file():
-            die(f"{f} not found; build first (tools/setup/build.sh)")
+    bt.check_run_args(args)
+    args.scene_args = ""  # set per scene before its renders
     return args
 
 

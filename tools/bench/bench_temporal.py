@@ -57,35 +57,31 @@ SETTINGS = {
 }
 
 
-def parse_args():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--scenes", default="atrium,cornell-dynamic,cornell-skinned")
+def add_run_args(ap, frames, sweep, seeds, settings):
+    """The options of a run that bench_temporal and bench_animations share (defaults their own)."""
     ap.add_argument("--width", type=int, default=160)
-    ap.add_argument("--frames", type=int, default=12, help="frames per run, --warm included")
+    ap.add_argument("--frames", type=int, default=frames, help="frames per run, --warm included")
     ap.add_argument("--warm", type=int, default=4, help="first frames rendered, not measured")
-    ap.add_argument("--spp", type=int, default=4, help="the path tracer's spp of the target error")
-    ap.add_argument("--sweep-spp", default="1,2,4,8")
-    ap.add_argument("--seeds", default="1,2,3")
+    ap.add_argument("--spp", type=int, default=4,
+                    help="the spp the settings are compared at (the path tracer's target error)")
+    ap.add_argument("--sweep-spp", default=sweep)
+    ap.add_argument("--seeds", default=seeds)
     ap.add_argument("--ref-spp", type=int, default=512)
-    ap.add_argument("--atrium-ref-spp", type=int, default=256)
     ap.add_argument("--max-depth", type=int, default=8)
-    ap.add_argument("--atrium", default=str(ATRIUM), help="atrium glTF (generated if absent)")
     ap.add_argument("--build", default="build", help="folder holding pathreuse and exr_compare")
-    ap.add_argument("--cache", default=str(REPO / "out" / "bench-temporal-cache"),
-                    help="reference frames, kept between runs")
     ap.add_argument("--json", help="write the figures here too")
     ap.add_argument("--cycles", help="a Python with bpy 5.2: measure Cycles too")
     ap.add_argument("--luxcore", help="a Python with pyluxcore 2.11: measure LuxCore BIDIR too "
                     "(needs --cycles's Python to export the frames)")
     ap.add_argument("--luxcore-ref-spp", type=int, default=128,
                     help="LuxCore's reference spp (its 4-spp frame takes 7x ours)")
-    ap.add_argument("--settings", default=";".join(SETTINGS),
+    ap.add_argument("--settings", default=settings,
                     help="the settings measured, by name, separated by ';'")
-    ap.add_argument("--scene-args", default="",
-                    help="options every render of ours takes, references too (e.g. '--env FILE'; "
-                    "part of the references' key); the peers do not see them")
     ap.add_argument("--quiet", action="store_true")
-    args = ap.parse_args()
+
+
+def check_run_args(args):
+    """add_run_args's options checked and parsed; the programs' paths in args.exe, args.cmp."""
     args.settings = [n.strip() for n in args.settings.split(";")]
     for n in args.settings:
         if n not in SETTINGS:
@@ -93,21 +89,36 @@ def parse_args():
     if args.luxcore and not args.cycles:
         die("--luxcore: give --cycles too (its bpy exports the frames LuxCore renders)")
     if "pathtrace" not in args.settings:
-        die("--settings: the speed-ups are over 'pathtrace', which must be one of them")
+        die("--settings: the gains are over 'pathtrace', which must be one of them")
     args.sweep_spp = sorted({int(s) for s in args.sweep_spp.split(",")} | {args.spp})
     args.seeds = [int(s) for s in args.seeds.split(",")]
     if args.frames - args.warm < 2 or args.warm < 0:
         die("--frames must exceed --warm by at least 2 (flicker needs frame pairs)")
-    # What load_scenes and Runner read.
-    args.atrium_frames = args.frames
-    args.timing_frames = args.atrium_timing_frames = args.frames
-    args.atrium_sweep_spp = args.sweep_spp
     args.reuse_args = ""
     build = Path(args.build) if Path(args.build).is_absolute() else REPO / args.build
     args.exe, args.cmp = build / "pathreuse", build / "exr_compare"
     for f in (args.exe, args.cmp):
         if not f.is_file():
             die(f"{f} not found; build first (tools/setup/build.sh)")
+
+
+def parse_args():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--scenes", default="atrium,cornell-dynamic,cornell-skinned")
+    add_run_args(ap, frames=12, sweep="1,2,4,8", seeds="1,2,3", settings=";".join(SETTINGS))
+    ap.add_argument("--atrium-ref-spp", type=int, default=256)
+    ap.add_argument("--atrium", default=str(ATRIUM), help="atrium glTF (generated if absent)")
+    ap.add_argument("--cache", default=str(REPO / "out" / "bench-temporal-cache"),
+                    help="reference frames, kept between runs")
+    ap.add_argument("--scene-args", default="",
+                    help="options every render of ours takes, references too (e.g. '--env FILE'; "
+                    "part of the references' key); the peers do not see them")
+    args = ap.parse_args()
+    check_run_args(args)
+    # What load_scenes and Runner read.
+    args.atrium_frames = args.frames
+    args.timing_frames = args.atrium_timing_frames = args.frames
+    args.atrium_sweep_spp = args.sweep_spp
     return args
 
 
