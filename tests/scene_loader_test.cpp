@@ -279,6 +279,13 @@ struct Quad {
                                 {"type", type}});
     return int(doc["accessors"].size() - 1);
   }
+  // Texture 0: a 2x2 PNG in a data URI.
+  void addTexture() {
+    doc["images"] = {{{"uri",
+                       "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAIAAAACCAIAAAD91JpzAAAAEkl"
+                       "EQVR4nGP4z8DAAMIM/4EAAB/uBfsL2WiLAAAAAElFTkSuQmCC"}}};
+    doc["textures"] = {{{"source", 0}}};
+  }
   void addNormals() {
     doc["meshes"][0]["primitives"][0]["attributes"]["NORMAL"] =
         addFloats({0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1}, 4, "VEC3");
@@ -327,10 +334,7 @@ TEST(SceneLoader, UnsupportedOptionalExtensionsAreNamedOnce) {
 TEST(SceneLoader, TransmissionTextureIsNamedInAWarning) {
   Quad q;
   q.doc["extensionsUsed"] = {"KHR_materials_transmission"};
-  q.doc["images"] = {{{"uri",
-                       "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAIAAAACCAIAAAD91JpzAAAAEkl"
-                       "EQVR4nGP4z8DAAMIM/4EAAB/uBfsL2WiLAAAAAElFTkSuQmCC"}}};
-  q.doc["textures"] = {{{"source", 0}}};
+  q.addTexture();
   q.doc["materials"] = {
       {{"name", "window"},
        {"extensions",
@@ -498,10 +502,7 @@ TEST(SceneLoader, MaterialsAndExtensions) {
 TEST(SceneLoader, TextureTransformOnEveryTexture) {
   Quad q;
   q.doc["extensionsUsed"] = {"KHR_texture_transform"};
-  q.doc["images"] = {{{"uri",
-                       "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAIAAAACCAIAAAD91JpzAAAAEkl"
-                       "EQVR4nGP4z8DAAMIM/4EAAB/uBfsL2WiLAAAAAElFTkSuQmCC"}}};
-  q.doc["textures"] = {{{"source", 0}}};
+  q.addTexture();
   const json mrTransform = {{"offset", {0.25, 0.5}}, {"scale", {2.0, 3.0}}};
   q.doc["materials"] = {
       {{"pbrMetallicRoughness",
@@ -547,10 +548,7 @@ TEST(SceneLoader, SpecularAndClearcoat) {
                              {"clearcoatRoughnessFactor", 0.1},
                              {"clearcoatTexture", {{"index", 0}}}}}}}}};
   q.doc["meshes"][0]["primitives"][0]["material"] = 0;
-  q.doc["images"] = {{{"uri",
-                       "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAIAAAACCAIAAAD91JpzAAAAEkl"
-                       "EQVR4nGP4z8DAAMIM/4EAAB/uBfsL2WiLAAAAAElFTkSuQmCC"}}};
-  q.doc["textures"] = {{{"source", 0}}};
+  q.addTexture();
   Scene s;
   ASSERT_EQ(tryLoad(q.write(), &s), "");
   EXPECT_TRUE(s.warnings.empty());
