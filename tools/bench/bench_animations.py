@@ -14,7 +14,7 @@ The scenes are made on first use under --work: the city and BrainStem as wrapper
 in ../shared/scenes (tools/scenes/gen_real_scenes.py; without that folder those scenes are
 refused, saying so), the atrium by tools/scenes/gen_atrium.py (--size 0.5, --light sun). Peers
 see the same glTF files (the environment as a uniform world); LuxCore renders the exported
-triangles without textures, so it is not run on the city. Needs numpy and PIL, hence
+triangles without textures, so it is not run on the city. Needs numpy and matplotlib, hence
 /usr/bin/python3. How each figure is made: tools/bench/bench_temporal.py.
 """
 
@@ -97,13 +97,10 @@ def load(args, work):
 def save_images(runner, sc, args, ref_exr, out):
     """The last measured frame at --spp, seed 1, of each of our settings, and its reference, as
     PNGs (sRGB, exposure 0) in out."""
-    from PIL import Image
-    import numpy as np
+    from .evaluation.plots import plt, tonemap
 
     def png(img, name):
-        x = np.clip(img, 0.0, 1.0)
-        x = np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1 / 2.4) - 0.055)
-        Image.fromarray((x * 255 + 0.5).astype(np.uint8)).save(out / f"{sc.key}_{name}.png")
+        plt.imsave(out / f"{sc.key}_{name}.png", tonemap(img, 0.0))
 
     out.mkdir(parents=True, exist_ok=True)
     last = sc.frames[-1]
