@@ -125,10 +125,10 @@ void expectFurnace(const Image& img, const std::string& what) {
                         << m.mean << " +- " << m.stderr_ << " (sphere row " << y << ")";
       }
   EXPECT_EQ(failures, 0) << what << ": " << failures << " of " << blocks << " blocks off";
-  // The blocks resolve 2%, so the test can fail: all but the noisiest 1% (silhouette blocks of
-  // the roughest metals, at grazing views).
+  // The blocks resolve 2%, so the test can fail: all but the noisiest 2% (silhouette blocks of
+  // the roughest metals and of rough glass, at grazing views).
   std::sort(noise.begin(), noise.end());
-  EXPECT_LT(noise[noise.size() * 99 / 100], 0.01) << what;
+  EXPECT_LT(noise[noise.size() * 98 / 100], 0.01) << what;
   ::testing::Test::RecordProperty(what + "_worst", std::to_string(worst));
 }
 

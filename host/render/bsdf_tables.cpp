@@ -97,6 +97,40 @@ double sheenAlbedo(float mu, float alpha, int samples) {
   return s * 2.0 * PR_PI / (double(nz) * double(nphi));
 }
 
+// The single-scattering albedo of white rough glass seen from wo (z > 0) with relative ior eta
+// (the other side's over wo's): over visible normals, both the reflection and the refraction
+// each microfacet gives, weighted by its Fresnel, each G2 / G1 (f cos / pdf of the sampling
+// rough_glass_sample does, kernels/shared/bsdf.h).
+double glassAlbedo(float mu, float alpha, float eta, int samples) {
+  const float3 wo = viewAt(mu, 0.0f);
+  const float a2 = alpha * alpha;
+  const double lo = ggx_lambda(mu, a2);
+  double s = 0.0;
+  for (int a = 0; a < samples; ++a)
+    for (int b = 0; b < samples; ++b) {
+      const float u1 = (float(a) + 0.5f) / float(samples), u2 = (float(b) + 0.5f) / float(samples);
+      const float3 h = ggx_sample_vndf(wo, alpha, alpha, u1, u2);
+      const float c = dot(wo, h);
+      if (!(c > 0.0f)) continue;
+      const double fr = fresnel_dielectric(c, eta);
+      const float3 wr = h * (2.0f * c) - wo;
+      if (wr.z > 0.0f) s += fr * (1.0 + lo) / (1.0 + lo + ggx_lambda(wr.z, a2));
+      const float sin2_t = (1.0f - c * c) / (eta * eta);
+      if (sin2_t >= 1.0f) continue;
+      const float3 wt = -wo / eta + h * (c / eta - std::sqrt(1.0f - sin2_t));
+      if (wt.z < 0.0f) s += (1.0 - fr) * (1.0 + lo) / (1.0 + lo + ggx_lambda(-wt.z, a2));
+    }
+  return s / (double(samples) * double(samples));
+}
+
+// The glass table's ior at grid point k of n.
+float gridIor(int k, int n) {
+  auto z = [](float ior) { return (ior - 1.0f) / (ior + 1.0f); };
+  const float lo = z(PR_GLASS_TABLE_MIN_IOR), hi = z(PR_GLASS_TABLE_MAX_IOR);
+  const float zk = lo + (hi - lo) * float(k) / float(n - 1);
+  return (1.0f + zk) / (1.0f - zk);
+}
+
 }  // namespace
 
 BsdfTables computeBsdfTables(int cosines, int roughnesses, int samples, int stride) {
@@ -162,6 +196,30 @@ BsdfTables computeBsdfTables(int cosines, int roughnesses, int samples, int stri
     }
     t.anisoEavg[size_t(row)] = float(avg);
   });
+  t.glassCosines = kBsdfGlassCos;
+  t.glassRoughnesses = kBsdfGlassRoughness;
+  t.glassIors = kBsdfGlassIor;
+  const int glassRows = 2 * t.glassIors * t.glassRoughnesses;
+  t.glassE.resize(size_t(glassRows) * size_t(t.glassCosines));
+  t.glassEavg.resize(size_t(glassRows));
+  parallelFor(glassRows, [&](int row) {
+    const int j = row % t.glassRoughnesses, k = (row / t.glassRoughnesses) % t.glassIors;
+    const float r = gridRoughness(j, t.glassRoughnesses), ior = gridIor(k, t.glassIors);
+    const float eta = row < glassRows / 2 ? ior : 1.0f / ior;
+    for (int i = 0; i < t.glassCosines; ++i) {
+      const size_t at = size_t(row) * size_t(t.glassCosines) + size_t(i);
+      if (at % size_t(stride) != 0) continue;
+      t.glassE[at] = float(glassAlbedo(gridCos(i, t.glassCosines), r * r, eta, samples / 2));
+    }
+    if (row % stride != 0) return;
+    const int points = 2 * t.glassCosines;
+    double avg = 0.0;
+    for (int i = 0; i < points; ++i) {
+      const float mu = (float(i) + 0.5f) / float(points);
+      avg += 2.0 * glassAlbedo(mu, r * r, eta, samples / 4) * mu / points;
+    }
+    t.glassEavg[size_t(row)] = float(avg);
+  });
   return t;
 }
 
@@ -203,6 +261,18 @@ std::string bsdfTablesHeader(const BsdfTables& t) {
   table("pr_ggx_es_aniso", "GGX albedo weighted by Schlick's (1 - v.h)^5.", t.anisoEs);
   table("pr_ggx_eavg_aniso", "GGX albedo averaged over the hemisphere: [ratio][roughness].",
         t.anisoEavg);
+  s += "// White rough glass (GGX reflection and refraction, no 1/eta^2): index\n"
+       "// [side][ior][roughness][cos], side 0 seen from outside (eta = ior), 1 from inside; a "
+       "grid\n"
+       "// uniform in sqrt(cos) from 0 to 1 (PR_BSDF_GLASS_COS points), in roughness from\n"
+       "// PR_TABLE_MIN_ROUGHNESS to 1 (PR_BSDF_GLASS_R) and in (ior - 1) / (ior + 1) from\n"
+       "// PR_GLASS_TABLE_MIN_IOR to PR_GLASS_TABLE_MAX_IOR (PR_BSDF_GLASS_IOR).\n";
+  s += "#define PR_BSDF_GLASS_COS " + std::to_string(t.glassCosines) + "\n";
+  s += "#define PR_BSDF_GLASS_R " + std::to_string(t.glassRoughnesses) + "\n";
+  s += "#define PR_BSDF_GLASS_IOR " + std::to_string(t.glassIors) + "\n\n";
+  table("pr_glass_e", "Rough glass albedo.", t.glassE);
+  table("pr_glass_eavg", "Rough glass albedo averaged over the hemisphere: [side][ior][roughness].",
+        t.glassEavg);
   s += "PR_NAMESPACE_END\n";
   return s;
 }

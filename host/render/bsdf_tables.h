@@ -17,6 +17,10 @@ constexpr int kBsdfTableSamples = 128;
 constexpr int kBsdfAnisoCos = 16;
 constexpr int kBsdfAnisoRoughness = 12;
 constexpr int kBsdfAnisoRatio = 8;
+// Rough glass: cosines x roughnesses x iors, for each side of the surface.
+constexpr int kBsdfGlassCos = 16;
+constexpr int kBsdfGlassRoughness = 16;
+constexpr int kBsdfGlassIor = 8;
 
 struct BsdfTables {
   int cosines = 0, roughnesses = 0;  // grid points, uniform in sqrt(cos) and in roughness
@@ -30,6 +34,12 @@ struct BsdfTables {
   std::vector<float> anisoE;     // [ratio][roughness][cos]
   std::vector<float> anisoEs;    // [ratio][roughness][cos]
   std::vector<float> anisoEavg;  // [ratio][roughness]
+  // White rough glass (reflection and refraction, no 1/eta^2) seen from outside (side 0, relative
+  // ior eta = ior) and inside (side 1, 1 / ior), on a grid uniform in sqrt(cos), in roughness
+  // from PR_TABLE_MIN_ROUGHNESS and in (ior - 1) / (ior + 1) over PR_GLASS_TABLE_*_IOR.
+  int glassCosines = 0, glassRoughnesses = 0, glassIors = 0;
+  std::vector<float> glassE;     // [side][ior][roughness][cos]
+  std::vector<float> glassEavg;  // 2 \int E(mu) mu dmu: [side][ior][roughness]
 };
 
 // The tables on a grid of `cosines` x `roughnesses` points (both ends included); `samples` is

@@ -93,10 +93,13 @@ dev::Material toDeviceMaterial(const Material& m, const MaterialOptions& options
   d.aniso_sin = std::sin(m.anisotropyRotation);
   d.aniso_texture = texture(m.anisotropyTexture);
   transform(m.anisotropyTexture, d.aniso_uv);
+  d.transmission_texture = texture(m.transmissionTexture);
+  transform(m.transmissionTexture, d.transmission_uv);
   d.uv_sets |= (m.clearcoatNormalTexture.texCoord == 1 ? PR_UV_COAT_NORMAL : 0u) |
                (m.sheenColorTexture.texCoord == 1 ? PR_UV_SHEEN : 0u) |
                (m.sheenRoughnessTexture.texCoord == 1 ? PR_UV_SHEEN_ROUGHNESS : 0u) |
-               (m.anisotropyTexture.texCoord == 1 ? PR_UV_ANISO : 0u);
+               (m.anisotropyTexture.texCoord == 1 ? PR_UV_ANISO : 0u) |
+               (m.transmissionTexture.texCoord == 1 ? PR_UV_TRANSMISSION : 0u);
   return d;
 }
 

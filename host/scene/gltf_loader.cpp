@@ -495,7 +495,7 @@ class Converter : Stage {
       if (const Value* e = extension(src.extensions, "KHR_materials_transmission")) {
         if (const Value* s = member(*e, "transmissionFactor"))
           m.transmission = float(s->GetNumberAsDouble());
-        warnTextures(*e, {"transmissionTexture"}, where);
+        m.transmissionTexture = extensionTexture(*e, "transmissionTexture", false, where);
       }
       if (const Value* e = extension(src.extensions, "KHR_materials_ior"))
         if (const Value* s = member(*e, "ior")) m.ior = float(s->GetNumberAsDouble());

@@ -100,6 +100,7 @@ struct Material {
   TextureRef specularTexture;            // linear, A scales specularFactor
   TextureRef specularColorTexture;       // sRGB
   TextureRef clearcoatTexture;           // linear, R
+  TextureRef transmissionTexture;        // linear, R (KHR_materials_transmission)
   TextureRef clearcoatRoughnessTexture;  // linear, G
   TextureRef clearcoatNormalTexture;     // linear tangent-space normal map of the coat
   float clearcoatNormalScale = 1.0f;

@@ -485,9 +485,10 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
       p.prev_x = h.p.x;
       p.prev_y = h.p.y;
       p.prev_z = h.p.z;
-      p.prev_nx = f.n.x;
-      p.prev_ny = f.n.y;
-      p.prev_nz = f.n.z;
+      const float3 n_l = frame_light_normal(&f);
+      p.prev_nx = n_l.x;
+      p.prev_ny = n_l.y;
+      p.prev_nz = n_l.z;
       p.last_pdf = step.pdf;
       p.flags = step.delta ? PR_PATH_SPECULAR : 0u;
     }

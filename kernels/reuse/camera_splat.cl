@@ -42,6 +42,8 @@ PR_INLINE float3 camera_splat_value(const SceneData* s, const ReuseParams* rp,
   const float importance =
       (float)(cam->width * cam->height) / (camera_plane_area(cam) * cos3_d2 * (float)rp->slots);
   const float3 tp = make_float3(vk->tp_r, vk->tp_g, vk->tp_b);
+  if (bsdf_transmits(&y->f.bsdf))  // a camera inside a glass object
+    f = f * segment_transmittance(s, &y->h, 0, -dir, length(y->h.p - camera_position(cam)));
   return tp * f * (cos_y * corr * importance * share);
 }
 

@@ -258,12 +258,14 @@ PR_INLINE float3 light_vertex_value(const Connector* cn, const EyePoint* x, cons
   const float dist2 = dot(dxy, dxy);
   if (!(dist2 > 0.0f)) return zero;
   const float3 dir = dxy * (1.0f / sqrt(dist2));  // from x to y
-  if (dot(dir, x->f.ng) <= 0.0f && !surface_lifted(cn->s, &x->h, &x->f)) return zero;
+  if (!surface_side_ok(cn->s, &x->h, &x->f, x->wo, dir)) return zero;
   float3 f_y;
   float pdf_leave, pdf_rev, cos_y, corr;
   if (!light_point_eval(cn->s, y, dir, &f_y, &pdf_leave, &pdf_rev, &cos_y, &corr)) return zero;
   float pdf_x;
-  const float3 f_x = eye_point_eval(x, dir, &pdf_x);
+  float3 f_x = eye_point_eval(x, dir, &pdf_x);
+  if (bsdf_transmits(&x->f.bsdf) || bsdf_transmits(&y->f.bsdf))
+    f_x = f_x * segment_transmittance(cn->s, &x->h, &y->h, dir, sqrt(dist2));
   const float p_l =
       solid_angle_to_area_pdf(pdf_arrive, fabs(dot(y->f.ng, vertex_dir(vk))), vk->t * vk->t);
   const float p_e =
@@ -476,8 +478,8 @@ PR_INLINE void strategy_sampled_vertex(Connector* cn, float3 xp, float pdf_x, co
       const float dist2 = dot(d, d);
       if (!(dist2 > 0.0f)) continue;
       const float3 dir = d * (1.0f / sqrt(dist2));  // from Y to z
-      if (dot(dir, y->f.ng) <= 0.0f && !surface_lifted(s, &y->h, &y->f)) continue;
-      float3 zng, f_z;
+      if (!surface_side_ok(s, &y->h, &y->f, y->wo, dir)) continue;
+      float3 zng, f_z, tr = make_float3(1.0f, 1.0f, 1.0f);
       float pdf_l, cos_z, corr = 1.0f;
       if (k == 0u) {
         // Vertex 0: the point on the light; f_z * tpz is its emission over the position pdf.
@@ -498,12 +500,17 @@ PR_INLINE void strategy_sampled_vertex(Connector* cn, float3 xp, float pdf_x, co
         if (z.delta || !light_point_eval(s, &z, dir, &f_z, &pdf_l, &pdf_rev_unused, &cos_z, &corr))
           continue;
         zng = z.f.ng;
+        if (bsdf_transmits(&y->f.bsdf) || bsdf_transmits(&z.f.bsdf))
+          tr = segment_transmittance(s, &y->h, &z.h, dir, sqrt(dist2));
       }
       const float p_l = solid_angle_to_area_pdf(pdf_l, fabs(dot(y->f.ng, dir)), dist2);
       const float w = mis_connection_weight(PR_STRATEGY_E, p_l, p_e, rp->mis_threshold);
       if (!(w > 0.0f)) continue;
       float pdf_unused;
-      const float3 f_y = eye_point_eval(y, dir, &pdf_unused);
+      float3 f_y = eye_point_eval(y, dir, &pdf_unused);
+      if (k == 0u && bsdf_transmits(&y->f.bsdf))
+        tr = segment_transmittance(s, &y->h, 0, dir, sqrt(dist2));
+      f_y = f_y * tr;
       const float3 tpz = make_float3(v[k].tp_r, v[k].tp_g, v[k].tp_b);
       const Ray r = (k == 0u && v[0].prim == PR_INVALID_INDEX)
                         ? surface_ray(s, &y->h, dir, sqrt(dist2) * (1.0f - 1e-4f))
@@ -640,7 +647,9 @@ PR_KERNEL void connect(PR_PARAMS(PR_ARGS_CONNECT)) {
           connect_term(
               &cn,
               t2 * le *
-                  (chain == 0u ? power_heuristic(pdf, environment_pdf(&s, x.h.p, x.f.n, d)) : 1.0f),
+                  (chain == 0u ? power_heuristic(
+                                     pdf, environment_pdf(&s, x.h.p, frame_light_normal(&x.f), d))
+                               : 1.0f),
               0, PR_REC_ADD);
         break;
       }
@@ -650,10 +659,10 @@ PR_KERNEL void connect(PR_PARAMS(PR_ARGS_CONNECT)) {
       const int is_delta = bsdf_is_delta(&y.f.bsdf);
       // An emitter met by the sample from x: its MIS share against next-event estimation at x.
       if (chain == 0u && (s.sd.materials[h.material].flags & PR_MAT_EMISSIVE))
-        connect_term(
-            &cn,
-            t2 * surface_emission(&s, &h) * power_heuristic(pdf, emitter_pdf(&s, &h, x.h.p, x.f.n)),
-            0, PR_REC_ADD);
+        connect_term(&cn,
+                     t2 * surface_emission(&s, &h) *
+                         power_heuristic(pdf, emitter_pdf(&s, &h, x.h.p, frame_light_normal(&x.f))),
+                     0, PR_REC_ADD);
       if (chain == 0u && !is_delta) {
         // Strategy L at x counts these paths, apart from E's share.
         if (rp.mis_threshold > 0.0f && !delta)

@@ -32,7 +32,8 @@ PR_NAMESPACE_BEGIN
 #define PR_BSDF_MICROFACET 0u
 #define PR_BSDF_MIRROR 1u
 #define PR_BSDF_GLASS 2u
-#define PR_BSDF_LAMBERT 3u  // pure Lambert (--force-diffuse: exact albedo, for furnace tests)
+#define PR_BSDF_LAMBERT 3u      // pure Lambert (--force-diffuse: exact albedo, for furnace tests)
+#define PR_BSDF_ROUGH_GLASS 4u  // GGX dielectric: reflection and refraction (Walter et al. 2007)
 
 #define PR_MODEL_ENERGY 0u  // energy-conserving layering, multiple-scattering GGX
 #define PR_MODEL_GLTF 1u    // the glTF specification's single-scattering model
@@ -42,7 +43,7 @@ PR_NAMESPACE_BEGIN
 #define PR_IMPORTANCE 1
 
 typedef struct {
-  float3 base;    // linear base colour
+  float3 base;    // linear base colour (glass: what each refraction multiplies)
   float3 f0;      // the dielectric layer's Fresnel at normal incidence (0.04: ior 1.5)
   float3 sheen;   // KHR_materials_sheen colour; 0: no sheen
   float3 coat_n;  // the coat's normal in this frame ((0, 0, 1): the shading normal)
@@ -99,6 +100,12 @@ PR_INLINE int bsdf_has_coat(const BsdfParams* m) {
 
 PR_INLINE int bsdf_is_delta(const BsdfParams* m) {
   return m->kind == PR_BSDF_MIRROR || m->kind == PR_BSDF_GLASS;
+}
+
+// Whether the BSDF passes light through its surface (glass, smooth or rough): its frame keeps
+// the geometric orientation, and directions on both sides carry light.
+PR_INLINE int bsdf_transmits(const BsdfParams* m) {
+  return m->kind == PR_BSDF_GLASS || m->kind == PR_BSDF_ROUGH_GLASS;
 }
 
 // ---- Tables (kernels/shared/bsdf_tables.h, made by tools/tables/bsdf_tables): bilinear on a grid
@@ -240,7 +247,7 @@ PR_INLINE BsdfLayers bsdf_layers(const BsdfParams* m, float3 w) {
 // at w, tinted as they reflect. The glTF model keeps no albedos: its base colour stands in.
 PR_INLINE float3 bsdf_albedo(const BsdfParams* m, float3 w) {
   const float3 one = make_float3(1.0f, 1.0f, 1.0f);
-  if (m->kind == PR_BSDF_LAMBERT || bsdf_gltf(m)) return m->base;
+  if (m->kind == PR_BSDF_LAMBERT || m->kind == PR_BSDF_ROUGH_GLASS || bsdf_gltf(m)) return m->base;
   const BsdfLayers l = bsdf_layers(m, w);
   const float3 dielectric =
       l.spec_albedo + m->base * fmax(one - l.spec_albedo, make_float3(0.0f, 0.0f, 0.0f));
@@ -523,6 +530,115 @@ PR_INLINE float3 lobe_diffuse_eval(const BsdfParams* m, const BsdfEval* e, float
          (fmax(one - bsdf_view(e)->spec_albedo, make_float3(0.0f, 0.0f, 0.0f)) * PR_INV_PI);
 }
 
+// ---- Rough glass: a GGX dielectric interface (Walter et al. 2007), isotropic, in a frame that
+// keeps the surface's orientation (wo.z < 0: wo inside). Reflection is untinted; refraction
+// multiplies by base and, for radiance, by 1/eta^2 (as the smooth glass). What single scattering
+// loses is given back at the view (rough_glass_compensation). Sampling: a visible normal from
+// wo's side, then reflection with the Fresnel's probability.
+
+// n on wi's side of a refraction over n on wo's.
+PR_INLINE float rough_glass_eta(const BsdfParams* m, float3 wo) {
+  return wo.z > 0.0f ? m->ior : 1.0f / m->ior;
+}
+
+// The single-scattering albedo of white rough glass seen from the view w, from the table, and in
+// *avg its average over the hemisphere of w's side.
+PR_INLINE float rough_glass_albedo(const BsdfParams* m, float3 w, float* avg) {
+  const float ior = clamp(m->ior, PR_GLASS_TABLE_MIN_IOR, PR_GLASS_TABLE_MAX_IOR);
+  const float z0 = (PR_GLASS_TABLE_MIN_IOR - 1.0f) / (PR_GLASS_TABLE_MIN_IOR + 1.0f);
+  const float z1 = (PR_GLASS_TABLE_MAX_IOR - 1.0f) / (PR_GLASS_TABLE_MAX_IOR + 1.0f);
+  int i, j, k;
+  const float fx = bsdf_table_at(sqrt(fabs(w.z)), PR_BSDF_GLASS_COS, &i);
+  const float fy = bsdf_table_at(bsdf_table_roughness(sqrt(m->alpha_x)), PR_BSDF_GLASS_R, &j);
+  const float fz =
+      bsdf_table_at(((ior - 1.0f) / (ior + 1.0f) - z0) / (z1 - z0), PR_BSDF_GLASS_IOR, &k);
+  const int side = w.z > 0.0f ? 0 : 1;
+  PR_CONSTANT const float* a = pr_glass_eavg + (side * PR_BSDF_GLASS_IOR + k) * PR_BSDF_GLASS_R + j;
+  const float a0 = a[0] + (a[1] - a[0]) * fy;
+  const float a1 = a[PR_BSDF_GLASS_R] + (a[PR_BSDF_GLASS_R + 1] - a[PR_BSDF_GLASS_R]) * fy;
+  *avg = a0 + (a1 - a0) * fz;
+  PR_CONSTANT const float* t =
+      pr_glass_e + side * PR_BSDF_GLASS_IOR * PR_BSDF_GLASS_R * PR_BSDF_GLASS_COS;
+  return bsdf_table3(t, PR_BSDF_GLASS_COS, PR_BSDF_GLASS_R, i, j, k, fx, fy, fz);
+}
+
+// What divides out single scattering's loss at the view w, per channel: 1 / E for white glass;
+// for tinted glass the light lost to further bounces between the microfacets is tinted as
+// often as they refract (Kulla and Conty's multiple-scattering Fresnel with the refraction's
+// tint for F, as Cycles' multiscatter glass takes it).
+PR_INLINE float3 rough_glass_compensation(const BsdfParams* m, float3 w) {
+  float avg;
+  const float e = fmax(rough_glass_albedo(m, w, &avg), 0.05f);
+  const float3 one = make_float3(1.0f, 1.0f, 1.0f);
+  const float3 fms = m->base * avg / (one - m->base * (1.0f - avg));
+  return one + fms * ((1.0f - e) / e);
+}
+
+// The microfacet normal that takes wo to wi (facing +z), 0 where none does from the sides
+// each direction is on.
+PR_INLINE int rough_glass_half(float3 wo, float3 wi, float eta, float3* h) {
+  float3 v = wo.z * wi.z > 0.0f ? wo + wi : wo + wi * eta;
+  const float len = length(v);
+  if (!(len > 0.0f)) return 0;
+  v = v / len;
+  if (v.z < 0.0f) v = -v;
+  if (!(dot(wo, v) * wo.z > 0.0f) || !(dot(wi, v) * wi.z > 0.0f)) return 0;
+  *h = v;
+  return 1;
+}
+
+// The pdf of sampling wi from wo.
+PR_INLINE float rough_glass_pdf(const BsdfParams* m, float3 wo, float3 wi) {
+  const float eta = rough_glass_eta(m, wo);
+  float3 h;
+  if (wo.z == 0.0f || wi.z == 0.0f || !rough_glass_half(wo, wi, eta, &h)) return 0.0f;
+  const float a2 = m->alpha_x * m->alpha_x;
+  const float co = fabs(wo.z), ho = fabs(dot(wo, h)), hi = fabs(dot(wi, h));
+  const float visible = ggx_d(h.z, a2) * ho / ((1.0f + ggx_lambda(co, a2)) * co);
+  const float fr = fresnel_dielectric(ho, eta);
+  if (wo.z * wi.z > 0.0f) return visible * fr / (4.0f * ho);
+  const float s = dot(wi, h) + dot(wo, h) / eta;  // the dots' signs differ
+  return visible * (1.0f - fr) * hi / (s * s);
+}
+
+PR_INLINE float3 rough_glass_eval(const BsdfParams* m, float3 wo, float3 wi, int mode) {
+  const float eta = rough_glass_eta(m, wo);
+  float3 h;
+  if (wo.z == 0.0f || wi.z == 0.0f || !rough_glass_half(wo, wi, eta, &h))
+    return make_float3(0.0f, 0.0f, 0.0f);
+  const float a2 = m->alpha_x * m->alpha_x;
+  const float co = fabs(wo.z), ci = fabs(wi.z), ho = fabs(dot(wo, h)), hi = fabs(dot(wi, h));
+  const float dg = ggx_d(h.z, a2) / (1.0f + ggx_lambda(co, a2) + ggx_lambda(ci, a2));
+  const float fr = fresnel_dielectric(ho, eta);
+  const float3 ms = rough_glass_compensation(m, mode == PR_RADIANCE ? wo : wi);
+  if (wo.z * wi.z > 0.0f) return ms * (fr * dg / (4.0f * co * ci));
+  const float s = dot(wi, h) + dot(wo, h) / eta;
+  float v = (1.0f - fr) * dg * hi * ho / (co * ci * s * s);
+  if (mode == PR_RADIANCE) v /= eta * eta;
+  return m->base * ms * v;
+}
+
+// A direction from wo (z == 0: none).
+PR_INLINE float3 rough_glass_sample(const BsdfParams* m, float3 wo, float u0, float u1, float u2) {
+  const float3 none = make_float3(0.0f, 0.0f, 0.0f);
+  const float sign = wo.z < 0.0f ? -1.0f : 1.0f;
+  const float3 h = ggx_sample_vndf(wo * sign, m->alpha_x, m->alpha_x, u1, u2) * sign;
+  const float c = dot(wo, h);  // > 0: h is on wo's side
+  if (!(c > 0.0f)) return none;
+  const float eta = rough_glass_eta(m, wo);
+  float3 wi;
+  if (u0 < fresnel_dielectric(c, eta)) {
+    wi = h * (2.0f * c) - wo;
+    if (!(wi.z * wo.z > 0.0f)) return none;
+  } else {
+    const float sin2_t = (1.0f - c * c) / (eta * eta);
+    if (sin2_t >= 1.0f) return none;
+    wi = -wo / eta + h * (c / eta - sqrt(1.0f - sin2_t));
+    if (!(wi.z * wo.z < 0.0f)) return none;
+  }
+  return wi;
+}
+
 // ---- The mixture, from the table
 
 // The lobes' probabilities at wo. glTF: each lobe its weight's share of what the lobes above
@@ -633,6 +749,11 @@ PR_INLINE float3 bsdf_eval_impl(const BsdfParams* m, float3 wo, float3 wi, int m
                                 float* pdf, float* pdf_rev) {
   *pdf = 0.0f;
   *pdf_rev = 0.0f;
+  if (m->kind == PR_BSDF_ROUGH_GLASS) {
+    *pdf = rough_glass_pdf(m, wo, wi);
+    if (want_rev) *pdf_rev = rough_glass_pdf(m, wi, wo);
+    return rough_glass_eval(m, wo, wi, mode);
+  }
   if (bsdf_is_delta(m) || wo.z <= 0.0f || wi.z <= 0.0f) return make_float3(0.0f, 0.0f, 0.0f);
   if (m->kind == PR_BSDF_LAMBERT) {
     *pdf = wi.z * PR_INV_PI;
@@ -698,6 +819,17 @@ PR_INLINE int bsdf_sample_impl(const BsdfParams* m, float3 wo, float u0, float u
     // Radiance is compressed by 1/eta^2 on entering a denser medium; importance is not.
     const float scale = mode == PR_RADIANCE ? 1.0f / (eta * eta) : 1.0f;
     *weight = m->base * scale;
+    return 1;
+  }
+  if (m->kind == PR_BSDF_ROUGH_GLASS) {
+    const float3 dir = rough_glass_sample(m, wo, u0, u1, u2);
+    if (dir.z == 0.0f) return 0;
+    float p_fwd = 0.0f, p_rev;
+    const float3 f = bsdf_eval_impl(m, wo, dir, mode, 0, &p_fwd, &p_rev);
+    if (!(p_fwd > 0.0f)) return 0;
+    *wi = dir;
+    *pdf = p_fwd;
+    *weight = f * (fabs(dir.z) / p_fwd);
     return 1;
   }
   if (wo.z <= 0.0f) return 0;

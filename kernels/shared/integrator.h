@@ -135,7 +135,8 @@ PR_INLINE Ray surface_segment(const SceneData* s, const SurfaceHit* a, const Sur
   return make_ray(o, e - o, 0.0f, 1.0f);
 }
 
-// A shading frame: ns and ng flipped to the side of wo for reflective surfaces; glass keeps
+// A shading frame: ns and ng flipped to the side of wo for reflective surfaces; glass (smooth or
+// rough) keeps
 // its geometric orientation so that the sign of wo tells entering from leaving. Where wo is
 // above a reflective surface but (nearly) below its shading normal's horizon (a smooth-shaded
 // facet seen edge-on), the shading normal is turned towards wo until wo is PR_MIN_VIEW_COS
@@ -159,12 +160,12 @@ PR_INLINE ShadingFrame shading_frame(const SceneData* s, const SurfaceHit* h, fl
   f.bsdf = material_bsdf(&s->sd, h, &aniso);
   f.ng = h->ng;
   f.n = h->ns;
-  const int flip = f.bsdf.kind != PR_BSDF_GLASS && dot(wo, f.ng) < 0.0f;
+  const int flip = !bsdf_transmits(&f.bsdf) && dot(wo, f.ng) < 0.0f;
   if (flip) {
     f.ng = -f.ng;
     f.n = -f.n;
   }
-  if (PR_TERMINATOR_OFFSET && f.bsdf.kind != PR_BSDF_GLASS) {
+  if (PR_TERMINATOR_OFFSET && !bsdf_transmits(&f.bsdf)) {
     const float c = dot(wo, f.n);
     if (c < PR_MIN_VIEW_COS) f.n = normalize(f.n + wo * (PR_MIN_VIEW_COS - c));
   }
@@ -212,6 +213,23 @@ PR_INLINE ShadingFrame shading_frame(const SceneData* s, const SurfaceHit* h, fl
 // over the smooth surface the normals describe.
 PR_INLINE int surface_lifted(const SceneData* s, const SurfaceHit* h, const ShadingFrame* f) {
   return f->may_lift && dot(surface_lift(&s->sd, h->prim, h->inst, h->b1, h->b2), f->n) > 0.0f;
+}
+
+// Whether light may pass between wo and w (both from surface h, in frame f) where the BSDF
+// gives it: a reflection on wo's side of the geometric surface, or below it where the surface is
+// lifted (surface_lifted); glass, on the side the shading normal says (reflection or
+// refraction), which the geometric surface must agree with, as path_step requires.
+PR_INLINE int surface_side_ok(const SceneData* s, const SurfaceHit* h, const ShadingFrame* f,
+                              float3 wo, float3 w) {
+  if (bsdf_transmits(&f->bsdf))
+    return (dot(w, f->ng) * dot(wo, f->ng) > 0.0f) == (dot(w, f->n) * dot(wo, f->n) > 0.0f);
+  return dot(w, f->ng) > 0.0f || surface_lifted(s, h, f);
+}
+
+// The normal that light choice and sampling weigh lights by from a point in frame f (zero:
+// none, every direction counts): none on glass, which lets light through from behind.
+PR_INLINE float3 frame_light_normal(const ShadingFrame* f) {
+  return bsdf_transmits(&f->bsdf) ? make_float3(0.0f, 0.0f, 0.0f) : f->n;
 }
 
 // One step of a path from a shaded point (every kernel continues its paths through this): the
@@ -288,6 +306,18 @@ PR_INLINE float3 volume_transmittance(const SceneData* s, const SurfaceHit* h, f
   return make_float3(exp(-sigma.x * t), exp(-sigma.y * t), exp(-sigma.z * t));
 }
 
+// The same for a connection segment of length t along dir from surface a to surface b (b null:
+// a point on a light), which no traced ray crossed: attenuated where it ends on b from behind,
+// else where it leaves a into its object (rough glass connects through its surface).
+PR_INLINE float3 segment_transmittance(const SceneData* s, const SurfaceHit* a, const SurfaceHit* b,
+                                       float3 dir, float t) {
+  if (b) {
+    const float3 tb = volume_transmittance(s, b, dir, t);
+    if (max3(tb) < 1.0f) return tb;
+  }
+  return volume_transmittance(s, a, -dir, t);
+}
+
 // Radiance from the environment along dir, for a ray that leaves the scene (0 without one).
 PR_INLINE float3 environment_radiance(const SceneData* s, float3 dir) {
   if (s->lights.env_light == PR_INVALID_INDEX) return make_float3(0.0f, 0.0f, 0.0f);
@@ -334,14 +364,15 @@ PR_INLINE int next_event(const SceneData* s, const SurfaceHit* h, const ShadingF
   const float2 ul = rng_next2(rng);
   const float u1 = ul.x, u2 = ul.y;
   float pmf, mis_pmf;
-  const u32 idx = light_choose(&s->lights, h->p, f->n, us.x, us.y, &pmf, &mis_pmf);
+  const float3 n_l = frame_light_normal(f);
+  const u32 idx = light_choose(&s->lights, h->p, n_l, us.x, us.y, &pmf, &mis_pmf);
   if (idx == PR_INVALID_INDEX || !(pmf > 0.0f)) return 0;
   const Light l = s->lights.lights[idx];
   LightSample ls;
   float b1, b2;
-  if (!light_sample_towards(&l, s->lights.env, pmf, h->p, f->n, u1, u2, &ls, &b1, &b2)) return 0;
+  if (!light_sample_towards(&l, s->lights.env, pmf, h->p, n_l, u1, u2, &ls, &b1, &b2)) return 0;
   // Below the geometric surface: only from a lifted point (shading_frame).
-  if (dot(ls.wi, f->ng) <= 0.0f && !surface_lifted(s, h, f)) return 0;
+  if (!surface_side_ok(s, h, f, wo, ls.wi)) return 0;
   float3 le = ls.le;
   if (light_is_triangle(l.type)) {
     const SurfaceHit e = surface_interp(&s->sd, l.prim, l.inst, b1, b2, 0);
@@ -349,7 +380,8 @@ PR_INLINE int next_event(const SceneData* s, const SurfaceHit* h, const ShadingF
   }
   float bsdf_pdf = 0.0f, bsdf_pdf_rev = 0.0f;
   const float3 wol = to_local(wo, f->t, f->b, f->n), wil = to_local(ls.wi, f->t, f->b, f->n);
-  const float3 fr = bsdf_eval_both(&f->bsdf, wol, wil, &bsdf_pdf, &bsdf_pdf_rev);
+  float3 fr = bsdf_eval_both(&f->bsdf, wol, wil, &bsdf_pdf, &bsdf_pdf_rev);
+  if (bsdf_transmits(&f->bsdf)) fr = fr * segment_transmittance(s, h, 0, ls.wi, ls.dist);
   const float cos_i = fabs(wil.z);
   // MIS from the pmf that BSDF-sampled emitter hits see (light_choice_pmf; shared/mis.h).
   const float w =

@@ -1,6 +1,7 @@
 // Materials as the kernels see them: glTF metallic-roughness with emission, transmission
-// (delta dielectric), alpha cut-out/coverage, textures with their transforms and uv sets, normal
-// maps, and the KHR_materials extensions (specular, clearcoat, sheen, anisotropy, volume).
+// (a dielectric interface, smooth or GGX-rough), alpha cut-out/coverage, textures with their
+// transforms and uv sets, normal maps, and the KHR_materials extensions (specular, clearcoat,
+// sheen, anisotropy, volume).
 #pragma once
 
 #include "shared/common.h"
@@ -11,14 +12,14 @@ PR_NAMESPACE_BEGIN
 #define PR_MAT_ALPHA_MASK 2u   // cut-out at alpha_cutoff
 #define PR_MAT_ALPHA_BLEND 4u  // stochastic coverage: pass through with probability 1 - alpha
 #define PR_MAT_MIRROR 8u       // delta reflection (metallic 1, roughness ~0)
-#define PR_MAT_GLASS 16u       // delta dielectric (KHR_materials_transmission)
+#define PR_MAT_GLASS 16u       // transmissive (KHR_materials_transmission): shading_frame
 #define PR_MAT_EMISSIVE 32u
 #define PR_MAT_LAMBERT 64u      // shaded as pure Lambert with the base colour (--force-diffuse)
 #define PR_MAT_GLTF_MODEL 128u  // the glTF specification's BSDF (--material-model gltf-reference)
 
 #define PR_NO_TEXTURE (-1)
 
-// 464 bytes.
+// 496 bytes.
 typedef struct {
   float base_r, base_g, base_b, base_a;  // linear baseColorFactor
   float emit_r, emit_g, emit_b;          // emissiveFactor * emissive_strength (radiance)
@@ -67,6 +68,10 @@ typedef struct {
   float aniso_cos, aniso_sin;
   i32 aniso_texture;
   float aniso_uv[6];
+  // KHR_materials_transmission's texture (R scales the factor), its transform.
+  i32 transmission_texture;
+  float transmission_uv[6];
+  float pad;
 } Material;
 
 #define PR_UV_BASE 1u
@@ -81,6 +86,7 @@ typedef struct {
 #define PR_UV_SHEEN 512u
 #define PR_UV_SHEEN_ROUGHNESS 1024u
 #define PR_UV_ANISO 2048u
+#define PR_UV_TRANSMISSION 4096u
 
 // One texture in the shared texel buffer (RGBA8 packed in u32, row-major). 16 bytes.
 typedef struct {
@@ -97,7 +103,7 @@ typedef struct {
 
 PR_NAMESPACE_END
 
-PR_STATIC_ASSERT(sizeof(pr::dev::Material) == 464, "Material layout");
+PR_STATIC_ASSERT(sizeof(pr::dev::Material) == 496, "Material layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::Material, flags) == 28, "Material layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::Material, alpha_cutoff) == 48, "Material layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::Material, base_uv) == 64, "Material layout");
@@ -107,4 +113,5 @@ PR_STATIC_ASSERT(offsetof(pr::dev::Material, spec_f0) == 176, "Material layout")
 PR_STATIC_ASSERT(offsetof(pr::dev::Material, coat_normal_texture) == 320, "Material layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::Material, sheen) == 352, "Material layout");
 PR_STATIC_ASSERT(offsetof(pr::dev::Material, aniso_strength) == 424, "Material layout");
+PR_STATIC_ASSERT(offsetof(pr::dev::Material, transmission_uv) == 468, "Material layout");
 PR_STATIC_ASSERT(sizeof(pr::dev::TextureInfo) == 16, "TextureInfo layout");

@@ -43,6 +43,9 @@ PR_NAMESPACE_BEGIN
 #define PR_MIN_SHEEN_ALPHA 0.0025f
 // The albedo tables' smallest roughness, sqrt of both of those.
 #define PR_TABLE_MIN_ROUGHNESS 0.05f
+// The rough-glass albedo table's iors, uniform in (ior - 1) / (ior + 1) between these.
+#define PR_GLASS_TABLE_MIN_IOR 1.05f
+#define PR_GLASS_TABLE_MAX_IOR 3.0f
 
 // ---- GGX
 

@@ -19,9 +19,10 @@
 
 PR_NAMESPACE_BEGIN
 
-// Rough enough to reconnect at: no delta lobe and every GGX lobe's alpha at least min_alpha.
+// Rough enough to reconnect at: no delta lobe and every GGX lobe's alpha at least min_alpha; not
+// glass, whose reconnections would cross the surface (the shift keeps to reflections).
 PR_INLINE int rs_rough(const BsdfParams* b, float min_alpha) {
-  if (bsdf_is_delta(b)) return 0;
+  if (bsdf_is_delta(b) || bsdf_transmits(b)) return 0;
   if (!(fmin(b->alpha_x, b->alpha_y) >= min_alpha)) return 0;
   return !(b->coat > 0.0f) || b->coat_alpha >= min_alpha;
 }

@@ -35,13 +35,14 @@ PR_INLINE float3 di_eval(const SceneData* s, const RsPrimary* x, PR_GLOBAL const
   if (r->light == PR_INVALID_INDEX) return zero;
   const Light l = s->lights.lights[r->light];
   float3 wi, le;
-  float g = 1.0f;
+  float g = 1.0f, dist = PR_INF_F;
   if (light_is_triangle(l.type)) {
     const SurfaceHit e = surface_at(&s->sd, l.prim, l.inst, r->b1, r->b2);
     const float3 d = e.p - x->h.p;
     const float d2 = dot(d, d);
     if (!(d2 > 0.0f)) return zero;
-    wi = d * (1.0f / sqrt(d2));
+    dist = sqrt(d2);
+    wi = d * (1.0f / dist);
     g = fabs(dot(wi, e.ng)) / d2;
     le = material_emission(&s->sd, &e);
     *shadow = surface_ray_to(s, &x->h, e.p, e.ng);
@@ -52,17 +53,20 @@ PR_INLINE float3 di_eval(const SceneData* s, const RsPrimary* x, PR_GLOBAL const
   } else {  // punctual: the light's own sample, which draws no random number
     LightSample ls;
     float b1, b2;
-    if (!light_sample_towards(&l, s->lights.env, 1.0f, x->h.p, x->f.n, 0.0f, 0.0f, &ls, &b1, &b2))
+    if (!light_sample_towards(&l, s->lights.env, 1.0f, x->h.p, frame_light_normal(&x->f), 0.0f,
+                              0.0f, &ls, &b1, &b2))
       return zero;
     wi = ls.wi;
     le = ls.le;
+    dist = ls.dist;
     *shadow =
         surface_ray(s, &x->h, ls.wi, ls.dist < PR_INF_F ? ls.dist * (1.0f - 1e-4f) : PR_INF_F);
   }
-  if (dot(wi, x->f.ng) <= 0.0f && !surface_lifted(s, &x->h, &x->f)) return zero;
+  if (!surface_side_ok(s, &x->h, &x->f, x->wo, wi)) return zero;
   const float3 wil = to_local(wi, x->f.t, x->f.b, x->f.n);
   float pdf;
-  return bsdf_eval(&x->f.bsdf, x->wol, wil, &pdf) * le * (fabs(wil.z) * g);
+  const float3 f = bsdf_eval(&x->f.bsdf, x->wol, wil, &pdf) * le * (fabs(wil.z) * g);
+  return bsdf_transmits(&x->f.bsdf) ? f * segment_transmittance(s, &x->h, 0, wi, dist) : f;
 }
 
 // The target of reservoir r's light at x, shadow ray included (traced counted in *traced), and

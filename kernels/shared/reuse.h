@@ -166,7 +166,7 @@ PR_INLINE LightPoint light_point(const SceneData* s, PR_GLOBAL const LightVertex
 // the eye side.
 PR_INLINE int light_point_eval(const SceneData* s, const LightPoint* y, float3 dir, float3* f,
                                float* pdf, float* pdf_rev, float* cos_t, float* corr) {
-  if (dot(-dir, y->f.ng) <= 0.0f && !surface_lifted(s, &y->h, &y->f)) return 0;
+  if (!surface_side_ok(s, &y->h, &y->f, y->wprev, -dir)) return 0;
   // The light path's BSDF: the view is towards the eye side (the adjoint of wprev's).
   *f = bsdf_eval_mode(&y->f.bsdf, y->wprevl, to_local(-dir, y->f.t, y->f.b, y->f.n), PR_IMPORTANCE,
                       pdf, pdf_rev);

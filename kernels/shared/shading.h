@@ -6,6 +6,7 @@
 #include "shared/geometry.h"
 #include "shared/material.h"
 #include "shared/math.h"
+#include "shared/rng.h"
 #include "shared/types.h"
 
 PR_NAMESPACE_BEGIN
@@ -335,6 +336,24 @@ PR_INLINE float material_anisotropy(const ShadingData* sd, const SurfaceHit* s, 
   return clamp(strength, 0.0f, 1.0f);
 }
 
+// Whether a transmissive material is glass at the point (else it is its opaque base): the
+// transmission factor x its texture is the chance, decided by a hash of the point so that every
+// kernel that shades the point sees the same surface (as alpha coverage, surface_passes).
+PR_INLINE int material_transmits_at(const ShadingData* sd, PR_GLOBAL const Material* m,
+                                    const SurfaceHit* s) {
+  float t = m->transmission;
+  if (m->transmission_texture != PR_NO_TEXTURE)
+    t *= texture_sample(sd, m->transmission_texture,
+                        material_uv(m, PR_UV_TRANSMISSION, m->transmission_uv, s->uv, s->uv1))
+             .x;
+  if (t >= 1.0f) return 1;
+  if (!(t > 0.0f)) return 0;
+  const u32 key = pr_hash_u32(
+      0x7a3c91e5u ^ s->prim ^
+      pr_hash_u32(s->inst ^ pr_hash_u32(pr_as_uint(s->b1) ^ pr_hash_u32(pr_as_uint(s->b2)))));
+  return (float)(key >> 8) * (1.0f / 16777216.0f) < t;
+}
+
 // The BSDF's parameters at the surface; in *aniso the anisotropy direction (cos, sin) from the
 // tangent towards the bitangent, (0, 0) where the surface is isotropic.
 PR_INLINE BsdfParams material_bsdf(const ShadingData* sd, const SurfaceHit* s, float2* aniso) {
@@ -409,9 +428,13 @@ PR_INLINE BsdfParams material_bsdf(const ShadingData* sd, const SurfaceHit* s, f
   else
     *aniso = make_float2(0.0f, 0.0f);
   p.model = (m->flags & PR_MAT_GLTF_MODEL) ? PR_MODEL_GLTF : PR_MODEL_ENERGY;
-  if (m->flags & PR_MAT_GLASS)
-    p.kind = PR_BSDF_GLASS;
-  else if (m->flags & PR_MAT_MIRROR)
+  if ((m->flags & PR_MAT_GLASS) && material_transmits_at(sd, m, s)) {
+    // A refraction tints by the square root of the base colour, so that light through a closed
+    // object is tinted by it once (as Cycles' Principled BSDF does).
+    p.base = make_float3(sqrt(fmax(p.base.x, 0.0f)), sqrt(fmax(p.base.y, 0.0f)),
+                         sqrt(fmax(p.base.z, 0.0f)));
+    p.kind = p.alpha_x > PR_MIN_ALPHA ? PR_BSDF_ROUGH_GLASS : PR_BSDF_GLASS;
+  } else if (m->flags & PR_MAT_MIRROR)
     p.kind = PR_BSDF_MIRROR;
   else if (m->flags & PR_MAT_LAMBERT)
     p.kind = PR_BSDF_LAMBERT;

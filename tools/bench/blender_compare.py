@@ -208,6 +208,13 @@ def _catalogue():
                                               "anisotropyRotation": 0.5}}, tangents=True)
     add("glass", "glass", (1.0,) * 3, 0.0, 0.0,
         {"KHR_materials_transmission": {"transmissionFactor": 1.0}})
+    # rough glass (GGX refraction), glass tinted as ToyCar's, glass at half its points
+    for tone, base in (("white", (1.0,) * 3), ("green", (0.3, 0.8, 0.3))):
+        for x in ((0.25, 0.5, 0.75) if tone == "white" else (0.0, 0.5)):
+            add(f"glass-{tone}-{r(x)}", "glass", base, 0.0, x,
+                {"KHR_materials_transmission": {"transmissionFactor": 1.0}})
+    add("glass-half-r050", "glass", (1.0,) * 3, 0.0, 0.5,
+        {"KHR_materials_transmission": {"transmissionFactor": 0.5}})
     # the roughnesses of the issue's figures (metal 0.7, white dielectric 0.3)
     add("issue-metal-white-r070", "issue", (1.0,) * 3, 1.0, 0.7)
     add("issue-dielectric-white-r030", "issue", (1.0,) * 3, 0.0, 0.3)

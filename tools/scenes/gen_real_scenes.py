@@ -15,6 +15,9 @@ vc         The Virtual City under a sun, with its sky dome's walls emitting thei
            "still6", camera 6 held where it is at --still-frame.
 brainstem  The skinned BrainStem walking on a grey floor before a back wall, with two cameras:
            "front" held still, and "orbit" circling it (10 degrees a second) as it walks.
+framed     Any asset as it is, with a camera "front" added that frames its bounding box (at
+           time 0) from the front (+Z), a little above, square: for comparing one still image
+           of it with a peer (tools/bench/asset_compare.py).
 """
 
 import argparse
@@ -95,17 +98,19 @@ class Extra:
         return len(self.doc["accessors"]) - 1
 
     def write(self, out):
+        """The wrapper, and its .bin where it added data (glTF allows no empty buffer)."""
         while len(self.data) % 4:
             self.data.append(0)
         bin_path = os.path.splitext(out)[0] + ".bin"
-        self.doc["buffers"].append({"byteLength": len(self.data),
-                                    "uri": os.path.basename(bin_path)})
         os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
-        with open(bin_path + ".tmp", "wb") as f:
-            f.write(self.data)
+        if self.data:
+            self.doc["buffers"].append({"byteLength": len(self.data),
+                                        "uri": os.path.basename(bin_path)})
+            with open(bin_path + ".tmp", "wb") as f:
+                f.write(self.data)
+            os.replace(bin_path + ".tmp", bin_path)
         with open(out + ".tmp", "w", encoding="utf-8") as f:
             json.dump(self.doc, f, indent=1)
-        os.replace(bin_path + ".tmp", bin_path)
         os.replace(out + ".tmp", out)
 
 
@@ -291,9 +296,46 @@ def light_brainstem(asset, extra, args):
     return "a floor and a back wall, cameras front and orbit"
 
 
+def bounds(asset):
+    """The axis-aligned box of every mesh node's POSITION corners in world space at time 0."""
+    lo, hi = [math.inf] * 3, [-math.inf] * 3
+    for i, n in enumerate(asset.doc["nodes"]):
+        if "mesh" not in n:
+            continue
+        m = world_matrix(asset, i, 0.0)
+        for p in asset.doc["meshes"][n["mesh"]]["primitives"]:
+            a = asset.doc["accessors"][p["attributes"]["POSITION"]]
+            for c in range(8):
+                v = [a["max"][k] if (c >> k) & 1 else a["min"][k] for k in range(3)]
+                w = [sum(m[r + 4 * k] * v[k] for k in range(3)) + m[r + 12] for r in range(3)]
+                lo = [min(x, y) for x, y in zip(lo, w)]
+                hi = [max(x, y) for x, y in zip(hi, w)]
+    if lo[0] > hi[0]:
+        raise gw.Invalid("no mesh to frame")
+    return lo, hi
+
+
+def frame_front(asset, extra, args):
+    doc = asset.doc
+    lo, hi = bounds(asset)
+    centre = [(a + b) / 2 for a, b in zip(lo, hi)]
+    radius = 0.5 * math.sqrt(sum((b - a) ** 2 for a, b in zip(lo, hi)))
+    yfov = 0.6
+    dist = radius / math.sin(yfov / 2) * 1.05
+    d = gw.normalize((0.0, 0.35, 1.0))
+    eye = tuple(c + dist * x for c, x in zip(centre, d))
+    cams = doc.setdefault("cameras", [])
+    cams.append({"name": "front", "type": "perspective",
+                 "perspective": {"yfov": yfov, "aspectRatio": 1.0, "znear": dist * 1e-3}})
+    doc["nodes"].append({"name": "front", "camera": len(cams) - 1, "translation": list(eye),
+                         "rotation": list(gw.quat_look(gw.sub(tuple(centre), eye)))})
+    doc["scenes"][doc.get("scene", 0)]["nodes"].append(len(doc["nodes"]) - 1)
+    return f"camera front at {', '.join('%.3g' % x for x in eye)}"
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("asset", choices=("vc", "brainstem"))
+    ap.add_argument("asset", choices=("vc", "brainstem", "framed"))
     ap.add_argument("source", help="the asset's .gltf")
     ap.add_argument("--out", required=True, help="the wrapper's .gltf (its .bin beside it)")
     ap.add_argument("--sky-strength", type=float, default=1.0,
@@ -306,7 +348,8 @@ def main():
         asset = Asset(args.source)
         asset.rebase(os.path.dirname(os.path.abspath(args.out)))
         extra = Extra(asset.doc)
-        what = (light_vc if args.asset == "vc" else light_brainstem)(asset, extra, args)
+        what = {"vc": light_vc, "brainstem": light_brainstem,
+                "framed": frame_front}[args.asset](asset, extra, args)
         extra.write(args.out)
     except (gw.Invalid, OSError, KeyError, ValueError, struct.error) as e:
         print(f"gen_real_scenes: {args.source}: {e}", file=sys.stderr)

@@ -1,0 +1,93 @@
+"""Compares one still image of each real glTF asset, rendered by pathreuse's path tracer and by
+Blender 5.2's Cycles, under a uniform white sky of radiance 1 and nothing else.
+
+Each asset (a folder of ../shared/scenes, or --scenes) gets a wrapper with a camera that frames
+it from the front (tools/scenes/gen_real_scenes.py framed); both renderers render frame 0 of it
+at the same size, spp and depth (Cycles through tools/bench/cycles_frames.py: Blender's importer,
+colour textures sRGB, CPU, box filter, no denoising or clamping). Over the pixels where either
+image differs from the sky by more than 2% (the asset), the tool gives the ratio ours / Cycles of
+the mean luminance and of each channel, and the 95th percentile over the 16x16 blocks wholly on
+the asset of |ours / Cycles - 1| (block means): the parts that differ show there.
+
+  /usr/bin/python3 -m tools.bench.asset_compare --cycles ~/.cache/pathreuse/bpy-5.2.3/bin/python \\
+      --binary build/pathreuse --assets StainedGlassLamp,ToyCar --spp 256 --width 256
+
+Cycles is a benchmark peer, not a dependency: --cycles names a Python 3.13 with PyPI's bpy 5.2.3.
+Writes WORK/NAME/{ours,cycles}/f_0000.exr, the ratio map WORK/NAME/ratio.png, and with --json the
+figures.
+"""
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from .benchlib import run_tool
+from .blender_compare import Images, compare, ratio_png
+
+HERE = Path(__file__).resolve().parent
+REPO = HERE.parents[1]
+
+
+def wrapper(name, scenes, work):
+    """The framed wrapper of asset `name` and its camera's index."""
+    src = Path(scenes) / name / f"{name}.gltf"
+    if not src.is_file():
+        sys.exit(f"asset_compare: {src}: no such asset")
+    out = Path(work) / name / f"{name}-framed.gltf"
+    run_tool("tools.scenes.gen_real_scenes", ["framed", src, "--out", out], check=True,
+             stdout=subprocess.DEVNULL)
+    cameras = json.loads(out.read_text())["cameras"]
+    return out, len(cameras) - 1
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--assets", default="StainedGlassLamp,ToyCar,DamagedHelmet,FlightHelmet")
+    ap.add_argument("--scenes", default=str(REPO.parent / "shared" / "scenes"))
+    ap.add_argument("--binary", default=str(REPO / "build" / "pathreuse"))
+    ap.add_argument("--cycles", required=True, help="a Python with bpy 5.2.3")
+    ap.add_argument("--spp", type=int, default=256)
+    ap.add_argument("--width", type=int, default=256, help="and height (default 256)")
+    ap.add_argument("--max-depth", type=int, default=16)
+    ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--block", type=int, default=16)
+    ap.add_argument("--work", default="/tmp/pathreuse-asset-compare")
+    ap.add_argument("--json", help="write the figures here")
+    a = ap.parse_args()
+    images = Images(a.binary, lambda: a.cycles)
+    rows = []
+    for name in a.assets.split(","):
+        scene, camera = wrapper(name, a.scenes, a.work)
+        d = Path(a.work) / name
+        size = ["--width", str(a.width), "--height", str(a.width)]
+        subprocess.run([a.binary, "render", str(scene), "--allow-outside-uris", "--camera",
+                        str(camera), "--mode", "pathtrace", "--spp", str(a.spp), "--max-depth",
+                        str(a.max_depth), "--env-color", "1,1,1", "--exr-float", "--frames", "0",
+                        "--out", str(d / "ours" / "f_%04d.exr"), "-q", *size], check=True,
+                       env=dict(os.environ, POCL_MAX_PTHREAD_COUNT=str(a.threads)))
+        subprocess.run([a.cycles, str(HERE / "cycles_frames.py"), str(scene), str(d / "cycles"),
+                        "--frames", "0-0", "--spp", str(a.spp), "--max-depth", str(a.max_depth),
+                        "--threads", str(a.threads), "--camera", "front", "--world", "1,1,1",
+                        *size], check=True, stdout=subprocess.DEVNULL)
+        ours = images.read(d / "ours" / "f_0000.exr")
+        cyc = images.read(d / "cycles" / "f_0000.exr")
+        mask = (np.abs(ours - 1).max(axis=2) > 0.02) | (np.abs(cyc - 1).max(axis=2) > 0.02)
+        row = {"asset": name, **compare(ours, cyc, mask, a.block)}
+        ratio_png(d / "ratio.png", ours, cyc, mask)
+        rows.append(row)
+        print(f"{name:18s} luminance {row['mean_ratio']:.3f}  rgb "
+              + " ".join(f"{x:.3f}" for x in row["rgb_ratio"])
+              + f"  blocks p95 {row['p95_block']:.3f} max {row['max_block']:.3f}"
+              + f" ({row['blocks']} blocks, {row['pixels']} px)", flush=True)
+    if a.json:
+        Path(a.json).write_text(json.dumps(rows, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
