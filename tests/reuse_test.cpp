@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <fstream>
 #include <functional>
 
 #include <nlohmann/json.hpp>
@@ -847,6 +848,45 @@ TEST(Reuse, ClosedGlassTintsByItsBaseColourOnce) {
     const Moments a = regionMean(tinted, 6, 6, 18, 18, c), b = regionMean(clear, 6, 6, 18, 18, c);
     ASSERT_GT(b.mean, 0.1) << "the wall shows through the clear box";
     EXPECT_NEAR(a.mean / b.mean, tint[c], 0.03) << "channel " << c;
+  }
+}
+
+// KHR_materials_transmission's texture: a pane whose texture is black on its left half and white
+// on its right, before an emissive wall under a black sky, is opaque (and unlit: the wall lights
+// its back) on the left and shows the wall through clear glass on the right.
+TEST(Reuse, TransmissionTextureMakesGlassWhereItIsWhite) {
+  test::GltfBuilder b;
+  const int wall = b.addMaterial({glm::vec4(0, 0, 0, 1), 0, 1, glm::vec3(1.0f), 2.0f});
+  test::MaterialSpec pane{glm::vec4(0.8f, 0.8f, 0.8f, 1), 0, 0};
+  pane.transmission = 1.0f;
+  pane.extensions = {{"KHR_materials_transmission",
+                      {{"transmissionFactor", 1.0}, {"transmissionTexture", {{"index", 0}}}}}};
+  b.addNode(b.addQuad({-4, -4, -2}, {4, -4, -2}, {4, 4, -2}, {-4, 4, -2}, wall));
+  test::MeshAttributes uv;
+  uv.uvs = {{0, 1}, {1, 1}, {1, 0}, {0, 0}};
+  b.addNode(b.addMesh({{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}}, {0, 1, 2, 0, 2, 3},
+                      b.addMaterial(pane), uv));
+  b.addCamera(glm::vec3(0.0f, 0.0f, 4.0f), glm::vec3(0.0f), 0.4f, 1.0f);
+  const std::string dir = test::tempDir("transmission-texture");
+  const std::string scene = b.write(dir, "pane");
+  Image texels(4, 1);
+  for (int x = 0; x < 4; ++x)
+    for (int c = 0; c < 4; ++c) texels.pixel(x, 0)[c] = (x >= 2 || c == 3) ? 1.0f : 0.0f;
+  writePng(dir + "/mask.png", texels);
+  nlohmann::json doc = nlohmann::json::parse(test::slurp(scene));
+  doc["images"] = {{{"uri", "mask.png"}}};
+  doc["samplers"] = {{{"magFilter", 9728}, {"minFilter", 9728}, {"wrapS", 33071}, {"wrapT", 33071}}};
+  doc["textures"] = {{{"source", 0}, {"sampler", 0}}};
+  std::ofstream(scene) << doc.dump();
+  const Image img = test::frameImage(
+      test::renderFrames(scene, "0", "--width 32 --height 32 --spp 16 --mode pathtrace --env none",
+                         "transmission-texture"),
+      0);
+  for (int c = 0; c < 3; ++c) {
+    const Moments opaque = regionMean(img, 10, 12, 14, 20, c), glass = regionMean(img, 18, 12, 22, 20, c);
+    // 2 x (1 - F) x sqrt(0.8) / 1.5^2: one refraction into the sheet, radiance compressed.
+    EXPECT_NEAR(glass.mean, 2.0 * 0.96 * std::sqrt(0.8) / 2.25, 0.03) << "the glass half";
+    EXPECT_LT(opaque.mean, 0.02 * glass.mean) << "the opaque half hides it";
   }
 }
 
