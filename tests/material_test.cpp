@@ -125,10 +125,11 @@ void expectFurnace(const Image& img, const std::string& what) {
                         << m.mean << " +- " << m.stderr_ << " (sphere row " << y << ")";
       }
   EXPECT_EQ(failures, 0) << what << ": " << failures << " of " << blocks << " blocks off";
-  // The blocks resolve 2%, so the test can fail: all but the noisiest 2% (silhouette blocks of
-  // the roughest metals and of rough glass, at grazing views).
+  // The blocks resolve 2% (at 1.6 standard errors or better), so the test can fail: all but the
+  // noisiest 2% (silhouette blocks of the roughest metals, and rough glass, whose light bounces
+  // inside the sphere).
   std::sort(noise.begin(), noise.end());
-  EXPECT_LT(noise[noise.size() * 98 / 100], 0.01) << what;
+  EXPECT_LT(noise[noise.size() * 98 / 100], 0.0125) << what;
   ::testing::Test::RecordProperty(what + "_worst", std::to_string(worst));
 }
 

@@ -875,7 +875,8 @@ TEST(Reuse, TransmissionTextureMakesGlassWhereItIsWhite) {
   writePng(dir + "/mask.png", texels);
   nlohmann::json doc = nlohmann::json::parse(test::slurp(scene));
   doc["images"] = {{{"uri", "mask.png"}}};
-  doc["samplers"] = {{{"magFilter", 9728}, {"minFilter", 9728}, {"wrapS", 33071}, {"wrapT", 33071}}};
+  doc["samplers"] = {
+      {{"magFilter", 9728}, {"minFilter", 9728}, {"wrapS", 33071}, {"wrapT", 33071}}};
   doc["textures"] = {{{"source", 0}, {"sampler", 0}}};
   std::ofstream(scene) << doc.dump();
   const Image img = test::frameImage(
@@ -883,7 +884,8 @@ TEST(Reuse, TransmissionTextureMakesGlassWhereItIsWhite) {
                          "transmission-texture"),
       0);
   for (int c = 0; c < 3; ++c) {
-    const Moments opaque = regionMean(img, 10, 12, 14, 20, c), glass = regionMean(img, 18, 12, 22, 20, c);
+    const Moments opaque = regionMean(img, 10, 12, 14, 20, c),
+                  glass = regionMean(img, 18, 12, 22, 20, c);
     // 2 x (1 - F) x sqrt(0.8) / 1.5^2: one refraction into the sheet, radiance compressed.
     EXPECT_NEAR(glass.mean, 2.0 * 0.96 * std::sqrt(0.8) / 2.25, 0.03) << "the glass half";
     EXPECT_LT(opaque.mean, 0.02 * glass.mean) << "the opaque half hides it";
