@@ -464,6 +464,24 @@ Estimate sphereAlbedoByEval(const BsdfParams& m, float3 wo, int n, uint32_t seed
   return {mean, std::sqrt(std::fmax(0.0, s2 / n - mean * mean) / n)};
 }
 
+// White glass's albedo seen from wo in radiance mode with radiance's 1/eta^2 taken out of the
+// refractions (E[f cos / pdf] over bsdf_sample, red channel): 1 where it keeps the light.
+double glassFurnace(const BsdfParams& m, float3 wo, uint32_t seed) {
+  Rng r = rng_make(seed, PR_RNG_TEST, 0, 0, 0);
+  const float eta = wo.z > 0 ? m.ior : 1.0f / m.ior;
+  double sum = 0;
+  const int n = 100000;
+  for (int i = 0; i < n; ++i) {
+    float3 wi, w;
+    float pdf;
+    int delta;
+    const float u0 = rng_next(&r), u1 = rng_next(&r), u2 = rng_next(&r);
+    if (bsdf_sample(&m, wo, u0, u1, u2, PR_RADIANCE, &wi, &w, &pdf, &delta))
+      sum += w.x * (wi.z * wo.z < 0 ? eta * eta : 1.0f);
+  }
+  return sum / n;
+}
+
 TEST(Bsdf, RoughGlassSamplesWhatItEvaluatesOnBothSides) {
   int k = 0;
   for (float roughness : {0.3f, 0.7f})
@@ -480,19 +498,7 @@ TEST(Bsdf, RoughGlassSamplesWhatItEvaluatesOnBothSides) {
         }
         // The white furnace: seen from wo, white glass reflects and refracts all that arrives
         // (radiance's 1/eta^2 taken out), to the albedo table's interpolation.
-        Rng r = rng_make(70u + k, PR_RNG_TEST, 0, 0, 0);
-        const float eta = cos_o > 0 ? ior : 1.0f / ior;
-        double sum = 0;
-        const int n = 100000;
-        for (int i = 0; i < n; ++i) {
-          float3 wi, w;
-          float pdf;
-          int delta;
-          const float u0 = rng_next(&r), u1 = rng_next(&r), u2 = rng_next(&r);
-          if (bsdf_sample(&m, wo, u0, u1, u2, PR_RADIANCE, &wi, &w, &pdf, &delta))
-            sum += w.x * (wi.z * wo.z < 0 ? eta * eta : 1.0f);
-        }
-        EXPECT_NEAR(sum / n, 1.0, 0.02)
+        EXPECT_NEAR(glassFurnace(m, wo, 70u + k), 1.0, 0.02)
             << "roughness " << roughness << " ior " << ior << " cos_o " << cos_o;
         EXPECT_GT(bsdfChiSquarePValue(m, wo, 200000, 60u + k), 1e-4)
             << "roughness " << roughness << " ior " << ior << " cos_o " << cos_o;
@@ -502,6 +508,40 @@ TEST(Bsdf, RoughGlassSamplesWhatItEvaluatesOnBothSides) {
   EXPECT_LT(bsdfChiSquarePValue(roughGlass(make_float3(1, 1, 1), 0.5f, 1.5f),
                                 dirFromCos(0.7f, 0.4f), 200000, 90u, 0.1f),
             1e-6);
+}
+
+// A clear coat over rough glass: sampling agrees with evaluation in both modes and from both
+// sides, the directions follow the pdf, the adjoint holds, and the white coated glass keeps the
+// light (the coat's reflection plus the glass under it, radiance's 1/eta^2 taken out). Without
+// the coat's share of what arrives the furnace reads up to a fifth too bright.
+TEST(Bsdf, CoatedRoughGlassSamplesWhatItEvaluates) {
+  BsdfParams m = roughGlass(make_float3(1, 1, 1), 0.6f, 1.5f);
+  m.coat = 1.0f;
+  m.coat_alpha = 0.04f;
+  int k = 0;
+  for (float cos_o : {0.9f, 0.3f, -0.6f}) {
+    const float3 wo = dirFromCos(cos_o, 0.4f);
+    for (int mode : {PR_RADIANCE, PR_IMPORTANCE}) {
+      const Estimate s = albedoBySampling(m, wo, 40000, 120u + k, mode);
+      const Estimate e = sphereAlbedoByEval(m, wo, 400000, 140u + k, mode);
+      const double tol = 5 * std::sqrt(s.stderr_ * s.stderr_ + e.stderr_ * e.stderr_) + 2e-3;
+      EXPECT_NEAR(s.mean, e.mean, tol) << "cos_o " << cos_o << " mode " << mode;
+    }
+    EXPECT_GT(bsdfChiSquarePValue(m, wo, 200000, 160u + k), 1e-4) << "cos_o " << cos_o;
+    EXPECT_NEAR(glassFurnace(m, wo, 180u + k), 1.0, 0.03) << "cos_o " << cos_o;
+    ++k;
+  }
+  Rng r = rng_make(13, PR_RNG_TEST, 0, 0, 0);
+  for (int i = 0; i < 1000; ++i) {
+    const float3 a = sample_uniform_sphere(rng_next(&r), rng_next(&r));
+    const float3 b = sample_uniform_sphere(rng_next(&r), rng_next(&r));
+    float p_ab, p_imp, p_imp_rev, p_ba;
+    const float3 fab = bsdf_eval(&m, a, b, &p_ab);
+    bsdf_eval(&m, b, a, &p_ba);
+    const float3 fimp = bsdf_eval_mode(&m, b, a, PR_IMPORTANCE, &p_imp, &p_imp_rev);
+    EXPECT_NEAR(fimp.x, fab.x, 1e-4f * std::fmax(1.0f, fab.x));
+    EXPECT_EQ(p_imp, p_ba);
+  }
 }
 
 // The adjoint across the surface: f for importance from b to a is f for radiance from a to b

@@ -735,21 +735,23 @@ TEST(Reuse, EqualsRetraceWithLightTracing) {
                            "--eye-paths --light-tracing");
 }
 
-// A room lit through rough glass: a closed box of tinted, absorbing rough glass
-// (KHR_materials_volume) and a pane (one sheet) that transmits at half its points (transmission
-// 0.5) with an emissive quad behind it, under a spot light and a point light. Every strategy
-// crosses the glass: next-event estimation, connections and splats pass through the pane, and
-// light paths refract in both.
+// A room lit through rough glass: a closed box of tinted, absorbing, clear-coated rough glass
+// (KHR_materials_volume, _clearcoat) and a pane (one sheet) that transmits at half its points
+// (transmission 0.5) with an emissive quad behind it, under a spot light and a point light. Every
+// strategy crosses the glass: next-event estimation, connections and splats pass through the pane,
+// and light paths refract in both.
 std::string roughGlassScene() {
   static const std::string path = [] {
     test::GltfBuilder b;
     const int white = b.addMaterial({glm::vec4(0.8f, 0.8f, 0.8f, 1), 0, 1});
     test::MaterialSpec glass{glm::vec4(0.9f, 0.7f, 0.5f, 1), 0, 0.4f};
     glass.transmission = 1.0f;
-    glass.extensions = {{"KHR_materials_volume",
-                         {{"thicknessFactor", 0.5},
-                          {"attenuationColor", {0.6, 0.8, 0.9}},
-                          {"attenuationDistance", 0.8}}}};
+    glass.extensions = {
+        {"KHR_materials_volume",
+         {{"thicknessFactor", 0.5},
+          {"attenuationColor", {0.6, 0.8, 0.9}},
+          {"attenuationDistance", 0.8}}},
+        {"KHR_materials_clearcoat", {{"clearcoatFactor", 1.0}, {"clearcoatRoughnessFactor", 0.2}}}};
     test::MaterialSpec panel{glm::vec4(0.8f, 0.8f, 0.8f, 1), 0, 0.3f};
     panel.transmission = 0.5f;
     const int lamp = b.addMaterial({glm::vec4(0, 0, 0, 1), 0, 1, glm::vec3(1.0f), 6.0f});

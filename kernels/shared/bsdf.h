@@ -639,6 +639,45 @@ PR_INLINE float3 rough_glass_sample(const BsdfParams* m, float3 wo, float u0, fl
   return wi;
 }
 
+// A clear coat over rough glass (KHR_materials_clearcoat on a transmissive material): the coat
+// reflects on the outside and passes on what it does not reflect there (lobe_coat_eval, its
+// albedo at the view); inside the object there is no coat between the directions. Sampled
+// with the coat's probability at wo where wo is outside.
+PR_INLINE float rough_glass_coat_choice(const BsdfParams* m, float3 wo) {
+  return bsdf_has_coat(m) && wo.z > 0.0f ? bsdf_coat_probability(m, dot(wo, m->coat_n)) : 0.0f;
+}
+
+PR_INLINE float3 rough_glass_coated_eval(const BsdfParams* m, float3 wo, float3 wi, int mode) {
+  const float3 glass = rough_glass_eval(m, wo, wi, mode);
+  if (!bsdf_has_coat(m)) return glass;
+  BsdfEval e;
+  e.wo = wo;
+  e.wi = wi;
+  e.h = normalize(wo + wi);
+  e.w5 = schlick_weight(fmax(dot(wo, e.h), 0.0f));
+  e.mode = mode;
+  e.lo = bsdf_layers(m, wo);
+  e.li = bsdf_layers(m, wi);
+  return lobe_coat_eval(m, &e, glass);
+}
+
+PR_INLINE float rough_glass_coated_pdf(const BsdfParams* m, float3 wo, float3 wi) {
+  const float pc = rough_glass_coat_choice(m, wo);
+  const float glass = rough_glass_pdf(m, wo, wi);
+  if (!(pc > 0.0f)) return glass;
+  return pc * lobe_coat_pdf(m, wo, wi, normalize(wo + wi)) + (1.0f - pc) * glass;
+}
+
+PR_INLINE float3 rough_glass_coated_sample(const BsdfParams* m, float3 wo, float u0, float u1,
+                                           float u2) {
+  const float pc = rough_glass_coat_choice(m, wo);
+  if (u0 < pc) {
+    const float3 wi = lobe_coat_sample(m, wo, u1, u2);
+    return wi.z > 0.0f && dot(wi, m->coat_n) > 0.0f ? wi : make_float3(0.0f, 0.0f, 0.0f);
+  }
+  return rough_glass_sample(m, wo, pc > 0.0f ? (u0 - pc) / (1.0f - pc) : u0, u1, u2);
+}
+
 // ---- The mixture, from the table
 
 // The lobes' probabilities at wo. glTF: each lobe its weight's share of what the lobes above
@@ -750,9 +789,9 @@ PR_INLINE float3 bsdf_eval_impl(const BsdfParams* m, float3 wo, float3 wi, int m
   *pdf = 0.0f;
   *pdf_rev = 0.0f;
   if (m->kind == PR_BSDF_ROUGH_GLASS) {
-    *pdf = rough_glass_pdf(m, wo, wi);
-    if (want_rev) *pdf_rev = rough_glass_pdf(m, wi, wo);
-    return rough_glass_eval(m, wo, wi, mode);
+    *pdf = rough_glass_coated_pdf(m, wo, wi);
+    if (want_rev) *pdf_rev = rough_glass_coated_pdf(m, wi, wo);
+    return rough_glass_coated_eval(m, wo, wi, mode);
   }
   if (bsdf_is_delta(m) || wo.z <= 0.0f || wi.z <= 0.0f) return make_float3(0.0f, 0.0f, 0.0f);
   if (m->kind == PR_BSDF_LAMBERT) {
@@ -822,7 +861,7 @@ PR_INLINE int bsdf_sample_impl(const BsdfParams* m, float3 wo, float u0, float u
     return 1;
   }
   if (m->kind == PR_BSDF_ROUGH_GLASS) {
-    const float3 dir = rough_glass_sample(m, wo, u0, u1, u2);
+    const float3 dir = rough_glass_coated_sample(m, wo, u0, u1, u2);
     if (dir.z == 0.0f) return 0;
     float p_fwd = 0.0f, p_rev;
     const float3 f = bsdf_eval_impl(m, wo, dir, mode, 0, &p_fwd, &p_rev);

@@ -199,7 +199,9 @@ PR_INLINE ShadingFrame shading_frame(const SceneData* s, const SurfaceHit* h, fl
     float3 nc = surface_coat_normal(&s->sd, h);
     if (flip) nc = -nc;
     const float c = dot(wo, nc);
-    if (c < PR_MIN_VIEW_COS) nc = normalize(nc + wo * (PR_MIN_VIEW_COS - c));
+    // (Glass keeps its coat on the outside, whichever side wo is on.)
+    if (c < PR_MIN_VIEW_COS && !bsdf_transmits(&f.bsdf))
+      nc = normalize(nc + wo * (PR_MIN_VIEW_COS - c));
     f.bsdf.coat_n = normalize(to_local(nc, f.t, f.b, f.n));
   }
 #endif

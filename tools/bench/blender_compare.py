@@ -215,6 +215,9 @@ def _catalogue():
                 {"KHR_materials_transmission": {"transmissionFactor": 1.0}})
     add("glass-half-r050", "glass", (1.0,) * 3, 0.0, 0.5,
         {"KHR_materials_transmission": {"transmissionFactor": 0.5}})
+    add("glass-coat-r050", "glass", (1.0,) * 3, 0.0, 0.5,
+        {"KHR_materials_transmission": {"transmissionFactor": 1.0},
+         "KHR_materials_clearcoat": {"clearcoatFactor": 1.0, "clearcoatRoughnessFactor": 0.1}})
     # the roughnesses of the issue's figures (metal 0.7, white dielectric 0.3)
     add("issue-metal-white-r070", "issue", (1.0,) * 3, 1.0, 0.7)
     add("issue-dielectric-white-r030", "issue", (1.0,) * 3, 0.0, 0.3)
