@@ -4,11 +4,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "support/render_helpers.h"
 #include "support/test_env.h"
 
 namespace pr {
@@ -93,6 +95,30 @@ TEST(SceneCli, LitWrappersOfSharedAssetsLoadAsTheirGeneratorSays) {
   EXPECT_EQ(s["triangles"]["dynamic"], b["triangles"]["dynamic"]);
   EXPECT_EQ(s["cameras"], 2);
   EXPECT_EQ(s["animation"]["frames"], b["animation"]["frames"]);
+
+  // `framed`: the asset as it is, one camera more, no buffer of its own (glTF forbids an empty
+  // one), and that camera sees the whole asset (under a white sky, the asset fills the middle
+  // and none of it touches the border).
+  const std::string framed = make("framed", brainstem);
+  const auto f = info(framed);
+  EXPECT_EQ(f["triangles"], b["triangles"]);
+  EXPECT_EQ(f["cameras"].get<int>(), b["cameras"].get<int>() + 1);
+  EXPECT_FALSE(std::filesystem::exists(dir + "/framed-lit.bin"));
+  const std::string out = test::renderFrames(
+      framed, "0",
+      "--allow-outside-uris --camera " + std::to_string(f["cameras"].get<int>() - 1) +
+          " --mode pathtrace --width 32 --height 32 --spp 1 --env-color 1,1,1",
+      "framed");
+  const Image img = test::frameImage(out, 0);
+  int asset = 0, border = 0;
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 32; ++x) {
+      const bool sky = std::fabs(img.pixel(x, y)[1] - 1.0f) < 1e-3f;
+      asset += !sky;
+      border += !sky && (x == 0 || y == 0 || x == 31 || y == 31);
+    }
+  EXPECT_GT(asset, 32 * 32 / 20) << "the asset is in view";
+  EXPECT_EQ(border, 0) << "and all of it";
 }
 
 TEST(SceneCli, BrokenFileIsOneLineExitTwo) {
