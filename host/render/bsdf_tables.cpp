@@ -65,6 +65,18 @@ float gridRoughness(int j, int n) {
   return PR_TABLE_MIN_ROUGHNESS + (1.0f - PR_TABLE_MIN_ROUGHNESS) * float(j) / float(n - 1);
 }
 
+// The hemispherical average 2 \int E(mu) mu dmu of an albedo E(mu), by the midpoint rule on
+// `points` cosines (a grid finer than the table's).
+template <class Albedo>
+double hemisphereAverage(int points, Albedo albedo) {
+  double avg = 0.0;
+  for (int k = 0; k < points; ++k) {
+    const float mu = (float(k) + 0.5f) / float(points);
+    avg += 2.0 * albedo(mu) * mu / points;
+  }
+  return avg;
+}
+
 // Runs task(0 .. count - 1) on every core: each is a pure function of its index.
 template <class Task>
 void parallelFor(int count, Task task) {
@@ -154,17 +166,12 @@ BsdfTables computeBsdfTables(int cosines, int roughnesses, int samples, int stri
       t.ggxEs[k] = float(es);
       t.sheenE[k] = float(sheenAlbedo(mu, alpha, samples));
     }
-    // The average over cosines by the midpoint rule on a grid finer than the table's.
     if (j % stride != 0) return;
-    const int points = 2 * cosines;
-    double avg = 0.0;
-    for (int k = 0; k < points; ++k) {
-      const float mu = (float(k) + 0.5f) / float(points);
+    t.ggxEavg[size_t(j)] = float(hemisphereAverage(2 * cosines, [&](float mu) {
       double e, es;
       ggxAlbedo(viewAt(mu, 0.0f), alpha, alpha, samples / 2, &e, &es);
-      avg += 2.0 * e * mu / points;
-    }
-    t.ggxEavg[size_t(j)] = float(avg);
+      return e;
+    }));
   });
   t.anisoCosines = kBsdfAnisoCos;
   t.anisoRoughnesses = kBsdfAnisoRoughness;
@@ -186,15 +193,11 @@ BsdfTables computeBsdfTables(int cosines, int roughnesses, int samples, int stri
       t.anisoEs[size_t(row) * size_t(t.anisoCosines) + size_t(i)] = float(es);
     }
     if (row % stride != 0) return;
-    const int points = 2 * t.anisoCosines;
-    double avg = 0.0;
-    for (int k = 0; k < points; ++k) {
-      const float mu = (float(k) + 0.5f) / float(points);
+    t.anisoEavg[size_t(row)] = float(hemisphereAverage(2 * t.anisoCosines, [&](float mu) {
       double e, es;
       ggxAlbedoAniso(mu, ax, ay, s / 2, &e, &es);
-      avg += 2.0 * e * mu / points;
-    }
-    t.anisoEavg[size_t(row)] = float(avg);
+      return e;
+    }));
   });
   t.glassCosines = kBsdfGlassCos;
   t.glassRoughnesses = kBsdfGlassRoughness;
@@ -212,13 +215,8 @@ BsdfTables computeBsdfTables(int cosines, int roughnesses, int samples, int stri
       t.glassE[at] = float(glassAlbedo(gridCos(i, t.glassCosines), r * r, eta, samples / 2));
     }
     if (row % stride != 0) return;
-    const int points = 2 * t.glassCosines;
-    double avg = 0.0;
-    for (int i = 0; i < points; ++i) {
-      const float mu = (float(i) + 0.5f) / float(points);
-      avg += 2.0 * glassAlbedo(mu, r * r, eta, samples / 4) * mu / points;
-    }
-    t.glassEavg[size_t(row)] = float(avg);
+    t.glassEavg[size_t(row)] = float(hemisphereAverage(
+        2 * t.glassCosines, [&](float mu) { return glassAlbedo(mu, r * r, eta, samples / 4); }));
   });
   return t;
 }

@@ -89,18 +89,18 @@ struct Material {
   TextureRef normalTexture;             // linear tangent-space normal map
   float normalScale = 1.0f;
   glm::vec3 emissiveFactor{0.0f};
-  TextureRef emissiveTexture;     // sRGB texture
-  float emissiveStrength = 1.0f;  // KHR_materials_emissive_strength
-  float transmission = 0.0f;      // KHR_materials_transmission factor
-  float ior = 1.5f;               // KHR_materials_ior
-  float specular = 1.0f;          // KHR_materials_specular: specularFactor
-  glm::vec3 specularColor{1.0f};  // specularColorFactor
-  float clearcoat = 0.0f;         // KHR_materials_clearcoat: clearcoatFactor
+  TextureRef emissiveTexture;      // sRGB texture
+  float emissiveStrength = 1.0f;   // KHR_materials_emissive_strength
+  float transmission = 0.0f;       // KHR_materials_transmission factor
+  TextureRef transmissionTexture;  // its texture: linear, R scales the factor
+  float ior = 1.5f;                // KHR_materials_ior
+  float specular = 1.0f;           // KHR_materials_specular: specularFactor
+  glm::vec3 specularColor{1.0f};   // specularColorFactor
+  float clearcoat = 0.0f;          // KHR_materials_clearcoat: clearcoatFactor
   float clearcoatRoughness = 0.0f;
   TextureRef specularTexture;            // linear, A scales specularFactor
   TextureRef specularColorTexture;       // sRGB
   TextureRef clearcoatTexture;           // linear, R
-  TextureRef transmissionTexture;        // linear, R (KHR_materials_transmission)
   TextureRef clearcoatRoughnessTexture;  // linear, G
   TextureRef clearcoatNormalTexture;     // linear tangent-space normal map of the coat
   float clearcoatNormalScale = 1.0f;

@@ -122,15 +122,18 @@ PR_INLINE float bsdf_table_roughness(float r) {
   return (r - PR_TABLE_MIN_ROUGHNESS) * (1.0f / (1.0f - PR_TABLE_MIN_ROUGHNESS));
 }
 
+// Bilinear in a table of rows of ni at the cell whose first corner is c, fractions (fx, fy).
+PR_INLINE float bsdf_table_bilinear(PR_CONSTANT const float* c, int ni, float fx, float fy) {
+  const float a = c[0] + (c[1] - c[0]) * fx;
+  const float b = c[ni] + (c[ni + 1] - c[ni]) * fx;
+  return a + (b - a) * fy;
+}
+
 PR_INLINE float bsdf_table2(PR_CONSTANT const float* t, float mu, float r) {
   int i, j;
   const float fx = bsdf_table_at(sqrt(fmax(mu, 0.0f)), PR_BSDF_TABLE_COS, &i);
   const float fy = bsdf_table_at(bsdf_table_roughness(r), PR_BSDF_TABLE_R, &j);
-  PR_CONSTANT const float* row = t + j * PR_BSDF_TABLE_COS + i;
-  const float a = row[0] + (row[1] - row[0]) * fx;
-  const float b =
-      row[PR_BSDF_TABLE_COS] + (row[PR_BSDF_TABLE_COS + 1] - row[PR_BSDF_TABLE_COS]) * fx;
-  return a + (b - a) * fy;
+  return bsdf_table_bilinear(t + j * PR_BSDF_TABLE_COS + i, PR_BSDF_TABLE_COS, fx, fy);
 }
 
 PR_INLINE float bsdf_table1(PR_CONSTANT const float* t, float r) {
@@ -167,10 +170,7 @@ PR_INLINE void ggx_albedo(float ax, float ay, float mu, float* e, float* es, flo
   const float fz = bsdf_table_at(bsdf_table_roughness(sqrt(amin / amax)), PR_BSDF_ANISO_Q, &k);
   *e = bsdf_table3(pr_ggx_e_aniso, PR_BSDF_ANISO_COS, PR_BSDF_ANISO_R, i, j, k, fx, fy, fz);
   *es = bsdf_table3(pr_ggx_es_aniso, PR_BSDF_ANISO_COS, PR_BSDF_ANISO_R, i, j, k, fx, fy, fz);
-  PR_CONSTANT const float* a = pr_ggx_eavg_aniso + k * PR_BSDF_ANISO_R + j;
-  const float a0 = a[0] + (a[1] - a[0]) * fy;
-  const float a1 = a[PR_BSDF_ANISO_R] + (a[PR_BSDF_ANISO_R + 1] - a[PR_BSDF_ANISO_R]) * fy;
-  *eavg = a0 + (a1 - a0) * fz;
+  *eavg = bsdf_table_bilinear(pr_ggx_eavg_aniso + k * PR_BSDF_ANISO_R + j, PR_BSDF_ANISO_R, fy, fz);
 }
 
 // ---- Layers
@@ -553,10 +553,8 @@ PR_INLINE float rough_glass_albedo(const BsdfParams* m, float3 w, float* avg) {
   const float fz =
       bsdf_table_at(((ior - 1.0f) / (ior + 1.0f) - z0) / (z1 - z0), PR_BSDF_GLASS_IOR, &k);
   const int side = w.z > 0.0f ? 0 : 1;
-  PR_CONSTANT const float* a = pr_glass_eavg + (side * PR_BSDF_GLASS_IOR + k) * PR_BSDF_GLASS_R + j;
-  const float a0 = a[0] + (a[1] - a[0]) * fy;
-  const float a1 = a[PR_BSDF_GLASS_R] + (a[PR_BSDF_GLASS_R + 1] - a[PR_BSDF_GLASS_R]) * fy;
-  *avg = a0 + (a1 - a0) * fz;
+  *avg = bsdf_table_bilinear(pr_glass_eavg + (side * PR_BSDF_GLASS_IOR + k) * PR_BSDF_GLASS_R + j,
+                             PR_BSDF_GLASS_R, fy, fz);
   PR_CONSTANT const float* t =
       pr_glass_e + side * PR_BSDF_GLASS_IOR * PR_BSDF_GLASS_R * PR_BSDF_GLASS_COS;
   return bsdf_table3(t, PR_BSDF_GLASS_COS, PR_BSDF_GLASS_R, i, j, k, fx, fy, fz);
@@ -587,32 +585,33 @@ PR_INLINE int rough_glass_half(float3 wo, float3 wi, float eta, float3* h) {
   return 1;
 }
 
-// The pdf of sampling wi from wo.
-PR_INLINE float rough_glass_pdf(const BsdfParams* m, float3 wo, float3 wi) {
-  const float eta = rough_glass_eta(m, wo);
-  float3 h;
-  if (wo.z == 0.0f || wi.z == 0.0f || !rough_glass_half(wo, wi, eta, &h)) return 0.0f;
-  const float a2 = m->alpha_x * m->alpha_x;
-  const float co = fabs(wo.z), ho = fabs(dot(wo, h)), hi = fabs(dot(wi, h));
-  const float visible = ggx_d(h.z, a2) * ho / ((1.0f + ggx_lambda(co, a2)) * co);
-  const float fr = fresnel_dielectric(ho, eta);
-  if (wo.z * wi.z > 0.0f) return visible * fr / (4.0f * ho);
-  const float s = dot(wi, h) + dot(wo, h) / eta;  // the dots' signs differ
-  return visible * (1.0f - fr) * hi / (s * s);
-}
-
-PR_INLINE float3 rough_glass_eval(const BsdfParams* m, float3 wo, float3 wi, int mode) {
+// f(wo, wi) for `mode`, with the pdfs of sampling wi from wo (*pdf) and wo from wi (*pdf_rev):
+// one half vector, D, Lambdas and Fresnel for the three (the Fresnel of a refraction is the same
+// from either side).
+PR_INLINE float3 rough_glass_eval(const BsdfParams* m, float3 wo, float3 wi, int mode, float* pdf,
+                                  float* pdf_rev) {
+  *pdf = 0.0f;
+  *pdf_rev = 0.0f;
   const float eta = rough_glass_eta(m, wo);
   float3 h;
   if (wo.z == 0.0f || wi.z == 0.0f || !rough_glass_half(wo, wi, eta, &h))
     return make_float3(0.0f, 0.0f, 0.0f);
   const float a2 = m->alpha_x * m->alpha_x;
   const float co = fabs(wo.z), ci = fabs(wi.z), ho = fabs(dot(wo, h)), hi = fabs(dot(wi, h));
-  const float dg = ggx_d(h.z, a2) / (1.0f + ggx_lambda(co, a2) + ggx_lambda(ci, a2));
+  const float d = ggx_d(h.z, a2), lo = ggx_lambda(co, a2), li = ggx_lambda(ci, a2);
+  const float dg = d / (1.0f + lo + li);
   const float fr = fresnel_dielectric(ho, eta);
+  // Visible-normal densities of h from wo and from wi.
+  const float vo = d * ho / ((1.0f + lo) * co), vi = d * hi / ((1.0f + li) * ci);
   const float3 ms = rough_glass_compensation(m, mode == PR_RADIANCE ? wo : wi);
-  if (wo.z * wi.z > 0.0f) return ms * (fr * dg / (4.0f * co * ci));
-  const float s = dot(wi, h) + dot(wo, h) / eta;
+  if (wo.z * wi.z > 0.0f) {
+    *pdf = vo * fr / (4.0f * ho);
+    *pdf_rev = vi * fr / (4.0f * hi);
+    return ms * (fr * dg / (4.0f * co * ci));
+  }
+  const float s = dot(wi, h) + dot(wo, h) / eta;  // the dots' signs differ
+  *pdf = vo * (1.0f - fr) * hi / (s * s);
+  *pdf_rev = vi * (1.0f - fr) * ho / (eta * eta * s * s);  // wi's s is eta x wo's
   float v = (1.0f - fr) * dg * hi * ho / (co * ci * s * s);
   if (mode == PR_RADIANCE) v /= eta * eta;
   return m->base * ms * v;
@@ -647,8 +646,10 @@ PR_INLINE float rough_glass_coat_choice(const BsdfParams* m, float3 wo) {
   return bsdf_has_coat(m) && wo.z > 0.0f ? bsdf_coat_probability(m, dot(wo, m->coat_n)) : 0.0f;
 }
 
-PR_INLINE float3 rough_glass_coated_eval(const BsdfParams* m, float3 wo, float3 wi, int mode) {
-  const float3 glass = rough_glass_eval(m, wo, wi, mode);
+// The same as rough_glass_eval with the coat over the glass.
+PR_INLINE float3 rough_glass_coated_eval(const BsdfParams* m, float3 wo, float3 wi, int mode,
+                                         float* pdf, float* pdf_rev) {
+  const float3 glass = rough_glass_eval(m, wo, wi, mode, pdf, pdf_rev);
   if (!bsdf_has_coat(m)) return glass;
   BsdfEval e;
   e.wo = wo;
@@ -656,16 +657,13 @@ PR_INLINE float3 rough_glass_coated_eval(const BsdfParams* m, float3 wo, float3 
   e.h = normalize(wo + wi);
   e.w5 = schlick_weight(fmax(dot(wo, e.h), 0.0f));
   e.mode = mode;
-  e.lo = bsdf_layers(m, wo);
-  e.li = bsdf_layers(m, wi);
+  // The coat reads the view's layers alone (bsdf_view).
+  e.lo = bsdf_layers(m, mode == PR_RADIANCE ? wo : wi);
+  e.li = e.lo;
+  const float po = rough_glass_coat_choice(m, wo), pi = rough_glass_coat_choice(m, wi);
+  if (po > 0.0f) *pdf = po * lobe_coat_pdf(m, wo, wi, e.h) + (1.0f - po) * *pdf;
+  if (pi > 0.0f) *pdf_rev = pi * lobe_coat_pdf(m, wi, wo, e.h) + (1.0f - pi) * *pdf_rev;
   return lobe_coat_eval(m, &e, glass);
-}
-
-PR_INLINE float rough_glass_coated_pdf(const BsdfParams* m, float3 wo, float3 wi) {
-  const float pc = rough_glass_coat_choice(m, wo);
-  const float glass = rough_glass_pdf(m, wo, wi);
-  if (!(pc > 0.0f)) return glass;
-  return pc * lobe_coat_pdf(m, wo, wi, normalize(wo + wi)) + (1.0f - pc) * glass;
 }
 
 PR_INLINE float3 rough_glass_coated_sample(const BsdfParams* m, float3 wo, float u0, float u1,
@@ -788,11 +786,7 @@ PR_INLINE float3 bsdf_eval_impl(const BsdfParams* m, float3 wo, float3 wi, int m
                                 float* pdf, float* pdf_rev) {
   *pdf = 0.0f;
   *pdf_rev = 0.0f;
-  if (m->kind == PR_BSDF_ROUGH_GLASS) {
-    *pdf = rough_glass_coated_pdf(m, wo, wi);
-    if (want_rev) *pdf_rev = rough_glass_coated_pdf(m, wi, wo);
-    return rough_glass_coated_eval(m, wo, wi, mode);
-  }
+  if (m->kind == PR_BSDF_ROUGH_GLASS) return rough_glass_coated_eval(m, wo, wi, mode, pdf, pdf_rev);
   if (bsdf_is_delta(m) || wo.z <= 0.0f || wi.z <= 0.0f) return make_float3(0.0f, 0.0f, 0.0f);
   if (m->kind == PR_BSDF_LAMBERT) {
     *pdf = wi.z * PR_INV_PI;

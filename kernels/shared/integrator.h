@@ -136,9 +136,8 @@ PR_INLINE Ray surface_segment(const SceneData* s, const SurfaceHit* a, const Sur
 }
 
 // A shading frame: ns and ng flipped to the side of wo for reflective surfaces; glass (smooth or
-// rough) keeps
-// its geometric orientation so that the sign of wo tells entering from leaving. Where wo is
-// above a reflective surface but (nearly) below its shading normal's horizon (a smooth-shaded
+// rough) keeps its geometric orientation so that the sign of wo tells entering from leaving. Where
+// wo is above a reflective surface but (nearly) below its shading normal's horizon (a smooth-shaded
 // facet seen edge-on), the shading normal is turned towards wo until wo is PR_MIN_VIEW_COS
 // above that horizon: the BSDFs only reflect between directions above their normal, which
 // made such views black. `may_lift`: wo is above the geometric surface, so that a reflection

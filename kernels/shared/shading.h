@@ -351,7 +351,7 @@ PR_INLINE int material_transmits_at(const ShadingData* sd, PR_GLOBAL const Mater
   const u32 key = pr_hash_u32(
       0x7a3c91e5u ^ s->prim ^
       pr_hash_u32(s->inst ^ pr_hash_u32(pr_as_uint(s->b1) ^ pr_hash_u32(pr_as_uint(s->b2)))));
-  return (float)(key >> 8) * (1.0f / 16777216.0f) < t;
+  return pr_u32_to_unit(key) < t;
 }
 
 // The BSDF's parameters at the surface; in *aniso the anisotropy direction (cos, sin) from the
