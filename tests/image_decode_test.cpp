@@ -1,12 +1,15 @@
 // Texture decoding refuses images whose headers promise more than the file holds, before any
-// large allocation (regressions from fuzzing the loader).
+// large allocation (regressions from fuzzing the loader); sRGB texels decode by the transfer
+// function, rounded once.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <string>
 #include <vector>
 
 #include "scene/image_decode.h"
+#include "shared/srgb.h"
 
 namespace pr {
 namespace {
@@ -61,6 +64,21 @@ TEST(ImageDecode, SmallValidImageStillDecodes) {
   EXPECT_EQ(img.rgba8[0], 255);
   EXPECT_EQ(img.rgba8[1], 0);
   EXPECT_EQ(img.rgba8[3], 255);
+}
+
+// The kernels' table (tools/tables/srgb_table.py) against IEC 61966-2-1 in double precision:
+// every entry the float nearest to the exact value, so every device decodes a texel alike.
+TEST(Srgb, TableIsTheTransferFunction) {
+  for (int b = 0; b < 256; ++b) {
+    const double c = b / 255.0;
+    const double exact = c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+    EXPECT_EQ(dev::pr_srgb_to_linear[b], static_cast<float>(exact)) << "byte " << b;
+    if (b > 0) {
+      EXPECT_GT(dev::pr_srgb_to_linear[b], dev::pr_srgb_to_linear[b - 1]) << "byte " << b;
+    }
+  }
+  EXPECT_EQ(dev::pr_srgb_to_linear[0], 0.0f);
+  EXPECT_EQ(dev::pr_srgb_to_linear[255], 1.0f);
 }
 
 }  // namespace

@@ -3,13 +3,14 @@
 #include <algorithm>
 #include <cmath>
 
+#include "shared/srgb.h"
+
 namespace pr {
 
 namespace {
 
 float srgbToLinear(uint8_t v) {
-  const float c = float(v) / 255.0f;
-  return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+  return dev::pr_srgb_to_linear[v];
 }
 
 float luminance(const glm::vec3& c) {

@@ -7,6 +7,7 @@
 #include "shared/material.h"
 #include "shared/math.h"
 #include "shared/rng.h"
+#include "shared/srgb.h"
 #include "shared/types.h"
 
 PR_NAMESPACE_BEGIN
@@ -64,10 +65,6 @@ PR_INLINE void triangle_world(const ShadingData* sd, u32 prim, u32 inst, float3*
   *e2 = pc - pa;
 }
 
-PR_INLINE float srgb_to_linear(float c) {
-  return c <= 0.04045f ? c * (1.0f / 12.92f) : pow((c + 0.055f) * (1.0f / 1.055f), 2.4f);
-}
-
 PR_INLINE int wrap_texel(int i, int n, u32 mode) {
   if (mode == 1u) return i < 0 ? 0 : (i >= n ? n - 1 : i);
   if (mode == 2u) {
@@ -82,15 +79,11 @@ PR_INLINE int wrap_texel(int i, int n, u32 mode) {
 
 PR_INLINE float4 texel_at(const ShadingData* sd, TextureInfo t, int x, int y) {
   const u32 w = sd->texels[t.offset + (u32)y * t.width + (u32)x];
-  float4 c = make_float4((float)(w & 255u), (float)((w >> 8) & 255u), (float)((w >> 16) & 255u),
-                         (float)(w >> 24)) *
-             (1.0f / 255.0f);
-  if (t.flags & PR_TEX_SRGB) {
-    c.x = srgb_to_linear(c.x);
-    c.y = srgb_to_linear(c.y);
-    c.z = srgb_to_linear(c.z);
-  }
-  return c;
+  const u32 r = w & 255u, g = (w >> 8) & 255u, b = (w >> 16) & 255u, a = w >> 24;
+  if (t.flags & PR_TEX_SRGB)
+    return make_float4(pr_srgb_to_linear[r], pr_srgb_to_linear[g], pr_srgb_to_linear[b],
+                       (float)a * (1.0f / 255.0f));
+  return make_float4((float)r, (float)g, (float)b, (float)a) * (1.0f / 255.0f);
 }
 
 // Bilinear (or nearest) lookup with the texture's wrap modes; linear RGBA.
