@@ -239,7 +239,8 @@ float scaleOfOne(const ProgramBuild& build) {
   k.setArg(1, out);
   ctx.queue().enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(1));
   ctx.queue().enqueueReadBuffer(out, CL_TRUE, 0, sizeof y, &y);
-  ctx.release(2 * sizeof y);
+  ctx.release("x", sizeof one);
+  ctx.release("y", sizeof y);
   return y;
 }
 

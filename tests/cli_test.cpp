@@ -104,5 +104,30 @@ TEST(Cli, KernelBuildsAreAnnouncedOnceAndTimedInTheFirstStatsLine) {
   EXPECT_EQ(r.err, "");
 }
 
+// The stats line's device memory by buffer sums to its total, and counts each buffer once: in
+// reuse mode the eye paths write into reuse's radiance and eye vertices, so the path tracer
+// keeps none of its own (one pixel's worth each, where it had one per pixel).
+TEST(Cli, DeviceBuffersSumToTheDeviceBytes) {
+  const int w = 32, h = 24;
+  for (const std::string mode : {"reuse", "pathtrace"}) {
+    const std::string dir = test::tempDir("buffers-" + mode);
+    auto r = test::runPathreuse("render '" + test::sourcePath("scenes/cornell-dynamic.gltf") +
+                                "' --frames 0 --width " + std::to_string(w) + " --height " +
+                                std::to_string(h) + " --spp 1 --mode " + mode + " --out '" + dir +
+                                "/f_%04d.exr' --stats '" + dir + "/stats.jsonl' --quiet");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const nlohmann::json line = nlohmann::json::parse(test::statsLines(dir).at(0));
+    uint64_t sum = 0;
+    for (const auto& [name, bytes] : line["device_buffers"].items()) sum += bytes.get<uint64_t>();
+    EXPECT_EQ(sum, line["device_bytes"].get<uint64_t>()) << mode;
+    const nlohmann::json& b = line["device_buffers"];
+    ASSERT_TRUE(b.contains("sample radiance")) << b.dump();
+    EXPECT_EQ(b["sample radiance"].get<uint64_t>(),
+              uint64_t(w * h) * 16 + (mode == "reuse" ? 16 : 0))
+        << mode;
+    EXPECT_EQ(b.contains("light vertex arena"), mode == "reuse") << b.dump();
+  }
+}
+
 }  // namespace
 }  // namespace pr

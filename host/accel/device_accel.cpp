@@ -14,7 +14,7 @@ namespace pr::accel {
 void DeviceAccel::upload(Context& ctx, Slot& slot, const char* name, const void* data,
                          uint64_t bytes, bool grow) {
   if (slot.bytes < std::max<uint64_t>(bytes, 64)) {
-    if (slot.bytes > 0) ctx.release(slot.bytes);
+    if (slot.bytes > 0) ctx.release(name, slot.bytes);
     // Per-frame buffers get headroom so a slowly growing instance count does not reallocate.
     const uint64_t want = std::max<uint64_t>(grow ? bytes + bytes / 2 : bytes, 64);
     slot.buffer = ctx.allocate(name, want, CL_MEM_READ_ONLY);

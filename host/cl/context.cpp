@@ -208,7 +208,16 @@ cl::Buffer Context::allocate(const std::string& name, uint64_t bytes, cl_mem_fla
                        device_.name);
   CL_CHECK(err);
   bytesInUse_ += bytes;
+  bytesByName_[name] += bytes;
   return buffer;
+}
+
+void Context::release(const std::string& name, uint64_t bytes) {
+  bytesInUse_ -= std::min(bytes, bytesInUse_);
+  auto it = bytesByName_.find(name);
+  if (it == bytesByName_.end()) return;
+  it->second -= std::min(bytes, it->second);
+  if (it->second == 0) bytesByName_.erase(it);
 }
 
 void Context::zero(const cl::Buffer& buffer, uint64_t bytes) {

@@ -45,12 +45,16 @@ class Context {
                                       const std::string& label);
 
   // A device buffer of `bytes`, checked against the device's max allocation; `name` is used in
-  // errors ("device out of memory: light vertex arena (1.2 GiB) ..."). Counted in bytesInUse().
+  // errors ("device out of memory: light vertex arena (1.2 GiB) ..."). Counted in bytesInUse()
+  // and, under its name, in bytesByName().
   cl::Buffer allocate(const std::string& name, uint64_t bytes,
                       cl_mem_flags flags = CL_MEM_READ_WRITE);
-  // Releases the count of a buffer made by allocate() (the buffer itself is reference counted).
-  void release(uint64_t bytes) { bytesInUse_ -= bytes <= bytesInUse_ ? bytes : bytesInUse_; }
+  // Releases the count of a buffer made by allocate() under `name` (the buffer itself is
+  // reference counted).
+  void release(const std::string& name, uint64_t bytes);
   uint64_t bytesInUse() const { return bytesInUse_; }
+  // The bytes in use by buffer name (buffers of one name summed), for --stats.
+  const std::map<std::string, uint64_t>& bytesByName() const { return bytesByName_; }
 
   // With a notice, the first build from source (not from the cache) prints one line on stderr:
   // a GPU's compiler may take minutes over the reuse kernels.
@@ -83,6 +87,7 @@ class Context {
   cl::Context context_;
   cl::CommandQueue queue_;
   uint64_t bytesInUse_ = 0;
+  std::map<std::string, uint64_t> bytesByName_;
   bool buildNotice_ = false;
   bool noticeGiven_ = false;
   std::map<std::string, double> buildSeconds_;

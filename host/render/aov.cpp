@@ -96,7 +96,7 @@ std::pair<double, double> AovRenderer::render(int64_t frame, double fps, int cam
     toRows(scene_.instanceTransform(i, then), &inst[i * 12]);
   CL_CHECK(ctx_.queue().enqueueWriteBuffer(prevInst_, CL_TRUE, 0, inst.size() * 4, inst.data()));
   if (n > outPixels_) {
-    if (out_()) ctx_.release(uint64_t(outPixels_) * kAovFloats * 4);
+    if (out_()) ctx_.release("aov images", uint64_t(outPixels_) * kAovFloats * 4);
     out_ = ctx_.allocate("aov images", uint64_t(n) * kAovFloats * 4);
     outPixels_ = n;
   }

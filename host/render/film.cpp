@@ -40,7 +40,8 @@ void Film::clear() {
 void Film::setAdaptive(const AdaptiveSettings& settings) {
   PR_CHECK(settings.threshold > 0.0f && settings.pilot >= 2 && settings.pilot <= settings.spp);
   adaptive_ = settings;
-  ctx_.release(8);  // the unread words budget_ and list_ were
+  ctx_.release("pixel budgets", 4);  // the unread words budget_ and list_ were
+  ctx_.release("pass pixel list", 4);
   odd_ = ctx_.allocate("odd pass sums", uint64_t(pixels()) * 16);
   oddBad_ = ctx_.allocate("odd pass bad samples", 4);
   budget_ = ctx_.allocate("pixel budgets", uint64_t(pixels()) * 4);

@@ -268,7 +268,7 @@ void GpuScene::setTime(double t) {
   // The moved flags change even when no transform does (all back to 0), so always upload.
   const uint64_t bytes = std::max<size_t>(n, 1) * sizeof(dev::ShadingInstance);
   if (n > instanceCapacity_ || !shadingInstances_()) {
-    if (shadingInstances_()) ctx_.release(instanceBytes_);
+    if (shadingInstances_()) ctx_.release("DSG instance transforms", instanceBytes_);
     shadingInstances_ = ctx_.allocate("DSG instance transforms", bytes, CL_MEM_READ_ONLY);
     instanceBytes_ = bytes;
     instanceCapacity_ = std::max<size_t>(n, 1);
@@ -420,7 +420,10 @@ void GpuScene::buildLights(double t) {
 
   const size_t count = std::max<size_t>(lights_.size(), 1);
   if (count > lightCapacity_) {
-    if (lightCapacity_) ctx_.release(lightBytes_);
+    if (lightCapacity_) {
+      ctx_.release("light table", lightCapacity_ * sizeof(dev::Light));
+      ctx_.release("light power table", lightCapacity_ * sizeof(float));
+    }
     lightCapacity_ = count;
     lightBytes_ = count * (sizeof(dev::Light) + sizeof(float));
     lightBuffer_ = ctx_.allocate("light table", count * sizeof(dev::Light), CL_MEM_READ_ONLY);

@@ -33,6 +33,7 @@ struct FrameStats {
   // render holds alike (render/multi_device.h counts them once).
   std::set<std::string> lightPathCounters;
   uint64_t deviceBytes = 0;
+  std::map<std::string, uint64_t> deviceBuffers;  // deviceBytes by buffer name
   uint64_t badSamples = 0;
   int passes = 0;  // sample passes rendered (each pixel's samples; fewer under --time-limit)
   // Under --noise-threshold, the mean and maximum of the pixels' samples (-1: `passes` each).

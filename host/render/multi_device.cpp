@@ -248,6 +248,7 @@ Image MultiDeviceSession::renderFrame(int64_t frame, FrameStats* total,
         if (i == 0 || !s.lightPathCounters.count(k)) t.counters[k] += v;
       t.lightPathCounters.insert(s.lightPathCounters.begin(), s.lightPathCounters.end());
       t.deviceBytes += s.deviceBytes;
+      for (const auto& [k, v] : s.deviceBuffers) t.deviceBuffers[k] += v;
       t.badSamples += s.badSamples;
     }
   }

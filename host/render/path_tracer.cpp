@@ -35,7 +35,10 @@ PathTracer::PathTracer(Context& ctx, GpuScene& scene, Film& film,
   };
   states_ = alloc("path states", n * sizeof(dev::PathState));
   hits_ = alloc("path hits", n * sizeof(dev::Hit));
-  radiance_ = alloc("sample radiance", n * 16);
+  // Driven by PathReuse (light paths to connect to), the eye paths write its radiance and eye
+  // vertices: those of its own are one unread element and none.
+  const bool own = settings.lightPaths == 0;
+  radiance_ = alloc("sample radiance", (own ? n : 1) * 16);
   shadows_ = alloc("shadow rays", n * sizeof(dev::ShadowRay));
   for (cl::Buffer& q : queues_) q = alloc("path queue", n * 4);
   shadowQueue_ = alloc("shadow queue", n * 4);
@@ -49,7 +52,7 @@ PathTracer::PathTracer(Context& ctx, GpuScene& scene, Film& film,
   diRes_ = alloc("direct light reservoirs", rsPixels * sizeof(dev::DirectReservoir));
   diPending_ = alloc("direct light candidates", rsPixels * sizeof(dev::DirectReservoir));
   if (settings.resample.enabled) {
-    rsEye_ = alloc("eye vertices", n * sizeof(dev::EyeVertex));
+    if (own) rsEye_ = alloc("eye vertices", n * sizeof(dev::EyeVertex));
     historyOut_ = alloc("path history", n * sizeof(dev::PathHistory));
     // One chain per pass, within 1 GiB.
     const uint64_t perChain = n * sizeof(dev::PathHistory);
@@ -80,7 +83,7 @@ void PathTracer::syncChains() {
       bytes_ += chainBytes_;
     } else if (!own && b()) {
       b = cl::Buffer();
-      ctx_.release(chainBytes_);
+      ctx_.release("path history", chainBytes_);
       bytes_ -= chainBytes_;
     }
   }
@@ -162,7 +165,7 @@ void PathTracer::beginFrame(int64_t frame, const dev::CameraParams& camera,
     const std::vector<dev::MovedInstance>& moved = scene_.movedInstances();
     const uint64_t bytes = std::max<uint64_t>(moved.size(), 1) * sizeof(dev::MovedInstance);
     if (bytes > movedBytes_) {
-      if (movedBytes_) ctx_.release(movedBytes_);
+      if (movedBytes_) ctx_.release("moved instances", movedBytes_);
       bytes_ += bytes - movedBytes_;
       moved_ = ctx_.allocate("moved instances", bytes, CL_MEM_READ_ONLY);
       ctx_.zero(moved_, bytes);
@@ -365,6 +368,7 @@ void PathTracer::reportRays(FrameStats* stats) {
 }
 
 void PathTracer::renderFrame(int64_t frame, const dev::CameraParams& camera, FrameStats* stats) {
+  PR_CHECK(settings_.lightPaths == 0);  // PathReuse renders the frames of its eye paths
   const Clock::time_point start = Clock::now();
   StageTimer timer;
   beginFrame(frame, camera, scene_.kernelArgs(), radiance_, noEye_);

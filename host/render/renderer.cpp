@@ -202,6 +202,7 @@ std::string statsLine(int64_t f, const RenderOptions& o, const FrameStats& fs,
   j["rays"] = fs.rays;
   if (!fs.counters.empty()) j["counters"] = fs.counters;
   j["device_bytes"] = fs.deviceBytes;
+  j["device_buffers"] = fs.deviceBuffers;
   j["bad_samples"] = fs.badSamples;
   // Samples per pixel: each pixel's own under --noise-threshold, else every pixel the same
   // (--time-limit cuts whole passes).

@@ -259,6 +259,7 @@ void RenderSession::renderRows(int64_t frame, Image* image, FrameStats* stats) {
   render(frame, fs);
   takeCounts(film_->readRows(image, &fs->badSamples), fs);
   fs->deviceBytes = ctx_.bytesInUse();
+  fs->deviceBuffers = ctx_.bytesByName();
 }
 
 std::vector<float> RenderSession::renderSums(int64_t frame, FrameStats* stats) {
@@ -268,6 +269,7 @@ std::vector<float> RenderSession::renderSums(int64_t frame, FrameStats* stats) {
   std::vector<float> sums = film_->readSums(&fs->badSamples);
   takeCounts(sums, fs);
   fs->deviceBytes = ctx_.bytesInUse();
+  fs->deviceBuffers = ctx_.bytesByName();
   return sums;
 }
 

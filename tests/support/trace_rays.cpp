@@ -35,7 +35,9 @@ TracedRays traceRays(accel::DeviceAccel& acc, const std::vector<dev::Ray>& rays,
   out.occluded.resize(n);
   CL_CHECK(ctx.queue().enqueueReadBuffer(hb, CL_TRUE, 0, n * sizeof(dev::Hit), out.hits.data()));
   CL_CHECK(ctx.queue().enqueueReadBuffer(ob, CL_TRUE, 0, n * sizeof(cl_uint), out.occluded.data()));
-  ctx.release(n * (sizeof(dev::Ray) + sizeof(dev::Hit) + sizeof(cl_uint)));
+  ctx.release("rays", n * sizeof(dev::Ray));
+  ctx.release("hits", n * sizeof(dev::Hit));
+  ctx.release("occluded", n * sizeof(cl_uint));
   return out;
 }
 
