@@ -43,23 +43,29 @@ void expectTangents(const TriangleMesh& m, glm::vec3 t, float w) {
   }
 }
 
+// glTF's v runs down the image and a normal map's +Y up it: the bitangent b = w cross(n, t)
+// points along -dP/dv (the handedness of the Khronos assets' authored tangents, e.g. the
+// FlightHelmet's: w = +1 where u runs along x and v along -y).
 TEST(Tangents, FollowTheUvGradientAndItsHandedness) {
-  TriangleMesh m = plane({{0, 0}, {1, 0}, {1, 1}, {0, 1}});  // u along x, v along y
+  TriangleMesh m = plane({{0, 0}, {1, 0}, {1, 1}, {0, 1}});  // u along x, v along y: b = -y
+  generateTangents(m, {});
+  expectTangents(m, {1, 0, 0}, -1.0f);
+  m = plane({{0, 1}, {1, 1}, {1, 0}, {0, 0}});  // u along x, v along -y (an image upright): b = +y
   generateTangents(m, {});
   expectTangents(m, {1, 0, 0}, 1.0f);
   m = plane({{1, 0}, {0, 0}, {0, 1}, {1, 1}});  // u mirrored: along -x, v still along y
   generateTangents(m, {});
-  expectTangents(m, {-1, 0, 0}, -1.0f);
-  m = plane({{0, 0}, {0, -1}, {1, -1}, {1, 0}});  // rotated: u along y, v along -x
+  expectTangents(m, {-1, 0, 0}, 1.0f);
+  m = plane({{0, 0}, {0, -1}, {1, -1}, {1, 0}});  // rotated: u along y, v along -x: b = +x
   generateTangents(m, {});
-  expectTangents(m, {0, 1, 0}, 1.0f);
+  expectTangents(m, {0, 1, 0}, -1.0f);
 }
 
 TEST(Tangents, ChooseTheNormalMapsUvSetPerTriangle) {
   TriangleMesh m = plane({{0, 0}, {0, 0}, {0, 0}, {0, 0}});  // TEXCOORD_0 without a gradient
   m.uvs1 = {{0, 0}, {0, -1}, {1, -1}, {1, 0}};
   generateTangents(m, {1, 1});
-  expectTangents(m, {0, 1, 0}, 1.0f);
+  expectTangents(m, {0, 1, 0}, -1.0f);
   // No gradient in the set it reads: some unit tangent orthogonal to the normal.
   generateTangents(m, {0, 0});
   for (const glm::vec4& t : m.tangents) {
@@ -74,11 +80,11 @@ TEST(Tangents, OfFlatVerticesFollowTheirFaces) {
   TriangleMesh m = plane({{0, 0}, {1, 0}, {1, 1}, {0, 1}});
   m.normals.assign(4, glm::vec3(0.0f));
   generateTangents(m, {});
-  expectTangents(m, {1, 0, 0}, 1.0f);
+  expectTangents(m, {1, 0, 0}, -1.0f);
   m = plane({{1, 0}, {0, 0}, {0, 1}, {1, 1}});  // u mirrored
   m.normals.assign(4, glm::vec3(0.0f));
   generateTangents(m, {});
-  expectTangents(m, {-1, 0, 0}, -1.0f);
+  expectTangents(m, {-1, 0, 0}, 1.0f);
   // A fold: the shared edge's tangent lies between the faces' planes; zero normals stay zero.
   m = plane({{0, 0}, {1, 0}, {1, 1}, {0, 1}});
   m.positions[3] = {0, 1, 1};
@@ -87,7 +93,7 @@ TEST(Tangents, OfFlatVerticesFollowTheirFaces) {
   for (size_t v = 0; v < 4; ++v) {
     EXPECT_NEAR(glm::length(glm::vec3(m.tangents[v])), 1.0f, 1e-5f);
     EXPECT_GT(m.tangents[v].x, 0.7f);
-    EXPECT_EQ(m.tangents[v].w, 1.0f);
+    EXPECT_EQ(m.tangents[v].w, -1.0f);
     EXPECT_EQ(m.normals[v], glm::vec3(0.0f));
   }
 }
@@ -284,7 +290,7 @@ TEST(NormalMap, ShadesByTheMappedNormalInBothModes) {
       const double ref = centreMean(f.write("nm-f"), m, "nm-f-r");
       ASSERT_GT(ref, 0.01);
       const double got = centreMean(p.write("nm-p"), m, "nm-p-r");
-      EXPECT_NEAR(got / ref, p.expectedRatio({1, 0, 0}, 1), 0.01) << "light angle " << angle;
+      EXPECT_NEAR(got / ref, p.expectedRatio({1, 0, 0}, -1), 0.01) << "light angle " << angle;
     }
   }
 }
@@ -340,14 +346,14 @@ TEST(NormalMap, GivenTangentsAndTheSecondUvSetSetTheFrame) {
     PlaneScene q;
     q.normalTexel = p.normalTexel;
     q.lightAngle = angle;
-    q.normalTexCoord = 1;  // generated from TEXCOORD_1: t = +y, b = cross(z, y) = -x
+    q.normalTexCoord = 1;  // generated from TEXCOORD_1: t = +y, b = -dP/dv = +x
     const double got1 = centreMean(q.write("nm-uv1"), "--mode pathtrace", "nm-uv1-r");
-    EXPECT_NEAR(got1 / ref, q.expectedRatio({0, 1, 0}, 1), 0.01) << angle;
+    EXPECT_NEAR(got1 / ref, q.expectedRatio({0, 1, 0}, -1), 0.01) << angle;
   }
 }
 
 // Without NORMAL the plane is flat and its TANGENT (here along +y, left-handed) is ignored:
-// the map reads the frame of the tangent generated from TEXCOORD_0 (t = +x, b = +y), static
+// the map reads the frame of the tangent generated from TEXCOORD_0 (t = +x, b = -y), static
 // or on a moving instance, in both modes.
 TEST(NormalMap, WithoutNormalsTheGivenTangentsAreIgnored) {
   for (const char* mode : {"pathtrace", "reuse"})
@@ -369,7 +375,7 @@ TEST(NormalMap, WithoutNormalsTheGivenTangentsAreIgnored) {
         // The unmapped flat plane: rho / pi * E * cos(angle), rho = 0.5, E = 2.
         EXPECT_NEAR(ref, 1.0 / M_PI * std::cos(angle), 0.01 * ref);
         const double got = centreMean(p.write("nm-np"), m, "nm-np-r");
-        EXPECT_NEAR(got / ref, p.expectedRatio({1, 0, 0}, 1), 0.01);
+        EXPECT_NEAR(got / ref, p.expectedRatio({1, 0, 0}, -1), 0.01);
       }
 }
 
@@ -383,8 +389,8 @@ TEST(NormalMap, FollowsDynamicInstancesAndMirrors) {
   };
   const json dyn = {{"dynamic", true}};
   const Case cases[] = {
-      {{{"mesh", 0}, {"extras", dyn}, {"rotation", {0, 0, 1, 0}}}, {-1, 0, 0}, 1},  // 180 deg
-      {{{"mesh", 0}, {"extras", dyn}, {"scale", {-1, 1, 1}}}, {-1, 0, 0}, -1}};
+      {{{"mesh", 0}, {"extras", dyn}, {"rotation", {0, 0, 1, 0}}}, {-1, 0, 0}, -1},  // 180 deg
+      {{{"mesh", 0}, {"extras", dyn}, {"scale", {-1, 1, 1}}}, {-1, 0, 0}, 1}};
   for (const Case& c : cases) {
     for (bool aboutX : {false, true}) {
       for (float angle : {0.6f, -0.6f}) {

@@ -1,6 +1,8 @@
 // Tangents as MikkTSpace builds them, without its vertex splitting: each triangle's dP/du and
 // dP/dv from its uvs, projected onto the plane of each corner's normal, summed at the vertex
-// weighted by the corner's angle; the handedness from the summed dP/dv. Vertices that glTF
+// weighted by the corner's angle; the handedness from the summed dP/dv, turned around: glTF's v
+// runs down the image, and a normal map's +Y is up it (so b = w cross(n, t) is along -dP/dv, as
+// in MikkTSpace run on 1 - v, which authored tangents follow). Vertices that glTF
 // exporters share across a uv seam or a mirrored uv island are already split (their uvs
 // differ), so the one remaining difference is a vertex whose triangles disagree in handedness.
 #include "scene/tangents.h"
@@ -73,7 +75,7 @@ void generateTangents(TriangleMesh& mesh, const std::vector<uint8_t>& uvSet) {
     const glm::vec3& n = normals[v];
     glm::vec3 t = sumT[v] - n * glm::dot(n, sumT[v]);
     t = usable(t) ? glm::normalize(t) : anyPerpendicular(n);
-    const float w = glm::dot(glm::cross(n, t), sumB[v]) < 0.0f ? -1.0f : 1.0f;
+    const float w = glm::dot(glm::cross(n, t), sumB[v]) > 0.0f ? -1.0f : 1.0f;
     mesh.tangents[v] = glm::vec4(t, w);
   }
 }

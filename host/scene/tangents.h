@@ -10,7 +10,8 @@
 namespace pr {
 
 // Fills mesh.tangents (one per vertex: xyz unit and orthogonal to the vertex normal, w = +1 or
-// -1 the bitangent's handedness, b = w cross(n, t)) from each triangle's uv gradient. uvSet[t]
+// -1 the bitangent's handedness, b = w cross(n, t), along -dP/dv: up the image, as glTF's
+// normal maps read +Y) from each triangle's uv gradient. uvSet[t]
 // (0 or 1) says which of mesh.uvs / mesh.uvs1 triangle t's normal map reads. A zero vertex
 // normal (a flat primitive) stands for the area-weighted normal of the vertex's triangles.
 void generateTangents(TriangleMesh& mesh, const std::vector<uint8_t>& uvSet);

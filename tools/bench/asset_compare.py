@@ -7,7 +7,9 @@ at the same size, spp and depth (Cycles through tools/bench/cycles_frames.py: Bl
 colour textures sRGB, CPU, box filter, no denoising or clamping). Over the pixels where either
 image differs from the sky by more than 2% (the asset), the tool gives the ratio ours / Cycles of
 the mean luminance and of each channel, and the 95th percentile over the 16x16 blocks wholly on
-the asset of |ours / Cycles - 1| (block means): the parts that differ show there.
+the asset of |ours / Cycles - 1| (block means): the parts that differ show there; and the mean
+over the asset's pixels (two pixels in from its outline) of |ours / Cycles - 1| of 3x3 means:
+what a normal map's orientation or a texture's lookup changes, which block means average away.
 
   /usr/bin/python3 -m tools.bench.asset_compare --cycles ~/.cache/pathreuse/bpy-5.2.3/bin/python \\
       --binary build/pathreuse --assets StainedGlassLamp,ToyCar --spp 256 --width 256
@@ -27,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from .benchlib import run_tool
-from .blender_compare import Images, compare, ratio_png
+from .blender_compare import LUMA, Images, compare, ratio_png
 
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parents[1]
@@ -43,6 +45,23 @@ def wrapper(name, scenes, work):
              stdout=subprocess.DEVNULL)
     cameras = json.loads(out.read_text())["cameras"]
     return out, len(cameras) - 1
+
+
+def box3(a):
+    """The 3x3 mean of each pixel (edges repeated)."""
+    p = np.pad(a, 1, mode="edge")
+    return sum(p[y:y + a.shape[0], x:x + a.shape[1]] for y in range(3) for x in range(3)) / 9
+
+
+def pixel_deviation(ours, cyc, mask):
+    """Mean |ours / Cycles - 1| of the 3x3 means of luminance over mask shrunk by two pixels."""
+    inner = mask.copy()
+    for _ in range(2):
+        p = np.pad(inner, 1, constant_values=False)
+        inner = inner & p[:-2, 1:-1] & p[2:, 1:-1] & p[1:-1, :-2] & p[1:-1, 2:]
+    a, b = box3(ours @ LUMA), box3(cyc @ LUMA)
+    sel = inner & (b > 0)
+    return float(np.abs(a[sel] / b[sel] - 1).mean()) if sel.any() else float("nan")
 
 
 def main():
@@ -77,12 +96,14 @@ def main():
         ours = images.read(d / "ours" / "f_0000.exr")
         cyc = images.read(d / "cycles" / "f_0000.exr")
         mask = (np.abs(ours - 1).max(axis=2) > 0.02) | (np.abs(cyc - 1).max(axis=2) > 0.02)
-        row = {"asset": name, **compare(ours, cyc, mask, a.block)}
+        row = {"asset": name, **compare(ours, cyc, mask, a.block),
+               "pixel_deviation": pixel_deviation(ours, cyc, mask)}
         ratio_png(d / "ratio.png", ours, cyc, mask)
         rows.append(row)
         print(f"{name:18s} luminance {row['mean_ratio']:.3f}  rgb "
               + " ".join(f"{x:.3f}" for x in row["rgb_ratio"])
               + f"  blocks p95 {row['p95_block']:.3f} max {row['max_block']:.3f}"
+              + f"  pixels {row['pixel_deviation']:.4f}"
               + f" ({row['blocks']} blocks, {row['pixels']} px)", flush=True)
     if a.json:
         Path(a.json).write_text(json.dumps(rows, indent=1))
