@@ -257,8 +257,10 @@ void addReuseOptions(CLI::App* render, RenderArgs& a) {
   pr::RenderOptions& ro = a.ro;
   listUnder(render, "Reuse and retrace");
   render
-      ->add_option("--light-paths", ro.lightPaths,
-                   "Light-path slots kept in the arena (reuse/retrace; default: one per pixel)")
+      ->add_option(
+          "--light-paths", ro.lightPaths,
+          "Light-path slots kept in the arena (reuse/retrace; default: one per pixel, at most "
+          "2097152)")
       ->check(CLI::Range(1, 1 << 26));
   render
       ->add_option("--paths-per-pixel", ro.pathsPerPixel,

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "render/options.h"
+#include "render/path_reuse.h"
 #include "util/error.h"
 
 namespace pr {
@@ -61,6 +62,16 @@ TEST(RenderOptions, OutPatterns) {
        {"out.exr", "%s.exr", "%d_%d.exr", "%n.exr", "%0999d.exr", "%x.exr", "%.exr", "dir/%d/"})
     EXPECT_THROW(validateOutPattern(bad), InputError) << bad;
   EXPECT_EQ(withExtension("out/frame_0001.exr", ".png"), "out/frame_0001.png");
+}
+
+// The arena's default: one light path per pixel up to 1080p and a little beyond, then 2^21
+// shared by all pixels (4K: one among four), so that the arena stays under 1.2 GiB.
+TEST(RenderOptions, DefaultLightPathsAreOnePerPixelUpTo2To21) {
+  EXPECT_EQ(defaultLightPaths(1), 1u);
+  EXPECT_EQ(defaultLightPaths(1280 * 720), 1280u * 720u);
+  EXPECT_EQ(defaultLightPaths(1920 * 1080), 1920u * 1080u);
+  EXPECT_EQ(defaultLightPaths(3840 * 2160), 1u << 21);
+  EXPECT_EQ(defaultLightPaths(uint64_t(1) << 40), 1u << 21);
 }
 
 }  // namespace

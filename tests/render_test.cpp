@@ -10,6 +10,8 @@
 #include <nlohmann/json.hpp>
 
 #include "io/image.h"
+#include "render/session.h"
+#include "scene/gltf_loader.h"
 #include "support/gltf_builder.h"
 #include "support/render_helpers.h"
 #include "support/test_env.h"
@@ -292,6 +294,48 @@ TEST(PathTrace, NoNonFiniteSamplesOnCornellNvpro) {
   int lines = 0;
   EXPECT_EQ(badSamplesIn(dir + "/stats.jsonl", &lines), 0u);
   EXPECT_EQ(lines, 1);
+}
+
+// A pass traces its paths in bands of pixels (PathTracerSettings::wavefrontPixels), each
+// path's own state kept for its band alone: the frames are the same floats for bands of 37
+// pixels as for one band, in every mode, with resampling's neighbours and history, adaptive
+// sampling's masked passes and a device's rows.
+TEST(Wavefront, BandsGiveTheSameFrames) {
+  const Scene scene = loadScene(test::sourcePath("scenes/cornell-dynamic.gltf"));
+  struct Case {
+    const char* name;
+    RenderMode mode;
+    bool resample;
+    float noise;
+    int rowBegin, rowEnd;
+  };
+  const Case cases[] = {{"pathtrace", RenderMode::PathTrace, false, 0.0f, 0, 0},
+                        {"pathtrace resampled", RenderMode::PathTrace, true, 0.0f, 0, 0},
+                        {"reuse", RenderMode::Reuse, true, 0.0f, 0, 0},
+                        {"retrace", RenderMode::Retrace, true, 0.0f, 0, 0},
+                        {"adaptive", RenderMode::PathTrace, true, 0.05f, 0, 0},
+                        {"rows", RenderMode::Reuse, true, 0.0f, 7, 23}};
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    auto render = [&](uint32_t band) {
+      RenderOptions ro;
+      ro.width = 40;
+      ro.height = 30;
+      ro.spp = c.noise > 0.0f ? 8 : 2;
+      ro.mode = c.mode;
+      ro.resample.asked = c.resample;
+      ro.noiseThreshold = c.noise;
+      ro.wavefrontPixels = band;
+      RenderSession session(scene, test::testContext().device(), ro);
+      if (c.rowEnd > 0) session.setRows(c.rowBegin, c.rowEnd);
+      std::vector<std::vector<float>> frames;
+      for (int f : {0, 1, 2}) frames.push_back(session.renderFrame(f, nullptr).rgba);
+      return frames;
+    };
+    const auto whole = render(kWavefrontPixels), bands = render(37);
+    ASSERT_EQ(whole.size(), bands.size());
+    for (size_t f = 0; f < whole.size(); ++f) EXPECT_EQ(whole[f], bands[f]) << "frame " << f;
+  }
 }
 
 }  // namespace

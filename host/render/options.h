@@ -63,6 +63,9 @@ struct FrameRange {
   int64_t last = -1;  // -1: up to the end of the animation
 };
 
+// The default band of a pass's paths (render/path_tracer.h): 720p in one band, 4K in eight.
+constexpr uint32_t kWavefrontPixels = uint32_t(1) << 20;
+
 struct RenderOptions {
   std::string scene;
   bool allowOutsideUris = false;  // LoadOptions::allowOutsideUris
@@ -118,6 +121,9 @@ struct RenderOptions {
   // --light-tracing / --no-light-tracing where given (resolveLightTracing).
   std::optional<bool> lightTracing;
   ResampleSettings resample;
+  // The pixels whose paths a pass traces at once (PathTracerSettings::wavefrontPixels). Not a
+  // command-line option: frames are the same floats whatever it is; the tests make it small.
+  uint32_t wavefrontPixels = kWavefrontPixels;
   // The environment light (scene/environment.h): a map file, "none", or "" (a uniform one of
   // envColor where --env-color is given, else white where the scene has no lights, else none).
   std::string env;

@@ -5,6 +5,7 @@
 // the same kernels with every slot traced again each frame.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -20,11 +21,20 @@
 
 namespace pr {
 
+// N_L where --light-paths is not given: one light path per pixel, at most 2^21 (1080p's 2,073,600
+// pixels keep one each; 4K shares one among four pixels). On the Cornell box a quarter of a path
+// per pixel costs 10% more relMSE at equal spp, a sixteenth the same, on the atrium nothing; at 4K
+// the whole arena would take 4.2 GiB of device memory (docs/design.md section 4).
+constexpr uint32_t kMaxDefaultLightPaths = uint32_t(1) << 21;
+inline uint32_t defaultLightPaths(uint64_t pixels) {
+  return uint32_t(std::min<uint64_t>(pixels, kMaxDefaultLightPaths));
+}
+
 struct PathReuseSettings {
   int spp = 4;
   int maxDepth = 8;
   uint32_t seed = 1;
-  uint32_t lightPaths = 0;  // N_L; 0: one per pixel
+  uint32_t lightPaths = 0;  // N_L; 0: defaultLightPaths of the image
   uint32_t pathsPerPixel = 4;
   float clamp = 0.0f;
   float misThreshold = 4.0f;   // connection MIS (kernels/reuse/connect.cl); 0 = off
@@ -36,8 +46,9 @@ struct PathReuseSettings {
   // Device memory for connect's terms (eye paths): each launch of connect and connect_shadow
   // takes as many pixel samples as fit.
   uint64_t connectRecordBytes = uint64_t(128) << 20;
-  bool retraceAll = false;  // --mode retrace
-  bool fixedNoise = false;  // camera samples keyed by frame 0 on every frame
+  uint32_t wavefrontPixels = kWavefrontPixels;  // the eye paths' bands (PathTracerSettings)
+  bool retraceAll = false;                      // --mode retrace
+  bool fixedNoise = false;                      // camera samples keyed by frame 0 on every frame
   // --resample: the eye paths resampled across pixels and frames (kernels/shared/resample.h),
   // with their share against the connections; its distance resolved (> 0, scene units).
   ResampleSettings resamplePaths;

@@ -33,24 +33,30 @@ PathTracer::PathTracer(Context& ctx, GpuScene& scene, Film& film,
     ctx_.zero(b, bytes);
     return b;
   };
-  states_ = alloc("path states", n * sizeof(dev::PathState));
-  hits_ = alloc("path hits", n * sizeof(dev::Hit));
+  PR_CHECK(settings.wavefrontPixels > 0);
+  band_ = uint32_t(std::min<uint64_t>(n, settings.wavefrontPixels));
+  const uint64_t band = band_;
+  states_ = alloc("path states", band * sizeof(dev::PathState));
+  hits_ = alloc("path hits", band * sizeof(dev::Hit));
   // Driven by PathReuse (light paths to connect to), the eye paths write its radiance and eye
   // vertices: those of its own are one unread element and none.
   const bool own = settings.lightPaths == 0;
   radiance_ = alloc("sample radiance", (own ? n : 1) * 16);
-  shadows_ = alloc("shadow rays", n * sizeof(dev::ShadowRay));
-  for (cl::Buffer& q : queues_) q = alloc("path queue", n * 4);
-  shadowQueue_ = alloc("shadow queue", n * 4);
+  shadows_ = alloc("shadow rays", band * sizeof(dev::ShadowRay));
+  for (cl::Buffer& q : queues_) q = alloc("path queue", band * 4);
+  shadowQueue_ = alloc("shadow queue", band * 4);
   queueSizes_ = alloc("queue sizes", dev::PR_QUEUE_COUNT * 4);
   rays_ = alloc("ray counters", dev::PR_PT_COUNT * 4);
   noEye_ = alloc("no eye vertices", 64);
+  // Without resampling, one unread element each. The reservoirs span the frame (neighbours and
+  // the history read them); a path's track and candidates are its band's.
   const uint64_t rsPixels = settings.resample.enabled ? n : 1;
-  rsTrack_ = alloc("path tracks", rsPixels * sizeof(dev::PathTrack));
+  const uint64_t rsBand = settings.resample.enabled ? band : 1;
+  rsTrack_ = alloc("path tracks", rsBand * sizeof(dev::PathTrack));
   rsRes_ = alloc("path reservoirs", rsPixels * sizeof(dev::PathReservoir));
-  rsPending_ = alloc("path candidates", rsPixels * sizeof(dev::PathReservoir));
+  rsPending_ = alloc("path candidates", rsBand * sizeof(dev::PathReservoir));
   diRes_ = alloc("direct light reservoirs", rsPixels * sizeof(dev::DirectReservoir));
-  diPending_ = alloc("direct light candidates", rsPixels * sizeof(dev::DirectReservoir));
+  diPending_ = alloc("direct light candidates", rsBand * sizeof(dev::DirectReservoir));
   if (settings.resample.enabled) {
     if (own) rsEye_ = alloc("eye vertices", n * sizeof(dev::EyeVertex));
     historyOut_ = alloc("path history", n * sizeof(dev::PathHistory));
@@ -240,36 +246,35 @@ void PathTracer::beginFrame(int64_t frame, const dev::CameraParams& camera,
   generateArgs_.frame = rngFrame;
   generateArgs_.states = states_;
   generateArgs_.radiance = radiance;
-  generateArgs_.count = n;
   generateArgs_.eye = eyeOut;
   generateArgs_.write_eye = settings_.lightPaths > 0 || settings_.resample.enabled ? 1 : 0;
   generateArgs_.resample = rsp.enabled;
   generateArgs_.rs_res = rsRes_;
   generateArgs_.di_res = diRes_;
   generateArgs_.queue = queues_[0];
-  generateArgs_.first = film_.first();
   generateArgs_.queue_size = queueSizes_;
   generateArgs_.budget = film_.budget();
   generateArgs_.set(generate_);
 }
 
-void PathTracer::tracePass(int sample, cl_uint masked, StageTimer* timer) {
-  const cl_uint first = film_.first(), n = film_.end();
+void PathTracer::traceBand(cl_uint first, cl_uint end, cl_uint masked, StageTimer* timer) {
   static const cl_uint kZero[dev::PR_QUEUE_COUNT] = {};
-  generateArgs_.sample = shadeArgs_.sample = shadowArgs_.sample = cl_uint(sample);
+  generateArgs_.first = generateArgs_.base = first;
+  generateArgs_.count = end;
   generateArgs_.masked = masked;
   generateArgs_.set(generate_, kargs::kPass);
+  extendArgs_.base = shadeArgs_.base = shadowArgs_.base = first;
   if (masked)
     CL_CHECK(ctx_.queue().enqueueWriteBuffer(queueSizes_, CL_FALSE, 0, sizeof kZero, kZero));
-  ctx_.launch1D(generate_, first, n, "generate", timer);
+  ctx_.launch1D(generate_, first, end, "generate", timer);
   // Each bounce runs over the paths still live (a queue pt_shade compacts), and traces the shadow
-  // rays it wrote; the queues' sizes come back to size the next launches, and a pass ends once no
-  // path is live. A masked pass starts with the pixels that take it.
-  cl_uint live = n - first;
+  // rays it wrote; the queues' sizes come back to size the next launches, and the band ends once
+  // no path is live. A masked pass starts with the pixels that take it.
+  cl_uint live = end - first;
   if (masked) {
     CL_CHECK(
         ctx_.queue().enqueueReadBuffer(queueSizes_, CL_TRUE, dev::PR_QUEUE_LIVE * 4, 4, &live));
-    PR_CHECK(live <= n - first);
+    PR_CHECK(live <= end - first);
   }
   for (int d = 0; d < settings_.maxDepth && live > 0; ++d) {
     const cl::Buffer& queue = queues_[d % 2];
@@ -291,6 +296,13 @@ void PathTracer::tracePass(int sample, cl_uint masked, StageTimer* timer) {
     ctx_.launch1D(shadow_, 0, sizes[dev::PR_QUEUE_SHADOW], "shadow", timer);
     live = sizes[dev::PR_QUEUE_LIVE];
   }
+}
+
+void PathTracer::tracePass(int sample, cl_uint masked, StageTimer* timer) {
+  const cl_uint first = film_.first(), n = film_.end();
+  generateArgs_.sample = shadeArgs_.sample = shadowArgs_.sample = cl_uint(sample);
+  for (cl_uint a = first; a < n; a += band_)
+    traceBand(a, std::min<cl_uint>(n, a + band_), masked, timer);
   if (settings_.resample.enabled) {
     const bool chained = sample < chains_;
     resampleArgs_.sample = cl_uint(sample);

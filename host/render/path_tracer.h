@@ -31,6 +31,9 @@ struct PathTracerSettings {
   uint32_t lightTracingPaths = 0;
   // --resample (kernels/shared/resample.h), its distance resolved (> 0, scene units).
   ResampleSettings resample;
+  // A pass traces the film's pixels in bands of at most this many: each path's own state (about
+  // 570 bytes with resampling) is kept for a band, not for the whole image.
+  uint32_t wavefrontPixels = kWavefrontPixels;
 };
 
 // Strategy T's scale N_L A / (spp C W H) (kernels/shared/eye_paths.h): light paths, samples per
@@ -84,6 +87,8 @@ class PathTracer : public Integrator {
 
  private:
   dev::ResampleParams resampleParams() const;
+  // The paths of the film's pixels [first, end) (one band: at most band_) through every bounce.
+  void traceBand(cl_uint first, cl_uint end, cl_uint masked, StageTimer* timer);
   // Allocates the chains of this device's passes (zeroed: no history) and frees the others'.
   void syncChains();
   // One chain's records of the film's rows (chainRowsBytes of them), read or written; `pass` is
@@ -107,6 +112,7 @@ class PathTracer : public Integrator {
   kargs::PtShadeArgs shadeArgs_;
   kargs::PtShadowArgs shadowArgs_;
   kargs::PtResampleArgs resampleArgs_;
+  uint32_t band_ = 0;  // the pixels a band of a pass holds (its paths' own buffers' length)
   cl::Buffer states_, hits_, radiance_, shadows_, rays_;
   cl::Buffer queues_[2];    // the live paths' indices, at this bounce and the next
   cl::Buffer shadowQueue_;  // the paths with a shadow ray at this bounce

@@ -152,6 +152,7 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
     p.seed = o.seed;
     p.fixedNoise = o.fixedNoise;
     p.resample = resample;
+    p.wavefrontPixels = o.wavefrontPixels;
     auto tracer = std::make_unique<PathTracer>(ctx_, *gpu_, *film_, p);
     pathTracer_ = tracer.get();
     integrator_ = std::move(tracer);
@@ -174,6 +175,7 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
     r.retraceAll = o.mode == RenderMode::Retrace;
     r.fixedNoise = o.fixedNoise;
     r.resamplePaths = resample;
+    r.wavefrontPixels = o.wavefrontPixels;
     auto reuse = std::make_unique<PathReuse>(ctx_, *gpu_, *film_, r);
     pathTracer_ = reuse->eyePaths();
     integrator_ = std::move(reuse);

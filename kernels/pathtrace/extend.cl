@@ -9,8 +9,9 @@ PR_KERNEL void pt_extend(PR_PARAMS(PR_ARGS_PT_EXTEND)) {
   if (j >= count) return;
   const uint i = queue[j];
   const SceneData s = PR_SCENE();
-  atomic_inc(rays + (states[i].depth == 0u ? PR_PT_CAMERA : PR_PT_BOUNCE));
+  const uint k = i - base;  // the path's own state in the band
+  atomic_inc(rays + (states[k].depth == 0u ? PR_PT_CAMERA : PR_PT_BOUNCE));
   Hit hit;
-  if (!trace_closest(&s, states[i].ray, &hit)) hit = hit_none();
-  hits[i] = hit;
+  if (!trace_closest(&s, states[k].ray, &hit)) hit = hit_none();
+  hits[k] = hit;
 }

@@ -384,20 +384,21 @@ PR_INLINE void queue_append(__global uint* queue, __global uint* size, int take,
 // One live path i: PR_SHADE_* of what it goes on with.
 PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
   const SceneData s = PR_SCENE();
-  PathState p = states[i];
+  const uint k = i - base;  // the path's own state in the band; the frame's at pixel i
+  PathState p = states[k];
   uint out = 0u;
 
   // --resample: the vertex this hit is, counted from x_1 (0: x_1 not met yet); the paths that
   // reach an emitter from x_2 on go to the pixel's reservoir instead of its radiance.
   const uint rel = rsp.enabled && p.x1_depth ? p.depth + 1u - p.x1_depth : 0u;
-  PR_GLOBAL PathTrack* track = rs_track + i;
+  PR_GLOBAL PathTrack* track = rs_track + k;
   const RsKey key = {seed, frame, p.pixel, sample};
-  const Hit hit = hits[i];
+  const Hit hit = hits[k];
   if (hit.prim == PR_INVALID_INDEX) {
     pt_escape(&s, &p, rel, pt_joinable(&p, light_paths, 1u), light_paths, rsp.eye_count, trace_cdf,
               trace_total, max_depth, track, rs_res + i, di_res + i, &key, radiance + i);
     p.alive = 0u;
-    states[i] = p;
+    states[k] = p;
     return 0u;
   }
   Rng rng = rng_make(seed, PR_RNG_CAMERA, frame, p.pixel, sample);
@@ -454,9 +455,9 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
             pt_next_event_weight(&s, &p, &h, &f, &ch, here_joinable, has_rev, dist2, light_paths,
                                  rsp.eye_count, trace_cdf, trace_total, max_depth, &ew);
         if (here_joinable) c = c * w;  // next_event left the weight to this
-        const uint op = rs_next_event_pending(&s, track, rs_pending + i, di_pending + i, &rsp, &p,
+        const uint op = rs_next_event_pending(&s, track, rs_pending + k, di_pending + k, &rsp, &p,
                                               &h, &f, wo, dist2, &ch, c, &ew);
-        pt_shadow_set(shadows + i, shadow, tp * c, op);
+        pt_shadow_set(shadows + k, shadow, tp * c, op);
         out = PR_SHADE_SHADOW;
       }
     } else {
@@ -498,7 +499,7 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
   p.tp_g = tp.y;
   p.tp_b = tp.z;
   p.rng_dim = rng.dim;
-  states[i] = p;
+  states[k] = p;
   return out | (p.alive ? PR_SHADE_LIVE : 0u);
 }
 

@@ -11,18 +11,19 @@ PR_KERNEL void pt_shadow(PR_PARAMS(PR_ARGS_PT_SHADOW)) {
   const uint j = (uint)get_global_id(0);
   if (j >= count) return;
   const uint i = shadow_queue[j];
-  const ShadowRay r = shadows[i];
+  const uint k = i - base;  // the path's own state in the band
+  const ShadowRay r = shadows[k];
   const SceneData s = PR_SCENE();
   atomic_inc(rays + PR_PT_SHADOW);
   if (trace_occluded(&s, r.ray)) return;
   if (resample && r.op) {
     const RsKey key = {seed, frame, i, sample};
     if (r.op & PR_RS_OP_DIRECT) {
-      const DirectReservoir c = di_pending[i];
+      const DirectReservoir c = di_pending[k];
       di_offer_keyed(di_res + i, &c, &key, (r.op & ~PR_RS_OP_DIRECT) - 1u);
       return;
     }
-    const PathReservoir c = rs_pending[i];
+    const PathReservoir c = rs_pending[k];
     rs_offer_keyed(rs_res + i, &c, &key, r.op - 1u);
     return;
   }

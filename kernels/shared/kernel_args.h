@@ -151,20 +151,24 @@
 // ---- The wavefront path tracer (kernels/pathtrace/) ----
 // Paths are indexed by pixel; each bounce's stages run over queues of path indices (`queue`,
 // `count` of them), which pt_shade compacts: the live paths into next_queue, the paths with a
-// shadow ray into shadow_queue, counted in queue_sizes (PR_QUEUE_*, shared/path_state.h).
+// shadow ray into shadow_queue, counted in queue_sizes (PR_QUEUE_*, shared/path_state.h). A pass
+// runs over bands of pixels: a path's own state (states, hits, shadows, rs_track, rs_pending,
+// di_pending) is at its pixel - `base`, the band's first; what the frame keeps (radiance, eye,
+// rs_res, di_res) at its pixel.
 
 #define PR_ARGS_PT_GENERATE(F, X)        \
   F(FRAME, VAL, CameraParams, cam)       \
   X(FRAME, VAL, uint, seed)              \
   X(FRAME, VAL, uint, frame)             \
   X(PASS, VAL, uint, sample)             \
+  X(PASS, VAL, uint, base)               \
   X(FRAME, OUT, PathState, states)       \
   X(FRAME, OUT, float4, radiance)        \
-  X(FRAME, VAL, uint, count)             \
+  X(PASS, VAL, uint, count)              \
   X(FRAME, OUT, EyeVertex, eye)          \
   X(FRAME, VAL, uint, write_eye)         \
   X(FRAME, OUT, uint, queue)             \
-  X(FRAME, VAL, uint, first)             \
+  X(PASS, VAL, uint, first)              \
   X(FRAME, VAL, uint, resample)          \
   X(FRAME, OUT, PathReservoir, rs_res)   \
   X(FRAME, OUT, DirectReservoir, di_res) \
@@ -177,7 +181,8 @@
   X(FRAME, OUT, Hit, hits)        \
   X(FRAME, OUT, uint, rays)       \
   X(PASS, IN, uint, queue)        \
-  X(PASS, VAL, uint, count)
+  X(PASS, VAL, uint, count)       \
+  X(PASS, VAL, uint, base)
 
 #define PR_ARGS_PT_SHADE(F, X)      \
   PR_ARGS_SCENE(F, X)               \
@@ -187,6 +192,7 @@
   X(FRAME, OUT, ShadowRay, shadows) \
   X(PASS, IN, uint, queue)          \
   X(PASS, VAL, uint, count)         \
+  X(PASS, VAL, uint, base)          \
   X(PASS, OUT, uint, next_queue)    \
   X(FRAME, OUT, uint, shadow_queue) \
   X(FRAME, OUT, uint, queue_sizes)  \
@@ -217,6 +223,7 @@
   X(FRAME, OUT, uint, rays)               \
   X(FRAME, IN, uint, shadow_queue)        \
   X(PASS, VAL, uint, count)               \
+  X(PASS, VAL, uint, base)                \
   X(FRAME, VAL, uint, seed)               \
   X(FRAME, VAL, uint, frame)              \
   X(PASS, VAL, uint, sample)              \
