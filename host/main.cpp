@@ -131,6 +131,9 @@ void addOutputOptions(CLI::App* render, RenderArgs& a) {
       ->capture_default_str();
   render->add_flag("--exr-float", ro.exrFloat, "Write 32-bit float EXR (default: half)");
   render->add_flag("--png", ro.png, "Also write an sRGB PNG beside each EXR");
+  render->add_option("--video", ro.video,
+                     "Also encode the frames as one H.264 video (.mp4, .mov or .mkv) at --fps, "
+                     "through ffmpeg, from their PNGs (--video writes them)");
   render
       ->add_option("--time-limit", ro.timeLimit,
                    "Seconds per frame: no sample pass starts once they have run out (at least "
@@ -395,7 +398,7 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a) {
 // what they are). Every other option, present or added later, is part of the estimator's key.
 const char* const kRunOnlyOptions[] = {
     "--out",    "--exr-float", "--png",   "--exposure", "--aov",    "--denoise", "--stats",
-    "--resume", "--warm-up",   "--quiet", "--frames",   "--device", "--help"};
+    "--resume", "--warm-up",   "--quiet", "--frames",   "--device", "--help",    "--video"};
 
 // Each option of `render` but the run-only ones, with what was given for it ("" where nothing,
 // the default): two runs with the same key render the same frames from the same inputs.
@@ -416,6 +419,7 @@ std::string estimatorKey(const CLI::App& render) {
 pr::RenderOptions toRenderOptions(const RenderArgs& a, const CLI::App& render) {
   pr::RenderOptions ro = a.ro;
   ro.estimatorKey = estimatorKey(render);
+  if (!ro.video.empty()) ro.png = true;  // the video is encoded from the PNGs
   if (!a.frames.empty()) {
     ro.frames = pr::parseFrameRange(a.frames);
     ro.framesGiven = true;

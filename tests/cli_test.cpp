@@ -1,6 +1,8 @@
 // The command line as a user meets it: exit codes, one-line errors, the devices listing.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include <nlohmann/json.hpp>
 
 #include "support/render_helpers.h"
@@ -127,6 +129,60 @@ TEST(Cli, DeviceBuffersSumToTheDeviceBytes) {
         << mode;
     EXPECT_EQ(b.contains("light vertex arena"), mode == "reuse") << b.dump();
   }
+}
+
+// What ffprobe reports of a video's first stream: "frames,width,height,rate".
+std::string probeVideo(const std::string& path) {
+  const std::string cmd =
+      "ffprobe -v error -count_frames -select_streams v:0 -show_entries "
+      "stream=nb_read_frames,width,height,r_frame_rate -of "
+      "compact=p=0:nk=1 '" +
+      path + "' 2>&1";
+  std::string out;
+  if (FILE* p = popen(cmd.c_str(), "r")) {
+    char buf[256];
+    while (fgets(buf, sizeof buf, p)) out += buf;
+    pclose(p);
+  }
+  while (!out.empty() && (out.back() == '\n' || out.back() == '\r')) out.pop_back();
+  return out;
+}
+
+// --video encodes every frame of the range, in order, at --fps (ffmpeg, which the set-up
+// installs): an odd size padded to even, and a resumed run's video holds the frames of the run
+// before it too.
+TEST(Cli, VideoEncodesEveryFrameOfTheRange) {
+  const std::string dir = test::tempDir("video");
+  const std::string common = "render '" + test::sourcePath("scenes/cornell-dynamic.gltf") +
+                             "' --width 33 --height 25 --spp 1 --fps 12 --quiet --out '" + dir +
+                             "/f_%04d.exr' --video '" + dir + "/clip.mp4'";
+  auto r = test::runPathreuse(common + " --frames 0-4");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const std::string mp4 = test::slurp(dir + "/clip.mp4");
+  ASSERT_GT(mp4.size(), 8u);
+  EXPECT_EQ(mp4.substr(4, 4), "ftyp");
+  EXPECT_EQ(probeVideo(dir + "/clip.mp4"), "34|26|12/1|5");
+  EXPECT_FALSE(test::slurp(dir + "/f_0004.png").empty()) << "--video writes the PNGs";
+  r = test::runPathreuse(common + " --frames 0-6 --resume");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(probeVideo(dir + "/clip.mp4"), "34|26|12/1|7");
+}
+
+// A container it does not write, or no ffmpeg: one line, exit 2, before any frame.
+TEST(Cli, VideoWithoutFfmpegOrAKnownContainerIsRefused) {
+  const std::string dir = test::tempDir("video-refused");
+  const std::string common = "render '" + test::sourcePath("scenes/cornell-dynamic.gltf") +
+                             "' --frames 0-1 --width 8 --height 6 --spp 1 --out '" + dir +
+                             "/f_%04d.exr' --video '" + dir;
+  auto r = test::runPathreuse(common + "/clip.avi'");
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+  EXPECT_NE(r.err.find(".mp4, .mov or .mkv"), std::string::npos) << r.err;
+  r = test::runPathreuse(common + "/clip.mp4'", "PATH=/nonexistent ");
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_EQ(lineCount(r.err), 1u) << r.err;
+  EXPECT_NE(r.err.find("ffmpeg is not on PATH"), std::string::npos) << r.err;
+  EXPECT_TRUE(test::slurp(dir + "/f_0000.exr").empty()) << "nothing rendered";
 }
 
 }  // namespace

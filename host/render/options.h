@@ -89,6 +89,7 @@ struct RenderOptions {
   std::string outPattern = "out/frame_%04d.exr";
   bool exrFloat = false;
   bool png = false;
+  std::string video;     // --video: the frames' PNGs encoded by ffmpeg (io/video.h); "" = none
   std::string aov;       // --aov: auxiliary images as extra EXR channels (render/aov.h); "" = none
   bool denoise = false;  // --denoise: Open Image Denoise (render/denoise.h)
   float exposure = 0.0f;

@@ -21,6 +21,7 @@
 #include "cl/context.h"
 #include "cl/device.h"
 #include "io/image.h"
+#include "io/video.h"
 #include "render/film.h"
 #include "render/frame_writer.h"
 #include "render/gpu_scene.h"
@@ -397,6 +398,17 @@ void removeStaleFiles(const RenderOptions& o, int frameCount) {
               << formatOutPath(o.outPattern, 0) << "\n";
 }
 
+// --video: every frame of the range (rendered now, or complete before with --resume) from its
+// PNG, in order.
+void writeVideo(const RenderOptions& o, const FrameRange& range) {
+  std::vector<std::string> pngs;
+  for (int64_t f = range.first; f <= range.last; ++f)
+    pngs.push_back(withExtension(formatOutPath(o.outPattern, f), ".png"));
+  encodeVideo(findFfmpeg(), pngs, o.fps, o.video);
+  if (!o.quiet)
+    std::cerr << "video: " << o.video << " (" << pngs.size() << " frames at " << o.fps << " fps)\n";
+}
+
 // Renders the session's frames in order, each written (render/frame_writer.h) while the next
 // one renders.
 int renderFrames(const RenderOptions& o, MultiDeviceSession& session, const FrameRange& range,
@@ -468,6 +480,7 @@ int renderFrames(const RenderOptions& o, MultiDeviceSession& session, const Fram
   // A signal after the last frame changes nothing.
   if (interrupted() && f <= range.last) return reportInterrupt(o, range, f);
   if (!o.quiet) printSummary(o, range, t);
+  if (!o.video.empty()) writeVideo(o, range);
   return kExitOk;
 }
 
@@ -515,6 +528,14 @@ bool unpackHistories(const std::string& data, MultiDeviceSession& session, const
 int runRender(const RenderOptions& o) {
   installInterruptHandlers(o.scene);
   validateRenderOptions(o);
+  if (!o.video.empty()) {
+    if (!videoContainerKnown(o.video))
+      throw InputError("--video " + o.video + ": name a .mp4, .mov or .mkv file");
+    if (findFfmpeg().empty())
+      throw InputError("--video " + o.video +
+                       ": ffmpeg is not on PATH (Debian: apt-get install ffmpeg, which "
+                       "tools/setup/install-deps.sh does)");
+  }
   LoadOptions loadOptions;
   loadOptions.allowOutsideUris = o.allowOutsideUris;
   loadOptions.digestInputs = keepsHistory(o);
@@ -526,6 +547,10 @@ int runRender(const RenderOptions& o) {
   if (!o.statsFile.empty()) inputs.refuse(o.statsFile, "--stats");
   // Unwritable output is found before the kernels are built, not after the first frame.
   checkWritable(formatOutPath(o.outPattern, first));
+  if (!o.video.empty()) {
+    inputs.refuse(o.video, "--video");
+    checkWritable(o.video);
+  }
   std::unique_ptr<StatsFile> stats;
   if (!o.statsFile.empty()) stats = std::make_unique<StatsFile>(o.statsFile, o.resume);
   const auto devices = enumerateDevices();

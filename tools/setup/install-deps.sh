@@ -5,7 +5,7 @@
 # tools/ci/oclgrind-check.sh; clang-format for tools/ci/format-check.sh; clang for
 # tools/ci/kernel-conformance.sh, the kernels' strict OpenCL C 1.2 gate; ccache, through which
 # CMakeLists.txt compiles where it is present; Slurm and munge for tools/slurm/'s single-node
-# test cluster).
+# test cluster; ffmpeg for --video, the demo's MP4).
 # Idempotent: runs apt-get only when something is missing.
 set -euo pipefail
 
@@ -16,7 +16,7 @@ packages=(
   libopenexr-dev libcli11-dev libgtest-dev zlib1g-dev libssl-dev
   assimp-testmodels python3
   python3-matplotlib python3-numpy
-  python3-venv oclgrind clang-format clang ccache
+  python3-venv oclgrind clang-format clang ccache ffmpeg
   slurmctld slurmd slurm-client munge
 )
 
