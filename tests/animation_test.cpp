@@ -203,6 +203,33 @@ TEST(Animation, ParentMotionMovesStaticLocalChild) {
   EXPECT_GE(s.bounds.max.y, 10.0f);
 }
 
+// Animations are clips: where two move the same node's same property the first plays there
+// (the Fox's Survey, not its Walk and Run over it), and a warning says so; one that moves
+// another node plays beside it, and the duration is of what plays.
+TEST(Animation, TheFirstClipPlaysWhereClipsShareATarget) {
+  Builder b;
+  const int mesh = b.triangle();
+  const int in = b.floats({0.0f, 1.0f}, "SCALAR");
+  const int longIn = b.floats({0.0f, 4.0f}, "SCALAR");
+  const int up = b.floats({0, 0, 0, 0, 10, 0}, "VEC3");
+  const int side = b.floats({0, 0, 0, 10, 0, 0}, "VEC3");
+  b.doc["nodes"] = {{{"mesh", mesh}}, {{"mesh", mesh}, {"translation", {0, 0, 5}}}};
+  b.doc["scenes"] = {{{"nodes", {0, 1}}}};
+  b.doc["animations"] =
+      json::array({oneChannel({{"input", in}, {"output", up}}, 0, "translation"),
+                   oneChannel({{"input", longIn}, {"output", side}}, 0, "translation"),
+                   oneChannel({{"input", in}, {"output", side}}, 1, "translation")});
+  b.doc["animations"][1]["name"] = "Walk";
+  const Scene s = loadScene(b.write("clips.gltf"), quiet());
+  expectNear(glm::vec3(s.nodeWorldTransform(0, 0.5)[3]), {0, 5, 0});  // the first clip
+  expectNear(glm::vec3(s.nodeWorldTransform(1, 0.5)[3]), {5, 0, 0});  // another node's
+  EXPECT_DOUBLE_EQ(s.animationDuration(), 1.0);                       // not the shadowed clip's 4 s
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_NE(s.warnings[0].find("animation 1 (Walk) animates what an earlier animation does"),
+            std::string::npos)
+      << s.warnings[0];
+}
+
 TEST(Animation, ExtrasDynamicIsInherited) {
   Builder b;
   const int mesh = b.triangle();

@@ -41,6 +41,34 @@ class Converter : Stage {
     return r;
   }
 
+  // glTF's animations are clips: all of them play, but where two animate one node's same
+  // property only the first does there (as Blender's importer and most viewers play the first
+  // clip), so the Fox plays its Survey, not Survey, Walk and Run at once. A warning names the
+  // animations that lose channels.
+  void keepFirstAnimationOfEachTarget() {
+    std::set<std::pair<int, int>> earlier;  // (node, path) an earlier animation drives
+    std::string shadowed;
+    int count = 0;
+    for (size_t a = 0; a < scene_.animations.size(); ++a) {
+      std::vector<AnimationChannel>& channels = scene_.animations[a].channels;
+      const size_t before = channels.size();
+      channels.erase(std::remove_if(channels.begin(), channels.end(),
+                                    [&](const AnimationChannel& c) {
+                                      return earlier.count({c.node, int(c.path)}) > 0;
+                                    }),
+                     channels.end());
+      for (const AnimationChannel& c : channels) earlier.insert({c.node, int(c.path)});
+      if (channels.size() < before && ++count)
+        shadowed +=
+            (shadowed.empty() ? "" : ", ") + std::to_string(a) +
+            (scene_.animations[a].name.empty() ? "" : " (" + scene_.animations[a].name + ")");
+    }
+    if (count > 0)
+      warn((count > 1 ? "animations " : "animation ") + shadowed +
+           (count > 1 ? " animate" : " animates") +
+           " what an earlier animation does; the earliest plays there, as one clip");
+  }
+
   void buildNodes() {
     const size_t n = model_.nodes.size();
     scene_.nodes.resize(n);
@@ -66,6 +94,7 @@ class Converter : Stage {
         dst.dynamic = d->IsBool() && d->Get<bool>();
       for (double w : src.weights) dst.weights.push_back(float(w));
     }
+    keepFirstAnimationOfEachTarget();
     for (uint32_t a = 0; a < scene_.animations.size(); ++a)
       for (uint32_t c = 0; c < scene_.animations[a].channels.size(); ++c) {
         const AnimationChannel& ch = scene_.animations[a].channels[c];
