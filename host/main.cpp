@@ -110,6 +110,9 @@ struct RenderArgs {
 void addSceneOptions(CLI::App* render, RenderArgs& a) {
   listUnder(render, "Scene and frames");
   render->add_flag("--allow-outside-uris", a.ro.allowOutsideUris, kOutsideHelp);
+  render->add_option("--animation", a.ro.animation,
+                     "The one animation that plays, by index or name (default: all of them; "
+                     "where two animate the same node, the first)");
   render->add_option("--frames", a.frames,
                      "Frame range A-B or one frame A (default: the whole animation)");
   render->add_option("--fps", a.ro.fps, "Frames per second: frame f is at time f / fps")

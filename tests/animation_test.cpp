@@ -228,6 +228,27 @@ TEST(Animation, TheFirstClipPlaysWhereClipsShareATarget) {
   EXPECT_NE(s.warnings[0].find("animation 1 (Walk) animates what an earlier animation does"),
             std::string::npos)
       << s.warnings[0];
+  // --animation: that clip alone, by name or index, and an unknown one named with the others.
+  LoadOptions walk = quiet();
+  walk.animation = "Walk";
+  const Scene w = loadScene(b.write("clips-walk.gltf"), walk);
+  expectNear(glm::vec3(w.nodeWorldTransform(0, 2.0)[3]), {5, 0, 0});
+  expectNear(glm::vec3(w.nodeWorldTransform(1, 0.5)[3]), {0, 0, 5});  // clip 2 does not play
+  EXPECT_DOUBLE_EQ(w.animationDuration(), 4.0);
+  EXPECT_TRUE(w.warnings.empty());
+  walk.animation = "2";
+  expectNear(glm::vec3(loadScene(b.write("clips-2.gltf"), walk).nodeWorldTransform(1, 0.5)[3]),
+             {5, 0, 0});
+  walk.animation = "Run";
+  try {
+    loadScene(b.write("clips-run.gltf"), walk);
+    ADD_FAILURE() << "an unknown animation loaded";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("--animation Run: no such animation (the scene has 0, "
+                                         "1 (Walk), 2)"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(Animation, ExtrasDynamicIsInherited) {

@@ -69,6 +69,7 @@ constexpr uint32_t kWavefrontPixels = uint32_t(1) << 20;
 struct RenderOptions {
   std::string scene;
   bool allowOutsideUris = false;  // LoadOptions::allowOutsideUris
+  std::string animation;          // LoadOptions::animation: "" = every animation
   FrameRange frames;
   bool framesGiven = false;
   double fps = 24.0;

@@ -538,6 +538,7 @@ int runRender(const RenderOptions& o) {
   }
   LoadOptions loadOptions;
   loadOptions.allowOutsideUris = o.allowOutsideUris;
+  loadOptions.animation = o.animation;
   loadOptions.digestInputs = keepsHistory(o);
   const Scene scene = loadScene(o.scene, loadOptions);
   noteUnlitScene(scene, o);

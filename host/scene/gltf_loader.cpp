@@ -46,6 +46,7 @@ class Converter : Stage {
   // clip), so the Fox plays its Survey, not Survey, Walk and Run at once. A warning names the
   // animations that lose channels.
   void keepFirstAnimationOfEachTarget() {
+    if (!doc_.options.animation.empty()) return keepOneAnimation(doc_.options.animation);
     std::set<std::pair<int, int>> earlier;  // (node, path) an earlier animation drives
     std::string shadowed;
     int count = 0;
@@ -67,6 +68,23 @@ class Converter : Stage {
       warn((count > 1 ? "animations " : "animation ") + shadowed +
            (count > 1 ? " animate" : " animates") +
            " what an earlier animation does; the earliest plays there, as one clip");
+  }
+
+  // --animation: the animation `which` names (its index or its name) alone.
+  void keepOneAnimation(const std::string& which) {
+    std::string names;
+    size_t chosen = scene_.animations.size();
+    for (size_t a = 0; a < scene_.animations.size(); ++a) {
+      const std::string& name = scene_.animations[a].name;
+      if (chosen == scene_.animations.size() && (which == std::to_string(a) || which == name))
+        chosen = a;
+      names += (a ? ", " : "") + std::to_string(a) + (name.empty() ? "" : " (" + name + ")");
+    }
+    if (chosen == scene_.animations.size())
+      fail("--animation " + which + ": no such animation" +
+           (names.empty() ? " (the scene has none)" : " (the scene has " + names + ")"));
+    for (size_t a = 0; a < scene_.animations.size(); ++a)
+      if (a != chosen) scene_.animations[a].channels.clear();
   }
 
   void buildNodes() {

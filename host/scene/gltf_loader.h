@@ -22,6 +22,9 @@ struct LoadOptions {
   // Hash the content of every file read into Scene::inputDigest (what a resume history is keyed
   // by); off, the cost of hashing a scene's textures is not paid.
   bool digestInputs = false;
+  // --animation: the one animation that plays, by index or name; "" = all of them (the first
+  // where two animate the same node's same property).
+  std::string animation;
 };
 
 Scene loadScene(const std::string& path, const LoadOptions& options = {});
