@@ -41,6 +41,29 @@ TEST(SceneCli, InfoCornellJson) {
   EXPECT_NEAR(j["bounds"]["max"][0].get<double>(), 5.05, 1e-4);
 }
 
+// The Fox's three clips animate the same joints: info lists them, the first plays, and the
+// others are named with the --animation that plays them.
+TEST(SceneCli, InfoListsTheClipsAndWhichPlays) {
+  PR_SHARED_SCENE(path, "Fox/Fox.gltf");
+  auto r = test::runPathreuse("info --json '" + path + "'");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const auto clips = nlohmann::json::parse(r.out)["animation"]["clips"];
+  ASSERT_EQ(clips.size(), 3u);
+  EXPECT_EQ(clips[0]["name"], "Survey");
+  EXPECT_EQ(clips[0]["plays"], true);
+  EXPECT_EQ(clips[1]["name"], "Walk");
+  EXPECT_EQ(clips[1]["plays"], false);
+  EXPECT_NEAR(clips[1]["duration_s"].get<double>(), 0.7083, 1e-3);
+  EXPECT_EQ(clips[2]["plays"], false);
+  r = test::runPathreuse("info '" + path + "'");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.out.find("1 Walk 0.708333 s (not played: --animation 1)"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("animations 1 (Walk), 2 (Run) animate what an earlier animation does"),
+            std::string::npos)
+      << r.out;
+}
+
 TEST(SceneCli, InfoBoxAnimated) {
   PR_SHARED_SCENE(path, "BoxAnimated/BoxAnimated.gltf");
   auto r = test::runPathreuse("info --json --fps 10 '" + path + "'");

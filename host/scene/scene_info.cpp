@@ -1,10 +1,19 @@
 #include "scene/scene_info.h"
 
+#include <algorithm>
 #include <sstream>
 
 namespace pr {
 
 namespace {
+
+// A clip's length in the file: its samplers' last key, whether or not its channels play.
+double clipDuration(const Animation& a) {
+  double d = 0.0;
+  for (const AnimationSampler& s : a.samplers) d = std::max(d, s.endTime());
+  return d;
+}
+
 nlohmann::ordered_json vec3Json(const glm::vec3& v) {
   return {v.x, v.y, v.z};
 }
@@ -44,6 +53,11 @@ nlohmann::ordered_json sceneInfoJson(const Scene& scene, double fps) {
   j["default_camera"] = scene.fileCameraCount() == 0;
   j["animation"] = {
       {"duration_s", scene.animationDuration()}, {"frames", scene.frameCount(fps)}, {"fps", fps}};
+  nlohmann::ordered_json clips = nlohmann::ordered_json::array();
+  for (const Animation& a : scene.animations)
+    clips.push_back(
+        {{"name", a.name}, {"duration_s", clipDuration(a)}, {"plays", !a.channels.empty()}});
+  j["animation"]["clips"] = clips;
   const Bounds& b = scene.bounds;
   if (b.empty()) {
     j["bounds"] = {{"min", nullptr}, {"max", nullptr}};
@@ -82,6 +96,16 @@ std::string sceneInfoText(const Scene& scene, double fps) {
     s << d << " s, " << scene.frameCount(fps) << " frames at " << fps << " fps\n";
   else
     s << "none (1 frame)\n";
+  if (scene.animations.size() > 1) {
+    s << "clips:     ";
+    for (size_t a = 0; a < scene.animations.size(); ++a) {
+      const Animation& c = scene.animations[a];
+      s << (a ? ", " : " ") << a << (c.name.empty() ? "" : " " + c.name) << " " << clipDuration(c)
+        << " s"
+        << (c.channels.empty() ? " (not played: --animation " + std::to_string(a) + ")" : "");
+    }
+    s << "\n";
+  }
   const Bounds& b = scene.bounds;
   s << "bounds:     ";
   if (b.empty())
