@@ -259,7 +259,7 @@ void PathTracer::beginFrame(int64_t frame, const dev::CameraParams& camera,
 
 void PathTracer::traceBand(cl_uint first, cl_uint end, cl_uint masked, StageTimer* timer) {
   static const cl_uint kZero[dev::PR_QUEUE_COUNT] = {};
-  generateArgs_.first = generateArgs_.base = first;
+  generateArgs_.first = first;
   generateArgs_.count = end;
   generateArgs_.masked = masked;
   generateArgs_.set(generate_, kargs::kPass);

@@ -1,5 +1,5 @@
-// pt_generate: one work-item per pixel of the band [first, count) (its states at pixel - base,
-// base = first). Reads the camera; writes a fresh PathState with the
+// pt_generate: one work-item per pixel of the band [first, count) (its state at pixel - first).
+// Reads the camera; writes a fresh PathState with the
 // camera ray through a jittered point of the pixel (random dimensions 0 and 1), and zero radiance;
 // with write_eye (--eye-paths, --resample), marks the sample's EyeVertex empty, and with
 // resample its reservoirs. Every path is live: the first
@@ -41,7 +41,7 @@ PR_KERNEL void pt_generate(PR_PARAMS(PR_ARGS_PT_GENERATE)) {
   s.eye_flags = 0u;
   const float cos_t = s.ray.dx * cam.fx + s.ray.dy * cam.fy + s.ray.dz * cam.fz;
   s.lt = cos_t * cos_t * cos_t;  // strategy T's camera factor at x_1 needs it (pt_shade)
-  states[i - base] = s;
+  states[i - first] = s;
   radiance[i] = (float4)(0.0f, 0.0f, 0.0f, 0.0f);
   if (write_eye) eye[i].prim = PR_INVALID_INDEX;  // until pt_shade meets x_1
   if (resample) {                                 // an empty reservoir (shared/resample.h)

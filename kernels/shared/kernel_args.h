@@ -153,15 +153,14 @@
 // `count` of them), which pt_shade compacts: the live paths into next_queue, the paths with a
 // shadow ray into shadow_queue, counted in queue_sizes (PR_QUEUE_*, shared/path_state.h). A pass
 // runs over bands of pixels: a path's own state (states, hits, shadows, rs_track, rs_pending,
-// di_pending) is at its pixel - `base`, the band's first; what the frame keeps (radiance, eye,
-// rs_res, di_res) at its pixel.
+// di_pending) is at its pixel - `base`, the band's first (pt_generate's `first`); what the frame
+// keeps (radiance, eye, rs_res, di_res) at its pixel.
 
 #define PR_ARGS_PT_GENERATE(F, X)        \
   F(FRAME, VAL, CameraParams, cam)       \
   X(FRAME, VAL, uint, seed)              \
   X(FRAME, VAL, uint, frame)             \
   X(PASS, VAL, uint, sample)             \
-  X(PASS, VAL, uint, base)               \
   X(FRAME, OUT, PathState, states)       \
   X(FRAME, OUT, float4, radiance)        \
   X(PASS, VAL, uint, count)              \
