@@ -41,11 +41,12 @@ class Converter : Stage {
     return r;
   }
 
-  // glTF's animations are clips: all of them play, but where two animate one node's same
-  // property only the first does there (as Blender's importer and most viewers play the first
+  // Which channels play. glTF's animations are clips: with --animation that one alone (see
+  // keepOneAnimation); else all of them, but where two animate one node's same property only the
+  // first does there (as Blender's importer and most viewers play the first
   // clip), so the Fox plays its Survey, not Survey, Walk and Run at once. A warning names the
   // animations that lose channels.
-  void keepFirstAnimationOfEachTarget() {
+  void chooseAnimations() {
     if (!doc_.options.animation.empty()) return keepOneAnimation(doc_.options.animation);
     std::set<std::pair<int, int>> earlier;  // (node, path) an earlier animation drives
     std::string shadowed;
@@ -112,7 +113,7 @@ class Converter : Stage {
         dst.dynamic = d->IsBool() && d->Get<bool>();
       for (double w : src.weights) dst.weights.push_back(float(w));
     }
-    keepFirstAnimationOfEachTarget();
+    chooseAnimations();
     for (uint32_t a = 0; a < scene_.animations.size(); ++a)
       for (uint32_t c = 0; c < scene_.animations[a].channels.size(); ++c) {
         const AnimationChannel& ch = scene_.animations[a].channels[c];
