@@ -12,7 +12,7 @@
 //   9   object of pass 0's first hit (its glTF node; -1: none); 10 its material (-1: none);
 //   11  the passes summed.
 #include "shared/camera.h"
-#include "shared/integrator.h"
+#include "shared/transport.h"
 #include "shared/kernel_args.h"
 
 #define PR_AOV_FLOATS 12

@@ -7,7 +7,7 @@
 #include <set>
 #include <vector>
 
-#include "render/bsdf_tables.h"
+#include "render/albedo_tables.h"
 #include "shared/bsdf.h"
 #include "shared/rng.h"
 #include "support/chi_square.h"
@@ -801,8 +801,8 @@ TEST(BsdfGltfModel, SingleScatteringAndTheCoatsFresnelAtNdotV) {
   }
 }
 
-// The committed tables are what tools/tables/bsdf_tables writes (host/render/bsdf_tables.cpp): they
-// were made from this microfacet code, at the committed grid and accuracy. Every 4th entry of
+// The committed tables are what tools/tables/bsdf_tables writes (host/render/albedo_tables.cpp):
+// they were made from this microfacet code, at the committed grid and accuracy. Every 4th entry of
 // each table is recomputed (all of them take 20 s; any change to the code that makes them
 // changes nearly all).
 TEST(BsdfTables, CommittedHeaderIsWhatTheToolWrites) {

@@ -13,7 +13,7 @@
 
 #include "io/image.h"
 #include "render/options.h"
-#include "scene/environment.h"
+#include "scene/environment_map.h"
 #include "scene/gltf_loader.h"
 #include "shared/environment.h"
 #include "support/chi_square.h"

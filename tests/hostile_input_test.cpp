@@ -16,7 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "io/image.h"
-#include "scene/environment.h"
+#include "scene/environment_map.h"
 #include "scene/image_decode.h"
 #include "support/background.h"
 #include "support/gltf_builder.h"

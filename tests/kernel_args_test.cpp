@@ -7,7 +7,7 @@
 #include <set>
 #include <string>
 
-#include "cl/kernel_args.h"
+#include "cl/kernel_binding.h"
 #include "shared/layout.h"
 #include "support/test_env.h"
 #include "util/error.h"

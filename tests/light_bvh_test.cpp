@@ -1,4 +1,4 @@
-// The light BVH (host/render/light_bvh.h, kernels/shared/light_bvh.h) on the CPU reference:
+// The light BVH (host/render/light_bvh_builder.h, kernels/shared/light_bvh.h) on the CPU reference:
 // the choice it makes follows the pmf it reports (chi-square), the pmfs of all lights add to
 // at most one, no light that can reach a point (above its normal) is given probability 0, the cones
 // and boxes of every node hold their children's after build and after refit, and a point next to
@@ -11,7 +11,7 @@
 #include <random>
 #include <vector>
 
-#include "render/light_bvh.h"
+#include "render/light_bvh_builder.h"
 #include "shared/lights.h"
 #include "shared/rng.h"
 #include "support/chi_square.h"

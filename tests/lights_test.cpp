@@ -11,7 +11,7 @@
 #include <cstring>
 #include <vector>
 
-#include "scene/environment.h"
+#include "scene/environment_map.h"
 #include "shared/lights.h"
 #include "shared/rng.h"
 #include "shared/types.h"

@@ -1,6 +1,6 @@
 // Coarse facets with smooth vertex normals (the shadow terminator): a hexagonal prism whose
 // vertex normals are a cylinder's, direct light only, against the smooth surface those normals
-// describe. Without the terminator offset (shared/integrator.h, surface_ray) the facets shadow
+// describe. Without the terminator offset (shared/transport.h, surface_ray) the facets shadow
 // each other where the smooth surface would be lit (5-15% darker bands beside the edges), and
 // facets seen edge-on, whose shading normal turns away from the camera, went black.
 #include <gtest/gtest.h>

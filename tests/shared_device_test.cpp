@@ -10,7 +10,7 @@
 
 #include "cl/context.h"
 #include "render/kernel_programs.h"
-#include "render/light_bvh.h"
+#include "render/light_bvh_builder.h"
 #include "support/test_env.h"
 #include "test/shared_check.h"
 

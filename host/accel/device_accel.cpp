@@ -1,12 +1,12 @@
 #include "accel/device_accel.h"
 
-#include "cl/kernel_args.h"
+#include "cl/kernel_binding.h"
 
 #include <algorithm>
 #include <string>
 #include <vector>
 
-#include "cl/error.h"
+#include "cl/cl_check.h"
 #include "util/error.h"
 
 namespace pr::accel {

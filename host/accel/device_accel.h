@@ -6,7 +6,7 @@
 
 #include "accel/scene_accel.h"
 #include "cl/context.h"
-#include "cl/kernel_args.h"
+#include "cl/kernel_binding.h"
 
 namespace pr::accel {
 

@@ -21,4 +21,4 @@
 #pragma GCC diagnostic pop
 #endif
 
-#include "cl/error.h"
+#include "cl/cl_check.h"

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "cl/kernel_args.h"
+#include "cl/kernel_binding.h"
 #include "render/integrator.h"
 #include "util/error.h"
 

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <vector>
 
-#include "cl/kernel_args.h"
+#include "cl/kernel_binding.h"
 #include "util/check.h"
 
 namespace pr {

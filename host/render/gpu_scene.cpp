@@ -9,7 +9,7 @@
 
 #include <glm/gtc/matrix_inverse.hpp>
 
-#include "cl/kernel_args.h"
+#include "cl/kernel_binding.h"
 #include "render/device_materials.h"
 #include "render/kernel_programs.h"
 #include "render/light_table.h"

@@ -11,9 +11,9 @@
 #include "accel/scene_accel.h"
 #include "cl/context.h"
 #include "render/device_materials.h"
-#include "render/light_bvh.h"
+#include "render/light_bvh_builder.h"
 #include "render/options.h"
-#include "scene/environment.h"
+#include "scene/environment_map.h"
 #include "scene/scene.h"
 #include "shared/camera.h"
 #include "shared/geometry.h"
@@ -27,7 +27,7 @@ struct GpuSceneOptions {
   // a diagnostic with exactly known albedo, used by the furnace tests.
   bool forceDiffuse = false;
   MaterialModel materialModel = MaterialModel::Energy;  // the BSDF model
-  bool shadowTerminator = true;  // smooth-shaded facets' terminator offset (shared/integrator.h)
+  bool shadowTerminator = true;  // smooth-shaded facets' terminator offset (shared/transport.h)
   LightSampler lightSampler = LightSampler::Auto;
   int bvhWidth = 0;         // children per BVH node; 0: defaultBvhWidth of the device
   Environment environment;  // the environment light; none where !present()

@@ -7,7 +7,7 @@
 
 #include <glm/glm.hpp>
 
-#include "scene/environment.h"
+#include "scene/environment_map.h"
 #include "scene/scene.h"
 #include "shared/environment.h"
 #include "shared/lights.h"

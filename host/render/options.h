@@ -97,7 +97,7 @@ struct RenderOptions {
   bool quiet = false;
   bool forceDiffuse = false;
   MaterialModel materialModel = MaterialModel::Energy;
-  bool shadowTerminator = true;  // the terminator offset (kernels/shared/integrator.h)
+  bool shadowTerminator = true;  // the terminator offset (kernels/shared/transport.h)
   LightSampler lightSampler = LightSampler::Auto;
   int bvhWidth = 0;  // 0: defaultBvhWidth of the device
   std::string statsFile;
@@ -126,7 +126,7 @@ struct RenderOptions {
   // The pixels whose paths a pass traces at once (PathTracerSettings::wavefrontPixels). Not a
   // command-line option: frames are the same floats whatever it is; the tests make it small.
   uint32_t wavefrontPixels = kWavefrontPixels;
-  // The environment light (scene/environment.h): a map file, "none", or "" (a uniform one of
+  // The environment light (scene/environment_map.h): a map file, "none", or "" (a uniform one of
   // envColor where --env-color is given, else white where the scene has no lights, else none).
   std::string env;
   std::string envColor;  // "R,G,B"; "" = white

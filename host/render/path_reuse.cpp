@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <numeric>
 
-#include "cl/kernel_args.h"
+#include "cl/kernel_binding.h"
 #include "util/check.h"
 #include "render/kernel_programs.h"
 #include "render/path_tracer.h"

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "cl/context.h"
-#include "cl/kernel_args.h"
+#include "cl/kernel_binding.h"
 #include "render/film.h"
 #include "render/gpu_scene.h"
 #include "render/integrator.h"

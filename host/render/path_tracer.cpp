@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "cl/kernel_args.h"
+#include "cl/kernel_binding.h"
 #include "render/history_format.h"
 #include "shared/path_state.h"
 #include "util/check.h"

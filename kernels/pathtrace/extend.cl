@@ -1,7 +1,7 @@
 // pt_extend: one work-item per live path (the bounce's queue). Reads the path's ray; writes its
 // closest hit (prim == PR_INVALID_INDEX when it escapes) and counts the ray in rays[PR_PT_CAMERA]
 // or rays[PR_PT_BOUNCE].
-#include "shared/integrator.h"
+#include "shared/transport.h"
 #include "shared/path_state.h"
 
 PR_KERNEL void pt_extend(PR_PARAMS(PR_ARGS_PT_EXTEND)) {

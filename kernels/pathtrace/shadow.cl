@@ -3,7 +3,7 @@
 // marked it (op: 1 + the random dimension that offers it), offers the path it ends to the
 // sample's reservoir (PR_RS_OP_DIRECT: x_1's direct light to the direct light's). Counts it in
 // rays[PR_PT_SHADOW].
-#include "shared/integrator.h"
+#include "shared/transport.h"
 #include "shared/path_state.h"
 #include "shared/resample_direct.h"
 

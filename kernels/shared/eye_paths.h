@@ -13,7 +13,7 @@
 #pragma once
 
 #include "shared/arena.h"
-#include "shared/integrator.h"
+#include "shared/transport.h"
 #include "shared/mis.h"
 
 PR_NAMESPACE_BEGIN

@@ -1,5 +1,5 @@
 // Every kernel's parameters, one table per kernel: the kernels' parameter lists, the host's
-// argument structs and setters (host/cl/kernel_args.h) and the start-up check of each built
+// argument structs and setters (host/cl/kernel_binding.h) and the start-up check of each built
 // kernel against its table (clGetKernelArgInfo) all come from these lists, so that an argument
 // is named once and never counted by hand.
 //

@@ -13,7 +13,7 @@
 #include "shared/arena.h"
 #include "shared/camera.h"
 #include "shared/eye_paths.h"
-#include "shared/integrator.h"
+#include "shared/transport.h"
 #include "shared/mis.h"
 #include "shared/path_state.h"
 

@@ -7,7 +7,7 @@
 // shadow ray traced.
 #pragma once
 
-#include "shared/integrator.h"
+#include "shared/transport.h"
 #include "shared/path_state.h"
 #include "shared/resample.h"
 

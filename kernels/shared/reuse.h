@@ -4,7 +4,7 @@
 #pragma once
 
 #include "shared/arena.h"
-#include "shared/integrator.h"
+#include "shared/transport.h"
 #include "shared/path_state.h"
 
 PR_NAMESPACE_BEGIN

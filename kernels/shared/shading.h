@@ -172,7 +172,7 @@ PR_INLINE float3 lift_to_tangent_plane(float3 pv, float3 nv, float3 p, float b, 
 // where the surface its normals describe would be, so that rays leaving there are not shadowed
 // by the neighbouring facets where that surface would not be; zero on flat and concave parts
 // (the point lies on or above every tangent plane), and at most the triangle's size. Rays use it
-// through the integrator's ray_exit (shared/integrator.h), which computes it only for the rays
+// through the integrator's ray_exit (shared/transport.h), which computes it only for the rays
 // it can move.
 
 PR_INLINE float3 surface_lift(const ShadingData* sd, u32 prim, u32 inst, float b1, float b2) {

@@ -3,7 +3,7 @@
 #include <map>
 #include <string>
 
-#include "cl/error.h"
+#include "cl/cl_check.h"
 #include "support/test_env.h"
 
 namespace pr::test {

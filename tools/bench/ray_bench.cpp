@@ -40,7 +40,7 @@
 #include "accel/scene_accel.h"
 #include "cl/context.h"
 #include "cl/device.h"
-#include "cl/error.h"
+#include "cl/cl_check.h"
 #include "scene/gltf_loader.h"
 #include "scene/scene.h"
 #include "shared/bvh.h"

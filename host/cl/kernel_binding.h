@@ -9,7 +9,7 @@
 
 #include "cl/cl.h"
 #include "cl/context.h"
-#include "cl/error.h"
+#include "cl/cl_check.h"
 #include "shared/camera.h"
 #include "shared/kernel_args.h"
 #include "shared/reuse.h"

@@ -1,4 +1,4 @@
-#include "render/bsdf_tables.h"
+#include "render/albedo_tables.h"
 
 #include <algorithm>
 #include <atomic>

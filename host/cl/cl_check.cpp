@@ -1,4 +1,4 @@
-#include "cl/error.h"
+#include "cl/cl_check.h"
 
 #include <cstring>
 

@@ -1,4 +1,4 @@
-#include "scene/environment.h"
+#include "scene/environment_map.h"
 
 #include <algorithm>
 #include <cmath>

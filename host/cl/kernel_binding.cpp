@@ -1,4 +1,4 @@
-#include "cl/kernel_args.h"
+#include "cl/kernel_binding.h"
 
 #include <string>
 

@@ -1,4 +1,4 @@
-#include "render/light_bvh.h"
+#include "render/light_bvh_builder.h"
 
 #include <algorithm>
 #include <array>
