@@ -13,14 +13,16 @@ namespace pr {
 
 int defaultBvhWidth(bool gpu) {
   // 4 on GPUs: on an H200 it traced 24-33% more rays per second than 2 (and than 8 in incoherent
-  // rays) and kept connect's registers in check where 8 slowed reuse by a fifth (docs/design.md).
+  // rays) and kept connect's registers in check where 8 slowed reuse by a fifth
+  // (docs/experiments/bvh-width.md).
   return gpu ? 4 : 8;
 }
 
 int defaultConnections(bool gpu) {
-  // Measured with tools/bench/bench_connections.py (docs/design.md section 5): on an H200 two
-  // resampled connections reached a given error 1.6-2.0x sooner than tracing every candidate;
-  // on a CPU (PoCL) tracing all was 1.15x better on the demo scenes and 1.2x worse on the atrium.
+  // Measured with tools/bench/bench_connections.py (docs/experiments/resampled-connections.md): on
+  // an H200 two resampled connections reached a given error 1.6-2.0x sooner than tracing every
+  // candidate; on a CPU (PoCL) tracing all was 1.15x better on the demo scenes and 1.2x worse on
+  // the atrium.
   return gpu ? 2 : 0;
 }
 

@@ -13,13 +13,13 @@ enum class RenderMode { Reuse, Retrace, PathTrace };
 // How a shaded point chooses the light it samples: through the light BVH, by weighing every
 // light from the point (exhaustive), by power alone, or (auto) the light BVH where the scene
 // has more lights than kAutoLightBvhMin, exhaustive where it has at most kAutoExhaustiveMax and
-// power between (measured: docs/design.md section 6).
+// power between (measured: docs/experiments/exhaustive-light-sampler.md).
 enum class LightSampler { Auto, Bvh, Exhaustive, Power };
 constexpr int kAutoLightBvhMin = 16;
 constexpr int kAutoExhaustiveMax = 4;
 
 // Children per BVH node for a device (0: auto): CPUs 8 (float8 slab tests), GPUs 4. Measured in
-// docs/ray-benchmark.md (CPU) and docs/design.md section 3 (an H200).
+// docs/ray-benchmark.md (CPU) and docs/experiments/bvh-width.md (an H200).
 int defaultBvhWidth(bool gpu);
 // Resampled connections per eye vertex where --connections is auto; 0: every candidate.
 int defaultConnections(bool gpu);
@@ -51,7 +51,7 @@ struct ResampleSettings {
   int history = 20;
   // --mode reuse: the samples a resampled eye path counts as in its MIS weights against the
   // connections to stored light paths (which count as C, --paths-per-pixel). 4: the least error
-  // on both animations of bench_temporal among 1, 4, 16 and 64 (docs/design.md section 5).
+  // on both animations of bench_temporal among 1, 4, 16 and 64 (experiments/path-resampling.md).
   float misCount = 4.0f;
 };
 
@@ -139,13 +139,13 @@ struct RenderOptions {
 
 // o.resample with `enabled` and `neighbors` resolved: --resample / --no-resample where given; else
 // on in --mode reuse/retrace with eye paths (it reached each animation's error at least as
-// soon, with a third or less of the flicker: docs/design.md section 5) and off in pathtrace
-// mode, which stays the plain path tracer, and with --no-eye-paths, which it needs.
+// soon, with a third or less of the flicker: docs/experiments/path-resampling.md) and off in
+// pathtrace mode, which stays the plain path tracer, and with --no-eye-paths, which it needs.
 ResampleSettings resolveResample(const RenderOptions& o);
 
 // Strategy T: --light-tracing / --no-light-tracing where given; else on in --mode reuse/retrace
 // with eye paths (it lowered the Cornell boxes' error per sample by 4-19%, the atrium's neither
-// way, for splats of 2-3 ms in frames of 0.15-0.3 s: docs/design.md section 5) and off in
+// way, for splats of 2-3 ms in frames of 0.15-0.3 s: docs/experiments/light-tracing.md) and off in
 // pathtrace mode.
 bool resolveLightTracing(const RenderOptions& o);
 
