@@ -58,8 +58,9 @@ std::vector<DeviceEntry> enumerateDevices() {
   // not) and grid width (below 65,535 or not) the first time it meets them, outside any
   // program binary: a new image size cost up to a minute of compiling (the demo: 42 s at a
   // first size, 33 s at a second, with PoCL's own cache empty). Its generic functions, which
-  // the program binaries in our kernel cache hold, ran no slower here (docs/design.md section
-  // 8). Before the first OpenCL call, and where the user has not chosen.
+  // the program binaries in our kernel cache hold, ran no slower here
+  // (docs/experiments/pocl-work-group-specialisation.md). Before the first OpenCL call, and where
+  // the user has not chosen.
   setenv("POCL_WORK_GROUP_SPECIALIZATION", "0", 0);
   std::vector<cl::Platform> platforms;
   cl_int err = cl::Platform::get(&platforms);

@@ -122,7 +122,7 @@ GpuScene::GpuScene(Context& ctx, const Scene& scene, const GpuSceneOptions& opti
   }
   // Weighing each light from the shaded point pays with a few lights and costs too much with a
   // dozen; below the tree's threshold, power chose as well as the tree for less
-  // (docs/design.md section 6).
+  // (docs/experiments/exhaustive-light-sampler.md, light-bvh.md).
   lightChoice_ = options_.lightSampler;
   if (lightChoice_ == LightSampler::Auto)
     lightChoice_ = treeLights > kAutoLightBvhMin      ? LightSampler::Bvh

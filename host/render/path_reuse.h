@@ -24,7 +24,7 @@ namespace pr {
 // N_L where --light-paths is not given: one light path per pixel, at most 2^21 (1080p's 2,073,600
 // pixels keep one each; 4K shares one among four pixels). On the Cornell box a quarter of a path
 // per pixel costs 10% more relMSE at equal spp, a sixteenth the same, on the atrium nothing; at 4K
-// the whole arena would take 4.2 GiB of device memory (docs/design.md section 4).
+// the whole arena would take 4.2 GiB of device memory (docs/experiments/device-memory.md).
 constexpr uint32_t kMaxDefaultLightPaths = uint32_t(1) << 21;
 inline uint32_t defaultLightPaths(uint64_t pixels) {
   return uint32_t(std::min<uint64_t>(pixels, kMaxDefaultLightPaths));

@@ -757,7 +757,7 @@ PR_INLINE float light_exhaustive_pmf(PR_GLOBAL const Light* lights, u32 count, u
 // Tree candidates per choice: the light BVH's bounds are loose where a point is among many
 // lights, so PR_LIGHT_CANDIDATES lights are drawn through it (stratified in u) and one is kept in
 // proportion to light_receiver_importance over its tree pmf (resampled importance sampling,
-// Talbot 2005). Measured on the many-lights atrium: docs/design.md section 6.
+// Talbot 2005). Measured on the many-lights atrium: docs/experiments/light-bvh.md.
 #ifndef PR_LIGHT_CANDIDATES
 #define PR_LIGHT_CANDIDATES 2u
 #endif

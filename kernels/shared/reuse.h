@@ -35,8 +35,8 @@ typedef struct {
 // Most resampled connections per eye vertex (ReuseParams.resample; reservoir slots in connect).
 #define PR_MAX_CONNECTIONS 4
 
-// What connect leaves for connect_shadow (docs/design.md section 5, "Connections, then their
-// shadow rays"): per pixel sample, in the order connect found them, the terms of its estimate,
+// What connect leaves for connect_shadow (docs/design.md section 5, "Connections (strategy L)"):
+// per pixel sample, in the order connect found them, the terms of its estimate,
 // each a ShadowRay whose value is added where its ray (if any) is unoccluded. The estimate is L,
 // summed as connect used to sum it: op PR_REC_ADD adds the value to L, PR_REC_GROUP to a partial
 // sum g, and PR_REC_CLOSE adds g to L and starts g again at 0, so that the floating-point sums,

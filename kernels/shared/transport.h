@@ -72,7 +72,8 @@ PR_CALLABLE int trace_occluded(const SceneData* s, Ray ray) {
 // are then not shadowed by their neighbours where the smooth surface their normals describe
 // would be lit (the shadow terminator); rays well above the facet, which its neighbours cannot
 // block, keep their exact origin, and the lift is computed for the others alone. Measured on the
-// atrium's fluted column: docs/design.md section 6. -DPR_TERMINATOR_OFFSET=0 turns it off.
+// atrium's fluted column: docs/experiments/shadow-terminator.md.
+// -DPR_TERMINATOR_OFFSET=0 turns it off.
 #ifndef PR_TERMINATOR_OFFSET
 #define PR_TERMINATOR_OFFSET 1
 #endif
