@@ -41,9 +41,37 @@ struct FrameStats {
   int sppMax = 0;
 };
 
+// State that an integrator carries from one frame to the next (--resample's reservoirs, one
+// chain per sample pass: render/path_tracer.h). --resume keeps it in a file beside each frame
+// (render/history_format.h) and several devices move a pass's chain with the pass
+// (render/multi_device.h).
+class FrameHistory {
+ public:
+  virtual ~FrameHistory() = default;
+  // Whether the last frame left a whole history, and its bytes under `key` (everything else it
+  // depends on: scene, options).
+  virtual bool hasHistory() const = 0;
+  virtual std::string writeHistory(const std::string& key) = 0;
+  // Whether `data` is a whole history of `key`, this device's chains and film rows and frame
+  // `frame` (the frame that wrote it), every record in range; applyHistory then loads it. The
+  // caller sets the scene to that frame's time before checking (the records name its lights).
+  virtual bool checkHistory(const std::string& data, const std::string& key,
+                            int64_t frame) const = 0;
+  virtual void applyHistory(const std::string& data) = 0;
+  // Passes [0, chains) keep a chain, on whichever device renders them: its records over the
+  // film's rows, and writing them where the pass now is.
+  virtual int chains() const = 0;
+  virtual std::string chain(int pass) = 0;
+  virtual void setChain(int pass, const std::string& records) = 0;
+};
+
 class Integrator {
  public:
   virtual ~Integrator() = default;
+  // What it carries between frames; null where each frame stands alone.
+  virtual FrameHistory* history() { return nullptr; }
+  // What the run's first line says of it besides mode and devices ("" where nothing).
+  virtual std::string describe() const { return ""; }
   // Renders frame `frame` (the scene already set to its time) into the film. Returns early,
   // leaving the film partial, once pr::interrupted(); the caller then drops the frame.
   virtual void renderFrame(int64_t frame, const dev::CameraParams& camera, FrameStats* stats) = 0;

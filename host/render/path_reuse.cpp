@@ -24,6 +24,11 @@ void setLightPathCounter(FrameStats* stats, const char* key, uint64_t value) {
 
 }  // namespace
 
+std::string PathReuse::describe() const {
+  return "arena " + std::to_string(slots_) + " slots x " + std::to_string(stride_) +
+         " vertices = " + std::to_string(arenaBytes() >> 20) + " MiB";
+}
+
 cl_uint PathReuse::historySlotOffset(const dev::ReuseParams& rp) const {
   // With a history, the light paths shift by a random offset every historyPeriod frames of the
   // RNG's frame key, so that the reservoir meets new candidates; between shifts the noise stays

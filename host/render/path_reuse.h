@@ -74,8 +74,10 @@ class PathReuse : public Integrator {
         sizeof(dev::LightVertex) + (settings_.eyePaths ? sizeof(dev::EyePathRatio) : 0);
     return uint64_t(slots_) * (sizeof(dev::PathHeader) + stride_ * vertex);
   }
-  // The eye paths' path tracer (null with --no-eye-paths): its --resample history is the run's.
-  PathTracer* eyePaths() { return eyePaths_.get(); }
+  // The eye paths' --resample history is the run's (none with --no-eye-paths).
+  FrameHistory* history() override { return eyePaths_.get(); }
+  // The arena's slots, vertices per slot and size.
+  std::string describe() const override;
   // The arena as it stands (for tests and diagnostics).
   void readArena(std::vector<dev::PathHeader>* headers, std::vector<dev::LightVertex>* vertices);
 

@@ -41,7 +41,7 @@ struct PathTracerSettings {
 float lightTracingScale(const dev::CameraParams& camera, uint32_t lightPaths, int spp,
                         uint32_t pathsPerPixel);
 
-class PathTracer : public Integrator {
+class PathTracer : public Integrator, public FrameHistory {
  public:
   PathTracer(Context& ctx, GpuScene& scene, Film& film, const PathTracerSettings& settings);
   void renderFrame(int64_t frame, const dev::CameraParams& camera, FrameStats* stats) override;
@@ -65,25 +65,20 @@ class PathTracer : public Integrator {
   void reportRays(FrameStats* stats);
 
   // --resample's history between frames (docs/design.md section 5), so that a resumed run goes
-  // on as the uninterrupted one would: whether the last frame left one whole, and its bytes
-  // (a header, the chains' records of the film's rows, a checksum) or reading them back. `key`
-  // names everything else it depends on (scene, options); a history of another key, size or frame
-  // is not read. checkHistory says whether `data` is a whole history of `key`, this device's
-  // chains and film rows and frame `frame` (the frame that wrote it), every record in range;
-  // applyHistory then loads it. The caller sets the scene to that frame's time before checking
-  // (the records name its lights) and again before the next frame.
-  bool hasHistory() const { return chainedPasses() > 0 && written_ >= chainedPasses(); }
-  std::string writeHistory(const std::string& key);
-  bool checkHistory(const std::string& data, const std::string& key, int64_t frame) const;
-  void applyHistory(const std::string& data);
+  // on as the uninterrupted one would: a header, the chains' records of the film's rows, a
+  // checksum. A history of another key, size or frame is not read.
+  FrameHistory* history() override { return this; }
+  bool hasHistory() const override { return chainedPasses() > 0 && written_ >= chainedPasses(); }
+  std::string writeHistory(const std::string& key) override;
+  bool checkHistory(const std::string& data, const std::string& key, int64_t frame) const override;
+  void applyHistory(const std::string& data) override;
 
   // Several devices: each holds the chains of its own passes alone, and a pass moving to another
-  // device takes its chain along (render/multi_device.h): the records of pass `pass`'s chain
-  // over the film's rows, and writing them where the pass now is.
+  // device takes its chain along.
   void setPasses(int begin, int end) override;
-  int chains() const { return chains_; }  // passes [0, chains) keep one, on whichever device
-  std::string chain(int pass);
-  void setChain(int pass, const std::string& records);
+  int chains() const override { return chains_; }
+  std::string chain(int pass) override;
+  void setChain(int pass, const std::string& records) override;
 
  private:
   dev::ResampleParams resampleParams() const;

@@ -183,9 +183,8 @@ void printStart(const RenderOptions& o, MultiDeviceSession& session, const Frame
             << ", on ";
   for (size_t i = 0; i < session.deviceCount(); ++i)
     std::cerr << (i ? " + " : "") << session.device(i).name;
-  if (auto* reuse = dynamic_cast<PathReuse*>(&session.session(0).integrator()))
-    std::cerr << "; arena " << reuse->slots() << " slots x " << reuse->stride()
-              << " vertices = " << (reuse->arenaBytes() >> 20) << " MiB";
+  const std::string more = session.session(0).integrator().describe();
+  if (!more.empty()) std::cerr << "; " << more;
   std::cerr << "\n";
 }
 

@@ -153,9 +153,7 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
     p.fixedNoise = o.fixedNoise;
     p.resample = resample;
     p.wavefrontPixels = o.wavefrontPixels;
-    auto tracer = std::make_unique<PathTracer>(ctx_, *gpu_, *film_, p);
-    pathTracer_ = tracer.get();
-    integrator_ = std::move(tracer);
+    integrator_ = std::make_unique<PathTracer>(ctx_, *gpu_, *film_, p);
   } else {
     PathReuseSettings r;
     r.spp = o.spp;
@@ -176,9 +174,7 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
     r.fixedNoise = o.fixedNoise;
     r.resamplePaths = resample;
     r.wavefrontPixels = o.wavefrontPixels;
-    auto reuse = std::make_unique<PathReuse>(ctx_, *gpu_, *film_, r);
-    pathTracer_ = reuse->eyePaths();
-    integrator_ = std::move(reuse);
+    integrator_ = std::make_unique<PathReuse>(ctx_, *gpu_, *film_, r);
   }
   integrator_->setTimeLimit(o.timeLimit);
   if (o.noiseThreshold > 0.0f) {
@@ -211,35 +207,38 @@ std::string RenderSession::environmentDigest() const {
 }
 
 bool RenderSession::hasHistory() const {
-  return pathTracer_ && pathTracer_->hasHistory();
+  const FrameHistory* h = integrator_->history();
+  return h && h->hasHistory();
 }
 
 std::string RenderSession::writeHistory(const std::string& key) {
-  return pathTracer_->writeHistory(key);
+  return integrator_->history()->writeHistory(key);
 }
 
 bool RenderSession::checkHistory(const std::string& data, const std::string& key, int64_t frame) {
-  if (!pathTracer_) return false;
+  FrameHistory* h = integrator_->history();
+  if (!h) return false;
   // What moved between that frame and the next is measured from that frame's scene, whose light
   // table the records are checked against.
   gpu_->setTime(frame / options_.fps);
-  return pathTracer_->checkHistory(data, key, frame);
+  return h->checkHistory(data, key, frame);
 }
 
 void RenderSession::applyHistory(const std::string& data) {
-  pathTracer_->applyHistory(data);
+  integrator_->history()->applyHistory(data);
 }
 
 int RenderSession::chains() const {
-  return pathTracer_ ? pathTracer_->chains() : 0;
+  const FrameHistory* h = integrator_->history();
+  return h ? h->chains() : 0;
 }
 
 std::string RenderSession::chain(int pass) {
-  return pathTracer_->chain(pass);
+  return integrator_->history()->chain(pass);
 }
 
 void RenderSession::setChain(int pass, const std::string& records) {
-  pathTracer_->setChain(pass, records);
+  integrator_->history()->setChain(pass, records);
 }
 
 FrameRange RenderSession::frameRange() const {

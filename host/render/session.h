@@ -104,9 +104,6 @@ class RenderSession {
   std::unique_ptr<AovRenderer> aov_;  // --aov
   bool samplesAov_ = false;
   std::vector<float> counts_;  // sampleCounts()
-  // The path tracer whose --resample history is the run's: integrator_ itself, or reuse's eye
-  // paths.
-  PathTracer* pathTracer_ = nullptr;
 };
 
 }  // namespace pr
