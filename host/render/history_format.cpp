@@ -1,8 +1,9 @@
 #include "render/history_format.h"
 
 #include <cmath>
+#include <cstddef>
 #include <cstring>
-#include <initializer_list>
+#include <limits>
 
 #include "util/check.h"
 #include "util/hash.h"
@@ -23,6 +24,28 @@ constexpr float kMaxRecordValue = 1e18f;
 bool finiteIn(float x, float lo, float hi) {
   return std::isfinite(x) && x >= lo && x <= hi;
 }
+
+// Every field of a record, in order, with its check.
+// clang-format off
+#define PR_RECORD_FIELDS(X)                                                             \
+  X(r.prim, Surface) X(r.inst, Surface) X(r.b1, Bary) X(r.b2, Bary)                     \
+  X(r.wx, Finite) X(r.wy, Finite) X(r.wz, Finite)                                       \
+  X(r.g_src, Bounded) X(r.rest_r, Bounded) X(r.rest_g, Bounded) X(r.rest_b, Bounded)    \
+  X(r.pdf_light, Bounded)                                                               \
+  X(r.f_r, Reservoir) X(r.f_g, Reservoir) X(r.f_b, Reservoir) X(r.kind, Kind)           \
+  X(r.p_hat, Reservoir) X(r.w_sum, Reservoir) X(r.m, Reservoir)                         \
+  X(r.suffix, Suffix) X(r.sp, Finite) X(r.rn, Finite) X(r.rh, Finite)                   \
+  X(d.light, Light) X(d.b1, Bary) X(d.b2, Bary) X(d.wx, Finite) X(d.wy, Finite)         \
+  X(d.wz, Finite) X(d.f_r, Reservoir) X(d.f_g, Reservoir) X(d.f_b, Reservoir)           \
+  X(d.p_hat, Reservoir) X(d.w_sum, Reservoir) X(d.m, Reservoir)                         \
+  X(prim, Surface) X(inst, Surface) X(b1, Bary) X(b2, Bary)                             \
+  X(wx, Finite) X(wy, Finite) X(wz, Finite) X(stamp, Any)
+// clang-format on
+
+#define PR_FIELD_SIZE(field, check) +sizeof(dev::PathHistory::field)
+static_assert(0 PR_RECORD_FIELDS(PR_FIELD_SIZE) == sizeof(dev::PathHistory),
+              "every field of a history record is listed in PR_RECORD_FIELDS with its check");
+#undef PR_FIELD_SIZE
 
 // A reservoir's numbers: its path's value f (per channel), target p_hat, weight sum w_sum and
 // confidence m are non-negative and bounded, and so is what the kernels make of them, f w_sum /
@@ -47,29 +70,56 @@ bool validBarycentrics(float b1, float b2) {
          b1 + b2 <= 1.0f + slack;
 }
 
-bool finiteAll(std::initializer_list<float> xs) {
-  for (float x : xs)
-    if (!std::isfinite(x)) return false;
-  return true;
+bool validKind(uint32_t kind) {
+  const uint32_t base = kind & PR_RS_KIND_MASK;
+  const uint32_t flags = PR_RS_JOINED | PR_RS_LAST2 | PR_RS_CAMERA;
+  return (base == PR_RS_DEEP || base == PR_RS_NEE2 || base == PR_RS_HIT2) &&
+         (kind & ~(PR_RS_KIND_MASK | flags)) == 0u;
+}
+
+// The checks of one field alone; the relational ones (Reservoir, Surface, Light, Bary) follow in
+// validRecord.
+bool validField(const char* record, const RecordField& field) {
+  const char* at = record + field.offset;
+  auto floats = [&](float lo, float hi) {
+    for (size_t i = 0; i < field.size / sizeof(float); ++i) {
+      float x;
+      std::memcpy(&x, at + i * sizeof x, sizeof x);
+      if (!finiteIn(x, lo, hi)) return false;
+    }
+    return true;
+  };
+  uint32_t u = 0;
+  if (field.size == sizeof u) std::memcpy(&u, at, sizeof u);
+  switch (field.check) {
+    case RecordCheck::Finite:
+      return floats(-std::numeric_limits<float>::max(), std::numeric_limits<float>::max());
+    case RecordCheck::Bounded:
+      return floats(0.0f, kMaxRecordValue);
+    case RecordCheck::Kind:
+      return validKind(u);
+    case RecordCheck::Suffix:
+      return (u & PR_RS_COUNT_MASK) <= PR_RS_SUFFIX;
+    default:
+      return true;
+  }
 }
 
 // A record the kernels can read safely and sum into a frame without overflow: its surfaces in
 // the scene, its numbers finite, its values, weights and pdfs non-negative and bounded.
-bool validRecord(const dev::PathHistory& h, const HistoryScene& scene) {
+bool validRecord(const char* record, const HistoryScene& scene) {
+  for (const RecordField& field : historyRecordFields())
+    if (!validField(record, field)) return false;
+  dev::PathHistory h;
+  std::memcpy(&h, record, sizeof h);
   const dev::DirectReservoir& d = h.d;
   const float df[3] = {d.f_r, d.f_g, d.f_b};
-  if (!finiteAll({d.wx, d.wy, d.wz}) || !validReservoir(df, d.p_hat, d.w_sum, d.m)) return false;
+  if (!validReservoir(df, d.p_hat, d.w_sum, d.m)) return false;
   if (d.light != PR_INVALID_INDEX && (d.light >= scene.lights || !validBarycentrics(d.b1, d.b2)))
     return false;
   const dev::PathReservoir& r = h.r;
   const float rf[3] = {r.f_r, r.f_g, r.f_b};
   if (!validReservoir(rf, r.p_hat, r.w_sum, r.m)) return false;
-  if (!finiteAll({h.wx, h.wy, h.wz, r.wx, r.wy, r.wz, r.rn, r.rh})) return false;
-  for (float x : {r.g_src, r.rest_r, r.rest_g, r.rest_b, r.pdf_light})
-    if (!finiteIn(x, 0.0f, kMaxRecordValue)) return false;
-  for (float x : r.sp)
-    if (!std::isfinite(x)) return false;
-  if ((r.suffix & PR_RS_COUNT_MASK) > PR_RS_SUFFIX) return false;
   if (h.prim != PR_INVALID_INDEX &&
       (!scene.validSurface(h.prim, h.inst) || !validBarycentrics(h.b1, h.b2)))
     return false;
@@ -78,6 +128,15 @@ bool validRecord(const dev::PathHistory& h, const HistoryScene& scene) {
 }
 
 }  // namespace
+
+const std::vector<RecordField>& historyRecordFields() {
+#define PR_FIELD_ENTRY(field, check)                                                      \
+  RecordField{#field, offsetof(dev::PathHistory, field), sizeof(dev::PathHistory::field), \
+              RecordCheck::check},
+  static const std::vector<RecordField> fields = {PR_RECORD_FIELDS(PR_FIELD_ENTRY)};
+#undef PR_FIELD_ENTRY
+  return fields;
+}
 
 std::string beginHistoryPart(HistoryHeader h) {
   std::memcpy(h.magic, kHistoryMagic, sizeof h.magic);
@@ -123,11 +182,8 @@ bool checkHistoryPart(const std::string& part, const HistoryLayout& want, const 
   uint64_t check = 0;
   std::memcpy(&check, part.data() + part.size() - sizeof check, sizeof check);
   if (Hash128().add(part.data() + sizeof h, bytes * h.chains).low() != check) return false;
-  for (size_t k = 0; k < bytes * h.chains; k += h.record) {
-    dev::PathHistory rec;
-    std::memcpy(&rec, part.data() + sizeof h + k, sizeof rec);
-    if (!validRecord(rec, scene)) return false;
-  }
+  for (size_t k = 0; k < bytes * h.chains; k += h.record)
+    if (!validRecord(part.data() + sizeof h + k, scene)) return false;
   *out = h;
   return true;
 }

@@ -36,6 +36,27 @@ struct HistoryScene {
   std::function<bool(uint32_t prim, uint32_t inst)> validSurface;
 };
 
+// How checkHistoryPart checks a field of a record (dev::PathHistory). Each field is named once in
+// historyRecordFields, whose sizes add up to the record's (a static_assert), so a field added to
+// the record without a check does not build.
+enum class RecordCheck {
+  Any,        // every value is safe (the stamp)
+  Finite,     // floats, each finite (directions, positions, ratios)
+  Bounded,    // floats, each in [0, 1e18] (a product of two stays finite)
+  Reservoir,  // f, p_hat, w_sum, m: bounded, and so is f w_sum / p_hat
+  Surface,    // prim, inst: a triangle of the scene where prim is not PR_INVALID_INDEX
+  Light,      // a light of the scene, or PR_INVALID_INDEX
+  Bary,       // barycentrics of the surface or light named beside them
+  Kind,       // PR_RS_DEEP, _NEE2 or _HIT2 with the flags PR_RS_JOINED, _LAST2, _CAMERA
+  Suffix,     // the count of points in sp, at most PR_RS_SUFFIX, with its flags
+};
+struct RecordField {
+  const char* name;
+  size_t offset, size;
+  RecordCheck check;
+};
+const std::vector<RecordField>& historyRecordFields();
+
 // A part of h.chains chains of (h.end - h.first) records each, zeroed, under header h (its magic
 // and record size set here); historyRecords gives chain c's records to fill, sealHistoryPart then
 // writes the checksum.
