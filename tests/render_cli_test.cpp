@@ -58,7 +58,7 @@ TEST(RenderCli, OptionsLandInTheirFields) {
   EXPECT_EQ(o.resample.radius, 5.0f);
   EXPECT_EQ(o.resample.history, 7);
   EXPECT_EQ(o.resample.misCount, 2.5f);
-  EXPECT_EQ(o.lightPaths, 1000);
+  EXPECT_EQ(o.arenaSlots, 1000);
   EXPECT_EQ(o.pathsPerPixel, 2);
   EXPECT_EQ(o.connections, 3);
   EXPECT_FALSE(o.eyePaths);

@@ -123,7 +123,7 @@ TEST(Reuse, ArenaEqualsAFullRetraceSlotBySlot) {
   Film film(ctx, 16, 12);
   PathReuseSettings rs;
   rs.spp = 1;
-  rs.lightPaths = 4096;
+  rs.arenaSlots = 4096;
   PathReuse reuse(ctx, gpu, film, rs);
   rs.retraceAll = true;
   PathReuse retrace(ctx, gpu, film, rs);

@@ -234,7 +234,7 @@ std::vector<Row> samplingRows() {
 
 std::vector<Row> connectionRows() {
   return {
-      Row{"--light-paths", kConnections, kResearch, kEstimator, PR_FIELD(ro.lightPaths),
+      Row{"--light-paths", kConnections, kResearch, kEstimator, PR_FIELD(ro.arenaSlots),
           "Light-path slots kept in the arena (reuse/retrace; default: one per pixel, at most "
           "2097152)"}
           .range(1, 1 << 26),

@@ -109,7 +109,7 @@ struct RenderOptions {
   // the same noise pattern each frame, to measure how much flicker fresh noise adds.
   bool fixedNoise = false;
   // Path reuse (docs/design.md section 5).
-  int lightPaths = 0;          // slots; 0: chosen from the image size
+  int arenaSlots = 0;          // --light-paths: N_L; 0: chosen from the image size
   int pathsPerPixel = 4;       // C: light paths each pixel sample connects to
   float clamp = 0.0f;          // clamp on the geometry term; 0 = off
   float connectionMis = 4.0f;  // MIS threshold on p_E / p_L (kernels/reuse/connect.cl); 0 = off

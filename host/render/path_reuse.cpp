@@ -43,7 +43,7 @@ PathReuse::PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseS
   if (settings_.maxDepth < 2) throw InputError("--max-depth: path reuse needs at least 2");
   if (settings_.pathsPerPixel < 1 || settings_.pathsPerPixel > 64)
     throw InputError("--paths-per-pixel: must be 1 to 64");
-  slots_ = settings_.lightPaths ? settings_.lightPaths : defaultLightPaths(film.pixels());
+  slots_ = settings_.arenaSlots ? settings_.arenaSlots : defaultLightPaths(film.pixels());
   stride_ = static_cast<uint32_t>(settings_.maxDepth - 1);
   const std::string opts = scene.buildOptions();
   invalidate_ = kargs::kernel<kargs::InvalidateArgs>(ctx, "reuse/invalidate.cl", opts);
@@ -103,8 +103,8 @@ PathReuse::PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseS
     pt.maxDepth = settings_.maxDepth;
     pt.seed = settings_.seed;
     pt.fixedNoise = settings_.fixedNoise;
-    pt.lightPaths = settings_.pathsPerPixel;
-    pt.lightTracingPaths = settings_.lightTracing ? slots_ : 0;
+    pt.pathsPerPixel = settings_.pathsPerPixel;
+    pt.lightTracingSlots = settings_.lightTracing ? slots_ : 0;
     pt.resample = settings_.resamplePaths;
     pt.wavefrontPixels = settings_.wavefrontPixels;
     eyePaths_ = std::make_unique<PathTracer>(ctx, scene, film, pt);

@@ -34,7 +34,7 @@ struct PathReuseSettings {
   int spp = 4;
   int maxDepth = 8;
   uint32_t seed = 1;
-  uint32_t lightPaths = 0;  // N_L; 0: defaultLightPaths of the image
+  uint32_t arenaSlots = 0;  // N_L (--light-paths); 0: defaultLightPaths of the image
   uint32_t pathsPerPixel = 4;
   float clamp = 0.0f;
   float misThreshold = 4.0f;   // connection MIS (kernels/reuse/connect.cl); 0 = off

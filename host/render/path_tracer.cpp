@@ -40,7 +40,7 @@ PathTracer::PathTracer(Context& ctx, GpuScene& scene, Film& film,
   hits_ = alloc("path hits", band * sizeof(dev::Hit));
   // Driven by PathReuse (light paths to connect to), the eye paths write its radiance and eye
   // vertices: those of its own are one unread element and none.
-  const bool own = settings.lightPaths == 0;
+  const bool own = settings.pathsPerPixel == 0;
   radiance_ = alloc("sample radiance", (own ? n : 1) * 16);
   shadows_ = alloc("shadow rays", band * sizeof(dev::ShadowRay));
   for (cl::Buffer& q : queues_) q = alloc("path queue", band * 4);
@@ -124,10 +124,10 @@ void PathTracer::setChain(int pass, const std::string& records) {
   writeChain(pass, records.data());
 }
 
-float lightTracingScale(const dev::CameraParams& camera, uint32_t lightPaths, int spp,
+float lightTracingScale(const dev::CameraParams& camera, uint32_t slots, int spp,
                         uint32_t pathsPerPixel) {
   const double pixels = double(camera.width) * camera.height;
-  return float(double(lightPaths) * dev::camera_plane_area(&camera) /
+  return float(double(slots) * dev::camera_plane_area(&camera) /
                (double(spp) * pathsPerPixel * pixels));
 }
 
@@ -142,7 +142,7 @@ dev::ResampleParams PathTracer::resampleParams() const {
   p.width = film_.width();
   p.height = film_.height();
   p.max_m = float(r.history);
-  p.eye_count = r.enabled && settings_.lightPaths > 0 ? r.misCount : 1.0f;
+  p.eye_count = r.enabled && settings_.pathsPerPixel > 0 ? r.misCount : 1.0f;
   return p;
 }
 
@@ -155,9 +155,9 @@ void PathTracer::beginFrame(int64_t frame, const dev::CameraParams& camera,
   syncChains();
   ctx_.zero(rays_, dev::PR_PT_COUNT * 4);
   dev::ResampleParams rsp = resampleParams();
-  if (settings_.lightTracingPaths > 0 && settings_.lightPaths > 0)
-    rsp.lt_scale =
-        lightTracingScale(camera, settings_.lightTracingPaths, settings_.spp, settings_.lightPaths);
+  if (settings_.lightTracingSlots > 0 && settings_.pathsPerPixel > 0)
+    rsp.lt_scale = lightTracingScale(camera, settings_.lightTracingSlots, settings_.spp,
+                                     settings_.pathsPerPixel);
   // The previous frame's reservoirs are taken where every chain was kept, the frame follows it
   // and no light changed (a light pdf in a kept path would differ).
   temporal_ = chainedPasses() > 0 && written_ >= chainedPasses() && frame == frame_ + 1 &&
@@ -183,7 +183,8 @@ void PathTracer::beginFrame(int64_t frame, const dev::CameraParams& camera,
     rsp.moved_count = cl_uint(moved.size());
   }
   // Resampling needs every sample's x_1, which the path tracer alone does not keep.
-  const cl::Buffer& eyeOut = settings_.resample.enabled && settings_.lightPaths == 0 ? rsEye_ : eye;
+  const cl::Buffer& eyeOut =
+      settings_.resample.enabled && settings_.pathsPerPixel == 0 ? rsEye_ : eye;
   kargs::setScene(&extendArgs_, sceneArgs);
   extendArgs_.states = states_;
   extendArgs_.hits = hits_;
@@ -199,7 +200,7 @@ void PathTracer::beginFrame(int64_t frame, const dev::CameraParams& camera,
   shadeArgs_.seed = settings_.seed;
   shadeArgs_.frame = rngFrame;
   shadeArgs_.max_depth = cl_uint(settings_.maxDepth);
-  shadeArgs_.light_paths = cl_uint(settings_.lightPaths);
+  shadeArgs_.paths_per_pixel = cl_uint(settings_.pathsPerPixel);
   shadeArgs_.trace_cdf = scene_.traceCdf();
   shadeArgs_.trace_total = scene_.traceTotalPower();
   shadeArgs_.eye = eyeOut;
@@ -247,7 +248,7 @@ void PathTracer::beginFrame(int64_t frame, const dev::CameraParams& camera,
   generateArgs_.states = states_;
   generateArgs_.radiance = radiance;
   generateArgs_.eye = eyeOut;
-  generateArgs_.write_eye = settings_.lightPaths > 0 || settings_.resample.enabled ? 1 : 0;
+  generateArgs_.write_eye = settings_.pathsPerPixel > 0 || settings_.resample.enabled ? 1 : 0;
   generateArgs_.resample = rsp.enabled;
   generateArgs_.rs_res = rsRes_;
   generateArgs_.di_res = diRes_;
@@ -380,7 +381,7 @@ void PathTracer::reportRays(FrameStats* stats) {
 }
 
 void PathTracer::renderFrame(int64_t frame, const dev::CameraParams& camera, FrameStats* stats) {
-  PR_CHECK(settings_.lightPaths == 0);  // PathReuse renders the frames of its eye paths
+  PR_CHECK(settings_.pathsPerPixel == 0);  // PathReuse renders the frames of its eye paths
   const Clock::time_point start = Clock::now();
   StageTimer timer;
   beginFrame(frame, camera, scene_.kernelArgs(), radiance_, noEye_);

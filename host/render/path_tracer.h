@@ -22,13 +22,13 @@ struct PathTracerSettings {
   int maxDepth = 8;
   uint32_t seed = 1;
   bool fixedNoise = false;  // RNG keyed by frame 0 on every frame
-  // --eye-paths: C light paths per camera sample that path reuse joins to each first eye
-  // vertex; the ends of eye paths on lights are weighted against those connections
-  // (kernels/shared/eye_paths.h). 0: the path tracer alone.
-  uint32_t lightPaths = 0;
+  // --eye-paths: C (--paths-per-pixel), the light paths per camera sample that path reuse joins
+  // to each first eye vertex; the ends of eye paths on lights are weighted against those
+  // connections (kernels/shared/eye_paths.h). 0: the path tracer alone.
+  uint32_t pathsPerPixel = 0;
   // --light-tracing: the N_L stored light paths that strategy T joins to the camera, against
   // which the eye paths are weighted too (0: off).
-  uint32_t lightTracingPaths = 0;
+  uint32_t lightTracingSlots = 0;
   // --resample (kernels/shared/resample.h), its distance resolved (> 0, scene units).
   ResampleSettings resample;
   // A pass traces the film's pixels in bands of at most this many: each path's own state (about
@@ -38,7 +38,7 @@ struct PathTracerSettings {
 
 // Strategy T's scale N_L A / (spp C W H) (kernels/shared/eye_paths.h): light paths, samples per
 // pixel, light paths per camera sample and the camera's image (plane area A, W x H pixels).
-float lightTracingScale(const dev::CameraParams& camera, uint32_t lightPaths, int spp,
+float lightTracingScale(const dev::CameraParams& camera, uint32_t slots, int spp,
                         uint32_t pathsPerPixel);
 
 class PathTracer : public Integrator, public FrameHistory {
@@ -48,7 +48,7 @@ class PathTracer : public Integrator, public FrameHistory {
   uint64_t deviceBytes() const override { return bytes_; }
 
   // One frame's kernel arguments, with the samples' radiance written to `radiance` (one float4
-  // per pixel) and, with lightPaths > 0, each sample's first non-delta vertex to `eye` (one
+  // per pixel) and, with pathsPerPixel > 0, each sample's first non-delta vertex to `eye` (one
   // EyeVertex per pixel); then one pass per sample index, which leaves both for the caller.
   // sceneArgs: the scene's arguments for this frame (GpuScene::kernelArgs).
   void beginFrame(int64_t frame, const dev::CameraParams& camera, const kargs::SceneArgs& sceneArgs,

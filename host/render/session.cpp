@@ -77,8 +77,8 @@ void validateRenderOptions(const RenderOptions& o) {
     throw InputError("--fps: must be in (0, 1000]");
   if (o.width < 0 || o.height < 0 || o.width > 16384 || o.height > 16384)
     throw InputError("--width/--height: must be 1 to 16384");
-  if (o.lightPaths < 0 || o.lightPaths > (1 << 26))
-    throw InputError("--light-paths " + std::to_string(o.lightPaths) + ": must be 1 to 67108864");
+  if (o.arenaSlots < 0 || o.arenaSlots > (1 << 26))
+    throw InputError("--light-paths " + std::to_string(o.arenaSlots) + ": must be 1 to 67108864");
   if (o.pathsPerPixel < 1 || o.pathsPerPixel > 64)
     throw InputError("--paths-per-pixel " + std::to_string(o.pathsPerPixel) + ": must be 1 to 64");
   if (!(o.clamp >= 0.0f) || !std::isfinite(o.clamp))
@@ -159,7 +159,7 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
     r.spp = o.spp;
     r.maxDepth = o.maxDepth;
     r.seed = o.seed;
-    r.lightPaths = static_cast<uint32_t>(o.lightPaths);
+    r.arenaSlots = static_cast<uint32_t>(o.arenaSlots);
     r.pathsPerPixel = static_cast<uint32_t>(o.pathsPerPixel);
     r.clamp = o.clamp;
     r.misThreshold = o.connectionMis;

@@ -1,12 +1,12 @@
 // pt_shade: one work-item per live path (the bounce's queue). Reads the path and its hit; adds
 // emission (MIS-weighted against next-event estimation) to the sample's radiance, writes a shadow
 // ray for next-event estimation, samples the BSDF for the next ray and applies Russian roulette.
-// With light_paths = C > 0 (--eye-paths), the eye path's ends on a light are weighted against
+// With paths_per_pixel = C > 0 (--eye-paths), the eye path's ends on a light are weighted against
 // the reuse connections that make the same paths too (shared/eye_paths.h): the path keeps the
 // ratio of the two ways' densities of its vertices beyond x_1 as it goes (mis_ratio_*, and every
 // weight here from shared/mis.h).
-// With light_paths > 0, x_1 (the first non-delta vertex) is written to the sample's EyeVertex for
-// connect. Writes the PathState, the radiance and the ShadowRay of the same index, and appends
+// With paths_per_pixel > 0, x_1 (the first non-delta vertex) is written to the sample's EyeVertex
+// for connect. Writes the PathState, the radiance and the ShadowRay of the same index, and appends
 // the path to next_queue if it goes on and to shadow_queue if it has a shadow ray (their order
 // varies from run to run; what each path computes does not: its random numbers are keyed by its
 // pixel and sample).
@@ -19,13 +19,13 @@
 // L's density of the path over that of the eye path's vertices beyond x_1 (eye_ratio holds
 // the rest), for a path ending at x_t on light l (normal n_tri, start density `start`) at z0,
 // with cos_x = |cos| at x_t and rev = the light-tracing density of x_{t-1} from x_t (1 at t = 2);
-// C = light_paths samples of L against eye_count of the eye path.
-PR_INLINE float eye_paths_light_side(const Light* l, float3 n_tri, float start, u32 light_paths,
+// C = paths_per_pixel samples of L against eye_count of the eye path.
+PR_INLINE float eye_paths_light_side(const Light* l, float3 n_tri, float start, u32 paths_per_pixel,
                                      float eye_count, float eye_ratio, float3 z0, float3 xt,
                                      float cos_x, float rev) {
   const float3 d = xt - z0;
   const float d2 = dot(d, d);
-  return (float)light_paths / eye_count * start *
+  return (float)paths_per_pixel / eye_count * start *
          eye_paths_emit_density(l, n_tri, d * (1.0f / sqrt(d2)), cos_x, d2) * rev * eye_ratio;
 }
 
@@ -51,15 +51,16 @@ PR_INLINE float pt_eye_share(const PathState* p, float w, float dens_n, float de
 
 // Whether the connections can make the paths that end after this path's last vertex x_t: x_2 is
 // non-delta and t >= x_1's depth + beyond.
-PR_INLINE int pt_joinable(const PathState* p, u32 light_paths, u32 beyond) {
-  return light_paths > 0u && (p->eye_flags & PR_EYE_JOINABLE) && p->depth >= p->x1_depth + beyond;
+PR_INLINE int pt_joinable(const PathState* p, u32 paths_per_pixel, u32 beyond) {
+  return paths_per_pixel > 0u && (p->eye_flags & PR_EYE_JOINABLE) &&
+         p->depth >= p->x1_depth + beyond;
 }
 
 // The weight of emission found at h along d (dist2 from the previous vertex): against next-event
 // estimation, and where the connections can make the path too (joinable), times their share;
 // its parts into *ew.
 PR_INLINE float pt_emission_weight(const SceneData* s, const PathState* p, const SurfaceHit* h,
-                                   float3 d, float dist2, int joinable, u32 light_paths,
+                                   float3 d, float dist2, int joinable, u32 paths_per_pixel,
                                    float eye_count, __global const float* trace_cdf,
                                    float trace_total, u32 max_depth, EyeWeight* ew) {
   const float3 prev = make_float3(p->prev_x, p->prev_y, p->prev_z);
@@ -80,7 +81,7 @@ PR_INLINE float pt_emission_weight(const SceneData* s, const PathState* p, const
     const int spec = (p->flags & PR_PATH_SPECULAR) != 0u;
     const float dens_h =
         spec ? 1.0f : solid_angle_to_area_pdf(p->last_pdf, fabs(dot(n_tri, d)), dist2);
-    const float dens_l = eye_paths_light_side(&l, n_tri, start, light_paths, eye_count,
+    const float dens_l = eye_paths_light_side(&l, n_tri, start, paths_per_pixel, eye_count,
                                               p->eye_ratio, h->p, prev, p->seg_cos, 1.0f);
     w = pt_eye_share(p, w, spec ? 0.0f : start, dens_h, dens_l, ew);
   }
@@ -91,7 +92,7 @@ PR_INLINE float pt_emission_weight(const SceneData* s, const PathState* p, const
 // times, where h is joinable, what the connections leave of the path; its parts into *ew.
 PR_INLINE float pt_next_event_weight(const SceneData* s, const PathState* p, const SurfaceHit* h,
                                      const ShadingFrame* f, const NextEventChoice* ch, int joinable,
-                                     int has_rev, float dist2, u32 light_paths, float eye_count,
+                                     int has_rev, float dist2, u32 paths_per_pixel, float eye_count,
                                      __global const float* trace_cdf, float trace_total,
                                      u32 max_depth, EyeWeight* ew) {
   float w = ch->delta ? 1.0f : power_heuristic(ch->pdf_light, ch->pdf_bsdf);
@@ -115,8 +116,8 @@ PR_INLINE float pt_next_event_weight(const SceneData* s, const PathState* p, con
                                                    : 0.0f;
     const float rev = has_rev ? solid_angle_to_area_pdf(ch->pdf_bsdf_rev, p->seg_cos, dist2) : 1.0f;
     const float dens_l =
-        eye_paths_light_side(&l, n_tri, dens_n, light_paths, eye_count, p->eye_ratio, ch->pos, h->p,
-                             fabs(dot(f->ng, wi)), rev);
+        eye_paths_light_side(&l, n_tri, dens_n, paths_per_pixel, eye_count, p->eye_ratio, ch->pos,
+                             h->p, fabs(dot(f->ng, wi)), rev);
     // T's ratio: at x_2 from the light's pdf of the step to x_1 (x_1's camera factor in p->lt),
     // beyond x_2 as fixed there.
     if (p->x1_depth == 1u && ew->t_len)
@@ -234,7 +235,7 @@ PR_INLINE float4 pt_rgb(float3 c) {
 // (joinable), times their share (the environment's direction is z_0: N's density of it and
 // H's per solid angle, L's of z_1 from the disk); its parts into *ew.
 PR_INLINE float pt_escape_weight(const SceneData* s, const PathState* p, float3 d, float pdf_light,
-                                 int joinable, u32 light_paths, float eye_count,
+                                 int joinable, u32 paths_per_pixel, float eye_count,
                                  __global const float* trace_cdf, float trace_total, u32 max_depth,
                                  EyeWeight* ew) {
   const int spec = (p->flags & PR_PATH_SPECULAR) != 0u;
@@ -250,7 +251,7 @@ PR_INLINE float pt_escape_weight(const SceneData* s, const PathState* p, float3 
                         eye_paths_direction_density(&l, s->lights.env, d);
     const float dens_h = spec ? 1.0f : p->last_pdf;
     const float dens_l =
-        eye_paths_light_side(&l, make_float3(0.0f, 0.0f, 1.0f), start, light_paths, eye_count,
+        eye_paths_light_side(&l, make_float3(0.0f, 0.0f, 1.0f), start, paths_per_pixel, eye_count,
                              p->eye_ratio, prev - d, prev, p->seg_cos, 1.0f);
     w = pt_eye_share(p, w, spec ? 0.0f : start, dens_h, dens_l, ew);
   }
@@ -261,7 +262,7 @@ PR_INLINE float pt_escape_weight(const SceneData* s, const PathState* p, float3 
 // sample's radiance, or with --resample from x_1 (rel 1) to the direct light's reservoir and
 // from x_2 on (rel >= 2) to the paths'.
 PR_INLINE void pt_escape(const SceneData* s, const PathState* p, uint rel, int joinable,
-                         u32 light_paths, float eye_count, __global const float* trace_cdf,
+                         u32 paths_per_pixel, float eye_count, __global const float* trace_cdf,
                          float trace_total, u32 max_depth, __global const PathTrack* track,
                          __global PathReservoir* res, __global DirectReservoir* di,
                          const RsKey* key, __global float4* radiance) {
@@ -273,8 +274,8 @@ PR_INLINE void pt_escape(const SceneData* s, const PathState* p, uint rel, int j
   const float pdf_light =
       (p->flags & PR_PATH_SPECULAR) && !rel ? 0.0f : environment_pdf(s, prev, prev_n, d);
   EyeWeight ew;
-  const float w = pt_escape_weight(s, p, d, pdf_light, joinable, light_paths, eye_count, trace_cdf,
-                                   trace_total, max_depth, &ew);
+  const float w = pt_escape_weight(s, p, d, pdf_light, joinable, paths_per_pixel, eye_count,
+                                   trace_cdf, trace_total, max_depth, &ew);
   if (rel == 1u &&
       di_offer_hit(s, p, track, s->lights.env_light, 0.0f, 0.0f, d, le, 1.0f, w, di, key))
     return;
@@ -395,8 +396,8 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
   const RsKey key = {seed, frame, p.pixel, sample};
   const Hit hit = hits[k];
   if (hit.prim == PR_INVALID_INDEX) {
-    pt_escape(&s, &p, rel, pt_joinable(&p, light_paths, 1u), light_paths, rsp.eye_count, trace_cdf,
-              trace_total, max_depth, track, rs_res + i, di_res + i, &key, radiance + i);
+    pt_escape(&s, &p, rel, pt_joinable(&p, paths_per_pixel, 1u), paths_per_pixel, rsp.eye_count,
+              trace_cdf, trace_total, max_depth, track, rs_res + i, di_res + i, &key, radiance + i);
     p.alive = 0u;
     states[k] = p;
     return 0u;
@@ -413,19 +414,19 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
     rs_track_hit(track, rel, &hit, h.p, tr,
                  solid_angle_to_area_pdf(p.last_pdf, fabs(dot(h.ng, d)), dist2));
   // Connections can make the paths that end after x_t, t >= 2 (x_t: the vertex `ray` left).
-  const int joinable = pt_joinable(&p, light_paths, 1u);
+  const int joinable = pt_joinable(&p, paths_per_pixel, 1u);
 
   if (s.sd.materials[h.material].flags & PR_MAT_EMISSIVE) {
     EyeWeight ew;
-    const float w = pt_emission_weight(&s, &p, &h, d, dist2, joinable, light_paths, rsp.eye_count,
-                                       trace_cdf, trace_total, max_depth, &ew);
+    const float w = pt_emission_weight(&s, &p, &h, d, dist2, joinable, paths_per_pixel,
+                                       rsp.eye_count, trace_cdf, trace_total, max_depth, &ew);
     pt_emission(&s, &p, &h, rel, d, dist2, w, &ew, tp, track, rs_res + i, di_res + i, &key,
                 radiance + i);
   }
   p.depth += 1u;
   const ShadingFrame f = shading_frame(&s, &h, wo);
   const int delta_here = bsdf_is_delta(&f.bsdf);
-  if (light_paths > 0u || rsp.enabled) {
+  if (paths_per_pixel > 0u || rsp.enabled) {
     if (p.x1_depth == 0u) {
       if (!delta_here && p.depth < max_depth) {
         // x_1: the eye vertex that connect joins to the stored light paths (and, resampling, the
@@ -435,12 +436,12 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
         p.lt = p.depth == 1u ? eye_paths_camera_factor(rsp.lt_scale, p.lt * dist2) : 0.0f;
         pt_write_eye(eye + p.pixel, &h, &hit, wo, tp, p.depth);
       }
-    } else if (light_paths > 0u) {
+    } else if (paths_per_pixel > 0u) {
       pt_eye_arrive(&p, &h, d, dist2, delta_here);
     }
   }
   // x_t with t >= 3: the light tracer's density of x_{t-1}, reached from this vertex.
-  const int has_rev = pt_joinable(&p, light_paths, 2u);
+  const int has_rev = pt_joinable(&p, paths_per_pixel, 2u);
   if (p.depth >= max_depth) {
     p.alive = 0u;
   } else {
@@ -448,12 +449,12 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
       Ray shadow;
       float3 c;
       NextEventChoice ch;
-      const int here_joinable = pt_joinable(&p, light_paths, 1u);
+      const int here_joinable = pt_joinable(&p, paths_per_pixel, 1u);
       if (next_event(&s, &h, &f, wo, !here_joinable, &rng, &shadow, &c, &ch)) {
         EyeWeight ew;
-        const float w =
-            pt_next_event_weight(&s, &p, &h, &f, &ch, here_joinable, has_rev, dist2, light_paths,
-                                 rsp.eye_count, trace_cdf, trace_total, max_depth, &ew);
+        const float w = pt_next_event_weight(&s, &p, &h, &f, &ch, here_joinable, has_rev, dist2,
+                                             paths_per_pixel, rsp.eye_count, trace_cdf, trace_total,
+                                             max_depth, &ew);
         if (here_joinable) c = c * w;  // next_event left the weight to this
         const uint op = rs_next_event_pending(&s, track, rs_pending + k, di_pending + k, &rsp, &p,
                                               &h, &f, wo, dist2, &ch, c, &ew);

@@ -183,26 +183,26 @@
   X(PASS, VAL, uint, count)       \
   X(PASS, VAL, uint, base)
 
-#define PR_ARGS_PT_SHADE(F, X)      \
-  PR_ARGS_SCENE(F, X)               \
-  X(FRAME, OUT, PathState, states)  \
-  X(FRAME, IN, Hit, hits)           \
-  X(FRAME, OUT, float4, radiance)   \
-  X(FRAME, OUT, ShadowRay, shadows) \
-  X(PASS, IN, uint, queue)          \
-  X(PASS, VAL, uint, count)         \
-  X(PASS, VAL, uint, base)          \
-  X(PASS, OUT, uint, next_queue)    \
-  X(FRAME, OUT, uint, shadow_queue) \
-  X(FRAME, OUT, uint, queue_sizes)  \
-  X(FRAME, VAL, uint, seed)         \
-  X(FRAME, VAL, uint, frame)        \
-  X(PASS, VAL, uint, sample)        \
-  X(FRAME, VAL, uint, max_depth)    \
-  X(FRAME, VAL, uint, light_paths)  \
-  X(FRAME, IN, float, trace_cdf)    \
-  X(FRAME, VAL, float, trace_total) \
-  X(FRAME, OUT, EyeVertex, eye)     \
+#define PR_ARGS_PT_SHADE(F, X)         \
+  PR_ARGS_SCENE(F, X)                  \
+  X(FRAME, OUT, PathState, states)     \
+  X(FRAME, IN, Hit, hits)              \
+  X(FRAME, OUT, float4, radiance)      \
+  X(FRAME, OUT, ShadowRay, shadows)    \
+  X(PASS, IN, uint, queue)             \
+  X(PASS, VAL, uint, count)            \
+  X(PASS, VAL, uint, base)             \
+  X(PASS, OUT, uint, next_queue)       \
+  X(FRAME, OUT, uint, shadow_queue)    \
+  X(FRAME, OUT, uint, queue_sizes)     \
+  X(FRAME, VAL, uint, seed)            \
+  X(FRAME, VAL, uint, frame)           \
+  X(PASS, VAL, uint, sample)           \
+  X(FRAME, VAL, uint, max_depth)       \
+  X(FRAME, VAL, uint, paths_per_pixel) \
+  X(FRAME, IN, float, trace_cdf)       \
+  X(FRAME, VAL, float, trace_total)    \
+  X(FRAME, OUT, EyeVertex, eye)        \
   PR_ARGS_PT_RESAMPLE(X, X)
 
 // --resample: the paths' candidates, offered by pt_shade and pt_shadow to their pixel's
