@@ -356,6 +356,42 @@ PR_INLINE void pt_camera_leave(PathState* p, const ShadingFrame* f, float3 wi, f
               : 0.0f;
 }
 
+// The eye path's bookkeeping at a vertex (--eye-paths or --resample): its first non-delta vertex
+// becomes x_1, the eye vertex that connect joins to the stored light paths (and, resampling, the
+// vertex pt_resample reconnects from); p->lt, cos^3 of the camera ray's angle until now, becomes
+// its camera factor for strategy T. Later vertices carry the eye path's densities for the MIS
+// weights against the connections.
+PR_INLINE void pt_eye_vertex(PathState* p, const SurfaceHit* h, const Hit* hit, float3 d,
+                             float dist2, float3 tp, int delta_here, u32 paths_per_pixel,
+                             uint max_depth, float lt_scale, __global EyeVertex* eye) {
+  if (p->x1_depth == 0u) {
+    if (!delta_here && p->depth < max_depth) {
+      p->x1_depth = p->depth;
+      p->lt = p->depth == 1u ? eye_paths_camera_factor(lt_scale, p->lt * dist2) : 0.0f;
+      pt_write_eye(eye, h, hit, -d, tp, p->depth);
+    }
+  } else if (paths_per_pixel > 0u) {
+    pt_eye_arrive(p, h, d, dist2, delta_here);
+  }
+}
+
+// The path leaves h along the sampled step: the next ray and what the next vertex needs of this
+// one (its position and light-side normal, the step's pdf, whether it was delta).
+PR_INLINE void pt_leave(const SceneData* s, PathState* p, const SurfaceHit* h,
+                        const ShadingFrame* f, const PathStep* step) {
+  p->seg_cos = fabs(dot(f->ng, step->wi));
+  p->ray = surface_ray(s, h, step->wi, PR_INF_F);
+  p->prev_x = h->p.x;
+  p->prev_y = h->p.y;
+  p->prev_z = h->p.z;
+  const float3 n_l = frame_light_normal(f);
+  p->prev_nx = n_l.x;
+  p->prev_ny = n_l.y;
+  p->prev_nz = n_l.z;
+  p->last_pdf = step->pdf;
+  p->flags = step->delta ? PR_PATH_SPECULAR : 0u;
+}
+
 PR_INLINE void pt_shadow_set(__global ShadowRay* r, Ray ray, float3 c, uint op) {
   r->ray = ray;
   r->c_r = c.x;
@@ -426,20 +462,9 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
   p.depth += 1u;
   const ShadingFrame f = shading_frame(&s, &h, wo);
   const int delta_here = bsdf_is_delta(&f.bsdf);
-  if (paths_per_pixel > 0u || rsp.enabled) {
-    if (p.x1_depth == 0u) {
-      if (!delta_here && p.depth < max_depth) {
-        // x_1: the eye vertex that connect joins to the stored light paths (and, resampling, the
-        // vertex pt_resample reconnects from); p.lt, cos^3 of the camera ray's angle until now,
-        // becomes its camera factor for strategy T.
-        p.x1_depth = p.depth;
-        p.lt = p.depth == 1u ? eye_paths_camera_factor(rsp.lt_scale, p.lt * dist2) : 0.0f;
-        pt_write_eye(eye + p.pixel, &h, &hit, wo, tp, p.depth);
-      }
-    } else if (paths_per_pixel > 0u) {
-      pt_eye_arrive(&p, &h, d, dist2, delta_here);
-    }
-  }
+  if (paths_per_pixel > 0u || rsp.enabled)
+    pt_eye_vertex(&p, &h, &hit, d, dist2, tp, delta_here, paths_per_pixel, max_depth, rsp.lt_scale,
+                  eye + p.pixel);
   // x_t with t >= 3: the light tracer's density of x_{t-1}, reached from this vertex.
   const int has_rev = pt_joinable(&p, paths_per_pixel, 2u);
   if (p.depth >= max_depth) {
@@ -482,17 +507,7 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
         p.eye_ratio = mis_ratio_leave(
             p.eye_ratio, delta_here ? 1.0f : pt_light_density(&f, &p, step.wi, wo, dist2),
             delta_here);
-      p.seg_cos = fabs(dot(f.ng, step.wi));
-      p.ray = surface_ray(&s, &h, step.wi, PR_INF_F);
-      p.prev_x = h.p.x;
-      p.prev_y = h.p.y;
-      p.prev_z = h.p.z;
-      const float3 n_l = frame_light_normal(&f);
-      p.prev_nx = n_l.x;
-      p.prev_ny = n_l.y;
-      p.prev_nz = n_l.z;
-      p.last_pdf = step.pdf;
-      p.flags = step.delta ? PR_PATH_SPECULAR : 0u;
+      pt_leave(&s, &p, &h, &f, &step);
     }
   }
   if (!(max3(tp) < PR_INF_F)) p.alive = 0u;  // NaN or Inf throughput ends the path
