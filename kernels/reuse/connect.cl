@@ -580,6 +580,30 @@ PR_INLINE float connect_camera_factor(const ReuseParams* rp, const CameraParams*
   return eye_paths_camera_factor(rp->lt_scale, camera_cos3_d2(cam, p));
 }
 
+// The connector of pixel i's sample `sample`: its light paths, weights, reservoir draws, history
+// and where its terms go (slot_offset: 0 without a history, PathReuse::renderFrame).
+PR_INLINE void connector_begin(Connector* cn, const SceneData* s, const ReuseParams* rp,
+                               __global const PathHeader* headers,
+                               __global const LightVertex* vertices,
+                               __global const EyePathRatio* ratios, uint i, uint sample,
+                               uint history_cap, uint slot_offset, __global ShadowRay* rec,
+                               uint cap) {
+  cn->s = s;
+  cn->rp = rp;
+  cn->headers = headers;
+  cn->vertices = vertices;
+  cn->j = i * rp->spp + sample;
+  cn->inv_c = 1.0f / (float)rp->paths_per_pixel;
+  cn->mis_c = rp->eye_count / (float)rp->paths_per_pixel;
+  cn->rr = rng_make(rp->seed, PR_RNG_RESAMPLE, rp->frame, i, sample);
+  cn->history_cap = history_cap;
+  cn->ratios = ratios;
+  cn->slot_offset = slot_offset;
+  cn->rec = rec;
+  cn->cap = cap;
+  connector_empty(cn);
+}
+
 PR_KERNEL void connect(PR_PARAMS(PR_ARGS_CONNECT)) {
   const uint q = (uint)get_global_id(0);  // the records' index; the pixel where not listed
   if (q >= record_end || q >= (listed ? list_count : rp.pixel_count)) return;
@@ -593,20 +617,8 @@ PR_KERNEL void connect(PR_PARAMS(PR_ARGS_CONNECT)) {
   // Its own stream, apart from eye_hit's.
   Rng rng = rng_make(rp.seed, PR_RNG_CONNECT, rp.frame, i, sample);
   Connector cn;
-  cn.s = &s;
-  cn.rp = &rp;
-  cn.headers = headers;
-  cn.vertices = vertices;
-  cn.j = i * rp.spp + sample;
-  cn.inv_c = 1.0f / (float)rp.paths_per_pixel;
-  cn.mis_c = rp.eye_count / (float)rp.paths_per_pixel;
-  cn.rr = rng_make(rp.seed, PR_RNG_RESAMPLE, rp.frame, i, sample);
-  cn.history_cap = history_cap;
-  cn.ratios = ratios;
-  cn.slot_offset = slot_offset;  // 0 without a history (PathReuse::renderFrame)
-  cn.rec = records + (size_t)(q - record_first) * record_cap;
-  cn.cap = record_cap;
-  connector_empty(&cn);
+  connector_begin(&cn, &s, &rp, headers, vertices, ratios, i, sample, history_cap, slot_offset,
+                  records + (size_t)(q - record_first) * record_cap, record_cap);
   EyePoint x = eye_point_at(&s, e.prim, e.inst, e.b1, e.b2, make_float3(e.wx, e.wy, e.wz),
                             make_float3(e.tp_r, e.tp_g, e.tp_b), e.depth);
   cn.cam_x = connect_camera_factor(&rp, &cam, &e, x.h.p);
