@@ -58,11 +58,11 @@ TEST(RenderCli, OptionsLandInTheirFields) {
   EXPECT_EQ(o.resample.radius, 5.0f);
   EXPECT_EQ(o.resample.history, 7);
   EXPECT_EQ(o.resample.misCount, 2.5f);
-  EXPECT_EQ(o.arenaSlots, 1000);
-  EXPECT_EQ(o.pathsPerPixel, 2);
-  EXPECT_EQ(o.connections, 3);
-  EXPECT_FALSE(o.eyePaths);
-  EXPECT_EQ(o.lightTracing, std::optional<bool>(false));
+  EXPECT_EQ(o.connect.arenaSlots, 1000);
+  EXPECT_EQ(o.connect.pathsPerPixel, 2);
+  EXPECT_EQ(o.connect.resample, 3);
+  EXPECT_FALSE(o.connect.eyePaths);
+  EXPECT_EQ(o.connect.lightTracing, std::optional<bool>(false));
   EXPECT_EQ(o.lightSampler, LightSampler::Power);
   EXPECT_EQ(o.materialModel, MaterialModel::Gltf);
   EXPECT_FALSE(o.shadowTerminator);
@@ -81,8 +81,8 @@ TEST(RenderCli, DefaultsAreRenderOptionsDefaults) {
   EXPECT_EQ(o.outPattern, fresh.outPattern);
   EXPECT_FALSE(o.framesGiven);
   EXPECT_FALSE(o.resample.asked.has_value());
-  EXPECT_FALSE(o.lightTracing.has_value());
-  EXPECT_EQ(o.connections, -1);
+  EXPECT_FALSE(o.connect.lightTracing.has_value());
+  EXPECT_EQ(o.connect.resample, -1);
   EXPECT_EQ(o.bvhWidth, 0);
 }
 

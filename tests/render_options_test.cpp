@@ -41,7 +41,7 @@ TEST(RenderOptions, ResamplingDefaultsByMode) {
   };
   for (const Case& c : cases) {
     o.mode = c.mode;
-    o.eyePaths = c.eyePaths;
+    o.connect.eyePaths = c.eyePaths;
     o.resample.asked = c.asked;
     const ResampleSettings r = resolveResample(o);
     EXPECT_EQ(r.enabled, c.enabled) << renderModeName(c.mode) << " " << c.eyePaths;

@@ -123,7 +123,7 @@ TEST(Reuse, ArenaEqualsAFullRetraceSlotBySlot) {
   Film film(ctx, 16, 12);
   PathReuseSettings rs;
   rs.spp = 1;
-  rs.arenaSlots = 4096;
+  rs.connect.arenaSlots = 4096;
   PathReuse reuse(ctx, gpu, film, rs);
   rs.retraceAll = true;
   PathReuse retrace(ctx, gpu, film, rs);
@@ -172,7 +172,7 @@ TEST(Reuse, ConnectRecordsInSmallLaunchesGiveTheSameFrames) {
   Film one(ctx, 16, 12), many(ctx, 16, 12);
   PathReuseSettings rs;
   rs.spp = 2;
-  rs.resample = 1;  // the reservoir's terms too
+  rs.connect.resample = 1;  // the reservoir's terms too
   PathReuse a(ctx, gpu, one, rs);
   ASSERT_EQ(a.connectLaunchPixels(), one.pixels());
   rs.connectRecordBytes = 37 * uint64_t(a.connectRecordCap()) * sizeof(dev::ShadowRay);

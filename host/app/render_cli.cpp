@@ -234,19 +234,20 @@ std::vector<Row> samplingRows() {
 
 std::vector<Row> connectionRows() {
   return {
-      Row{"--light-paths", kConnections, kResearch, kEstimator, PR_FIELD(ro.arenaSlots),
+      Row{"--light-paths", kConnections, kResearch, kEstimator, PR_FIELD(ro.connect.arenaSlots),
           "Light-path slots kept in the arena (reuse/retrace; default: one per pixel, at most "
           "2097152)"}
           .range(1, 1 << 26),
-      Row{"--paths-per-pixel", kConnections, kResearch, kEstimator, PR_FIELD(ro.pathsPerPixel),
+      Row{"--paths-per-pixel", kConnections, kResearch, kEstimator,
+          PR_FIELD(ro.connect.pathsPerPixel),
           "Light paths each pixel sample connects to (reuse/retrace)"}
           .range(1, 64)
           .withDefault(),
-      Row{"--clamp", kConnections, kResearch, kEstimator, PR_FIELD(ro.clamp),
+      Row{"--clamp", kConnections, kResearch, kEstimator, PR_FIELD(ro.connect.clamp),
           "Upper bound on the connection geometry term (reuse/retrace; 0 = off, unbiased)"}
           .range(0, 1e30)
           .withDefault(),
-      Row{"--connection-mis", kConnections, kResearch, kEstimator, PR_FIELD(ro.connectionMis),
+      Row{"--connection-mis", kConnections, kResearch, kEstimator, PR_FIELD(ro.connect.mis),
           "Connection MIS threshold R (reuse/retrace): where the eye's BSDF sample finds a "
           "connected light vertex R or more times likelier than the light tracer did, the path "
           "is shared with a connection from that sample (fewer fireflies near corners; 0 = "
@@ -260,20 +261,21 @@ std::vector<Row> connectionRows() {
           .oneOf({"1", "2", "3", "4", "all", "auto"})
           .withDefault(),
       Row{"--connection-history", kConnections, kResearch, kEstimator,
-          PR_FIELD(ro.connectionHistory),
+          PR_FIELD(ro.connect.historyCap),
           "Carry each pixel sample's reservoir of connections at its first eye vertex from "
           "frame to frame (reuse/retrace; generalized RIS), standing for at most this many "
           "times C candidates; 0 = off"}
           .range(0, 1000)
           .withDefault(),
       Row{"--connection-history-period", kConnections, kResearch, kEstimator,
-          PR_FIELD(ro.connectionHistoryPeriod),
+          PR_FIELD(ro.connect.historyPeriod),
           "With a connection history, the light paths each pixel sample connects to shift "
           "every this many frames: 1 gives the least error per frame, more keeps the noise "
           "steady for longer (less flicker)"}
           .range(1, 1000)
           .withDefault(),
-      Row{"--eye-paths,!--no-eye-paths", kConnections, kResearch, kEstimator, PR_FIELD(ro.eyePaths),
+      Row{"--eye-paths,!--no-eye-paths", kConnections, kResearch, kEstimator,
+          PR_FIELD(ro.connect.eyePaths),
           "Reuse/retrace: trace whole eye paths as the path tracer does and weigh them against "
           "the connections to stored light paths over whole paths (MIS), so that connections "
           "count where they sample a path better, and eye paths elsewhere (dark corners, "
@@ -281,7 +283,7 @@ std::vector<Row> connectionRows() {
           "eye vertex, with next-event estimation, strategy E and the delta-chain extension "
           "there"},
       Row{"--light-tracing,!--no-light-tracing", kConnections, kResearch, kEstimator,
-          PR_FIELD(ro.lightTracing),
+          PR_FIELD(ro.connect.lightTracing),
           "Reuse/retrace with eye paths: also join every stored light vertex to the camera "
           "(light tracing, strategy T), weighted against the eye paths and the connections over "
           "whole paths: the technique for caustics seen on diffuse surfaces. On by default "
@@ -562,15 +564,15 @@ RenderOptions toRenderOptions(const RenderArgs& a, const CLI::App& render) {
                                                      : LightSampler::Auto;
   ro.bvhWidth = a.bvhWidth == "auto" ? 0 : std::stoi(a.bvhWidth);
   if (a.resample || a.noResample) ro.resample.asked = a.resample;
-  if (ro.eyePaths && render.get_option("--connection-mis")->count() > 0 && !ro.quiet)
+  if (ro.connect.eyePaths && render.get_option("--connection-mis")->count() > 0 && !ro.quiet)
     std::cerr << "note: --connection-mis is used with --no-eye-paths only; eye paths weigh "
                  "whole paths by MIS instead\n";
-  if (ro.lightTracing.value_or(false) && ro.mode == RenderMode::PathTrace && !ro.quiet)
+  if (ro.connect.lightTracing.value_or(false) && ro.mode == RenderMode::PathTrace && !ro.quiet)
     std::cerr << "note: --light-tracing joins stored light paths to the camera in --mode reuse or "
                  "retrace; the path tracer has none\n";
-  ro.connections = a.connections == "auto"  ? -1
-                   : a.connections == "all" ? 0
-                                            : std::stoi(a.connections);
+  ro.connect.resample = a.connections == "auto"  ? -1
+                        : a.connections == "all" ? 0
+                                                 : std::stoi(a.connections);
   return ro;
 }
 

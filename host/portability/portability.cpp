@@ -332,7 +332,7 @@ RenderOptions suiteRenderOptions(const PortabilityOptions& o) {
   base.quiet = true;
   // One estimator on every device (auto would resample connections on GPUs only): the suite
   // compares implementations, not per-device defaults.
-  base.connections = 0;
+  base.connect.resample = 0;
   validateRenderOptions(base);
   return base;
 }

@@ -17,6 +17,13 @@ std::string kernelBuildOptions(const KernelFeatures& f) {
   return o;
 }
 
+std::string techniqueBuildOptions(const Techniques& t) {
+  std::string o;
+  if (t.eyePaths) o += " -DPR_EYE_PATHS=1";
+  if (t.resample) o += " -DPR_RESAMPLE=1";
+  return o;
+}
+
 std::vector<KernelProgram> kernelProgramVariants() {
   // Three scene variants between them take each BVH width and light sampler once, and every
   // flag both ways; the first is what the demo scenes build.
@@ -38,13 +45,17 @@ std::vector<KernelProgram> kernelProgramVariants() {
 
   std::vector<KernelProgram> out;
   for (const char* file :
-       {"pathtrace/generate.cl", "pathtrace/extend.cl", "pathtrace/shade.cl", "pathtrace/shadow.cl",
+       {"pathtrace/generate.cl", "pathtrace/extend.cl", "pathtrace/shadow.cl",
         "pathtrace/resample.cl", "reuse/invalidate.cl", "reuse/light_trace.cl", "reuse/eye_hit.cl",
         "reuse/connect_shadow.cl", "reuse/camera_splat.cl", "aov.cl"})
     for (const std::string& o : scene) out.push_back({file, o});
+  // The stages with technique hooks, in every combination their integrators build.
+  const Techniques none, eye{true, false}, resample{false, true}, both{true, true};
   for (const std::string& o : scene) {
-    out.push_back({"reuse/connect.cl", o});
-    out.push_back({"reuse/connect.cl", o + " " + kConnectDeferredOption});
+    for (const Techniques& t : {none, eye, resample, both})
+      out.push_back({"pathtrace/shade.cl", o + techniqueBuildOptions(t)});
+    for (const Techniques& t : {none, eye})
+      out.push_back({"reuse/connect.cl", o + techniqueBuildOptions(t)});
   }
   // The film's programs take no scene.
   for (const char* file : {"accumulate.cl", "adaptive.cl"}) {

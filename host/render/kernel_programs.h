@@ -20,8 +20,15 @@ struct KernelFeatures {
 // The -D options of a scene's programs.
 std::string kernelBuildOptions(const KernelFeatures& f);
 
-// connect.cl with eye paths: its terms go to connect_shadow, it traces no ray.
-inline constexpr const char* kConnectDeferredOption = "-DPR_CONNECT_DEFERRED=1";
+// The techniques a stage's program is built with (kernels/shared/techniques.h): its hooks are
+// compiled in where they are on, and absent where off.
+struct Techniques {
+  bool eyePaths = false;  // PR_EYE_PATHS: eye paths weighted against the connections
+  bool resample = false;  // PR_RESAMPLE: path and direct-light resampling
+};
+
+// The -D options of the techniques, to append to a scene's (empty where none is on).
+std::string techniqueBuildOptions(const Techniques& t);
 // The shared helpers' device test (tests/shared_device_test.cpp): every BSDF feature.
 inline constexpr const char* kSharedCheckOptions =
     "-DPR_HAS_SHEEN=1 -DPR_HAS_COAT=1 -DPR_HAS_ANISOTROPY=1 -DPR_HAS_GLTF_MODEL=1 "

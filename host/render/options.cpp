@@ -29,13 +29,13 @@ int defaultConnections(bool gpu) {
 ResampleSettings resolveResample(const RenderOptions& o) {
   ResampleSettings r = o.resample;
   const bool reuse = o.mode != RenderMode::PathTrace;
-  r.enabled = r.asked.value_or(reuse && o.eyePaths);
+  r.enabled = r.asked.value_or(reuse && o.connect.eyePaths);
   if (r.neighbors < 0) r.neighbors = reuse ? 0 : 1;
   return r;
 }
 
 bool resolveLightTracing(const RenderOptions& o) {
-  return o.lightTracing.value_or(o.mode != RenderMode::PathTrace && o.eyePaths);
+  return o.connect.lightTracing.value_or(o.mode != RenderMode::PathTrace && o.connect.eyePaths);
 }
 
 const char* renderModeName(RenderMode m) {

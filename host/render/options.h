@@ -55,6 +55,26 @@ struct ResampleSettings {
   float misCount = 4.0f;
 };
 
+// Path reuse's connections to the stored light paths (--mode reuse/retrace; docs/design.md
+// section 5), as the options give them; the session resolves `resample` and `lightTracing` for
+// the device and the mode before PathReuse takes them.
+struct ConnectionSettings {
+  int arenaSlots = 0;     // --light-paths: N_L; 0: one per pixel, at most 2^21 (defaultLightPaths)
+  int pathsPerPixel = 4;  // --paths-per-pixel: C, light paths each pixel sample connects to
+  float clamp = 0.0f;     // --clamp on the geometry term; 0 = off
+  float mis = 4.0f;       // --connection-mis: threshold on p_E / p_L (reuse/connect.cl); 0 = off
+  // --connections: RIS-chosen connections per eye vertex (1-4); 0: every candidate; -1:
+  // defaultConnections of the device.
+  int resample = -1;
+  int historyCap = 0;  // --connection-history: a pixel sample's carried reservoir, per C; 0 = off
+  int historyPeriod = 1;  // frames between moves of the history's light-path offset (>= 1)
+  bool eyePaths = true;   // full eye paths, weighted against the connections over whole paths
+  // Strategy T: the stored light paths' vertices joined to the camera (light tracing), weighted
+  // against the eye paths and the connections (kernels/shared/eye_paths.h). Needs eye paths.
+  // --light-tracing / --no-light-tracing where given (resolveLightTracing).
+  std::optional<bool> lightTracing;
+};
+
 // The largest frame number: one more still fits, as does the count of frames from 0 to it.
 constexpr int64_t kMaxFrame = INT64_MAX - 1;
 
@@ -108,20 +128,7 @@ struct RenderOptions {
   // Camera samples keyed by frame 0 on every frame (the scene still moves with the frame):
   // the same noise pattern each frame, to measure how much flicker fresh noise adds.
   bool fixedNoise = false;
-  // Path reuse (docs/design.md section 5).
-  int arenaSlots = 0;          // --light-paths: N_L; 0: chosen from the image size
-  int pathsPerPixel = 4;       // C: light paths each pixel sample connects to
-  float clamp = 0.0f;          // clamp on the geometry term; 0 = off
-  float connectionMis = 4.0f;  // MIS threshold on p_E / p_L (kernels/reuse/connect.cl); 0 = off
-  int connections = -1;        // RIS-chosen connections per eye vertex (1-4); 0: every candidate;
-                               // -1: defaultConnections of the device
-  int connectionHistory = 0;   // cap on a pixel sample's carried reservoir, per C; 0 = off
-  int connectionHistoryPeriod = 1;  // frames between moves of the history's light-path offset
-  bool eyePaths = true;  // full eye paths, weighted against the connections over whole paths
-  // Strategy T: the stored light paths' vertices joined to the camera (light tracing), weighted
-  // against the eye paths and the connections (kernels/shared/eye_paths.h). Needs eye paths.
-  // --light-tracing / --no-light-tracing where given (resolveLightTracing).
-  std::optional<bool> lightTracing;
+  ConnectionSettings connect;  // path reuse's (--mode reuse/retrace)
   ResampleSettings resample;
   // The pixels whose paths a pass traces at once (PathTracerSettings::wavefrontPixels). Not a
   // command-line option: frames are the same floats whatever it is; the tests make it small.

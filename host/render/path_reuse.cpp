@@ -33,30 +33,36 @@ cl_uint PathReuse::historySlotOffset(const dev::ReuseParams& rp) const {
   // With a history, the light paths shift by a random offset every historyPeriod frames of the
   // RNG's frame key, so that the reservoir meets new candidates; between shifts the noise stays
   // put (less flicker). Without one, the fixed mapping.
-  if (settings_.historyCap == 0) return 0;
-  const uint32_t key = rp.frame / settings_.historyPeriod;
+  if (settings_.connect.historyCap == 0) return 0;
+  const uint32_t key = rp.frame / uint32_t(settings_.connect.historyPeriod);
   return dev::pr_hash_u32(rp.seed ^ dev::pr_hash_u32(key ^ 0x534c4f54u)) % rp.slots;
 }
 
 PathReuse::PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseSettings& settings)
     : ctx_(ctx), scene_(scene), film_(film), settings_(settings) {
   if (settings_.maxDepth < 2) throw InputError("--max-depth: path reuse needs at least 2");
-  if (settings_.pathsPerPixel < 1 || settings_.pathsPerPixel > 64)
+  if (settings_.connect.pathsPerPixel < 1 || settings_.connect.pathsPerPixel > 64)
     throw InputError("--paths-per-pixel: must be 1 to 64");
-  slots_ = settings_.arenaSlots ? settings_.arenaSlots : defaultLightPaths(film.pixels());
+  PR_CHECK(settings_.connect.lightTracing.has_value() && settings_.connect.resample >= 0 &&
+           settings_.connect.arenaSlots >= 0);  // resolved by the session
+  lightTracing_ = *settings_.connect.lightTracing;
+  slots_ = settings_.connect.arenaSlots ? uint32_t(settings_.connect.arenaSlots)
+                                        : defaultLightPaths(film.pixels());
   stride_ = static_cast<uint32_t>(settings_.maxDepth - 1);
   const std::string opts = scene.buildOptions();
   invalidate_ = kargs::kernel<kargs::InvalidateArgs>(ctx, "reuse/invalidate.cl", opts);
   lightTrace_ = kargs::kernel<kargs::LightTraceArgs>(ctx, "reuse/light_trace.cl", opts);
   eyeHit_ = kargs::kernel<kargs::EyeHitArgs>(ctx, "reuse/eye_hit.cl", opts);
   // With eye paths, connect traces no ray: its terms go to connect_shadow (kernels/reuse).
-  connect_ = kargs::kernel<kargs::ConnectArgs>(
-      ctx, "reuse/connect.cl", settings_.eyePaths ? opts + " " + kConnectDeferredOption : opts);
-  if (settings_.eyePaths)
+  Techniques techniques;
+  techniques.eyePaths = settings_.connect.eyePaths;
+  connect_ = kargs::kernel<kargs::ConnectArgs>(ctx, "reuse/connect.cl",
+                                               opts + techniqueBuildOptions(techniques));
+  if (settings_.connect.eyePaths)
     connectShadow_ = kargs::kernel<kargs::ConnectShadowArgs>(ctx, "reuse/connect_shadow.cl", opts);
   // Strategy T's weights need the eye paths' ratios (kernels/shared/eye_paths.h).
-  PR_CHECK(!settings_.lightTracing || settings_.eyePaths);
-  if (settings_.lightTracing)
+  PR_CHECK(!lightTracing_ || settings_.connect.eyePaths);
+  if (lightTracing_)
     cameraSplat_ = kargs::kernel<kargs::CameraSplatArgs>(ctx, "reuse/camera_splat.cl", opts);
   auto alloc = [&](const char* name, uint64_t bytes) {
     bytes_ += bytes;
@@ -67,7 +73,7 @@ PathReuse::PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseS
   // The arena first: the largest buffer, so a too large request fails naming it.
   vertices_ = alloc("light vertex arena", uint64_t(slots_) * stride_ * sizeof(dev::LightVertex));
   // With eye paths, L's weights' light side beside each vertex; else one unread element.
-  ratios_ = alloc("eye-path ratios", (settings_.eyePaths ? uint64_t(slots_) * stride_ : 1) *
+  ratios_ = alloc("eye-path ratios", (settings_.connect.eyePaths ? uint64_t(slots_) * stride_ : 1) *
                                          sizeof(dev::EyePathRatio));
   headers_ = alloc("path headers", uint64_t(slots_) * sizeof(dev::PathHeader));
   list_ = alloc("invalid slot list", uint64_t(slots_) * 4);
@@ -78,17 +84,18 @@ PathReuse::PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseS
   eye_ = alloc("eye vertices", uint64_t(film.pixels()) * sizeof(dev::EyeVertex));
   radiance_ = alloc("sample radiance", uint64_t(film.pixels()) * 16);
   counters_ = alloc("reuse counters", dev::PR_C_COUNT * 4);
-  splat_ = alloc("camera splats",
-                 (settings_.lightTracing ? uint64_t(film.pixels()) : 1) * PR_SPLAT_WORDS * 4);
+  splat_ =
+      alloc("camera splats", (lightTracing_ ? uint64_t(film.pixels()) : 1) * PR_SPLAT_WORDS * 4);
   // Without a history, one element each: the kernels take them but never read them.
-  const bool history = settings_.historyCap > 0;
+  const bool history = settings_.connect.historyCap > 0;
   changed_ = alloc("changed slot stamps", uint64_t(history ? slots_ : 1) * 4);
   const uint64_t records = history ? uint64_t(film.pixels()) * settings_.spp : 1;
   history_ = alloc("connection history", records * sizeof(dev::ConnectionHistory));
-  if (settings_.eyePaths) {
+  if (settings_.connect.eyePaths) {
     // Per pixel sample: L's connections at x, each a term (at most C per stored vertex k >= 1)
     // and their sum's end, the history's one term, a reservoir's terms and their sum's end.
-    recordCap_ = settings_.pathsPerPixel * (stride_ - 1) + 1 + 1 + settings_.resample + 1;
+    recordCap_ = uint32_t(settings_.connect.pathsPerPixel) * (stride_ - 1) + 1 + 1 +
+                 uint32_t(settings_.connect.resample) + 1;
     const uint64_t perSample = uint64_t(recordCap_) * sizeof(dev::ShadowRay);
     recordPixels_ = static_cast<uint32_t>(
         std::clamp<uint64_t>(settings_.connectRecordBytes / perSample, 1, film.pixels()));
@@ -97,14 +104,14 @@ PathReuse::PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseS
       alloc("connection records",
             std::max<uint64_t>(uint64_t(recordPixels_) * recordCap_, 1) * sizeof(dev::ShadowRay));
   recordCounts_ = alloc("connection record counts", uint64_t(recordPixels_) * 4);
-  if (settings_.eyePaths) {
+  if (settings_.connect.eyePaths) {
     PathTracerSettings pt;
     pt.spp = settings_.spp;
     pt.maxDepth = settings_.maxDepth;
     pt.seed = settings_.seed;
     pt.fixedNoise = settings_.fixedNoise;
-    pt.pathsPerPixel = settings_.pathsPerPixel;
-    pt.lightTracingSlots = settings_.lightTracing ? slots_ : 0;
+    pt.pathsPerPixel = uint32_t(settings_.connect.pathsPerPixel);
+    pt.lightTracingSlots = lightTracing_ ? slots_ : 0;
     pt.resample = settings_.resamplePaths;
     pt.wavefrontPixels = settings_.wavefrontPixels;
     eyePaths_ = std::make_unique<PathTracer>(ctx, scene, film, pt);
@@ -118,18 +125,18 @@ dev::ReuseParams PathReuse::frameParams(int64_t frame) const {
   rp.slots = slots_;
   rp.stride = stride_;
   rp.max_depth = static_cast<uint32_t>(settings_.maxDepth);
-  rp.paths_per_pixel = settings_.pathsPerPixel;
+  rp.paths_per_pixel = cl_uint(settings_.connect.pathsPerPixel);
   rp.spp = static_cast<uint32_t>(settings_.spp);
   rp.pixel_count = film_.end();  // the bound of the film's pixels [first, end)
   rp.frame = settings_.fixedNoise ? 0u : rngFrameKey(frame);  // RNG key only
-  rp.clamp = settings_.clamp;
+  rp.clamp = settings_.connect.clamp;
   // With eye paths, strategy E's paths are the path tracer's.
-  rp.mis_threshold = settings_.eyePaths ? 0.0f : settings_.misThreshold;
-  rp.eye_paths = settings_.eyePaths ? 1u : 0u;
+  rp.mis_threshold = settings_.connect.eyePaths ? 0.0f : settings_.connect.mis;
+  rp.eye_paths = settings_.connect.eyePaths ? 1u : 0u;
   // pt_shade weighs the eye paths with the same count (PathTracer::resampleParams).
   rp.eye_count = settings_.resamplePaths.enabled ? settings_.resamplePaths.misCount : 1.0f;
-  PR_CHECK(settings_.resample <= PR_MAX_CONNECTIONS);  // the CLI allows 1-4
-  rp.resample = settings_.resample;
+  PR_CHECK(settings_.connect.resample <= PR_MAX_CONNECTIONS);  // the CLI allows 1-4
+  rp.resample = cl_uint(settings_.connect.resample);
   rp.trace_total = scene_.traceTotalPower();
   rp.scene_radius = scene_.sceneRadius();
   rp.cx = scene_.sceneCentre().x, rp.cy = scene_.sceneCentre().y, rp.cz = scene_.sceneCentre().z;
@@ -142,14 +149,15 @@ void PathReuse::renderFrame(int64_t frame, const dev::CameraParams& camera, Fram
   StageTimer timer;
   ctx_.zero(counters_, dev::PR_C_COUNT * 4);
   dev::ReuseParams rp = frameParams(frame);
-  if (settings_.lightTracing)
-    rp.lt_scale = lightTracingScale(camera, slots_, settings_.spp, settings_.pathsPerPixel);
+  if (lightTracing_)
+    rp.lt_scale =
+        lightTracingScale(camera, slots_, settings_.spp, uint32_t(settings_.connect.pathsPerPixel));
 
   // 1. Which slots must be traced again. With a connection history, retrace learns the same
   // changed slots as reuse (invalidate marks them and leaves the arena alone), so that the
   // histories, and the frames, agree.
   const kargs::SceneArgs sceneArgs = scene_.kernelArgs();
-  const bool history = settings_.historyCap > 0;
+  const bool history = settings_.connect.historyCap > 0;
   const cl_uint frameStamp = history ? ++frames_ : 0;
   cl_uint toTrace = slots_;
   const cl::Buffer* list = &allSlots_;
@@ -195,7 +203,7 @@ void PathReuse::renderFrame(int64_t frame, const dev::CameraParams& camera, Fram
   // the passes: the film's sum is then the splats and the samples in pass order, as one device
   // adds them, wherever the passes after the first device's run.
   // With a time limit (one device) the splats are kept, to be scaled to the passes rendered.
-  const bool splat = settings_.lightTracing && passBegin_ == 0;
+  const bool splat = lightTracing_ && passBegin_ == 0;
   if (splat) splatToCamera(camera, rp, sceneArgs, &timer);
   const int passes = tracePasses(frame, camera, rp, sceneArgs, frameStamp, start, &timer);
   if (passes < 0) return;
@@ -256,7 +264,7 @@ int PathReuse::tracePasses(int64_t frame, const dev::CameraParams& camera,
   cn.vertices = vertices_;
   cn.radiance = radiance_;
   cn.counters = counters_;
-  cn.history_cap = settings_.historyCap;
+  cn.history_cap = cl_uint(settings_.connect.historyCap);
   cn.slot_offset = historySlotOffset(rp);
   cn.frame_stamp = frameStamp;
   cn.changed = changed_;

@@ -30,19 +30,20 @@ inline uint32_t defaultLightPaths(uint64_t pixels) {
   return uint32_t(std::min<uint64_t>(pixels, kMaxDefaultLightPaths));
 }
 
+// ConnectionSettings' defaults as PathReuse takes them: every candidate traced, no strategy T.
+inline ConnectionSettings resolvedConnectionDefaults() {
+  ConnectionSettings c;
+  c.resample = 0;
+  c.lightTracing = false;
+  return c;
+}
+
 struct PathReuseSettings {
   int spp = 4;
   int maxDepth = 8;
   uint32_t seed = 1;
-  uint32_t arenaSlots = 0;  // N_L (--light-paths); 0: defaultLightPaths of the image
-  uint32_t pathsPerPixel = 4;
-  float clamp = 0.0f;
-  float misThreshold = 4.0f;   // connection MIS (kernels/reuse/connect.cl); 0 = off
-  uint32_t resample = 0;       // resampled connections per eye vertex (connect.cl); 0: all
-  uint32_t historyCap = 0;     // connection history (connect.cl): carried candidates per C; 0: off
-  uint32_t historyPeriod = 1;  // frames between moves of the history's light-path offset (>= 1)
-  bool eyePaths = true;        // connections weighted against the path tracer's eye paths
-  bool lightTracing = false;   // strategy T: camera_splat (needs eyePaths)
+  // The connections, resolved: `resample` >= 0 (0: every candidate), `lightTracing` given.
+  ConnectionSettings connect = resolvedConnectionDefaults();
   // Device memory for connect's terms (eye paths): each launch of connect and connect_shadow
   // takes as many pixel samples as fit.
   uint64_t connectRecordBytes = uint64_t(128) << 20;
@@ -71,7 +72,7 @@ class PathReuse : public Integrator {
   uint32_t stride() const { return stride_; }
   uint64_t arenaBytes() const {
     const uint64_t vertex =
-        sizeof(dev::LightVertex) + (settings_.eyePaths ? sizeof(dev::EyePathRatio) : 0);
+        sizeof(dev::LightVertex) + (settings_.connect.eyePaths ? sizeof(dev::EyePathRatio) : 0);
     return uint64_t(slots_) * (sizeof(dev::PathHeader) + stride_ * vertex);
   }
   // The eye paths' --resample history is the run's (none with --no-eye-paths).
@@ -102,6 +103,7 @@ class PathReuse : public Integrator {
   Film& film_;
   PathReuseSettings settings_;
   uint32_t slots_ = 0, stride_ = 0;
+  bool lightTracing_ = false;  // strategy T: camera_splat
   bool first_ = true;
   uint32_t frames_ = 0;  // frames rendered with a connection history: its clock
   cl::Kernel invalidate_, lightTrace_, eyeHit_, connect_, connectShadow_, cameraSplat_;

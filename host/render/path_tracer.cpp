@@ -9,6 +9,7 @@
 
 #include "cl/kernel_binding.h"
 #include "render/history_format.h"
+#include "render/kernel_programs.h"
 #include "shared/path_state.h"
 #include "util/check.h"
 #include "util/hash.h"
@@ -22,7 +23,12 @@ PathTracer::PathTracer(Context& ctx, GpuScene& scene, Film& film,
   const std::string opts = scene.buildOptions();
   generate_ = kargs::kernel<kargs::PtGenerateArgs>(ctx, "pathtrace/generate.cl", opts);
   extend_ = kargs::kernel<kargs::PtExtendArgs>(ctx, "pathtrace/extend.cl", opts);
-  shade_ = kargs::kernel<kargs::PtShadeArgs>(ctx, "pathtrace/shade.cl", opts);
+  // Driven by PathReuse (paths per pixel > 0), the eye paths are weighted against its connections.
+  Techniques techniques;
+  techniques.eyePaths = settings.pathsPerPixel > 0;
+  techniques.resample = settings.resample.enabled;
+  shade_ = kargs::kernel<kargs::PtShadeArgs>(ctx, "pathtrace/shade.cl",
+                                             opts + techniqueBuildOptions(techniques));
   shadow_ = kargs::kernel<kargs::PtShadowArgs>(ctx, "pathtrace/shadow.cl", opts);
   if (settings.resample.enabled)
     resample_ = kargs::kernel<kargs::PtResampleArgs>(ctx, "pathtrace/resample.cl", opts);
@@ -134,7 +140,6 @@ float lightTracingScale(const dev::CameraParams& camera, uint32_t slots, int spp
 dev::ResampleParams PathTracer::resampleParams() const {
   dev::ResampleParams p{};
   const ResampleSettings& r = settings_.resample;
-  p.enabled = r.enabled ? 1u : 0u;
   p.neighbors = cl_uint(r.neighbors);
   p.radius = r.radius;
   p.min_alpha = r.roughness * r.roughness;  // GGX alpha = roughness^2, as the materials map it
@@ -218,7 +223,7 @@ void PathTracer::beginFrame(int64_t frame, const dev::CameraParams& camera,
   shadowArgs_.shadow_queue = shadowQueue_;
   shadowArgs_.seed = settings_.seed;
   shadowArgs_.frame = rngFrame;
-  shadowArgs_.resample = rsp.enabled;
+  shadowArgs_.resample = settings_.resample.enabled ? 1u : 0u;
   shadowArgs_.rs_res = rsRes_;
   shadowArgs_.rs_pending = rsPending_;
   shadowArgs_.di_res = diRes_;
@@ -249,7 +254,7 @@ void PathTracer::beginFrame(int64_t frame, const dev::CameraParams& camera,
   generateArgs_.radiance = radiance;
   generateArgs_.eye = eyeOut;
   generateArgs_.write_eye = settings_.pathsPerPixel > 0 || settings_.resample.enabled ? 1 : 0;
-  generateArgs_.resample = rsp.enabled;
+  generateArgs_.resample = settings_.resample.enabled ? 1u : 0u;
   generateArgs_.rs_res = rsRes_;
   generateArgs_.di_res = diRes_;
   generateArgs_.queue = queues_[0];

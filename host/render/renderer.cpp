@@ -430,7 +430,7 @@ int renderFrames(const RenderOptions& o, MultiDeviceSession& session, const Fram
       ++t.skipped;
       continue;
     }
-    if (t.skipped > 0 && t.rendered == 0 && o.connectionHistory > 0 &&
+    if (t.skipped > 0 && t.rendered == 0 && o.connect.historyCap > 0 &&
         o.mode != RenderMode::PathTrace && !o.quiet)
       std::cerr << "note: --resume: the connection history starts afresh at frame " << f
                 << " (frames from here differ from an uninterrupted run's, unbiased)\n";

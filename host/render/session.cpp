@@ -77,22 +77,24 @@ void validateRenderOptions(const RenderOptions& o) {
     throw InputError("--fps: must be in (0, 1000]");
   if (o.width < 0 || o.height < 0 || o.width > 16384 || o.height > 16384)
     throw InputError("--width/--height: must be 1 to 16384");
-  if (o.arenaSlots < 0 || o.arenaSlots > (1 << 26))
-    throw InputError("--light-paths " + std::to_string(o.arenaSlots) + ": must be 1 to 67108864");
-  if (o.pathsPerPixel < 1 || o.pathsPerPixel > 64)
-    throw InputError("--paths-per-pixel " + std::to_string(o.pathsPerPixel) + ": must be 1 to 64");
-  if (!(o.clamp >= 0.0f) || !std::isfinite(o.clamp))
+  if (o.connect.arenaSlots < 0 || o.connect.arenaSlots > (1 << 26))
+    throw InputError("--light-paths " + std::to_string(o.connect.arenaSlots) +
+                     ": must be 1 to 67108864");
+  if (o.connect.pathsPerPixel < 1 || o.connect.pathsPerPixel > 64)
+    throw InputError("--paths-per-pixel " + std::to_string(o.connect.pathsPerPixel) +
+                     ": must be 1 to 64");
+  if (!(o.connect.clamp >= 0.0f) || !std::isfinite(o.connect.clamp))
     throw InputError("--clamp: must be 0 (off) or positive");
-  if (!(o.connectionMis >= 0.0f) || !std::isfinite(o.connectionMis))
+  if (!(o.connect.mis >= 0.0f) || !std::isfinite(o.connect.mis))
     throw InputError("--connection-mis: must be 0 (off) or positive");
-  if (o.connectionHistoryPeriod < 1 || o.connectionHistoryPeriod > 1000)
-    throw InputError("--connection-history-period " + std::to_string(o.connectionHistoryPeriod) +
+  if (o.connect.historyPeriod < 1 || o.connect.historyPeriod > 1000)
+    throw InputError("--connection-history-period " + std::to_string(o.connect.historyPeriod) +
                      ": must be 1 to 1000");
   if (!std::isfinite(o.exposure)) throw InputError("--exposure: must be finite");
   if (!o.aov.empty()) parseAovs(o.aov);
   if (!(o.timeLimit >= 0.0) || !std::isfinite(o.timeLimit))
     throw InputError("--time-limit: must be 0 (none) or positive seconds");
-  if (o.timeLimit > 0.0 && o.connectionHistory > 0)
+  if (o.timeLimit > 0.0 && o.connect.historyCap > 0)
     throw InputError(
         "--time-limit: cannot be combined with --connection-history, whose "
         "reservoirs follow every pass of every frame");
@@ -103,7 +105,7 @@ void validateRenderOptions(const RenderOptions& o) {
     if (o.adaptiveMinSpp != 0 && (o.adaptiveMinSpp < 2 || o.adaptiveMinSpp > o.spp))
       throw InputError("--adaptive-min-spp " + std::to_string(o.adaptiveMinSpp) +
                        ": must be 2 to --spp (" + std::to_string(o.spp) + ")");
-    if (o.connectionHistory > 0)
+    if (o.connect.historyCap > 0)
       throw InputError(
           "--noise-threshold: cannot be combined with --connection-history, whose "
           "reservoirs follow every pass of every pixel");
@@ -138,9 +140,10 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
   film_ = std::make_unique<Film>(ctx_, width_, height_);
   const RenderOptions& o = options_;
   ResampleSettings resample = resolveResample(o);
-  if (resample.enabled && o.mode != RenderMode::PathTrace && !o.eyePaths)
+  if (resample.enabled && o.mode != RenderMode::PathTrace && !o.connect.eyePaths)
     throw InputError("--resample: resamples the eye paths, which --no-eye-paths turns off");
-  if (o.lightTracing.value_or(false) && o.mode != RenderMode::PathTrace && !o.eyePaths)
+  if (o.connect.lightTracing.value_or(false) && o.mode != RenderMode::PathTrace &&
+      !o.connect.eyePaths)
     throw InputError(
         "--light-tracing: weighs its paths against the eye paths, which --no-eye-paths "
         "turns off");
@@ -159,17 +162,10 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
     r.spp = o.spp;
     r.maxDepth = o.maxDepth;
     r.seed = o.seed;
-    r.arenaSlots = static_cast<uint32_t>(o.arenaSlots);
-    r.pathsPerPixel = static_cast<uint32_t>(o.pathsPerPixel);
-    r.clamp = o.clamp;
-    r.misThreshold = o.connectionMis;
-    r.resample = static_cast<uint32_t>(
-        o.connections >= 0 ? o.connections
-                           : defaultConnections((ctx_.device().type & CL_DEVICE_TYPE_GPU) != 0));
-    r.historyCap = static_cast<uint32_t>(o.connectionHistory);
-    r.historyPeriod = static_cast<uint32_t>(o.connectionHistoryPeriod);
-    r.eyePaths = o.eyePaths;
-    r.lightTracing = resolveLightTracing(o);
+    r.connect = o.connect;
+    if (r.connect.resample < 0)
+      r.connect.resample = defaultConnections((ctx_.device().type & CL_DEVICE_TYPE_GPU) != 0);
+    r.connect.lightTracing = resolveLightTracing(o);
     r.retraceAll = o.mode == RenderMode::Retrace;
     r.fixedNoise = o.fixedNoise;
     r.resamplePaths = resample;

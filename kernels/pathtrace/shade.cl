@@ -1,68 +1,25 @@
 // pt_shade: one work-item per live path (the bounce's queue). Reads the path and its hit; adds
 // emission (MIS-weighted against next-event estimation) to the sample's radiance, writes a shadow
 // ray for next-event estimation, samples the BSDF for the next ray and applies Russian roulette.
-// With paths_per_pixel = C > 0 (--eye-paths), the eye path's ends on a light are weighted against
-// the reuse connections that make the same paths too (shared/eye_paths.h): the path keeps the
-// ratio of the two ways' densities of its vertices beyond x_1 as it goes (mis_ratio_*, and every
-// weight here from shared/mis.h).
-// With paths_per_pixel > 0, x_1 (the first non-delta vertex) is written to the sample's EyeVertex
-// for connect. Writes the PathState, the radiance and the ShadowRay of the same index, and appends
-// the path to next_queue if it goes on and to shadow_queue if it has a shadow ray (their order
-// varies from run to run; what each path computes does not: its random numbers are keyed by its
-// pixel and sample).
-#include "shared/eye_paths.h"
+// Writes the PathState, the radiance and the ShadowRay of the same index, and appends the path to
+// next_queue if it goes on and to shadow_queue if it has a shadow ray (their order varies from
+// run to run; what each path computes does not: its random numbers are keyed by its pixel and
+// sample).
+// That is the path tracer. The techniques built in (shared/techniques.h) hook into it where they
+// are called: PR_EYE_PATHS weighs the paths against the connections to stored light paths
+// (shade_eye_paths.h), PR_RESAMPLE offers them to the pixel's reservoirs (shade_resample.h). With
+// either, x_1 (the first non-delta vertex) is written to the sample's EyeVertex, for connect and
+// pt_resample.
+#include "pathtrace/shade_eye_paths.h"
+#include "pathtrace/shade_resample.h"
 #include "shared/reuse.h"
-#include "shared/path_state.h"
-#include "shared/resample.h"
-#include "shared/resample_direct.h"
-
-// L's density of the path over that of the eye path's vertices beyond x_1 (eye_ratio holds
-// the rest), for a path ending at x_t on light l (normal n_tri, start density `start`) at z0,
-// with cos_x = |cos| at x_t and rev = the light-tracing density of x_{t-1} from x_t (1 at t = 2);
-// C = paths_per_pixel samples of L against eye_count of the eye path.
-PR_INLINE float eye_paths_light_side(const Light* l, float3 n_tri, float start, u32 paths_per_pixel,
-                                     float eye_count, float eye_ratio, float3 z0, float3 xt,
-                                     float cos_x, float rev) {
-  const float3 d = xt - z0;
-  const float d2 = dot(d, d);
-  return (float)paths_per_pixel / eye_count * start *
-         eye_paths_emit_density(l, n_tri, d * (1.0f / sqrt(d2)), cos_x, d2) * rev * eye_ratio;
-}
-
-// The light tracer's density of x_{t-1} (the vertex `p.ray` left, at squared distance dist2)
-// sampled from a non-delta x_t in frame f, arriving from wi and leaving towards wo.
-PR_INLINE float pt_light_density(const ShadingFrame* f, const PathState* p, float3 wi, float3 wo,
-                                 float dist2) {
-  return solid_angle_to_area_pdf(eye_paths_bsdf_pdf(f, wi, wo), p->seg_cos, dist2);
-}
-
-// A path that the connections make too, ending on a light after x_t, t = p->depth: T's ratio
-// (fixed at x_2) and the eye path's share of it from N's, H's and L's densities, times w; the
-// parts into *ew.
-PR_INLINE float pt_eye_share(const PathState* p, float w, float dens_n, float dens_h, float dens_l,
-                             EyeWeight* ew) {
-  ew->t = p->x1_depth == 1u && ew->t_len ? p->lt : 0.0f;
-  if (dens_l > 0.0f) w *= eye_paths_eye_share(dens_n / dens_l, dens_h / dens_l, ew->t);
-  ew->n = dens_n;
-  ew->h = dens_h;
-  ew->l = dens_l;
-  return w;
-}
-
-// Whether the connections can make the paths that end after this path's last vertex x_t: x_2 is
-// non-delta and t >= x_1's depth + beyond.
-PR_INLINE int pt_joinable(const PathState* p, u32 paths_per_pixel, u32 beyond) {
-  return paths_per_pixel > 0u && (p->eye_flags & PR_EYE_JOINABLE) &&
-         p->depth >= p->x1_depth + beyond;
-}
 
 // The weight of emission found at h along d (dist2 from the previous vertex): against next-event
 // estimation, and where the connections can make the path too (joinable), times their share;
 // its parts into *ew.
 PR_INLINE float pt_emission_weight(const SceneData* s, const PathState* p, const SurfaceHit* h,
-                                   float3 d, float dist2, int joinable, u32 paths_per_pixel,
-                                   float eye_count, __global const float* trace_cdf,
-                                   float trace_total, u32 max_depth, EyeWeight* ew) {
+                                   float3 d, float dist2, int joinable, const EyeMis* em,
+                                   u32 max_depth, EyeWeight* ew) {
   const float3 prev = make_float3(p->prev_x, p->prev_y, p->prev_z);
   const float3 prev_n = make_float3(p->prev_nx, p->prev_ny, p->prev_nz);
   float w = 1.0f;
@@ -72,19 +29,7 @@ PR_INLINE float pt_emission_weight(const SceneData* s, const PathState* p, const
   ew->n = ew->h = ew->l = ew->t = 0.0f;
   // Strategy T: x_1 .. x_t before the light, t = p->depth; its ratio was fixed at x_2.
   ew->t_len = eye_paths_camera_len(p->depth, max_depth);
-  const u32 li = joinable ? emitter_light(s, h) : PR_INVALID_INDEX;
-  if (li != PR_INVALID_INDEX) {
-    // The connections' share of the path (eye_paths.h); the eye path's N and H split the rest.
-    const Light l = s->lights.lights[li];
-    const float3 n_tri = eye_paths_light_normal(s, &l);
-    const float start = eye_paths_start_density(&l, li, trace_cdf, trace_total);
-    const int spec = (p->flags & PR_PATH_SPECULAR) != 0u;
-    const float dens_h =
-        spec ? 1.0f : solid_angle_to_area_pdf(p->last_pdf, fabs(dot(n_tri, d)), dist2);
-    const float dens_l = eye_paths_light_side(&l, n_tri, start, paths_per_pixel, eye_count,
-                                              p->eye_ratio, h->p, prev, p->seg_cos, 1.0f);
-    w = pt_eye_share(p, w, spec ? 0.0f : start, dens_h, dens_l, ew);
-  }
+  if (PR_EYE_PATHS && joinable) w = ep_emission_share(s, p, h, d, dist2, em, w, ew);
   return w;
 }
 
@@ -92,137 +37,15 @@ PR_INLINE float pt_emission_weight(const SceneData* s, const PathState* p, const
 // times, where h is joinable, what the connections leave of the path; its parts into *ew.
 PR_INLINE float pt_next_event_weight(const SceneData* s, const PathState* p, const SurfaceHit* h,
                                      const ShadingFrame* f, const NextEventChoice* ch, int joinable,
-                                     int has_rev, float dist2, u32 paths_per_pixel, float eye_count,
-                                     __global const float* trace_cdf, float trace_total,
-                                     u32 max_depth, EyeWeight* ew) {
-  float w = ch->delta ? 1.0f : power_heuristic(ch->pdf_light, ch->pdf_bsdf);
+                                     int has_rev, float dist2, const EyeMis* em, u32 max_depth,
+                                     EyeWeight* ew) {
+  const float w = ch->delta ? 1.0f : power_heuristic(ch->pdf_light, ch->pdf_bsdf);
   ew->pt = w;
   ew->n = ew->h = ew->l = ew->t = 0.0f;
   ew->t_len = eye_paths_camera_len(p->depth, max_depth);  // x_1 .. x_t, t = p->depth
-  if (!joinable) return w;  // the plain path tracer: no light record to read
-  const Light l = s->lights.lights[ch->light];
-  if (eye_paths_light(&l)) {
-    const float3 n_tri =
-        light_is_triangle(l.type) ? eye_paths_light_normal(s, &l) : make_float3(0.0f, 0.0f, 1.0f);
-    const float3 dz = ch->pos - h->p;
-    const float dz2 = dot(dz, dz);
-    const float3 wi = dz * (1.0f / sqrt(dz2));
-    // The environment's direction is z_0: its densities per solid angle.
-    const float dens_n = eye_paths_start_density(&l, ch->light, trace_cdf, trace_total) *
-                         eye_paths_direction_density(&l, s->lights.env, ch->wi);
-    const float dens_h = light_is_triangle(l.type)
-                             ? solid_angle_to_area_pdf(ch->pdf_bsdf, fabs(dot(n_tri, wi)), dz2)
-                         : eye_paths_light_hit(&l) ? ch->pdf_bsdf
-                                                   : 0.0f;
-    const float rev = has_rev ? solid_angle_to_area_pdf(ch->pdf_bsdf_rev, p->seg_cos, dist2) : 1.0f;
-    const float dens_l =
-        eye_paths_light_side(&l, n_tri, dens_n, paths_per_pixel, eye_count, p->eye_ratio, ch->pos,
-                             h->p, fabs(dot(f->ng, wi)), rev);
-    // T's ratio: at x_2 from the light's pdf of the step to x_1 (x_1's camera factor in p->lt),
-    // beyond x_2 as fixed there.
-    if (p->x1_depth == 1u && ew->t_len)
-      ew->t = p->depth == 2u ? eye_paths_camera_ratio(p->lt, ch->pdf_bsdf_rev, dist2) : p->lt;
-    if (dens_l > 0.0f) w *= eye_paths_eye_share(dens_n / dens_l, dens_h / dens_l, ew->t);
-    ew->n = dens_n;
-    ew->h = dens_h;
-    ew->l = dens_l;
-  }
+  if (PR_EYE_PATHS && joinable)
+    return ep_next_event_share(s, p, h, f, ch, has_rev, dist2, em, w, ew);
   return w;
-}
-
-// --resample, at a hit `rel` vertices beyond x_1 (2 and on: x_3 ...) or, escaped along d
-// (escaped), from the vertex `rel` - 1 beyond it: the path's end on an emitter (le, weighted
-// ew->pt by the path tracer and with ew's share against the connections, pdf_light its light
-// pdf) offered to the pixel's reservoir.
-PR_INLINE void rs_offer_emission(PR_GLOBAL const PathTrack* t, PR_GLOBAL PathReservoir* r,
-                                 const PathState* p, uint rel, float3 le, const EyeWeight* ew,
-                                 float pdf_light, int escaped, float3 d, const RsKey* key) {
-  const int t2 = rel == 2u && !(p->flags & PR_PATH_SPECULAR);
-  const float3 rest = make_float3(t->rest_r, t->rest_g, t->rest_b) * le * (t2 ? 1.0f : ew->pt);
-  PathReservoir c;
-  rs_candidate(&c, t, make_float3(t->f2_r, t->f2_g, t->f2_b), make_float3(t->wx, t->wy, t->wz),
-               t->g_src, rest, t->pdf, t2 ? PR_RS_HIT2 : PR_RS_DEEP, pdf_light, p->last_pdf, ew,
-               rel == 2u);
-  if (escaped) rs_suffix_push(&c.suffix, c.sp, d, 1);
-  rs_offer_keyed(r, &c, key, PR_RS_DIM(p->depth + 1u, 0u));
-}
-
-// --resample, after the BSDF step at vertex `rel` beyond x_1 (0: x_1; 1: x_2, surface h in frame
-// f, reached along -wo at squared distance dist2): the tracked path goes on along `step`; q the
-// roulette's survival probability (1: none).
-PR_INLINE void rs_track_step(PR_GLOBAL PathTrack* t, const ResampleParams* rsp, uint rel,
-                             const SurfaceHit* h, const ShadingFrame* f, float3 wo, float dist2,
-                             const PathStep* step, float q) {
-  const float pdf = step->delta ? 1.0f : step->pdf;
-  const float3 fc = step->weight * pdf;
-  if (rel == 0u) {
-    t->x1_ok = rs_rough(&f->bsdf, rsp->min_alpha) && dot(step->wi, f->ng) > 0.0f;
-    t->f1_r = fc.x;
-    t->f1_g = fc.y;
-    t->f1_b = fc.z;
-    t->pdf = pdf * q;
-    return;
-  }
-  if (rel == 1u) {
-    t->f2_r = fc.x;
-    t->f2_g = fc.y;
-    t->f2_b = fc.z;
-    t->wx = step->wi.x;
-    t->wy = step->wi.y;
-    t->wz = step->wi.z;
-    t->rest_r = t->rest_g = t->rest_b = 1.0f;
-    t->pdf2 = pdf;
-    t->g_src = !step->delta && rs_reconnectable(t->x1_ok, h, f, wo, dist2, step->wi, rsp)
-                   ? fabs(dot(h->ng, wo)) / dist2
-                   : 0.0f;
-  } else {
-    t->rest_r *= fc.x;
-    t->rest_g *= fc.y;
-    t->rest_b *= fc.z;
-  }
-  t->pdf *= pdf * q;
-}
-
-// --resample: next-event estimation's path at vertex `rel` >= 1 beyond x_1, the candidate for
-// pt_shadow to offer if its shadow ray is unoccluded, into *c. The light's point (at_infinity: its
-// direction) ends the path's suffix.
-PR_INLINE void rs_next_event(PathReservoir* c, PR_GLOBAL const PathTrack* t,
-                             const ResampleParams* rsp, uint rel, const SurfaceHit* h,
-                             const ShadingFrame* f, float3 wo, float dist2,
-                             const NextEventChoice* ch, int at_infinity, const EyeWeight* ew) {
-  if (rel == 1u) {
-    const float g = rs_reconnectable(t->x1_ok, h, f, wo, dist2, ch->wi, rsp)
-                        ? fabs(dot(h->ng, wo)) / dist2
-                        : 0.0f;
-    rs_candidate(c, t, ch->fr_cos, ch->wi, g, ch->le, t->pdf * ch->pdf,
-                 ch->delta ? PR_RS_DEEP : PR_RS_NEE2, ch->pdf_light, ch->pdf_bsdf, ew, 1);
-  } else {
-    const float3 rest = make_float3(t->rest_r, t->rest_g, t->rest_b) * ch->fr_cos * ch->le * ew->pt;
-    rs_candidate(c, t, make_float3(t->f2_r, t->f2_g, t->f2_b), make_float3(t->wx, t->wy, t->wz),
-                 t->g_src, rest, t->pdf * ch->pdf, PR_RS_DEEP, 0.0f, 0.0f, ew, 0);
-  }
-  rs_suffix_push(&c->suffix, c->sp, at_infinity ? ch->wi : ch->pos, at_infinity);
-}
-
-// --resample: next-event estimation (contribution c) at path p's vertex h, to a reservoir once
-// pt_shadow finds it unoccluded: at x_1 the direct light's, from x_2 on the paths'. Its candidate
-// goes into *di_pending or *pending, and the shadow ray's op is returned (1 + the random
-// dimension that offers it, PR_RS_OP_DIRECT for the direct light; 0: into the radiance).
-PR_INLINE uint rs_next_event_pending(const SceneData* s, PR_GLOBAL const PathTrack* t,
-                                     PR_GLOBAL PathReservoir* pending,
-                                     PR_GLOBAL DirectReservoir* di_pending,
-                                     const ResampleParams* rsp, const PathState* p,
-                                     const SurfaceHit* h, const ShadingFrame* f, float3 wo,
-                                     float dist2, const NextEventChoice* ch, float3 c,
-                                     const EyeWeight* ew) {
-  if (!rsp->enabled || !p->x1_depth) return 0u;
-  const uint depth = p->depth, rel = depth - p->x1_depth;
-  if (rel == 0u) return di_next_event_pending(s, di_pending, ch, c, PR_RS_DIM(depth, 1u));
-  PathReservoir cand;
-  rs_next_event(&cand, t, rsp, rel, h, f, wo, dist2, ch,
-                light_at_infinity(s->lights.lights[ch->light].type), ew);
-  *pending = cand;
-  return PR_RS_DIM(depth, 1u) + 1u;
 }
 
 // A contribution as the radiance buffer holds it.
@@ -232,38 +55,23 @@ PR_INLINE float4 pt_rgb(float3 c) {
 
 // The weight of the environment found along d (escaped), pdf_light next-event estimation's
 // density of d: against next-event estimation, and where the connections can make the path
-// (joinable), times their share (the environment's direction is z_0: N's density of it and
-// H's per solid angle, L's of z_1 from the disk); its parts into *ew.
+// (joinable), times their share; its parts into *ew.
 PR_INLINE float pt_escape_weight(const SceneData* s, const PathState* p, float3 d, float pdf_light,
-                                 int joinable, u32 paths_per_pixel, float eye_count,
-                                 __global const float* trace_cdf, float trace_total, u32 max_depth,
-                                 EyeWeight* ew) {
+                                 int joinable, const EyeMis* em, u32 max_depth, EyeWeight* ew) {
   const int spec = (p->flags & PR_PATH_SPECULAR) != 0u;
   float w = spec ? 1.0f : power_heuristic(p->last_pdf, pdf_light);
   ew->pt = w;
   ew->n = ew->h = ew->l = ew->t = 0.0f;
   ew->t_len = eye_paths_camera_len(p->depth, max_depth);
-  const u32 li = s->lights.env_light;
-  if (joinable && li != PR_INVALID_INDEX) {
-    const Light l = s->lights.lights[li];
-    const float3 prev = make_float3(p->prev_x, p->prev_y, p->prev_z);
-    const float start = eye_paths_start_density(&l, li, trace_cdf, trace_total) *
-                        eye_paths_direction_density(&l, s->lights.env, d);
-    const float dens_h = spec ? 1.0f : p->last_pdf;
-    const float dens_l =
-        eye_paths_light_side(&l, make_float3(0.0f, 0.0f, 1.0f), start, paths_per_pixel, eye_count,
-                             p->eye_ratio, prev - d, prev, p->seg_cos, 1.0f);
-    w = pt_eye_share(p, w, spec ? 0.0f : start, dens_h, dens_l, ew);
-  }
+  if (PR_EYE_PATHS && joinable) w = ep_escape_share(s, p, d, em, w, ew);
   return w;
 }
 
 // The path escaped: the environment's light (weighted as pt_escape_weight says) into the
-// sample's radiance, or with --resample from x_1 (rel 1) to the direct light's reservoir and
-// from x_2 on (rel >= 2) to the paths'.
-PR_INLINE void pt_escape(const SceneData* s, const PathState* p, uint rel, int joinable,
-                         u32 paths_per_pixel, float eye_count, __global const float* trace_cdf,
-                         float trace_total, u32 max_depth, __global const PathTrack* track,
+// sample's radiance, or resampling from x_1 (rel 1) to the direct light's reservoir and from x_2
+// on (rel >= 2) to the paths'.
+PR_INLINE void pt_escape(const SceneData* s, const PathState* p, uint rel, const EyeMis* em,
+                         u32 max_depth, __global const PathTrack* track,
                          __global PathReservoir* res, __global DirectReservoir* di,
                          const RsKey* key, __global float4* radiance) {
   const float3 d = make_float3(p->ray.dx, p->ray.dy, p->ray.dz);
@@ -274,20 +82,19 @@ PR_INLINE void pt_escape(const SceneData* s, const PathState* p, uint rel, int j
   const float pdf_light =
       (p->flags & PR_PATH_SPECULAR) && !rel ? 0.0f : environment_pdf(s, prev, prev_n, d);
   EyeWeight ew;
-  const float w = pt_escape_weight(s, p, d, pdf_light, joinable, paths_per_pixel, eye_count,
-                                   trace_cdf, trace_total, max_depth, &ew);
-  if (rel == 1u &&
+  const float w = pt_escape_weight(s, p, d, pdf_light, pt_joinable(p, 1u), em, max_depth, &ew);
+  if (PR_RESAMPLE && rel == 1u &&
       di_offer_hit(s, p, track, s->lights.env_light, 0.0f, 0.0f, d, le, 1.0f, w, di, key))
     return;
-  if (rel < 2u) {
-    *radiance += pt_rgb(make_float3(p->tp_r, p->tp_g, p->tp_b) * le * w);
+  if (PR_RESAMPLE && rel >= 2u) {
+    rs_offer_emission(track, res, p, rel, le, &ew, pdf_light, 1, d, key);
     return;
   }
-  rs_offer_emission(track, res, p, rel, le, &ew, pdf_light, 1, d, key);
+  *radiance += pt_rgb(make_float3(p->tp_r, p->tp_g, p->tp_b) * le * w);
 }
 
 // Emission at h (reached along d at squared distance dist2), weighted w by the path tracer (ew:
-// its parts), into the sample's radiance, or with --resample at x_2 (rel 1) to the direct light's
+// its parts), into the sample's radiance, or resampling at x_2 (rel 1) to the direct light's
 // reservoir and from x_3 on (rel >= 2) to the paths'.
 PR_INLINE void pt_emission(const SceneData* s, const PathState* p, const SurfaceHit* h, uint rel,
                            float3 d, float dist2, float w, const EyeWeight* ew, float3 tp,
@@ -295,48 +102,17 @@ PR_INLINE void pt_emission(const SceneData* s, const PathState* p, const Surface
                            __global DirectReservoir* di, const RsKey* key,
                            __global float4* radiance) {
   const float3 le = surface_emission(s, h);
-  if (rel == 1u && di_offer_hit(s, p, track, emitter_light(s, h), h->b1, h->b2, d, le,
-                                fabs(dot(h->ng, d)) / dist2, w, di, key))
+  if (PR_RESAMPLE && rel == 1u &&
+      di_offer_hit(s, p, track, emitter_light(s, h), h->b1, h->b2, d, le,
+                   fabs(dot(h->ng, d)) / dist2, w, di, key))
     return;
-  if (rel < 2u) {
-    *radiance += pt_rgb(tp * le * w);
+  if (PR_RESAMPLE && rel >= 2u) {
+    const float pdf_light = emitter_pdf(s, h, make_float3(p->prev_x, p->prev_y, p->prev_z),
+                                        make_float3(p->prev_nx, p->prev_ny, p->prev_nz));
+    rs_offer_emission(track, res, p, rel, le, ew, pdf_light, 0, h->p, key);
     return;
   }
-  const float pdf_light = emitter_pdf(s, h, make_float3(p->prev_x, p->prev_y, p->prev_z),
-                                      make_float3(p->prev_nx, p->prev_ny, p->prev_nz));
-  rs_offer_emission(track, res, p, rel, le, ew, pdf_light, 0, h->p, key);
-}
-
-// --resample: the hit `rel` >= 1 vertices beyond x_1 (at p) joins the tracked path, with the
-// transmittance tr of the segment to it.
-PR_INLINE void rs_track_hit(__global PathTrack* t, uint rel, const Hit* hit, float3 p, float3 tr,
-                            float p2) {
-  if (rel == 1u) {  // x_2, p2 its density per unit area from x_1
-    t->p2 = p2;
-    t->prim = hit->prim;
-    t->inst = hit->inst;
-    t->b1 = hit->u;
-    t->b2 = hit->v;
-    t->f1_r *= tr.x;
-    t->f1_g *= tr.y;
-    t->f1_b *= tr.z;
-    t->suffix = 0u;
-  } else {
-    t->rest_r *= tr.x;
-    t->rest_g *= tr.y;
-    t->rest_b *= tr.z;
-    rs_track_push(t, p, hit->inst != PR_INVALID_INDEX);
-  }
-}
-
-// --eye-paths: the eye path's density of this vertex x_t (t >= 2; 1 when sampled from a delta
-// vertex) into its running ratio, and whether x_2 is joinable.
-PR_INLINE void pt_eye_arrive(PathState* p, const SurfaceHit* h, float3 d, float dist2,
-                             int delta_here) {
-  if (p->depth == p->x1_depth + 1u) p->eye_flags = delta_here ? 0u : PR_EYE_JOINABLE;
-  p->eye_ratio = mis_ratio_arrive(p->eye_ratio,
-                                  solid_angle_to_area_pdf(p->last_pdf, fabs(dot(h->ng, d)), dist2),
-                                  (p->flags & PR_PATH_SPECULAR) != 0u);
+  *radiance += pt_rgb(tp * le * w);
 }
 
 PR_INLINE void pt_write_eye(__global EyeVertex* out, const SurfaceHit* h, const Hit* hit, float3 wo,
@@ -346,31 +122,21 @@ PR_INLINE void pt_write_eye(__global EyeVertex* out, const SurfaceHit* h, const 
   *out = e;
 }
 
-// Strategy T: leaving x_2 (of an x_1 seen straight from the camera) along wi, T's density over
-// L's for the vertices beyond, from the light tracer's pdf of the step from x_2 to x_1.
-PR_INLINE void pt_camera_leave(PathState* p, const ShadingFrame* f, float3 wi, float3 wo,
-                               float dist2, float lt_scale) {
-  if (!(lt_scale > 0.0f) || p->x1_depth != 1u || p->depth != 2u) return;
-  p->lt = (p->eye_flags & PR_EYE_JOINABLE)
-              ? eye_paths_camera_ratio(p->lt, eye_paths_bsdf_pdf(f, wi, wo), dist2)
-              : 0.0f;
-}
-
-// The eye path's bookkeeping at a vertex (--eye-paths or --resample): its first non-delta vertex
-// becomes x_1, the eye vertex that connect joins to the stored light paths (and, resampling, the
-// vertex pt_resample reconnects from); p->lt, cos^3 of the camera ray's angle until now, becomes
-// its camera factor for strategy T. Later vertices carry the eye path's densities for the MIS
-// weights against the connections.
+// The eye path's bookkeeping at a vertex (with eye paths or resampling): its first non-delta
+// vertex becomes x_1, the eye vertex that connect joins to the stored light paths (and,
+// resampling, the vertex pt_resample reconnects from); p->lt, cos^3 of the camera ray's angle
+// until now, becomes its camera factor for strategy T. With eye paths, later vertices carry the
+// eye path's densities for the MIS weights against the connections.
 PR_INLINE void pt_eye_vertex(PathState* p, const SurfaceHit* h, const Hit* hit, float3 d,
-                             float dist2, float3 tp, int delta_here, u32 paths_per_pixel,
-                             uint max_depth, float lt_scale, __global EyeVertex* eye) {
+                             float dist2, float3 tp, int delta_here, uint max_depth, float lt_scale,
+                             __global EyeVertex* eye) {
   if (p->x1_depth == 0u) {
     if (!delta_here && p->depth < max_depth) {
       p->x1_depth = p->depth;
       p->lt = p->depth == 1u ? eye_paths_camera_factor(lt_scale, p->lt * dist2) : 0.0f;
       pt_write_eye(eye, h, hit, -d, tp, p->depth);
     }
-  } else if (paths_per_pixel > 0u) {
+  } else if (PR_EYE_PATHS) {
     pt_eye_arrive(p, h, d, dist2, delta_here);
   }
 }
@@ -419,21 +185,23 @@ PR_INLINE void queue_append(__global uint* queue, __global uint* size, int take,
 }
 
 // One live path i: PR_SHADE_* of what it goes on with.
+
+// One live path i: PR_SHADE_* of what it goes on with.
 PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
   const SceneData s = PR_SCENE();
   const uint k = i - base;  // the path's own state in the band; the frame's at pixel i
   PathState p = states[k];
   uint out = 0u;
+  const EyeMis em = {paths_per_pixel, rsp.eye_count, trace_cdf, trace_total};
 
-  // --resample: the vertex this hit is, counted from x_1 (0: x_1 not met yet); the paths that
+  // Resampling: the vertex this hit is, counted from x_1 (0: x_1 not met yet); the paths that
   // reach an emitter from x_2 on go to the pixel's reservoir instead of its radiance.
-  const uint rel = rsp.enabled && p.x1_depth ? p.depth + 1u - p.x1_depth : 0u;
+  const uint rel = PR_RESAMPLE && p.x1_depth > 0u ? p.depth + 1u - p.x1_depth : 0u;
   PR_GLOBAL PathTrack* track = rs_track + k;
   const RsKey key = {seed, frame, p.pixel, sample};
   const Hit hit = hits[k];
   if (hit.prim == PR_INVALID_INDEX) {
-    pt_escape(&s, &p, rel, pt_joinable(&p, paths_per_pixel, 1u), paths_per_pixel, rsp.eye_count,
-              trace_cdf, trace_total, max_depth, track, rs_res + i, di_res + i, &key, radiance + i);
+    pt_escape(&s, &p, rel, &em, max_depth, track, rs_res + i, di_res + i, &key, radiance + i);
     p.alive = 0u;
     states[k] = p;
     return 0u;
@@ -446,27 +214,25 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
   const float3 tr = volume_transmittance(&s, &h, d, hit.t);
   float3 tp = make_float3(p.tp_r, p.tp_g, p.tp_b) * tr;
   const float dist2 = hit.t * hit.t;
-  if (rel)
+  if (rel > 0u)  // resampling (rel is 0 without it)
     rs_track_hit(track, rel, &hit, h.p, tr,
                  solid_angle_to_area_pdf(p.last_pdf, fabs(dot(h.ng, d)), dist2));
-  // Connections can make the paths that end after x_t, t >= 2 (x_t: the vertex `ray` left).
-  const int joinable = pt_joinable(&p, paths_per_pixel, 1u);
 
   if (s.sd.materials[h.material].flags & PR_MAT_EMISSIVE) {
     EyeWeight ew;
-    const float w = pt_emission_weight(&s, &p, &h, d, dist2, joinable, paths_per_pixel,
-                                       rsp.eye_count, trace_cdf, trace_total, max_depth, &ew);
+    // Connections can make the paths that end after x_t, t >= 2 (x_t: the vertex `ray` left).
+    const float w =
+        pt_emission_weight(&s, &p, &h, d, dist2, pt_joinable(&p, 1u), &em, max_depth, &ew);
     pt_emission(&s, &p, &h, rel, d, dist2, w, &ew, tp, track, rs_res + i, di_res + i, &key,
                 radiance + i);
   }
   p.depth += 1u;
   const ShadingFrame f = shading_frame(&s, &h, wo);
   const int delta_here = bsdf_is_delta(&f.bsdf);
-  if (paths_per_pixel > 0u || rsp.enabled)
-    pt_eye_vertex(&p, &h, &hit, d, dist2, tp, delta_here, paths_per_pixel, max_depth, rsp.lt_scale,
-                  eye + p.pixel);
+  if (PR_EYE_PATHS || PR_RESAMPLE)
+    pt_eye_vertex(&p, &h, &hit, d, dist2, tp, delta_here, max_depth, rsp.lt_scale, eye + p.pixel);
   // x_t with t >= 3: the light tracer's density of x_{t-1}, reached from this vertex.
-  const int has_rev = pt_joinable(&p, paths_per_pixel, 2u);
+  const int has_rev = pt_joinable(&p, 2u);
   if (p.depth >= max_depth) {
     p.alive = 0u;
   } else {
@@ -474,15 +240,16 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
       Ray shadow;
       float3 c;
       NextEventChoice ch;
-      const int here_joinable = pt_joinable(&p, paths_per_pixel, 1u);
+      const int here_joinable = pt_joinable(&p, 1u);
       if (next_event(&s, &h, &f, wo, !here_joinable, &rng, &shadow, &c, &ch)) {
         EyeWeight ew;
         const float w = pt_next_event_weight(&s, &p, &h, &f, &ch, here_joinable, has_rev, dist2,
-                                             paths_per_pixel, rsp.eye_count, trace_cdf, trace_total,
-                                             max_depth, &ew);
+                                             &em, max_depth, &ew);
         if (here_joinable) c = c * w;  // next_event left the weight to this
-        const uint op = rs_next_event_pending(&s, track, rs_pending + k, di_pending + k, &rsp, &p,
-                                              &h, &f, wo, dist2, &ch, c, &ew);
+        const uint op = PR_RESAMPLE
+                            ? rs_next_event_pending(&s, track, rs_pending + k, di_pending + k, &rsp,
+                                                    &p, &h, &f, wo, dist2, &ch, c, &ew)
+                            : 0u;
         pt_shadow_set(shadows + k, shadow, tp * c, op);
         out = PR_SHADE_SHADOW;
       }
@@ -500,13 +267,9 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
       const float rr = rng_next(&rng);
       const float q = p.depth >= 3u ? fmin(max3(tp), 1.0f) : 1.0f;
       if (p.depth >= 3u && !russian_roulette(max3(tp), rr, &tp)) p.alive = 0u;
-      if (rsp.enabled && p.x1_depth && p.alive)
+      if (PR_RESAMPLE && p.x1_depth > 0u && p.alive)
         rs_track_step(track, &rsp, p.depth - p.x1_depth, &h, &f, wo, dist2, &step, q);
-      pt_camera_leave(&p, &f, step.wi, wo, dist2, rsp.lt_scale);
-      if (has_rev)  // x_{t-1}'s light-tracing density from here (1 where this is delta)
-        p.eye_ratio = mis_ratio_leave(
-            p.eye_ratio, delta_here ? 1.0f : pt_light_density(&f, &p, step.wi, wo, dist2),
-            delta_here);
+      if (PR_EYE_PATHS) ep_leave(&p, &f, step.wi, wo, dist2, rsp.lt_scale, has_rev, delta_here);
       pt_leave(&s, &p, &h, &f, &step);
     }
   }

@@ -26,17 +26,16 @@
 // connections are resampled into a reservoir that each pixel sample carries to the next frame
 // (history_resolve); one shadow ray there.
 //
-// With --eye-paths (rp.eye_paths), the path tracer's pass has written the sample's radiance and
+// With --eye-paths (PR_EYE_PATHS), the path tracer's pass has written the sample's radiance and
 // x (its first non-delta vertex): connect adds strategy L there alone, each connection with its
 // share against the eye path's ways of making the same path (eye_path_weight, from the ratios
 // light_trace kept beside each vertex; shared/eye_paths.h).
 #include "shared/reuse.h"
 
-// Built with 1 for --eye-paths (PathReuse): connect then traces no ray, and leaves the estimate's
-// terms, shadow rays with what each adds, to connect_shadow (ShadowRay records, shared/reuse.h).
-#ifndef PR_CONNECT_DEFERRED
-#define PR_CONNECT_DEFERRED 0
-#endif
+// With PR_EYE_PATHS (--eye-paths, shared/techniques.h) connect traces no ray, and leaves the
+// estimate's terms, shadow rays with what each adds, to connect_shadow (ShadowRay records,
+// shared/reuse.h).
+#include "shared/techniques.h"
 // After reuse.h: its FP_CONTRACT OFF (shared/bvh.h) holds here too.
 #include "shared/camera.h"
 #include "shared/eye_paths.h"
@@ -87,7 +86,7 @@ typedef struct {
   HistoryReservoir hr;  // strategy L's connections at the first eye vertex, carried
   HistoryReservoir he;  // strategy E's there, this frame's alone
   __global const EyePathRatio* ratios;  // --eye-paths: beside the vertices (light_trace)
-  // The estimate's terms (ShadowRay records, shared/reuse.h): with PR_CONNECT_DEFERRED written to
+  // The estimate's terms (ShadowRay records, shared/reuse.h): with PR_EYE_PATHS written to
   // rec for connect_shadow (at most cap of them), else traced and summed into L and g here.
   __global ShadowRay* rec;
   uint n_rec, cap, overflow;
@@ -98,7 +97,7 @@ typedef struct {
 // One term of the estimate, of value v where `ray` (if not 0) is unoccluded.
 PR_INLINE void connect_term(Connector* cn, float3 v, const Ray* ray, u32 op) {
   if ((op & PR_REC_SUM_MASK) == PR_REC_GROUP) ++cn->members;
-#if PR_CONNECT_DEFERRED
+#if PR_EYE_PATHS
   if (cn->n_rec >= cn->cap) {
     cn->overflow = 1u;
     return;
@@ -274,7 +273,7 @@ PR_INLINE float3 light_vertex_value(const Connector* cn, const EyePoint* x, cons
   const float t = eye_paths_camera_len(k + 1u, cn->rp->max_depth)
                       ? eye_paths_camera_ratio(cn->cam_x, pdf_leave, dist2)
                       : 0.0f;
-  const float mis = cn->rp->eye_paths
+  const float mis = PR_EYE_PATHS
                         ? eye_path_weight(cn->ratios[vk - cn->vertices], k, pdf_x,
                                           fabs(dot(y->h.ng, dir)), dist2, pdf_rev, cn->mis_c, t)
                         : mis_connection_weight(PR_STRATEGY_L, p_l, p_e, cn->rp->mis_threshold);
@@ -292,7 +291,7 @@ PR_INLINE float3 light_vertex_value_at(const Connector* cn, const EyePoint* x, u
   __global const LightVertex* v = cn->vertices + (size_t)slot * cn->rp->stride;
   if (k < 1u || k >= cn->headers[slot].vertex_count || x->depth + k + 1u > cn->rp->max_depth)
     return zero;
-  if (cn->rp->eye_paths && !eye_paths_slot(cn, slot)) return zero;
+  if (PR_EYE_PATHS && !eye_paths_slot(cn, slot)) return zero;
   const LightPoint y = light_point(s, v + k);
   if (y.delta) return zero;
   // The light tracer's pdf of the step to y_k, as strategy_light_vertices finds it.
@@ -341,7 +340,7 @@ PR_INLINE void strategy_light_vertices(Connector* cn, const EyePoint* x, int his
     float pdf_step = (mis && count > 1u)
                          ? light_emit_pdf(s, cn->headers[slot].light, v, vertex_dir(v + 1))
                          : 0.0f;
-    if (rp->eye_paths && !eye_paths_slot(cn, slot)) continue;  // the path tracer's alone
+    if (PR_EYE_PATHS && !eye_paths_slot(cn, slot)) continue;  // the path tracer's alone
     for (uint k = 1u; k < count && x->depth + k + 1u <= rp->max_depth; ++k) {
       const LightPoint y = light_point(s, v + k);
       const float pdf_arrive = pdf_step;
@@ -576,7 +575,7 @@ PR_INLINE void connect_count(const ConnectCounts* n, uint shadow_rays, uint boun
 // alone): its camera factor at p, 0 where T cannot make them.
 PR_INLINE float connect_camera_factor(const ReuseParams* rp, const CameraParams* cam,
                                       const EyeVertex* e, float3 p) {
-  if (!rp->eye_paths || e->depth != 1u || !(rp->lt_scale > 0.0f)) return 0.0f;
+  if (!PR_EYE_PATHS || e->depth != 1u || !(rp->lt_scale > 0.0f)) return 0.0f;
   return eye_paths_camera_factor(rp->lt_scale, camera_cos3_d2(cam, p));
 }
 
@@ -609,7 +608,7 @@ PR_KERNEL void connect(PR_PARAMS(PR_ARGS_CONNECT)) {
   if (q >= record_end || q >= (listed ? list_count : rp.pixel_count)) return;
   const uint i = listed ? pixels[q] : q;
   const EyeVertex e = eye[i];
-#if PR_CONNECT_DEFERRED
+#if PR_EYE_PATHS
   record_counts[q - record_first] = 0u;  // until the terms are written
 #endif
   if (e.prim == PR_INVALID_INDEX) return;
@@ -632,10 +631,9 @@ PR_KERNEL void connect(PR_PARAMS(PR_ARGS_CONNECT)) {
     // The previous eye vertex's kept connections (each vertex of a delta chain has its own).
     reservoir_resolve(&cn);
     // With --eye-paths, the path tracer's eye paths make everything but L's connections at x.
-    const int eye_paths = PR_CONNECT_DEFERRED || rp.eye_paths;
-    if (!eye_paths) strategy_next_event(&cn, &x, &rng, &shadow_rays);
+    if (!PR_EYE_PATHS) strategy_next_event(&cn, &x, &rng, &shadow_rays);
     strategy_light_vertices(&cn, &x, history_open);
-    if (eye_paths) break;
+    if (PR_EYE_PATHS) break;
     // The completeness extension: one BSDF direction, kept only through delta surfaces.
     const float u0 = rng_next(&rng);
     const float2 u12 = rng_next2(&rng);
@@ -704,7 +702,7 @@ PR_KERNEL void connect(PR_PARAMS(PR_ARGS_CONNECT)) {
   }
   if (history_cap > 0u) history_resolve(&cn, &e, hist, changed, frame_stamp);
   reservoir_resolve(&cn);
-#if PR_CONNECT_DEFERRED
+#if PR_EYE_PATHS
   record_counts[q - record_first] = cn.n_rec;
   if (cn.overflow) atomic_inc(counters + PR_C_RECORD_OVERFLOW);
 #else

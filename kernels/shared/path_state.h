@@ -167,8 +167,8 @@ typedef struct {
 } MovedInstance;
 
 // What the resampling kernels are told. 48 bytes.
+// Whether they run at all is pt_shade's PR_RESAMPLE (shared/techniques.h).
 typedef struct {
-  u32 enabled;      // 0: the path tracer alone
   u32 neighbors;    // k of pairwise MIS (0: the pixel's own paths, resampled)
   float radius;     // in pixels
   float min_alpha;  // GGX alpha below which a vertex is too smooth to reconnect at
@@ -181,7 +181,7 @@ typedef struct {
   float eye_count;
   // Strategy T: N_L A / (spp C W H) (eye_paths_camera_factor); 0: off.
   float lt_scale;
-  u32 pad2;
+  u32 pad1, pad2;
 } ResampleParams;
 
 PR_NAMESPACE_END
