@@ -635,14 +635,15 @@ TEST(SceneLoader, PunctualLightsAndCameras) {
   expectRefused(q.write());
 }
 
-// Each edit breaks the quad in one way; each must be refused with one line naming the file.
-TEST(SceneLoader, BrokenQuadsAreRefused) {
-  struct Case {
-    const char* name;
-    std::function<void(Quad&)> edit;
-    const char* expected;  // part of the message
-  };
-  const std::vector<Case> cases = {
+struct BrokenQuad {
+  const char* name;
+  std::function<void(Quad&)> edit;
+  const char* expected;  // part of the message
+};
+
+// Each edit breaks the quad in one way.
+std::vector<BrokenQuad> brokenQuads() {
+  return {
       {"accessor past view", [](Quad& q) { q.doc["accessors"][0]["count"] = 5; },
        "reads past the end of bufferView 0"},
       {"view past buffer", [](Quad& q) { q.doc["bufferViews"][1]["byteLength"] = 100; },
@@ -742,7 +743,11 @@ TEST(SceneLoader, BrokenQuadsAreRefused) {
        },
        "light 0"},
   };
-  for (const Case& c : cases) {
+}
+
+// Each broken quad must be refused with one line naming the file.
+TEST(SceneLoader, BrokenQuadsAreRefused) {
+  for (const BrokenQuad& c : brokenQuads()) {
     SCOPED_TRACE(c.name);
     Quad q;
     c.edit(q);

@@ -281,98 +281,107 @@ class Validator : Stage {
       checkTextureInfo(doc_, m.normalTexture.index, "normalTexture", where);
       checkTextureInfo(doc_, m.occlusionTexture.index, "occlusionTexture", where);
       checkEmission(m, where);
-      if (const Value* e = extension(m.extensions, "KHR_materials_ior"))
-        if (const Value* s = member(*e, "ior"))
-          if (!s->IsNumber() || !finite(s->GetNumberAsDouble()) || s->GetNumberAsDouble() <= 0.0)
-            fail("KHR_materials_ior ior must be a number > 0", where);
-      if (const Value* e = extension(m.extensions, "KHR_materials_transmission"))
-        if (const Value* s = member(*e, "transmissionFactor"))
-          checkFactor(s->IsNumber() ? s->GetNumberAsDouble() : -1.0, 0.0, 1.0,
-                      "KHR_materials_transmission transmissionFactor", where);
-      auto number = [&](const Value* e, const char* key, double lo, double hi, const char* ext) {
-        if (const Value* s = member(*e, key))
-          checkFactor(s->IsNumber() ? s->GetNumberAsDouble() : -1.0, lo, hi,
-                      std::string(ext) + " " + key, where);
+      checkMaterialExtensions(m, where);
+      checkTextureTransforms(m, where);
+    }
+  }
+
+  // The KHR_materials_* extensions' values.
+  void checkMaterialExtensions(const tinygltf::Material& m, const std::string& where) {
+    if (const Value* e = extension(m.extensions, "KHR_materials_ior"))
+      if (const Value* s = member(*e, "ior"))
+        if (!s->IsNumber() || !finite(s->GetNumberAsDouble()) || s->GetNumberAsDouble() <= 0.0)
+          fail("KHR_materials_ior ior must be a number > 0", where);
+    if (const Value* e = extension(m.extensions, "KHR_materials_transmission"))
+      if (const Value* s = member(*e, "transmissionFactor"))
+        checkFactor(s->IsNumber() ? s->GetNumberAsDouble() : -1.0, 0.0, 1.0,
+                    "KHR_materials_transmission transmissionFactor", where);
+    auto number = [&](const Value* e, const char* key, double lo, double hi, const char* ext) {
+      if (const Value* s = member(*e, key))
+        checkFactor(s->IsNumber() ? s->GetNumberAsDouble() : -1.0, lo, hi,
+                    std::string(ext) + " " + key, where);
+    };
+    auto finiteNumber = [&](const Value* e, const char* key, const char* ext) {
+      if (const Value* s = member(*e, key))
+        if (!s->IsNumber() || !finite(s->GetNumberAsDouble()))
+          fail(std::string(ext) + " " + key + " must be a finite number", where);
+    };
+    if (const Value* e = extension(m.extensions, "KHR_materials_specular")) {
+      number(e, "specularFactor", 0.0, 1.0, "KHR_materials_specular");
+      if (const Value* c = member(*e, "specularColorFactor")) {
+        bool ok = c->IsArray() && c->ArrayLen() == 3;
+        for (int k = 0; ok && k < 3; ++k)
+          ok = c->Get(k).IsNumber() && finite(c->Get(k).GetNumberAsDouble()) &&
+               c->Get(k).GetNumberAsDouble() >= 0.0;
+        if (!ok) fail("KHR_materials_specular specularColorFactor must be 3 numbers >= 0", where);
+      }
+    }
+    if (const Value* e = extension(m.extensions, "KHR_materials_volume")) {
+      number(e, "thicknessFactor", 0.0, 3.0e38, "KHR_materials_volume");
+      if (const Value* d = member(*e, "attenuationDistance"))
+        if (!d->IsNumber() || !finite(d->GetNumberAsDouble()) || d->GetNumberAsDouble() <= 0.0)
+          fail("KHR_materials_volume attenuationDistance must be a number > 0", where);
+      if (const Value* c = member(*e, "attenuationColor")) {
+        bool ok = c->IsArray() && c->ArrayLen() == 3;
+        for (int k = 0; ok && k < 3; ++k)
+          ok = c->Get(k).IsNumber() && c->Get(k).GetNumberAsDouble() >= 0.0 &&
+               c->Get(k).GetNumberAsDouble() <= 1.0;
+        if (!ok) fail("KHR_materials_volume attenuationColor must be 3 numbers in 0..1", where);
+      }
+    }
+    if (const Value* e = extension(m.extensions, "KHR_materials_clearcoat")) {
+      number(e, "clearcoatFactor", 0.0, 1.0, "KHR_materials_clearcoat");
+      number(e, "clearcoatRoughnessFactor", 0.0, 1.0, "KHR_materials_clearcoat");
+      if (const Value* t = member(*e, "clearcoatNormalTexture"))
+        if (t->IsObject())
+          finiteNumber(t, "scale", "KHR_materials_clearcoat clearcoatNormalTexture");
+    }
+    if (const Value* e = extension(m.extensions, "KHR_materials_sheen")) {
+      if (const Value* c = member(*e, "sheenColorFactor")) {
+        bool ok = c->IsArray() && c->ArrayLen() == 3;
+        for (int k = 0; ok && k < 3; ++k)
+          ok = c->Get(k).IsNumber() && c->Get(k).GetNumberAsDouble() >= 0.0 &&
+               c->Get(k).GetNumberAsDouble() <= 1.0;
+        if (!ok) fail("KHR_materials_sheen sheenColorFactor must be 3 numbers in 0..1", where);
+      }
+      number(e, "sheenRoughnessFactor", 0.0, 1.0, "KHR_materials_sheen");
+    }
+    if (const Value* e = extension(m.extensions, "KHR_materials_anisotropy")) {
+      number(e, "anisotropyStrength", 0.0, 1.0, "KHR_materials_anisotropy");
+      finiteNumber(e, "anisotropyRotation", "KHR_materials_anisotropy");
+    }
+  }
+
+  // KHR_texture_transform on every texture the material uses.
+  void checkTextureTransforms(const tinygltf::Material& m, const std::string& where) {
+    const auto& pbr = m.pbrMetallicRoughness;
+    const std::pair<const char*, const tinygltf::ExtensionMap*> textures[] = {
+        {"baseColorTexture", &pbr.baseColorTexture.extensions},
+        {"metallicRoughnessTexture", &pbr.metallicRoughnessTexture.extensions},
+        {"emissiveTexture", &m.emissiveTexture.extensions},
+        {"normalTexture", &m.normalTexture.extensions},
+        {"occlusionTexture", &m.occlusionTexture.extensions}};
+    for (const auto& [name, extensions] : textures) {
+      const Value* t = extension(*extensions, "KHR_texture_transform");
+      if (!t) continue;
+      const std::string twhere = where + ", " + name;
+      auto arr2 = [&](const char* key) {
+        if (const Value* v = member(*t, key)) {
+          bool ok = v->IsArray() && v->ArrayLen() == 2;
+          for (int k = 0; ok && k < 2; ++k)
+            ok = v->Get(k).IsNumber() && finite(v->Get(k).GetNumberAsDouble());
+          if (!ok)
+            fail(std::string("KHR_texture_transform ") + key + " must be 2 finite numbers", twhere);
+        }
       };
-      auto finiteNumber = [&](const Value* e, const char* key, const char* ext) {
-        if (const Value* s = member(*e, key))
-          if (!s->IsNumber() || !finite(s->GetNumberAsDouble()))
-            fail(std::string(ext) + " " + key + " must be a finite number", where);
-      };
-      if (const Value* e = extension(m.extensions, "KHR_materials_specular")) {
-        number(e, "specularFactor", 0.0, 1.0, "KHR_materials_specular");
-        if (const Value* c = member(*e, "specularColorFactor")) {
-          bool ok = c->IsArray() && c->ArrayLen() == 3;
-          for (int k = 0; ok && k < 3; ++k)
-            ok = c->Get(k).IsNumber() && finite(c->Get(k).GetNumberAsDouble()) &&
-                 c->Get(k).GetNumberAsDouble() >= 0.0;
-          if (!ok) fail("KHR_materials_specular specularColorFactor must be 3 numbers >= 0", where);
-        }
-      }
-      if (const Value* e = extension(m.extensions, "KHR_materials_volume")) {
-        number(e, "thicknessFactor", 0.0, 3.0e38, "KHR_materials_volume");
-        if (const Value* d = member(*e, "attenuationDistance"))
-          if (!d->IsNumber() || !finite(d->GetNumberAsDouble()) || d->GetNumberAsDouble() <= 0.0)
-            fail("KHR_materials_volume attenuationDistance must be a number > 0", where);
-        if (const Value* c = member(*e, "attenuationColor")) {
-          bool ok = c->IsArray() && c->ArrayLen() == 3;
-          for (int k = 0; ok && k < 3; ++k)
-            ok = c->Get(k).IsNumber() && c->Get(k).GetNumberAsDouble() >= 0.0 &&
-                 c->Get(k).GetNumberAsDouble() <= 1.0;
-          if (!ok) fail("KHR_materials_volume attenuationColor must be 3 numbers in 0..1", where);
-        }
-      }
-      if (const Value* e = extension(m.extensions, "KHR_materials_clearcoat")) {
-        number(e, "clearcoatFactor", 0.0, 1.0, "KHR_materials_clearcoat");
-        number(e, "clearcoatRoughnessFactor", 0.0, 1.0, "KHR_materials_clearcoat");
-        if (const Value* t = member(*e, "clearcoatNormalTexture"))
-          if (t->IsObject())
-            finiteNumber(t, "scale", "KHR_materials_clearcoat clearcoatNormalTexture");
-      }
-      if (const Value* e = extension(m.extensions, "KHR_materials_sheen")) {
-        if (const Value* c = member(*e, "sheenColorFactor")) {
-          bool ok = c->IsArray() && c->ArrayLen() == 3;
-          for (int k = 0; ok && k < 3; ++k)
-            ok = c->Get(k).IsNumber() && c->Get(k).GetNumberAsDouble() >= 0.0 &&
-                 c->Get(k).GetNumberAsDouble() <= 1.0;
-          if (!ok) fail("KHR_materials_sheen sheenColorFactor must be 3 numbers in 0..1", where);
-        }
-        number(e, "sheenRoughnessFactor", 0.0, 1.0, "KHR_materials_sheen");
-      }
-      if (const Value* e = extension(m.extensions, "KHR_materials_anisotropy")) {
-        number(e, "anisotropyStrength", 0.0, 1.0, "KHR_materials_anisotropy");
-        finiteNumber(e, "anisotropyRotation", "KHR_materials_anisotropy");
-      }
-      // KHR_texture_transform on every texture the material uses.
-      const std::pair<const char*, const tinygltf::ExtensionMap*> textures[] = {
-          {"baseColorTexture", &pbr.baseColorTexture.extensions},
-          {"metallicRoughnessTexture", &pbr.metallicRoughnessTexture.extensions},
-          {"emissiveTexture", &m.emissiveTexture.extensions},
-          {"normalTexture", &m.normalTexture.extensions},
-          {"occlusionTexture", &m.occlusionTexture.extensions}};
-      for (const auto& [name, extensions] : textures) {
-        const Value* t = extension(*extensions, "KHR_texture_transform");
-        if (!t) continue;
-        const std::string twhere = where + ", " + name;
-        auto arr2 = [&](const char* key) {
-          if (const Value* v = member(*t, key)) {
-            bool ok = v->IsArray() && v->ArrayLen() == 2;
-            for (int k = 0; ok && k < 2; ++k)
-              ok = v->Get(k).IsNumber() && finite(v->Get(k).GetNumberAsDouble());
-            if (!ok)
-              fail(std::string("KHR_texture_transform ") + key + " must be 2 finite numbers",
-                   twhere);
-          }
-        };
-        arr2("offset");
-        arr2("scale");
-        if (const Value* r = member(*t, "rotation"))
-          if (!r->IsNumber() || !finite(r->GetNumberAsDouble()))
-            fail("KHR_texture_transform rotation must be a finite number", twhere);
-        if (const Value* c = member(*t, "texCoord"))
-          if (!c->IsInt() || c->GetNumberAsInt() < 0)
-            fail("KHR_texture_transform texCoord must be a non-negative integer", twhere);
-      }
+      arr2("offset");
+      arr2("scale");
+      if (const Value* r = member(*t, "rotation"))
+        if (!r->IsNumber() || !finite(r->GetNumberAsDouble()))
+          fail("KHR_texture_transform rotation must be a finite number", twhere);
+      if (const Value* c = member(*t, "texCoord"))
+        if (!c->IsInt() || c->GetNumberAsInt() < 0)
+          fail("KHR_texture_transform texCoord must be a non-negative integer", twhere);
     }
   }
 

@@ -87,18 +87,36 @@ PR_INLINE LightVertex light_vertex(float3 p, float t, float3 dir, uint ng_oct, u
   return v;
 }
 
-PR_KERNEL void light_trace(PR_PARAMS(PR_ARGS_LIGHT_TRACE)) {
-  const uint i = (uint)get_global_id(0);
-  if (i >= list_count) return;
-  const uint slot = list[i];
-  const SceneData s = PR_SCENE();
+// A slot's header before its path is traced: valid, no light, no vertex, absorbed.
+PR_INLINE PathHeader light_header_empty(uint generation) {
   PathHeader h;
-  h.generation = headers[slot].generation;
+  h.generation = generation;
   h.light = PR_INVALID_INDEX;
   h.vertex_count = 0u;
   h.end = PR_END_ABSORBED;
   h.valid = 1u;
   h.escape_x = h.escape_y = h.escape_z = 0.0f;
+  return h;
+}
+
+// Eye paths' light side: the step from vertex k (frame f, arrived from wo) along wi, with its
+// densities both ways (1 on both sides where delta).
+PR_INLINE void light_walk_leave(EyePathWalk* walk, uint k, const ShadingFrame* f, float3 wo,
+                                float3 wi) {
+  const int delta = bsdf_is_delta(&f->bsdf);
+  float pdf_fwd = 0.0f, pdf_rev = 0.0f;
+  if (!delta)
+    bsdf_eval_both(&f->bsdf, to_local(wo, f->t, f->b, f->n), to_local(wi, f->t, f->b, f->n),
+                   &pdf_fwd, &pdf_rev);
+  eye_path_walk_leave(walk, k, delta, pdf_fwd, pdf_rev);
+}
+
+PR_KERNEL void light_trace(PR_PARAMS(PR_ARGS_LIGHT_TRACE)) {
+  const uint i = (uint)get_global_id(0);
+  if (i >= list_count) return;
+  const uint slot = list[i];
+  const SceneData s = PR_SCENE();
+  PathHeader h = light_header_empty(headers[slot].generation);
   __global LightVertex* out = vertices + (size_t)slot * rp.stride;
   Rng rng = rng_make(rp.seed, PR_RNG_LIGHT, 0u, slot, h.generation);
   const float us = rng_next(&rng);
@@ -178,14 +196,7 @@ PR_KERNEL void light_trace(PR_PARAMS(PR_ARGS_LIGHT_TRACE)) {
     const ShadingFrame f = shading_frame(&s, &q, wo);
     PathStep step;
     if (!path_step(&s, &q, &f, wo, u0, v1, v2, PR_IMPORTANCE, &step)) break;
-    if (walk_on) {
-      const int delta = bsdf_is_delta(&f.bsdf);
-      float pdf_fwd = 0.0f, pdf_rev = 0.0f;
-      if (!delta)
-        bsdf_eval_both(&f.bsdf, to_local(wo, f.t, f.b, f.n), to_local(step.wi, f.t, f.b, f.n),
-                       &pdf_fwd, &pdf_rev);
-      eye_path_walk_leave(&walk, k, delta, pdf_fwd, pdf_rev);
-    }
+    if (walk_on) light_walk_leave(&walk, k, &f, wo, step.wi);
     float3 w = step.weight * shading_normal_correction(wo, step.wi, f.n, f.ng);
     // On the throughput relative to what left the light, from the third vertex on.
     if (k >= 2u && !russian_roulette(max3(tp * w) / tp0, rr, &w)) break;
