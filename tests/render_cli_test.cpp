@@ -2,6 +2,8 @@
 // --help-all list, the estimator key, and the generated option tables in the docs.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <functional>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -9,6 +11,7 @@
 #include <CLI/CLI.hpp>
 
 #include "app/render_cli.h"
+#include "util/error.h"
 #include "support/test_env.h"
 
 namespace pr {
@@ -88,6 +91,40 @@ TEST(RenderCli, DefaultsAreRenderOptionsDefaults) {
 
 // --help lists what every user needs; --help-all the research knobs too, under their groups.
 // Hidden or not, a knob parses and names itself in its errors.
+// Options built in code meet the table's ranges too: each value outside its option's range is
+// refused naming the option and the value; the defaults (automatic sentinels included) and a
+// value within range pass.
+TEST(RenderCli, OptionsBuiltInCodeMeetTheTablesRanges) {
+  EXPECT_NO_THROW(checkOptionRanges(RenderOptions{}));
+  RenderOptions fine;
+  fine.spp = 16;
+  fine.connect.pathsPerPixel = 64;
+  fine.resample.radius = 256.0f;
+  EXPECT_NO_THROW(checkOptionRanges(fine));
+  const std::vector<std::pair<std::function<void(RenderOptions&)>, std::string>> bad = {
+      {[](RenderOptions& o) { o.spp = 0; }, "--spp 0: "},
+      {[](RenderOptions& o) { o.maxDepth = 65; }, "--max-depth 65: "},
+      {[](RenderOptions& o) { o.fps = 0.0; }, "--fps 0: "},
+      {[](RenderOptions& o) { o.width = -3; }, "--width -3: "},
+      {[](RenderOptions& o) { o.connect.pathsPerPixel = 0; }, "--paths-per-pixel 0: "},
+      {[](RenderOptions& o) { o.connect.clamp = -1.0f; }, "--clamp -1: "},
+      {[](RenderOptions& o) { o.connect.historyPeriod = 0; }, "--connection-history-period 0: "},
+      {[](RenderOptions& o) { o.resample.radius = 0.5f; }, "--resample-radius 0.5: "},
+      {[](RenderOptions& o) { o.envStrength = std::nanf(""); }, "--env-strength nan: "},
+      {[](RenderOptions& o) { o.exposure = 100.0f; }, "--exposure 100: "},
+  };
+  for (const auto& [edit, message] : bad) {
+    RenderOptions o;
+    edit(o);
+    try {
+      checkOptionRanges(o);
+      ADD_FAILURE() << message << "was accepted";
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind(message, 0), 0u) << e.what();
+    }
+  }
+}
+
 TEST(RenderCli, HelpListsEverydayOptionsAndHelpAllTheResearchKnobs) {
   Parsed brief(false), all(true);
   const std::string shortHelp = brief.render->help();

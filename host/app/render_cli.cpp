@@ -14,6 +14,7 @@
 #include <CLI/CLI.hpp>
 
 #include "app/cli_checks.h"
+#include "util/error.h"
 
 namespace pr {
 namespace {
@@ -395,6 +396,38 @@ CLI::Option* addRow(CLI::App* render, const Row& r, RenderArgs& a) {
   if (std::holds_alternative<TextsField>(r.field)) opt->allow_extra_args(false);
   return opt;
 }
+
+// A number as the range errors print it.
+std::string numberText(double x) {
+  std::ostringstream out;
+  out << x;
+  return out.str();
+}
+
+}  // namespace
+
+void checkOptionRanges(const RenderOptions& o) {
+  RenderArgs given, defaults;
+  given.ro = o;
+  for (const Row& r : table()) {
+    if (!(r.lo <= r.hi)) continue;
+    std::visit(
+        [&](auto field) {
+          using T = std::decay_t<decltype(field(given))>;
+          if constexpr (std::is_arithmetic_v<T> && !std::is_same_v<T, bool>) {
+            const T value = field(given);
+            if (value == field(defaults)) return;  // not given: the default (0 or -1: automatic)
+            const double x = static_cast<double>(value);
+            if (!(x >= r.lo && x <= r.hi))
+              throw InputError(longName(r.names) + " " + numberText(x) + ": must be in [" +
+                               numberText(r.lo) + ", " + numberText(r.hi) + "]");
+          }
+        },
+        r.field);
+  }
+}
+
+namespace {
 
 // Each estimator option with what was given for it ("" where nothing, the default), after the
 // scene: two runs with the same key render the same frames from the same inputs.

@@ -41,6 +41,11 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& a, bool listResearch);
 // The parsed options as RenderOptions, with the estimator key built from the table.
 RenderOptions toRenderOptions(const RenderArgs& a, const CLI::App& render);
 
+// Each option's range in the table, checked on options built in code (the command line's are
+// checked as it is parsed): a value other than RenderOptions' default outside its option's range
+// throws InputError naming the option. What joins several options is validateRenderOptions'.
+void checkOptionRanges(const RenderOptions& o);
+
 // Whether the command line asks for --help-all (the research knobs are then listed).
 bool asksForHelpAll(int argc, const char* const* argv);
 

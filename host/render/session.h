@@ -22,7 +22,8 @@ namespace pr {
 class PathTracer;
 class AovRenderer;
 
-// Checks the options that do not need the scene; throws InputError naming the option.
+// Checks what joins several options and what needs more than a range (each option's range is the
+// option table's: app/render_cli.h); throws InputError naming the option.
 void validateRenderOptions(const RenderOptions& o);
 
 // Neither an emissive triangle nor a punctual light.
