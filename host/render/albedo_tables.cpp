@@ -135,6 +135,24 @@ double glassAlbedo(float mu, float alpha, float eta, int samples) {
   return s / (double(samples) * double(samples));
 }
 
+// The GGX albedo seen from wo, each microfacet weighted by the exact dielectric Fresnel's
+// shape at ior eta (fresnel_dielectric_weight).
+double ggxDielectricAlbedo(float3 wo, float alpha, float eta, int samples) {
+  const double lo = ggx_lambda_xy(wo, alpha, alpha);
+  double s = 0.0;
+  for (int a = 0; a < samples; ++a)
+    for (int b = 0; b < samples; ++b) {
+      const float u1 = (float(a) + 0.5f) / float(samples), u2 = (float(b) + 0.5f) / float(samples);
+      const float3 h = ggx_sample_vndf(wo, alpha, alpha, u1, u2);
+      const float voh = dot(wo, h);
+      const float3 wi = h * (2.0f * voh) - wo;
+      if (!(wi.z > 0.0f)) continue;
+      s += (1.0 + lo) / (1.0 + lo + ggx_lambda_xy(wi, alpha, alpha)) *
+           fresnel_dielectric_weight(voh, eta);
+    }
+  return s / (double(samples) * double(samples));
+}
+
 // The glass table's ior at grid point k of n.
 float gridIor(int k, int n) {
   auto z = [](float ior) { return (ior - 1.0f) / (ior + 1.0f); };
@@ -218,6 +236,27 @@ BsdfTables computeBsdfTables(int cosines, int roughnesses, int samples, int stri
     t.glassEavg[size_t(row)] = float(hemisphereAverage(
         2 * t.glassCosines, [&](float mu) { return glassAlbedo(mu, r * r, eta, samples / 4); }));
   });
+  t.dielectricCosines = kBsdfDielectricCos;
+  t.dielectricRoughnesses = kBsdfDielectricRoughness;
+  t.dielectricIors = kBsdfDielectricIor;
+  const int dielectricRows = t.dielectricIors * t.dielectricRoughnesses;
+  t.dielectricE.resize(size_t(dielectricRows) * size_t(t.dielectricCosines));
+  t.dielectricWeight.resize(size_t(t.dielectricIors));
+  parallelFor(dielectricRows, [&](int row) {
+    const int j = row % t.dielectricRoughnesses, k = row / t.dielectricRoughnesses;
+    const float r = gridRoughness(j, t.dielectricRoughnesses);
+    const float ior = gridIor(k, t.dielectricIors);
+    for (int i = 0; i < t.dielectricCosines; ++i) {
+      const size_t at = size_t(row) * size_t(t.dielectricCosines) + size_t(i);
+      if (at % size_t(stride) != 0) continue;
+      t.dielectricE[at] = float(ggxDielectricAlbedo(viewAt(gridCos(i, t.dielectricCosines), 0.0f),
+                                                    r * r, ior, samples / 2));
+    }
+  });
+  for (int k = 0; k < t.dielectricIors; k += stride)
+    t.dielectricWeight[size_t(k)] = float(hemisphereAverage(4096, [&](float mu) {
+      return fresnel_dielectric_weight(mu, gridIor(k, t.dielectricIors));
+    }));
   return t;
 }
 
@@ -271,6 +310,17 @@ std::string bsdfTablesHeader(const BsdfTables& t) {
   table("pr_glass_e", "Rough glass albedo.", t.glassE);
   table("pr_glass_eavg", "Rough glass albedo averaged over the hemisphere: [side][ior][roughness].",
         t.glassEavg);
+  s +=
+      "// The dielectric layer's GGX albedo weighted by the exact Fresnel's shape\n"
+      "// (fresnel_dielectric_weight): index [ior][roughness][cos] on a grid uniform in sqrt(cos)\n"
+      "// (PR_BSDF_DIELECTRIC_COS points), in roughness (PR_BSDF_DIELECTRIC_R) and in\n"
+      "// (ior - 1) / (ior + 1) (PR_BSDF_DIELECTRIC_IOR) as the glass tables.\n";
+  s += "#define PR_BSDF_DIELECTRIC_COS " + std::to_string(t.dielectricCosines) + "\n";
+  s += "#define PR_BSDF_DIELECTRIC_R " + std::to_string(t.dielectricRoughnesses) + "\n";
+  s += "#define PR_BSDF_DIELECTRIC_IOR " + std::to_string(t.dielectricIors) + "\n\n";
+  table("pr_ggx_ed", "GGX albedo weighted by the dielectric Fresnel's shape.", t.dielectricE);
+  table("pr_fresnel_wavg", "The shape averaged over the hemisphere (cosine-weighted): [ior].",
+        t.dielectricWeight);
   s += "PR_NAMESPACE_END\n";
   return s;
 }

@@ -21,6 +21,10 @@ constexpr int kBsdfAnisoRatio = 8;
 constexpr int kBsdfGlassCos = 16;
 constexpr int kBsdfGlassRoughness = 16;
 constexpr int kBsdfGlassIor = 8;
+// The dielectric layer's Fresnel (fresnel_dielectric_weight): cosines x roughnesses x iors.
+constexpr int kBsdfDielectricCos = 16;
+constexpr int kBsdfDielectricRoughness = 12;
+constexpr int kBsdfDielectricIor = 8;
 
 struct BsdfTables {
   int cosines = 0, roughnesses = 0;  // grid points, uniform in sqrt(cos) and in roughness
@@ -40,6 +44,11 @@ struct BsdfTables {
   int glassCosines = 0, glassRoughnesses = 0, glassIors = 0;
   std::vector<float> glassE;     // [side][ior][roughness][cos]
   std::vector<float> glassEavg;  // 2 \int E(mu) mu dmu: [side][ior][roughness]
+  // GGX albedo weighted by the exact dielectric Fresnel's shape (fresnel_dielectric_weight), on a
+  // grid uniform in sqrt(cos), in roughness and in (ior - 1) / (ior + 1) as the glass tables.
+  int dielectricCosines = 0, dielectricRoughnesses = 0, dielectricIors = 0;
+  std::vector<float> dielectricE;       // [ior][roughness][cos]
+  std::vector<float> dielectricWeight;  // the shape's 2 \int w(mu) mu dmu: [ior]
 };
 
 // The tables on a grid of `cosines` x `roughnesses` points (both ends included); `samples` is

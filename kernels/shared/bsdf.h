@@ -173,17 +173,39 @@ PR_INLINE void ggx_albedo(float ax, float ay, float mu, float* e, float* es, flo
   *eavg = bsdf_table_bilinear(pr_ggx_eavg_aniso + k * PR_BSDF_ANISO_R + j, PR_BSDF_ANISO_R, fy, fz);
 }
 
+// The energy model's dielectric layer of ior `ior` (alpha the lobe's): the GGX albedo seen from
+// cos mu weighted by the exact Fresnel's shape (fresnel_dielectric_weight), and in *wavg the
+// shape's hemispherical average; from the tables, ior and roughness clamped to their range.
+PR_INLINE float dielectric_albedo(float alpha, float mu, float ior, float* wavg) {
+  const float n = clamp(ior, PR_GLASS_TABLE_MIN_IOR, PR_GLASS_TABLE_MAX_IOR);
+  const float z0 = (PR_GLASS_TABLE_MIN_IOR - 1.0f) / (PR_GLASS_TABLE_MIN_IOR + 1.0f);
+  const float z1 = (PR_GLASS_TABLE_MAX_IOR - 1.0f) / (PR_GLASS_TABLE_MAX_IOR + 1.0f);
+  int i, j, k;
+  const float fx = bsdf_table_at(sqrt(fmax(mu, 0.0f)), PR_BSDF_DIELECTRIC_COS, &i);
+  const float fy = bsdf_table_at(bsdf_table_roughness(sqrt(alpha)), PR_BSDF_DIELECTRIC_R, &j);
+  const float fz =
+      bsdf_table_at(((n - 1.0f) / (n + 1.0f) - z0) / (z1 - z0), PR_BSDF_DIELECTRIC_IOR, &k);
+  *wavg = pr_fresnel_wavg[k] + (pr_fresnel_wavg[k + 1] - pr_fresnel_wavg[k]) * fz;
+  return bsdf_table3(pr_ggx_ed, PR_BSDF_DIELECTRIC_COS, PR_BSDF_DIELECTRIC_R, i, j, k, fx, fy, fz);
+}
+
 // ---- Layers
 
-// The multiple-scattering factor of a GGX lobe with Schlick Fresnel (f0, f90) seen at a
-// direction whose single-scattering albedo with F = 1 is e (average eavg): 1 + Fms (1 - e) / e,
-// Fms the Fresnel of the bounces after the first (Kulla and Conty's appendix, one Fresnel
-// taken out since it multiplies a lobe that has it): a white conductor's albedo is then 1.
-PR_INLINE float3 ggx_ms_factor(float3 f0, float f90, float e, float eavg) {
-  const float3 favg = f0 + (make_float3(f90, f90, f90) - f0) * (1.0f / 21.0f);
+// The multiple-scattering factor of a GGX lobe with Fresnel f0 + (f90 - f0) w (w's hemispherical
+// average wavg) seen at a direction whose single-scattering albedo with F = 1 is e (average
+// eavg): 1 + Fms (1 - e) / e, Fms the Fresnel of the bounces after the first (Kulla and Conty's
+// appendix, one Fresnel taken out since it multiplies a lobe that has it): a white conductor's
+// albedo is then 1.
+PR_INLINE float3 ggx_ms_factor_w(float3 f0, float f90, float wavg, float e, float eavg) {
+  const float3 favg = f0 + (make_float3(f90, f90, f90) - f0) * wavg;
   const float3 one = make_float3(1.0f, 1.0f, 1.0f);
   const float3 fms = favg * eavg / (one - favg * (1.0f - eavg));
   return one + fms * ((1.0f - e) / e);
+}
+
+// The same with Schlick's Fresnel, whose shape averages 1/21 over the hemisphere.
+PR_INLINE float3 ggx_ms_factor(float3 f0, float f90, float e, float eavg) {
+  return ggx_ms_factor_w(f0, f90, 1.0f / 21.0f, e, eavg);
 }
 
 // What the layering needs of one direction w: the layers' directional albedos and the
@@ -229,16 +251,21 @@ PR_INLINE BsdfLayers bsdf_layers(const BsdfParams* m, float3 w) {
     l.metal_albedo = (m->base * e + (one - m->base) * es) * l.metal_ms;
   }
   if (m->metallic < 1.0f) {
-    l.spec_ms = ggx_ms_factor(m->f0, m->f90, e, eavg);
-    l.spec_albedo = (m->f0 * e + (make_float3(m->f90, m->f90, m->f90) - m->f0) * es) * l.spec_ms;
+    // The dielectric layer: the exact Fresnel's shape at the material's ior.
+    float wavg;
+    const float ed = dielectric_albedo(sqrt(m->alpha_x * m->alpha_y), w.z, m->ior, &wavg);
+    l.spec_ms = ggx_ms_factor_w(m->f0, m->f90, wavg, e, eavg);
+    l.spec_albedo = (m->f0 * e + (make_float3(m->f90, m->f90, m->f90) - m->f0) * ed) * l.spec_ms;
   }
   if (bsdf_has_coat(m) && cc > 0.0f) {
     const float rc = sqrt(m->coat_alpha);
-    const float ec = fmax(bsdf_table2(pr_ggx_e, cc, rc), 1e-3f),
-                esc = bsdf_table2(pr_ggx_es, cc, rc);
-    l.coat_ms =
-        ggx_ms_factor(make_float3(0.04f, 0.04f, 0.04f), 1.0f, ec, bsdf_table1(pr_ggx_eavg, rc)).x;
-    l.coat_albedo = m->coat * (0.04f * ec + 0.96f * esc) * l.coat_ms;
+    const float ec = fmax(bsdf_table2(pr_ggx_e, cc, rc), 1e-3f);
+    float wavg;
+    const float edc = dielectric_albedo(m->coat_alpha, cc, PR_COAT_IOR, &wavg);
+    l.coat_ms = ggx_ms_factor_w(make_float3(0.04f, 0.04f, 0.04f), 1.0f, wavg, ec,
+                                bsdf_table1(pr_ggx_eavg, rc))
+                    .x;
+    l.coat_albedo = m->coat * (0.04f * ec + 0.96f * edc) * l.coat_ms;
   }
   return l;
 }
@@ -310,7 +337,7 @@ typedef struct {
 // What evaluation shares between the lobes.
 typedef struct {
   float3 wo, wi, h;
-  float3 fd;  // the dielectric layer's Fresnel at wo.h (Schlick, f0 to f90)
+  float3 fd;  // the dielectric layer's Fresnel at wo.h, f0 to f90 (fresnel_dielectric_weight)
   float w5;   // Schlick's weight at wo.h
   int mode;
   BsdfLayers lo, li;  // the layers of wo and wi
@@ -382,7 +409,11 @@ PR_INLINE float3 lobe_coat_eval(const BsdfParams* m, const BsdfEval* e, float3 b
         ggx_reflection(co, ci, dot(e->h, m->coat_n), m->coat_alpha * m->coat_alpha, &unused);
     // glTF: the coat's lobe weighted by its Fresnel at N.V; energy: the microfacet's Fresnel
     // with the multiple-scattering factor.
-    coat_spec *= bsdf_gltf(m) ? lv->coat_albedo : m->coat * coat_fresnel(e->w5) * lv->coat_ms;
+    coat_spec *= bsdf_gltf(m) ? lv->coat_albedo
+                              : m->coat *
+                                    coat_fresnel(fresnel_dielectric_weight(
+                                        fmax(dot(e->wo, e->h), 0.0f), PR_COAT_IOR)) *
+                                    lv->coat_ms;
     // The caller weights by the cosine to the shading normal; a tilted coat reflects by the
     // cosine to its own, on the light's side (wi, or wo for importance).
     if (m->coat_n.z < 1.0f) coat_spec *= e->mode == PR_RADIANCE ? ci / e->wi.z : co / e->wo.z;
@@ -801,7 +832,11 @@ PR_INLINE float3 bsdf_eval_impl(const BsdfParams* m, float3 wo, float3 wi, int m
   if (hl <= 0.0f) return make_float3(0.0f, 0.0f, 0.0f);
   e.h = e.h / hl;
   e.w5 = schlick_weight(fmax(dot(wo, e.h), 0.0f));
-  e.fd = m->f0 + (make_float3(m->f90, m->f90, m->f90) - m->f0) * e.w5;
+  // The dielectric layer's Fresnel: Schlick's in the glTF model, the exact one's shape in the
+  // energy model.
+  const float wd =
+      bsdf_gltf(m) ? e.w5 : fresnel_dielectric_weight(fmax(dot(wo, e.h), 0.0f), m->ior);
+  e.fd = m->f0 + (make_float3(m->f90, m->f90, m->f90) - m->f0) * wd;
   e.mode = mode;
   // wi's layers where the value (seen from wi, or the glTF sheen's scaling) or pdf_rev needs
   // them.

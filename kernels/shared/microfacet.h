@@ -82,9 +82,11 @@ PR_INLINE float schlick_weight(float c) {
   return m2 * m2 * m;
 }
 
-// The coat's Fresnel (an ior 1.5 dielectric, as KHR_materials_clearcoat fixes it).
-PR_INLINE float coat_fresnel(float w5) {
-  return 0.04f + 0.96f * w5;
+// The coat's Fresnel (an ior 1.5 dielectric, as KHR_materials_clearcoat fixes it) from the
+// weight of its shape: Schlick's (1 - c)^5, or fresnel_dielectric_weight at PR_COAT_IOR.
+#define PR_COAT_IOR 1.5f
+PR_INLINE float coat_fresnel(float w) {
+  return 0.04f + 0.96f * w;
 }
 
 // GGX specular reflection D G2 / (4 cos_o cos_i) for alpha^2 = a2, given the cosines of wo, wi
@@ -148,6 +150,18 @@ PR_INLINE float fresnel_dielectric(float cos_i, float eta) {
   const float rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
   const float rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
   return 0.5f * (rs * rs + rp * rp);
+}
+
+// The energy model's dielectric layers take the exact Fresnel's shape where Schlick's (1 - c)^5
+// would stand (F = f0 + (f90 - f0) w), as Cycles' Principled BSDF does: the exact Fresnel of
+// relative ior eta (clamped to the tables' PR_GLASS_TABLE_*_IOR) at cos c, run from 0 at normal
+// incidence to 1 at grazing. At ior 1.5 and 45 degrees it is 5x Schlick's weight: a dark rough
+// dielectric seen at 45 degrees reflected 14% less than Cycles' with Schlick's.
+PR_INLINE float fresnel_dielectric_weight(float c, float eta) {
+  const float n = clamp(eta, PR_GLASS_TABLE_MIN_IOR, PR_GLASS_TABLE_MAX_IOR);
+  const float r = (n - 1.0f) / (n + 1.0f);
+  const float f0 = r * r;
+  return clamp((fresnel_dielectric(clamp(c, 0.0f, 1.0f), n) - f0) / (1.0f - f0), 0.0f, 1.0f);
 }
 
 PR_NAMESPACE_END
