@@ -10,6 +10,9 @@ the mean luminance and of each channel, and the 95th percentile over the 16x16 b
 the asset of |ours / Cycles - 1| (block means): the parts that differ show there; and the mean
 over the asset's pixels (two pixels in from its outline) of |ours / Cycles - 1| of 3x3 means:
 what a normal map's orientation or a texture's lookup changes, which block means average away.
+Its parts are its materials: ours renders with `--aov material`, and for each material with at
+least --part-pixels pixels two in from the outline, the ratio of the mean luminance; the line
+gives the part furthest from Cycles ("parts worst"), --json every part.
 
   /usr/bin/python3 -m tools.bench.asset_compare --cycles ~/.cache/pathreuse/bpy-5.2.3/bin/python \\
       --binary build/pathreuse --assets StainedGlassLamp,ToyCar --spp 256 --width 256
@@ -24,6 +27,7 @@ import json
 import os
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -64,9 +68,45 @@ def pixel_deviation(ours, cyc, mask):
     return float(np.abs(a[sel] / b[sel] - 1).mean()) if sel.any() else float("nan")
 
 
+def read_channel(binary, exr, name):
+    """One channel of an EXR (e.g. material.ID) as a float array, through exr_compare."""
+    with tempfile.TemporaryDirectory() as tmp:
+        raw = Path(tmp) / "channel.raw"
+        subprocess.run([str(Path(binary).parent / "exr_compare"), "--raw-channel", name, str(exr),
+                        str(raw)], check=True)
+        with open(raw, "rb") as f:
+            w, h = np.fromfile(f, "<u4", 2)
+            return np.fromfile(f, "<f4").reshape(int(h), int(w))
+
+
+def material_names(scene):
+    """The wrapper's glTF material names by index."""
+    doc = json.loads(Path(scene).read_text())
+    return [m.get("name", f"material {i}") for i, m in enumerate(doc.get("materials", []))]
+
+
+def parts(ours, cyc, mask, ids, names, min_pixels):
+    """Per material with at least min_pixels pixels two in from the asset's outline: its name,
+    pixel count and ratio ours / Cycles of the mean luminance, furthest from 1 first."""
+    inner = mask & np.roll(mask, 2, 0) & np.roll(mask, -2, 0) & np.roll(mask, 2, 1) \
+        & np.roll(mask, -2, 1)
+    yo, yc = ours @ LUMA, cyc @ LUMA
+    rows = []
+    for k in np.unique(ids[inner]):
+        sel = inner & (ids == k)
+        n = int(sel.sum())
+        if n < min_pixels or not (yc[sel].mean() > 0):
+            continue
+        i = int(k)
+        name = names[i] if 0 <= i < len(names) else f"id {i}"
+        rows.append({"material": name, "pixels": n, "ratio": float(yo[sel].mean() / yc[sel].mean())})
+    return sorted(rows, key=lambda r: -abs(r["ratio"] - 1))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--assets", default="StainedGlassLamp,ToyCar,DamagedHelmet,FlightHelmet")
+    ap.add_argument("--assets", default="StainedGlassLamp,ToyCar,DamagedHelmet,FlightHelmet,"
+                    "CesiumMan,Fox,BrainStem")
     ap.add_argument("--scenes", default=str(REPO.parent / "shared" / "scenes"))
     ap.add_argument("--binary", default=str(REPO / "build" / "pathreuse"))
     ap.add_argument("--cycles", required=True, help="a Python with bpy 5.2.3")
@@ -76,6 +116,8 @@ def main():
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--block", type=int, default=16)
     ap.add_argument("--work", default="/tmp/pathreuse-asset-compare")
+    ap.add_argument("--part-pixels", type=int, default=200,
+                    help="pixels a material needs to count as a part (default 200)")
     ap.add_argument("--json", help="write the figures here")
     a = ap.parse_args()
     images = Images(a.binary, lambda: a.cycles)
@@ -87,7 +129,8 @@ def main():
         subprocess.run([a.binary, "render", str(scene), "--allow-outside-uris", "--camera",
                         str(camera), "--mode", "pathtrace", "--spp", str(a.spp), "--max-depth",
                         str(a.max_depth), "--env-color", "1,1,1", "--exr-float", "--frames", "0",
-                        "--out", str(d / "ours" / "f_%04d.exr"), "-q", *size], check=True,
+                        "--out", str(d / "ours" / "f_%04d.exr"), "-q", "--aov", "material",
+                        *size], check=True,
                        env=dict(os.environ, POCL_MAX_PTHREAD_COUNT=str(a.threads)))
         subprocess.run([a.cycles, str(HERE / "cycles_frames.py"), str(scene), str(d / "cycles"),
                         "--frames", "0-0", "--spp", str(a.spp), "--max-depth", str(a.max_depth),
@@ -96,15 +139,20 @@ def main():
         ours = images.read(d / "ours" / "f_0000.exr")
         cyc = images.read(d / "cycles" / "f_0000.exr")
         mask = (np.abs(ours - 1).max(axis=2) > 0.02) | (np.abs(cyc - 1).max(axis=2) > 0.02)
+        ids = read_channel(a.binary, d / "ours" / "f_0000.exr", "material.ID")
         row = {"asset": name, **compare(ours, cyc, mask, a.block),
-               "pixel_deviation": pixel_deviation(ours, cyc, mask)}
+               "pixel_deviation": pixel_deviation(ours, cyc, mask),
+               "parts": parts(ours, cyc, mask, ids, material_names(scene), a.part_pixels)}
+        worst = row["parts"][0] if row["parts"] else {"material": "none", "ratio": float("nan")}
         ratio_png(d / "ratio.png", ours, cyc, mask)
         rows.append(row)
         print(f"{name:18s} luminance {row['mean_ratio']:.3f}  rgb "
               + " ".join(f"{x:.3f}" for x in row["rgb_ratio"])
               + f"  blocks p95 {row['p95_block']:.3f} max {row['max_block']:.3f}"
               + f"  pixels {row['pixel_deviation']:.4f}"
-              + f" ({row['blocks']} blocks, {row['pixels']} px)", flush=True)
+              + f" ({row['blocks']} blocks, {row['pixels']} px)"
+              + f"  parts worst {worst['ratio']:.3f} ({worst['material']}) of {len(row['parts'])}",
+              flush=True)
     if a.json:
         Path(a.json).write_text(json.dumps(rows, indent=1))
     return 0

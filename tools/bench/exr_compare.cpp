@@ -3,6 +3,7 @@
 // and notes: one JSON object on stdout.
 //   exr_compare A.exr [B.exr]
 //   exr_compare --raw A.exr A.raw [B.exr B.raw ...]
+//   exr_compare --raw-channel NAME A.exr A.raw   (one channel, e.g. material.ID of --aov)
 // The differences are pr::compareImages's (host/portability/compare.cpp), the one relMSE of the
 // project: `pathreuse portability`, the tests and, through this program, the Python tools
 // (tools/bench/) all measure with it. relmse = mean over pixels and RGB of (A - B)^2 / (B^2 +
@@ -10,7 +11,8 @@
 // over all pixels; both over the pixels whose values are finite in both images, the others
 // counted in non_finite.
 // --raw writes width and height (uint32, little-endian) then float32 RGB, row by row from the
-// top, so that scripts without an EXR reader (tools/bench/evaluate.py, numpy) can load the pixels.
+// top, so that scripts without an EXR reader (tools/bench/evaluate.py, numpy) can load the pixels;
+// --raw-channel the same with one float32 per pixel.
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
@@ -40,7 +42,31 @@ void writeRaw(const pr::Image& img, const std::string& path) {
 
 }  // namespace
 
+void writeRawChannel(const std::string& exr, const std::string& name, const std::string& path) {
+  const pr::Image img = pr::readExr(exr);
+  const std::vector<float> values = pr::readExrChannel(exr, name);
+  const uint32_t size[2] = {uint32_t(img.width), uint32_t(img.height)};
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(reinterpret_cast<const char*>(size), sizeof size);
+  out.write(reinterpret_cast<const char*>(values.data()),
+            std::streamsize(values.size() * sizeof(float)));
+  if (!out) throw std::runtime_error(path + ": cannot write");
+}
+
 int main(int argc, char** argv) {
+  if (argc >= 2 && std::string(argv[1]) == "--raw-channel") {
+    if (argc != 5) {
+      std::cerr << "usage: exr_compare --raw-channel NAME A.exr A.raw\n";
+      return 2;
+    }
+    try {
+      writeRawChannel(argv[3], argv[2], argv[4]);
+    } catch (const std::exception& e) {
+      std::cerr << "error: " << e.what() << "\n";
+      return 2;
+    }
+    return 0;
+  }
   if (argc >= 2 && std::string(argv[1]) == "--raw") {
     if (argc < 4 || argc % 2 != 0) {
       std::cerr << "usage: exr_compare --raw A.exr A.raw [B.exr B.raw ...]\n";

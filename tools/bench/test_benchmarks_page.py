@@ -91,7 +91,9 @@ class Extraction(unittest.TestCase):
                 "0.310  pixels 0.0630 (120 blocks, 30000 px)")
         got = bp.asset_table("progress\n" + line + "\n")
         self.assertIn("| StainedGlassLamp | 0.969 | 0.956 0.974 0.978 | 0.095 | 0.310 | 0.0630 "
-                      "| 120 | 30000 |", got)
+                      "| 120 | 30000 |  |", got)
+        parts = line + "  parts worst 0.912 (RubberWoodMat) of 6"
+        self.assertIn("| 30000 | 0.912 RubberWoodMat (of 6) |", bp.asset_table(parts + "\n"))
         self.assertEqual(bp.asset_table("nothing\n"), "")
 
 
