@@ -14,6 +14,14 @@
 #include "pathtrace/shade_resample.h"
 #include "shared/reuse.h"
 
+// The path tracer's weight w of a path ending on a light, as *ew's first part; the connections'
+// parts are 0 until a hook sets them, and T's length is that of x_1 .. x_t, t = p->depth.
+PR_INLINE void pt_weight_parts(const PathState* p, float w, u32 max_depth, EyeWeight* ew) {
+  ew->pt = w;
+  ew->n = ew->h = ew->l = ew->t = 0.0f;
+  ew->t_len = eye_paths_camera_len(p->depth, max_depth);
+}
+
 // The weight of emission found at h along d (dist2 from the previous vertex): against next-event
 // estimation, and where the connections can make the path too (joinable), times their share;
 // its parts into *ew.
@@ -25,10 +33,7 @@ PR_INLINE float pt_emission_weight(const SceneData* s, const PathState* p, const
   float w = 1.0f;
   if (!(p->flags & PR_PATH_SPECULAR))
     w = power_heuristic(p->last_pdf, emitter_pdf(s, h, prev, prev_n));
-  ew->pt = w;
-  ew->n = ew->h = ew->l = ew->t = 0.0f;
-  // Strategy T: x_1 .. x_t before the light, t = p->depth; its ratio was fixed at x_2.
-  ew->t_len = eye_paths_camera_len(p->depth, max_depth);
+  pt_weight_parts(p, w, max_depth, ew);  // T's ratio was fixed at x_2
   if (PR_EYE_PATHS && joinable) w = ep_emission_share(s, p, h, d, dist2, em, w, ew);
   return w;
 }
@@ -40,9 +45,7 @@ PR_INLINE float pt_next_event_weight(const SceneData* s, const PathState* p, con
                                      int has_rev, float dist2, const EyeMis* em, u32 max_depth,
                                      EyeWeight* ew) {
   const float w = ch->delta ? 1.0f : power_heuristic(ch->pdf_light, ch->pdf_bsdf);
-  ew->pt = w;
-  ew->n = ew->h = ew->l = ew->t = 0.0f;
-  ew->t_len = eye_paths_camera_len(p->depth, max_depth);  // x_1 .. x_t, t = p->depth
+  pt_weight_parts(p, w, max_depth, ew);
   if (PR_EYE_PATHS && joinable)
     return ep_next_event_share(s, p, h, f, ch, has_rev, dist2, em, w, ew);
   return w;
@@ -60,9 +63,7 @@ PR_INLINE float pt_escape_weight(const SceneData* s, const PathState* p, float3 
                                  int joinable, const EyeMis* em, u32 max_depth, EyeWeight* ew) {
   const int spec = (p->flags & PR_PATH_SPECULAR) != 0u;
   float w = spec ? 1.0f : power_heuristic(p->last_pdf, pdf_light);
-  ew->pt = w;
-  ew->n = ew->h = ew->l = ew->t = 0.0f;
-  ew->t_len = eye_paths_camera_len(p->depth, max_depth);
+  pt_weight_parts(p, w, max_depth, ew);
   if (PR_EYE_PATHS && joinable) w = ep_escape_share(s, p, d, em, w, ew);
   return w;
 }

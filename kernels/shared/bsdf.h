@@ -122,6 +122,15 @@ PR_INLINE float bsdf_table_roughness(float r) {
   return (r - PR_TABLE_MIN_ROUGHNESS) * (1.0f / (1.0f - PR_TABLE_MIN_ROUGHNESS));
 }
 
+// The cell and fraction of an ior on the ior axis of the glass and dielectric tables (n points
+// uniform in (ior - 1) / (ior + 1) from PR_GLASS_TABLE_MIN_IOR to _MAX_IOR), ior clamped to it.
+PR_INLINE float bsdf_table_ior(float ior, int n, int* k) {
+  const float c = clamp(ior, PR_GLASS_TABLE_MIN_IOR, PR_GLASS_TABLE_MAX_IOR);
+  const float z0 = (PR_GLASS_TABLE_MIN_IOR - 1.0f) / (PR_GLASS_TABLE_MIN_IOR + 1.0f);
+  const float z1 = (PR_GLASS_TABLE_MAX_IOR - 1.0f) / (PR_GLASS_TABLE_MAX_IOR + 1.0f);
+  return bsdf_table_at(((c - 1.0f) / (c + 1.0f) - z0) / (z1 - z0), n, k);
+}
+
 // Bilinear in a table of rows of ni at the cell whose first corner is c, fractions (fx, fy).
 PR_INLINE float bsdf_table_bilinear(PR_CONSTANT const float* c, int ni, float fx, float fy) {
   const float a = c[0] + (c[1] - c[0]) * fx;
@@ -177,14 +186,10 @@ PR_INLINE void ggx_albedo(float ax, float ay, float mu, float* e, float* es, flo
 // cos mu weighted by the exact Fresnel's shape (fresnel_dielectric_weight), and in *wavg the
 // shape's hemispherical average; from the tables, ior and roughness clamped to their range.
 PR_INLINE float dielectric_albedo(float alpha, float mu, float ior, float* wavg) {
-  const float n = clamp(ior, PR_GLASS_TABLE_MIN_IOR, PR_GLASS_TABLE_MAX_IOR);
-  const float z0 = (PR_GLASS_TABLE_MIN_IOR - 1.0f) / (PR_GLASS_TABLE_MIN_IOR + 1.0f);
-  const float z1 = (PR_GLASS_TABLE_MAX_IOR - 1.0f) / (PR_GLASS_TABLE_MAX_IOR + 1.0f);
   int i, j, k;
   const float fx = bsdf_table_at(sqrt(fmax(mu, 0.0f)), PR_BSDF_DIELECTRIC_COS, &i);
   const float fy = bsdf_table_at(bsdf_table_roughness(sqrt(alpha)), PR_BSDF_DIELECTRIC_R, &j);
-  const float fz =
-      bsdf_table_at(((n - 1.0f) / (n + 1.0f) - z0) / (z1 - z0), PR_BSDF_DIELECTRIC_IOR, &k);
+  const float fz = bsdf_table_ior(ior, PR_BSDF_DIELECTRIC_IOR, &k);
   *wavg = pr_fresnel_wavg[k] + (pr_fresnel_wavg[k + 1] - pr_fresnel_wavg[k]) * fz;
   return bsdf_table3(pr_ggx_ed, PR_BSDF_DIELECTRIC_COS, PR_BSDF_DIELECTRIC_R, i, j, k, fx, fy, fz);
 }
@@ -575,14 +580,10 @@ PR_INLINE float rough_glass_eta(const BsdfParams* m, float3 wo) {
 // The single-scattering albedo of white rough glass seen from the view w, from the table, and in
 // *avg its average over the hemisphere of w's side.
 PR_INLINE float rough_glass_albedo(const BsdfParams* m, float3 w, float* avg) {
-  const float ior = clamp(m->ior, PR_GLASS_TABLE_MIN_IOR, PR_GLASS_TABLE_MAX_IOR);
-  const float z0 = (PR_GLASS_TABLE_MIN_IOR - 1.0f) / (PR_GLASS_TABLE_MIN_IOR + 1.0f);
-  const float z1 = (PR_GLASS_TABLE_MAX_IOR - 1.0f) / (PR_GLASS_TABLE_MAX_IOR + 1.0f);
   int i, j, k;
   const float fx = bsdf_table_at(sqrt(fabs(w.z)), PR_BSDF_GLASS_COS, &i);
   const float fy = bsdf_table_at(bsdf_table_roughness(sqrt(m->alpha_x)), PR_BSDF_GLASS_R, &j);
-  const float fz =
-      bsdf_table_at(((ior - 1.0f) / (ior + 1.0f) - z0) / (z1 - z0), PR_BSDF_GLASS_IOR, &k);
+  const float fz = bsdf_table_ior(m->ior, PR_BSDF_GLASS_IOR, &k);
   const int side = w.z > 0.0f ? 0 : 1;
   *avg = bsdf_table_bilinear(pr_glass_eavg + (side * PR_BSDF_GLASS_IOR + k) * PR_BSDF_GLASS_R + j,
                              PR_BSDF_GLASS_R, fy, fz);
