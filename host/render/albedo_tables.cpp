@@ -24,9 +24,11 @@ float gridCos(int i, int n) {
 
 // Albedo integrals of GGX with F = 1 seen from wo: E = E[G2 / G1] over visible normals (f cos /
 // pdf of visible-normal sampling), and the same weighted by (1 - v.h)^5.
-void ggxAlbedo(float3 wo, float ax, float ay, int samples, double* e, double* es) {
+// Each reflection of wo off a GGX microfacet, on a stratified grid of samples x samples visible
+// normals: visit(wo.h, G2 / G1), the sample's share of the albedo with F = 1.
+template <class Visit>
+void ggxReflections(float3 wo, float ax, float ay, int samples, Visit visit) {
   const double lo = ggx_lambda_xy(wo, ax, ay);
-  double se = 0.0, ses = 0.0;
   for (int a = 0; a < samples; ++a)
     for (int b = 0; b < samples; ++b) {
       const float u1 = (float(a) + 0.5f) / float(samples), u2 = (float(b) + 0.5f) / float(samples);
@@ -34,10 +36,16 @@ void ggxAlbedo(float3 wo, float ax, float ay, int samples, double* e, double* es
       const float voh = dot(wo, h);
       const float3 wi = h * (2.0f * voh) - wo;
       if (!(wi.z > 0.0f)) continue;
-      const double w = (1.0 + lo) / (1.0 + lo + ggx_lambda_xy(wi, ax, ay));
-      se += w;
-      ses += w * schlick_weight(voh);
+      visit(voh, (1.0 + lo) / (1.0 + lo + ggx_lambda_xy(wi, ax, ay)));
     }
+}
+
+void ggxAlbedo(float3 wo, float ax, float ay, int samples, double* e, double* es) {
+  double se = 0.0, ses = 0.0;
+  ggxReflections(wo, ax, ay, samples, [&](float voh, double w) {
+    se += w;
+    ses += w * schlick_weight(voh);
+  });
   const double count = double(samples) * double(samples);
   *e = se / count;
   *es = ses / count;
@@ -138,18 +146,9 @@ double glassAlbedo(float mu, float alpha, float eta, int samples) {
 // The GGX albedo seen from wo, each microfacet weighted by the exact dielectric Fresnel's
 // shape at ior eta (fresnel_dielectric_weight).
 double ggxDielectricAlbedo(float3 wo, float alpha, float eta, int samples) {
-  const double lo = ggx_lambda_xy(wo, alpha, alpha);
   double s = 0.0;
-  for (int a = 0; a < samples; ++a)
-    for (int b = 0; b < samples; ++b) {
-      const float u1 = (float(a) + 0.5f) / float(samples), u2 = (float(b) + 0.5f) / float(samples);
-      const float3 h = ggx_sample_vndf(wo, alpha, alpha, u1, u2);
-      const float voh = dot(wo, h);
-      const float3 wi = h * (2.0f * voh) - wo;
-      if (!(wi.z > 0.0f)) continue;
-      s += (1.0 + lo) / (1.0 + lo + ggx_lambda_xy(wi, alpha, alpha)) *
-           fresnel_dielectric_weight(voh, eta);
-    }
+  ggxReflections(wo, alpha, alpha, samples,
+                 [&](float voh, double w) { s += w * fresnel_dielectric_weight(voh, eta); });
   return s / (double(samples) * double(samples));
 }
 

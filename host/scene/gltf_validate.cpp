@@ -1,6 +1,7 @@
 #include "scene/gltf_validate.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <set>
 
@@ -306,28 +307,28 @@ class Validator : Stage {
         if (!s->IsNumber() || !finite(s->GetNumberAsDouble()))
           fail(std::string(ext) + " " + key + " must be a finite number", where);
     };
+    // A colour: 3 finite numbers in [0, hi]; `what` says the range in the error.
+    auto colour = [&](const Value* e, const char* key, double hi, const char* ext,
+                      const char* what) {
+      if (const Value* c = member(*e, key)) {
+        bool ok = c->IsArray() && c->ArrayLen() == 3;
+        for (int k = 0; ok && k < 3; ++k) {
+          const double x = c->Get(k).IsNumber() ? c->Get(k).GetNumberAsDouble() : -1.0;
+          ok = finite(x) && x >= 0.0 && x <= hi;
+        }
+        if (!ok) fail(std::string(ext) + " " + key + " must be 3 numbers " + what, where);
+      }
+    };
     if (const Value* e = extension(m.extensions, "KHR_materials_specular")) {
       number(e, "specularFactor", 0.0, 1.0, "KHR_materials_specular");
-      if (const Value* c = member(*e, "specularColorFactor")) {
-        bool ok = c->IsArray() && c->ArrayLen() == 3;
-        for (int k = 0; ok && k < 3; ++k)
-          ok = c->Get(k).IsNumber() && finite(c->Get(k).GetNumberAsDouble()) &&
-               c->Get(k).GetNumberAsDouble() >= 0.0;
-        if (!ok) fail("KHR_materials_specular specularColorFactor must be 3 numbers >= 0", where);
-      }
+      colour(e, "specularColorFactor", HUGE_VAL, "KHR_materials_specular", ">= 0");
     }
     if (const Value* e = extension(m.extensions, "KHR_materials_volume")) {
       number(e, "thicknessFactor", 0.0, 3.0e38, "KHR_materials_volume");
       if (const Value* d = member(*e, "attenuationDistance"))
         if (!d->IsNumber() || !finite(d->GetNumberAsDouble()) || d->GetNumberAsDouble() <= 0.0)
           fail("KHR_materials_volume attenuationDistance must be a number > 0", where);
-      if (const Value* c = member(*e, "attenuationColor")) {
-        bool ok = c->IsArray() && c->ArrayLen() == 3;
-        for (int k = 0; ok && k < 3; ++k)
-          ok = c->Get(k).IsNumber() && c->Get(k).GetNumberAsDouble() >= 0.0 &&
-               c->Get(k).GetNumberAsDouble() <= 1.0;
-        if (!ok) fail("KHR_materials_volume attenuationColor must be 3 numbers in 0..1", where);
-      }
+      colour(e, "attenuationColor", 1.0, "KHR_materials_volume", "in 0..1");
     }
     if (const Value* e = extension(m.extensions, "KHR_materials_clearcoat")) {
       number(e, "clearcoatFactor", 0.0, 1.0, "KHR_materials_clearcoat");
@@ -337,13 +338,7 @@ class Validator : Stage {
           finiteNumber(t, "scale", "KHR_materials_clearcoat clearcoatNormalTexture");
     }
     if (const Value* e = extension(m.extensions, "KHR_materials_sheen")) {
-      if (const Value* c = member(*e, "sheenColorFactor")) {
-        bool ok = c->IsArray() && c->ArrayLen() == 3;
-        for (int k = 0; ok && k < 3; ++k)
-          ok = c->Get(k).IsNumber() && c->Get(k).GetNumberAsDouble() >= 0.0 &&
-               c->Get(k).GetNumberAsDouble() <= 1.0;
-        if (!ok) fail("KHR_materials_sheen sheenColorFactor must be 3 numbers in 0..1", where);
-      }
+      colour(e, "sheenColorFactor", 1.0, "KHR_materials_sheen", "in 0..1");
       number(e, "sheenRoughnessFactor", 0.0, 1.0, "KHR_materials_sheen");
     }
     if (const Value* e = extension(m.extensions, "KHR_materials_anisotropy")) {
