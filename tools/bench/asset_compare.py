@@ -57,12 +57,18 @@ def box3(a):
     return sum(p[y:y + a.shape[0], x:x + a.shape[1]] for y in range(3) for x in range(3)) / 9
 
 
-def pixel_deviation(ours, cyc, mask):
-    """Mean |ours / Cycles - 1| of the 3x3 means of luminance over mask shrunk by two pixels."""
+def shrink(mask, pixels=2):
+    """The mask less its pixels within `pixels` steps (4-neighbour) of its outline."""
     inner = mask.copy()
-    for _ in range(2):
+    for _ in range(pixels):
         p = np.pad(inner, 1, constant_values=False)
         inner = inner & p[:-2, 1:-1] & p[2:, 1:-1] & p[1:-1, :-2] & p[1:-1, 2:]
+    return inner
+
+
+def pixel_deviation(ours, cyc, mask):
+    """Mean |ours / Cycles - 1| of the 3x3 means of luminance over mask shrunk by two pixels."""
+    inner = shrink(mask)
     a, b = box3(ours @ LUMA), box3(cyc @ LUMA)
     sel = inner & (b > 0)
     return float(np.abs(a[sel] / b[sel] - 1).mean()) if sel.any() else float("nan")
@@ -88,8 +94,7 @@ def material_names(scene):
 def parts(ours, cyc, mask, ids, names, min_pixels):
     """Per material with at least min_pixels pixels two in from the asset's outline: its name,
     pixel count and ratio ours / Cycles of the mean luminance, furthest from 1 first."""
-    inner = mask & np.roll(mask, 2, 0) & np.roll(mask, -2, 0) & np.roll(mask, 2, 1) \
-        & np.roll(mask, -2, 1)
+    inner = shrink(mask)
     yo, yc = ours @ LUMA, cyc @ LUMA
     rows = []
     for k in np.unique(ids[inner]):

@@ -71,16 +71,20 @@ def run_tool(module, args, python=None, **kwargs):
                           **kwargs)
 
 
-def machine_lines(exe):
-    """Markdown list items: machine, OpenCL devices, PoCL package, commit."""
-    cpu = "unknown"
+def cpu_model():
+    """The CPU's model name from /proc/cpuinfo ('unknown' where there is none)."""
     try:
         for line in Path("/proc/cpuinfo").read_text().splitlines():
             if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
+                return line.split(":", 1)[1].strip()
     except OSError:
         pass
+    return "unknown"
+
+
+def machine_lines(exe):
+    """Markdown list items: machine, OpenCL devices, PoCL package, commit."""
+    cpu = cpu_model()
     dev = subprocess.run([str(exe), "devices"], capture_output=True, text=True).stdout.strip()
     commit = subprocess.run(["git", "-C", str(REPO), "rev-parse", "--short", "HEAD"],
                             capture_output=True, text=True).stdout.strip() or "unknown"

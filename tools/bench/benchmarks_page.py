@@ -50,6 +50,8 @@ from dataclasses import dataclass
 from datetime import datetime, timezone
 from pathlib import Path
 
+from .benchlib import cpu_model
+
 REPO = Path(__file__).resolve().parents[2]
 PAGE = REPO / "docs" / "benchmarks.md"
 SHARED_SCENES = REPO.parent / "shared" / "scenes"  # where the bench tools read them
@@ -461,16 +463,6 @@ assert set(CHECKS) == set(NEEDS)
 def missing_needs(section, ctx):
     """[(need, why)] of the section's needs that are not met."""
     return [(n, why) for n in section.needs for why in [ctx.missing(n)] if why]
-
-
-def cpu_model():
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return "unknown CPU"
 
 
 def machine(section, ctx):
