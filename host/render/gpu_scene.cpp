@@ -190,6 +190,7 @@ void GpuScene::uploadShading() {
   if (mats.empty()) mats.push_back(toDeviceMaterial(Material{}));
 
   const DeviceTextures packed = packTextures(scene_.textures);
+  vertexCount_ = verts.size();
   vertices_ =
       upload("shading vertices", verts.data(), verts.size() * sizeof(verts[0]), &shadingBytes_);
   triangles_ =
@@ -214,6 +215,7 @@ bool GpuScene::deformMeshes(double t, std::vector<bool>* changed) {
     lastPositions_[m] = shape.positions;
     lastNormals_[m] = shape.normals;
     (*changed)[m] = any = true;
+    if (previousKnown_) copyToPrevious(meshFirstVertex_[m], shape.vertexCount(), false);
     accel::BuildOptions build;
     build.width = bvhWidth_;
     dsg_.replaceMesh(static_cast<uint32_t>(m), shape.positions, shape.indices, build);
@@ -229,7 +231,45 @@ bool GpuScene::deformMeshes(double t, std::vector<bool>* changed) {
   return any;
 }
 
+void GpuScene::keepPrevious() {
+  if (keepPrevious_) return;
+  keepPrevious_ = true;
+  previousKnown_ = false;
+  const bool deforms = std::any_of(
+      scene_.dynamicMeshes.begin(), scene_.dynamicMeshes.end(),
+      [&](const TriangleMesh& m) { return scene_.meshDeforms(&m - scene_.dynamicMeshes.data()); });
+  if (deforms) {
+    const uint64_t bytes = std::max<uint64_t>(vertexCount_, 1) * sizeof(dev::ShadingVertex);
+    prevVertices_ = ctx_.allocate("previous shading vertices", bytes, CL_MEM_READ_ONLY);
+    shadingBytes_ += bytes;
+    ctx_.zero(prevVertices_, bytes);
+  }
+  const uint64_t bytes =
+      std::max<uint64_t>(scene_.instances.size(), 1) * sizeof(dev::ShadingInstance);
+  prevInstances_ = ctx_.allocate("previous DSG instance transforms", bytes, CL_MEM_READ_ONLY);
+  instanceBytes_ += bytes;
+  ctx_.zero(prevInstances_, bytes);
+  copyToPrevious(0, vertexCount_, true);
+}
+
+void GpuScene::copyToPrevious(uint64_t firstVertex, uint64_t vertexCount, bool instances) {
+  const uint64_t vs = sizeof(dev::ShadingVertex);
+  if (prevVertices_() && vertexCount > 0)
+    CL_CHECK(ctx_.queue().enqueueCopyBuffer(vertices_, prevVertices_, firstVertex * vs,
+                                            firstVertex * vs, vertexCount * vs));
+  // Before the first setTime there are no transforms yet: the previous ones stay zero, unread
+  // while previousKnown() is false.
+  if (instances && shadingInstances_() && !scene_.instances.empty())
+    CL_CHECK(
+        ctx_.queue().enqueueCopyBuffer(shadingInstances_, prevInstances_, 0, 0,
+                                       scene_.instances.size() * sizeof(dev::ShadingInstance)));
+}
+
 void GpuScene::setTime(double t) {
+  // What this call replaces becomes the previous shapes (copied before it is written over; the
+  // queue runs in order).
+  previousKnown_ = keepPrevious_ && !firstFrame_;
+  if (previousKnown_) copyToPrevious(0, 0, true);
   std::vector<bool> reshaped;
   deformMeshes(t, &reshaped);
   const size_t n = scene_.instances.size();
@@ -285,6 +325,9 @@ void GpuScene::setTime(double t) {
     CL_CHECK(ctx_.queue().enqueueWriteBuffer(lightBuffer_, CL_TRUE, 0,
                                              lights_.size() * sizeof(dev::Light), lights_.data()));
   }
+  // The first shapes kept: the previous ones start as these, so that what does not change
+  // before the next setTime is known there too.
+  if (keepPrevious_ && !previousKnown_) copyToPrevious(0, vertexCount_, true);
   firstFrame_ = false;
 }
 

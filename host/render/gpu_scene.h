@@ -81,6 +81,19 @@ class GpuScene {
   // world-to-object transforms: where this frame's scene may differ from the previous one's
   // (path resampling's temporal reuse).
   const std::vector<dev::MovedInstance>& movedInstances() const { return moved_; }
+  // From now on keep the previous setTime's shapes beside the current ones: its instance
+  // transforms and, where a mesh deforms, its shading vertices (path resampling rebuilds the
+  // previous frame's x_1 on them). Until the next setTime they are the current ones.
+  void keepPrevious();
+  // Whether previousVertices and previousInstances hold the previous setTime's shapes (a
+  // setTime after keepPrevious that followed another).
+  bool previousKnown() const { return previousKnown_; }
+  // The previous shapes (the current buffers where nothing keeps them: never deformed, or not
+  // asked for).
+  const cl::Buffer& previousVertices() const { return prevVertices_() ? prevVertices_ : vertices_; }
+  const cl::Buffer& previousInstances() const {
+    return prevInstances_() ? prevInstances_ : shadingInstances_;
+  }
   // Host seconds the last setTime spent deforming meshes and rebuilding their BVHs.
   double lastDeformSeconds() const { return deformSeconds_; }
   bool hasAlphaMaterials() const { return hasAlpha_; }
@@ -95,6 +108,9 @@ class GpuScene {
   // Deforming meshes at t: their BVHs built again and shading vertices uploaded where their
   // shape changed (*changed, per dynamic mesh). Returns whether any did.
   bool deformMeshes(double t, std::vector<bool>* changed);
+  // Copies the current shapes to the previous ones: vertex range [first, first + count) (all
+  // where count is 0) and the instance transforms.
+  void copyToPrevious(uint64_t firstVertex, uint64_t vertexCount, bool instances);
   void buildLights(double t);
   // moved_ from the instances' bounds and transforms before this frame's setInstances and after
   // (reshaped: per instance, its mesh deformed this frame).
@@ -152,6 +168,9 @@ class GpuScene {
   bool lightsAnimated_ = false;
 
   cl::Buffer vertices_, triangles_, shadingInstances_, materials_, textures_, texels_;
+  cl::Buffer prevVertices_, prevInstances_;  // keepPrevious
+  bool keepPrevious_ = false, previousKnown_ = false;
+  uint64_t vertexCount_ = 0;
   cl::Buffer lightBuffer_, cdfBuffer_, lightNodeBuffer_, primLightBuffer_, envBuffer_;
   float envMeanLuminance_ = 0.0f;
   uint64_t lightNodeBytes_ = 0;

@@ -32,6 +32,8 @@ PathTracer::PathTracer(Context& ctx, GpuScene& scene, Film& film,
   shadow_ = kargs::kernel<kargs::PtShadowArgs>(ctx, "pathtrace/shadow.cl", opts);
   if (settings.resample.enabled)
     resample_ = kargs::kernel<kargs::PtResampleArgs>(ctx, "pathtrace/resample.cl", opts);
+  // Temporal reuse rebuilds the previous frame's x_1 on that frame's shapes.
+  if (settings.resample.enabled && settings.resample.history > 0) scene.keepPrevious();
   const uint64_t n = film.pixels();
   auto alloc = [&](const char* name, uint64_t bytes) {
     bytes_ += bytes;
@@ -186,6 +188,7 @@ void PathTracer::beginFrame(int64_t frame, const dev::CameraParams& camera,
       CL_CHECK(ctx_.queue().enqueueWriteBuffer(
           moved_, CL_FALSE, 0, moved.size() * sizeof(dev::MovedInstance), moved.data()));
     rsp.moved_count = cl_uint(moved.size());
+    rsp.prev_known = temporal_ && scene_.previousKnown() ? 1u : 0u;
   }
   // Resampling needs every sample's x_1, which the path tracer alone does not keep.
   const cl::Buffer& eyeOut =
@@ -244,6 +247,8 @@ void PathTracer::beginFrame(int64_t frame, const dev::CameraParams& camera,
     resampleArgs_.prev_cam = prevCamera;
     resampleArgs_.cam = camera;
     resampleArgs_.moved = moved_;
+    resampleArgs_.prev_vertices = scene_.previousVertices();
+    resampleArgs_.prev_instances = scene_.previousInstances();
     resampleArgs_.stamp = stamp_;
     resampleArgs_.set(resample_, kargs::kScene | kargs::kFrame);
   }

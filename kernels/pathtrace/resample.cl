@@ -130,7 +130,8 @@ PR_INLINE void rs_merge_path(const SceneData* s, const RsPrimary* x, const RsPri
                              __global const MovedInstance* moved, const ResampleParams* rsp,
                              RsMerge* mg, uint* traced) {
   const int has_c = rs_has_path(rc);
-  if (rs_has_path(ri) && (!past || rs_temporal_ok(s, moved, rsp->moved_count, ri, xi, x))) {
+  if (rs_has_path(ri) &&
+      (!past || rs_temporal_ok(s, moved, rsp->moved_count, ri, xi, x, rsp->prev_known))) {
     float3 f = make_float3(ri->f_r, ri->f_g, ri->f_b);
     float g = ri->g_src, jac = 1.0f;
     const float p = same ? ri->p_hat : rs_target_at(s, x, ri, rsp, &f, &g, &jac, traced);
@@ -140,7 +141,7 @@ PR_INLINE void rs_merge_path(const SceneData* s, const RsPrimary* x, const RsPri
     }
   }
   float p_back = 0.0f;
-  if (has_c && (!past || rs_temporal_ok(s, moved, rsp->moved_count, rc, xi, x))) {
+  if (has_c && (!past || rs_temporal_ok(s, moved, rsp->moved_count, rc, xi, x, rsp->prev_known))) {
     float3 f;
     float g, jac = 1.0f;
     const float p = same ? rc->p_hat : rs_target_at(s, xi, rc, rsp, &f, &g, &jac, traced);
@@ -154,10 +155,10 @@ PR_INLINE void rs_merge_direct(const SceneData* s, const RsPrimary* x, const RsP
                                __global const DirectReservoir* dc,
                                __global const DirectReservoir* di, int past, int same, float c_i,
                                float kf, float total, float u, uint d,
-                               __global const MovedInstance* moved, uint moved_count, RsMerge* mg,
-                               uint* traced) {
+                               __global const MovedInstance* moved, uint moved_count,
+                               uint prev_known, RsMerge* mg, uint* traced) {
   const int has_c = di_has_light(dc);
-  if (di_has_light(di) && (!past || di_temporal_ok(s, moved, moved_count, di, xi, x))) {
+  if (di_has_light(di) && (!past || di_temporal_ok(s, moved, moved_count, di, xi, x, prev_known))) {
     float3 f = make_float3(di->f_r, di->f_g, di->f_b);
     const float p = same ? di->p_hat : di_target_at(s, x, di, &f, traced);
     if (p > 0.0f) {
@@ -166,7 +167,7 @@ PR_INLINE void rs_merge_direct(const SceneData* s, const RsPrimary* x, const RsP
     }
   }
   float p_back = 0.0f;
-  if (has_c && (!past || di_temporal_ok(s, moved, moved_count, dc, xi, x))) {
+  if (has_c && (!past || di_temporal_ok(s, moved, moved_count, dc, xi, x, prev_known))) {
     float3 f;
     p_back = same ? dc->p_hat : di_target_at(s, xi, dc, &f, traced);
   }
@@ -221,6 +222,16 @@ PR_INLINE uint rs_history_pixel(const CameraParams* prev_cam, float3 p, uint fir
   return q;
 }
 
+// Whether the previous frame's record h continues x_1 at x where either lies on what moved: the
+// same instance, its shapes then known (prev_known, sp), seen about the same way (shading normals
+// within 26 degrees). Another surface's paths would come in at the record's full confidence.
+PR_INLINE int rs_history_similar(const SceneData* sp, const RsPrimary* x, uint prev_known,
+                                 __global const PathHistory* h) {
+  if (!prev_known || h->inst != x->h.inst) return 0;
+  const SurfaceHit then = surface_at(&sp->sd, h->prim, h->inst, h->b1, h->b2);
+  return dot(then.ns, x->h.ns) > 0.9f;
+}
+
 PR_KERNEL void pt_resample(PR_PARAMS(PR_ARGS_PT_RESAMPLE_SPATIAL)) {
   const uint w = (uint)get_global_id(0);
   if (listed ? w >= list_count : w + first >= end) return;
@@ -230,6 +241,11 @@ PR_KERNEL void pt_resample(PR_PARAMS(PR_ARGS_PT_RESAMPLE_SPATIAL)) {
   rs_history_start(out, &e, stamp);
   if (e.prim == PR_INVALID_INDEX) return;  // no x_1: nothing was resampled
   const SceneData s = PR_SCENE();
+  // The previous frame's shapes, on which its x_1 are rebuilt (rsp.prev_known: they are known;
+  // they differ from this frame's only on what moved).
+  SceneData sp = s;
+  sp.sd.vertices = prev_vertices;
+  sp.sd.instances = prev_instances;
   __global const PathReservoir* rc = rs_res + j;
   __global const DirectReservoir* dc = di_res + j;
   const RsPrimary x = rs_primary(&s, &e, &rsp, &cam);
@@ -250,8 +266,15 @@ PR_KERNEL void pt_resample(PR_PARAMS(PR_ARGS_PT_RESAMPLE_SPATIAL)) {
     ++k;
   }
   const float u_t = rng_next(&rng);
-  const uint q =
-      temporal ? rs_history_pixel(&prev_cam, x.h.p, first, end, history, stamp) : PR_INVALID_INDEX;
+  // Where the previous frame saw x_1: on what moved, where its point was then.
+  const int x_moved = !rs_unmoved(&s, e.inst);
+  const float3 p_then =
+      x_moved && rsp.prev_known ? surface_at(&sp.sd, e.prim, e.inst, e.b1, e.b2).p : x.h.p;
+  uint q =
+      temporal ? rs_history_pixel(&prev_cam, p_then, first, end, history, stamp) : PR_INVALID_INDEX;
+  if (q != PR_INVALID_INDEX && (x_moved || !rs_unmoved(&s, history[q].inst)) &&
+      !rs_history_similar(&sp, &x, rsp.prev_known, history + q))
+    q = PR_INVALID_INDEX;
   // Each reservoir's confidence of the previous frame (0: not a domain of that reservoir).
   const float c_t = q != PR_INVALID_INDEX ? fmin(history[q].r.m, rsp.max_m) : 0.0f;
   const float c_td = q != PR_INVALID_INDEX ? fmin(history[q].d.m, rsp.max_m) : 0.0f;
@@ -263,12 +286,13 @@ PR_KERNEL void pt_resample(PR_PARAMS(PR_ARGS_PT_RESAMPLE_SPATIAL)) {
   for (uint d = 0u; d < k + (q != PR_INVALID_INDEX ? 1u : 0u); ++d) {
     const int past = d == k;
     const EyeVertex ei = past ? rs_history_eye(history + q) : eye[nb[d]];
-    const int same = past && rs_same_eye(&ei, &e);
+    // The same x_1 seen the same way, where it did not move: the shift is the identity.
+    const int same = past && !x_moved && rs_same_eye(&ei, &e);
     RsPrimary xi;
     if (same)
       xi = x;
     else if (has_c || has_dc || past)
-      xi = rs_primary(&s, &ei, &rsp, &cam);
+      xi = rs_primary(past ? &sp : &s, &ei, &rsp, &cam);
     const float u_d = rng_next(&rng_d);
     if (!past || c_t > 0.0f)
       rs_merge_path(&s, &x, &xi, rc, past ? &history[q].r : rs_res + nb[d], past, same,
@@ -277,7 +301,7 @@ PR_KERNEL void pt_resample(PR_PARAMS(PR_ARGS_PT_RESAMPLE_SPATIAL)) {
     if (!past || c_td > 0.0f)
       rs_merge_direct(&s, &x, &xi, dc, past ? &history[q].d : di_res + nb[d], past, same,
                       past ? c_td : 1.0f, (float)dom_d, total_d, u_d, d, moved, rsp.moved_count,
-                      &md, &traced);
+                      rsp.prev_known, &md, &traced);
   }
   const float u_c = rng_next(&rng), u_dc = rng_next(&rng_d);
   if (has_c)

@@ -235,27 +235,30 @@
 // pt_resample: each pixel sample's reservoir with its neighbours' and the previous frame's by
 // reconnection, into its radiance and history_out (one pass over the film's pixels [first, end)).
 // temporal: `history` holds this pass's reservoirs of the previous frame, seen by prev_cam, and
-// `moved` (rsp.moved_count boxes) where the scene changed since.
-#define PR_ARGS_PT_RESAMPLE_SPATIAL(F, X) \
-  PR_ARGS_SCENE(F, X)                     \
-  X(FRAME, VAL, ResampleParams, rsp)      \
-  X(FRAME, IN, EyeVertex, eye)            \
-  X(FRAME, IN, PathReservoir, rs_res)     \
-  X(FRAME, IN, DirectReservoir, di_res)   \
-  X(FRAME, OUT, float4, radiance)         \
-  X(FRAME, VAL, uint, seed)               \
-  X(FRAME, VAL, uint, frame)              \
-  X(PASS, VAL, uint, sample)              \
-  X(FRAME, VAL, uint, first)              \
-  X(FRAME, VAL, uint, end)                \
-  X(FRAME, OUT, uint, rays)               \
-  X(PASS, VAL, uint, temporal)            \
-  X(PASS, IN, PathHistory, history)       \
-  X(PASS, OUT, PathHistory, history_out)  \
-  X(FRAME, VAL, CameraParams, prev_cam)   \
-  X(FRAME, VAL, CameraParams, cam)        \
-  X(FRAME, IN, MovedInstance, moved)      \
-  X(FRAME, VAL, uint, stamp)              \
+// `moved` (rsp.moved_count boxes) where the scene changed since, prev_vertices and prev_instances
+// the previous frame's shapes (GpuScene::previousVertices).
+#define PR_ARGS_PT_RESAMPLE_SPATIAL(F, X)       \
+  PR_ARGS_SCENE(F, X)                           \
+  X(FRAME, VAL, ResampleParams, rsp)            \
+  X(FRAME, IN, EyeVertex, eye)                  \
+  X(FRAME, IN, PathReservoir, rs_res)           \
+  X(FRAME, IN, DirectReservoir, di_res)         \
+  X(FRAME, OUT, float4, radiance)               \
+  X(FRAME, VAL, uint, seed)                     \
+  X(FRAME, VAL, uint, frame)                    \
+  X(PASS, VAL, uint, sample)                    \
+  X(FRAME, VAL, uint, first)                    \
+  X(FRAME, VAL, uint, end)                      \
+  X(FRAME, OUT, uint, rays)                     \
+  X(PASS, VAL, uint, temporal)                  \
+  X(PASS, IN, PathHistory, history)             \
+  X(PASS, OUT, PathHistory, history_out)        \
+  X(FRAME, VAL, CameraParams, prev_cam)         \
+  X(FRAME, VAL, CameraParams, cam)              \
+  X(FRAME, IN, MovedInstance, moved)            \
+  X(FRAME, IN, ShadingVertex, prev_vertices)    \
+  X(FRAME, IN, ShadingInstance, prev_instances) \
+  X(FRAME, VAL, uint, stamp)                    \
   PR_ARGS_PIXEL_LIST(X, X)
 
 // ---- The film (kernels/accumulate.cl) ----

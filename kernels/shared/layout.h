@@ -146,6 +146,7 @@
   F(ResampleParams, min_dist2)        \
   F(ResampleParams, moved_count)      \
   F(ResampleParams, lt_scale)         \
+  F(ResampleParams, prev_known)       \
   F(PathHeader, end)                  \
   F(PathHeader, valid)                \
   F(PathHeader, escape_z)             \

@@ -181,7 +181,8 @@ typedef struct {
   float eye_count;
   // Strategy T: N_L A / (spp C W H) (eye_paths_camera_factor); 0: off.
   float lt_scale;
-  u32 pad1, pad2;
+  u32 prev_known;  // pt_resample's prev_vertices and prev_instances hold the previous frame's
+  u32 pad2;
 } ResampleParams;
 
 PR_NAMESPACE_END

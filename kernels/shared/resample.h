@@ -73,19 +73,24 @@ PR_INLINE float rs_eye_share(u32 kind, float rn, float rh, float p2, float pdf2,
 }
 
 // A pixel sample's x_1, rebuilt from its EyeVertex; ok: rough enough to reconnect from; cam:
-// its camera factor for strategy T (0: T cannot make its paths).
+// its camera factor for strategy T (0: T cannot make its paths); own: the scene of its frame,
+// whose shapes its rays leave from (the previous frame's for a previous x_1, which may lie on
+// what moved since).
 typedef struct {
   SurfaceHit h;
   ShadingFrame f;
   float3 wo, wol, tp;
   int ok;
   float cam;
+  const SceneData* own;
 } RsPrimary;
 
-// The x_1 of EyeVertex e, seen by camera c (an x_1 of the previous frame: depth 0, cam 0).
+// The x_1 of EyeVertex e in scene s, seen by camera c (an x_1 of the previous frame: depth 0,
+// cam 0, and s that frame's shapes).
 PR_INLINE RsPrimary rs_primary(const SceneData* s, const EyeVertex* e, const ResampleParams* rp,
                                const CameraParams* c) {
   RsPrimary x;
+  x.own = s;
   x.h = surface_at(&s->sd, e->prim, e->inst, e->b1, e->b2);
   x.cam = e->depth == 1u && rp->lt_scale > 0.0f
               ? eye_paths_camera_factor(rp->lt_scale, camera_cos3_d2(c, x.h.p))
@@ -131,7 +136,7 @@ PR_INLINE float3 rs_shift(const SceneData* s, const RsPrimary* x, PR_GLOBAL cons
   const float t = camera ? eye_paths_camera_ratio(x->cam, pdf2_rev, d2) : 0.0f;
   const float w = rs_weight2(r->kind, r->pdf_light, pdf2) *
                   rs_eye_share(r->kind, r->rn, r->rh, pdf1 * *g_dst, pdf2, t);
-  *seg = surface_segment(s, &x->h, &h2);
+  *seg = surface_segment_between(x->own, &x->h, s, &h2);
   return f1 * fx2 * make_float3(r->rest_r, r->rest_g, r->rest_b) * w;
 }
 
@@ -209,17 +214,18 @@ PR_INLINE void rs_candidate(PathReservoir* c, PR_GLOBAL const PathTrack* t, floa
 // --- Temporal reuse ----------------------------------------------------------------------------
 //
 // A path of the previous frame is a path of this one where nothing that moved between the two
-// frames comes near it: then its vertices, the visibility of its segments, its BSDFs and its
-// lights are the same in both scenes (lights that move turn temporal reuse off for the frame).
-// `moved` lists every instance that moved or changed shape (MovedInstance): a path is reused only
-// where none of its vertices lies on one and its suffix, and both reconnection segments (from the
-// previous frame's x_1 and from this one's), meet none, then or now: exactly, against each
-// frame's shape at that frame's transform. A suffix point, known by its position alone, is
-// tested against the boxes where it lay on a DSG instance. The test is one function of the path
-// and the two x_1, so the shift and its inverse are defined on the same paths, and the previous
-// frame's target at a path is this frame's, which pt_resample evaluates.
-// This is the arena's exact invalidation (reuse/invalidate.cl) for eye paths: a stored path that
-// a moving object disturbs is never reused.
+// frames comes near it: then its vertices beyond x_1, the visibility of its segments, its BSDFs
+// and its lights are the same in both scenes (lights that move turn temporal reuse off for the
+// frame). `moved` lists every instance that moved or changed shape (MovedInstance): a path is
+// reused only where x_2 lies on none and its suffix, and the reconnection from the previous
+// frame's x_1, meet none, then or now: exactly, against each frame's shape at that frame's
+// transform. (This frame's reconnection is its shadow ray, traced in this frame's scene.) A suffix
+// point, known by its position alone, is tested against the boxes where it lay on a DSG instance.
+// x_1 may lie on what moved: the previous frame's is rebuilt on that frame's shapes (RsPrimary.own)
+// and its segments leave those. The test is one function of the path and the two x_1, so the
+// shift and its inverse are defined on the same paths, and the previous frame's target at a path
+// is what pt_resample evaluates. This is the arena's exact invalidation (reuse/invalidate.cl) for
+// eye paths: a stored path that a moving object disturbs is never reused.
 
 // Appends point p (direction: a direction, the path's end at infinity) to a suffix.
 PR_INLINE void rs_suffix_push(u32* suffix, float* sp, float3 p, int direction) {
@@ -323,20 +329,43 @@ PR_INLINE int rs_same_point(float3 a, float3 b) {
   return a.x == b.x && a.y == b.y && a.z == b.z;
 }
 
+// Whether x_1 at x can take part in temporal reuse: where it did not move, or where the previous
+// frame's shapes are known (prev_known: x, if of the previous frame, was rebuilt on them) and it
+// is not glass (whose transmittance a segment from it would measure in this frame's shapes).
+PR_INLINE int rs_x1_ok(const SceneData* s, const RsPrimary* x, u32 prev_known) {
+  return rs_unmoved(s, x->h.inst) || (prev_known && !bsdf_transmits(&x->f.bsdf));
+}
+
+// Whether ray r, o + t d for 0 <= t <= tmax, meets none of the moved instances.
+PR_INLINE int rs_clear_ray(const SceneData* s, PR_GLOBAL const MovedInstance* moved, u32 count,
+                           Ray r) {
+  return rs_clear(s, moved, count, make_float3(r.ox, r.oy, r.oz), make_float3(r.dx, r.dy, r.dz),
+                  r.tmax);
+}
+
+// Whether the segment from x_1 at x to x_2 (h2) meets nothing that moved: from x itself where x
+// did not move; else the shadow ray's own segment, which leaves x's shape of x's frame (a segment
+// from x itself would meet that shape at once).
+PR_INLINE int rs_reconnection_clear(const SceneData* s, PR_GLOBAL const MovedInstance* moved,
+                                    u32 count, const RsPrimary* x, const SurfaceHit* h2) {
+  if (rs_unmoved(s, x->h.inst)) return rs_clear(s, moved, count, x->h.p, h2->p - x->h.p, 1.0f);
+  return rs_clear_ray(s, moved, count, surface_segment_between(x->own, &x->h, s, h2));
+}
+
 // Whether path r can be taken between frames, reconnected to x_1 at xa in one and at xb in the
-// other: its suffix kept whole, no vertex on what moved and no segment meeting it.
+// other: its suffix kept whole, x_2 and its suffix on nothing that moved, and no segment meeting
+// what moved. An x_1 on what moved is the point of its own frame's shape (rs_x1_ok).
 PR_INLINE int rs_temporal_ok(const SceneData* s, PR_GLOBAL const MovedInstance* moved, u32 count,
                              PR_GLOBAL const PathReservoir* r, const RsPrimary* xa,
-                             const RsPrimary* xb) {
+                             const RsPrimary* xb, u32 prev_known) {
   if (r->prim == PR_INVALID_INDEX || (r->suffix & PR_RS_LONG)) return 0;
   const u32 n = r->suffix & PR_RS_COUNT_MASK;
   if (n == 0u) return 0;
-  if (!rs_unmoved(s, xa->h.inst) || !rs_unmoved(s, xb->h.inst) || !rs_unmoved(s, r->inst)) return 0;
-  const float3 x2 = surface_at(&s->sd, r->prim, r->inst, r->b1, r->b2).p;
-  if (!rs_clear(s, moved, count, xa->h.p, x2 - xa->h.p, 1.0f) ||
-      (!rs_same_point(xa->h.p, xb->h.p) && !rs_clear(s, moved, count, xb->h.p, x2 - xb->h.p, 1.0f)))
+  if (!rs_x1_ok(s, xa, prev_known) || !rs_x1_ok(s, xb, prev_known) || !rs_unmoved(s, r->inst))
     return 0;
-  float3 a = x2;
+  const SurfaceHit h2 = surface_at(&s->sd, r->prim, r->inst, r->b1, r->b2);
+  if (!rs_reconnection_clear(s, moved, count, xa, &h2)) return 0;
+  float3 a = h2.p;
   for (u32 k = 0u; k < n; ++k) {
     const float3 p = make_float3(r->sp[3u * k], r->sp[3u * k + 1u], r->sp[3u * k + 2u]);
     if (k + 1u == n && (r->suffix & PR_RS_ESCAPES))

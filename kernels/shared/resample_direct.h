@@ -45,11 +45,11 @@ PR_INLINE float3 di_eval(const SceneData* s, const RsPrimary* x, PR_GLOBAL const
     wi = d * (1.0f / dist);
     g = fabs(dot(wi, e.ng)) / d2;
     le = material_emission(&s->sd, &e);
-    *shadow = surface_ray_to(s, &x->h, e.p, e.ng);
+    *shadow = surface_ray_to(x->own, &x->h, e.p, e.ng);
   } else if (r->light == s->lights.env_light) {
     wi = make_float3(r->wx, r->wy, r->wz);
     le = environment_radiance(s, wi);
-    *shadow = surface_ray(s, &x->h, wi, PR_INF_F);
+    *shadow = surface_ray(x->own, &x->h, wi, PR_INF_F);
   } else {  // punctual: the light's own sample, which draws no random number
     LightSample ls;
     float b1, b2;
@@ -60,13 +60,13 @@ PR_INLINE float3 di_eval(const SceneData* s, const RsPrimary* x, PR_GLOBAL const
     le = ls.le;
     dist = ls.dist;
     *shadow =
-        surface_ray(s, &x->h, ls.wi, ls.dist < PR_INF_F ? ls.dist * (1.0f - 1e-4f) : PR_INF_F);
+        surface_ray(x->own, &x->h, ls.wi, ls.dist < PR_INF_F ? ls.dist * (1.0f - 1e-4f) : PR_INF_F);
   }
-  if (!surface_side_ok(s, &x->h, &x->f, x->wo, wi)) return zero;
+  if (!surface_side_ok(x->own, &x->h, &x->f, x->wo, wi)) return zero;
   const float3 wil = to_local(wi, x->f.t, x->f.b, x->f.n);
   float pdf;
   const float3 f = bsdf_eval(&x->f.bsdf, x->wol, wil, &pdf) * le * (fabs(wil.z) * g);
-  return bsdf_transmits(&x->f.bsdf) ? f * segment_transmittance(s, &x->h, 0, wi, dist) : f;
+  return bsdf_transmits(&x->f.bsdf) ? f * segment_transmittance(x->own, &x->h, 0, wi, dist) : f;
 }
 
 // The target of reservoir r's light at x, shadow ray included (traced counted in *traced), and
@@ -81,36 +81,39 @@ PR_INLINE float di_target_at(const SceneData* s, const RsPrimary* x,
   return trace_occluded(s, shadow) ? 0.0f : p;
 }
 
-// Whether reservoir r's light can be taken between frames, seen from x_1 at xa in one and at xb
-// in the other: neither x_1 on what moved, nor either segment (ray, towards a light at infinity)
-// meeting it.
-PR_INLINE int di_temporal_ok(const SceneData* s, PR_GLOBAL const MovedInstance* moved, u32 count,
-                             PR_GLOBAL const DirectReservoir* r, const RsPrimary* pa,
-                             const RsPrimary* pb) {
-  if (r->light == PR_INVALID_INDEX || !rs_unmoved(s, pa->h.inst) || !rs_unmoved(s, pb->h.inst))
-    return 0;
-  const float3 xa = pa->h.p, xb = pb->h.p;
-  const int one = rs_same_point(xa, xb);  // one segment, tested once
+// Whether the segment from x_1 at x to reservoir r's light (a ray, towards a light at infinity)
+// meets nothing that moved: from x itself where x did not move; else the segment of its shadow
+// ray (di_eval's, which leaves x's shape of x's frame), where x sees the light at all.
+PR_INLINE int di_segment_clear(const SceneData* s, PR_GLOBAL const MovedInstance* moved, u32 count,
+                               PR_GLOBAL const DirectReservoir* r, const RsPrimary* x) {
+  if (!rs_unmoved(s, x->h.inst)) {
+    Ray shadow;
+    const float3 f = di_eval(s, x, r, &shadow);
+    return luminance(f) > 0.0f && rs_clear_ray(s, moved, count, shadow);
+  }
+  const float3 p = x->h.p;
   const Light l = s->lights.lights[r->light];
   if (light_is_triangle(l.type)) {
     const float3 y = surface_at(&s->sd, l.prim, l.inst, r->b1, r->b2).p;
-    return rs_clear(s, moved, count, xa, y - xa, 1.0f) &&
-           (one || rs_clear(s, moved, count, xb, y - xb, 1.0f));
+    return rs_clear(s, moved, count, p, y - p, 1.0f);
   }
-  if (r->light == s->lights.env_light) {
-    const float3 w = make_float3(r->wx, r->wy, r->wz);
-    return rs_clear(s, moved, count, xa, w, PR_INF_F) &&
-           (one || rs_clear(s, moved, count, xb, w, PR_INF_F));
-  }
-  LightSample la, lb;
+  if (r->light == s->lights.env_light)
+    return rs_clear(s, moved, count, p, make_float3(r->wx, r->wy, r->wz), PR_INF_F);
+  LightSample ls;
   float b1, b2;
-  if (!light_sample_towards(&l, s->lights.env, 1.0f, xa, make_float3(0.0f, 0.0f, 0.0f), 0.0f, 0.0f,
-                            &la, &b1, &b2) ||
-      !light_sample_towards(&l, s->lights.env, 1.0f, xb, make_float3(0.0f, 0.0f, 0.0f), 0.0f, 0.0f,
-                            &lb, &b1, &b2))
+  return light_sample_towards(&l, s->lights.env, 1.0f, p, make_float3(0.0f, 0.0f, 0.0f), 0.0f, 0.0f,
+                              &ls, &b1, &b2) &&
+         rs_clear(s, moved, count, p, ls.wi, ls.dist);
+}
+
+// Whether reservoir r's light can be taken between frames, seen from x_1 at xa in one and at xb
+// in the other: each x_1 where it may be (rs_x1_ok), and neither segment meeting what moved.
+PR_INLINE int di_temporal_ok(const SceneData* s, PR_GLOBAL const MovedInstance* moved, u32 count,
+                             PR_GLOBAL const DirectReservoir* r, const RsPrimary* pa,
+                             const RsPrimary* pb, u32 prev_known) {
+  if (r->light == PR_INVALID_INDEX || !rs_x1_ok(s, pa, prev_known) || !rs_x1_ok(s, pb, prev_known))
     return 0;
-  return rs_clear(s, moved, count, xa, la.wi, la.dist) &&
-         (one || rs_clear(s, moved, count, xb, lb.wi, lb.dist));
+  return di_segment_clear(s, moved, count, r, pa);
 }
 
 // A candidate into *c: light li at (b1, b2) or along dir, its f at its own x_1, resampling

@@ -125,15 +125,21 @@ PR_INLINE Ray surface_ray_to(const SceneData* s, const SurfaceHit* h, float3 q, 
   return make_ray(o, e - o, 0.0f, 1.0f);
 }
 
-// A shadow segment between two surface points, each leaving its surface as surface_ray does.
-PR_INLINE Ray surface_segment(const SceneData* s, const SurfaceHit* a, const SurfaceHit* b) {
+// A shadow segment between surface points a (of scene sa's shapes) and b (of sb's), each leaving
+// its surface as surface_ray does.
+PR_INLINE Ray surface_segment_between(const SceneData* sa, const SurfaceHit* a, const SceneData* sb,
+                                      const SurfaceHit* b) {
   const float3 d = b->p - a->p;
-  float3 sa, sb;
+  float3 na, nb;
   const float3 o = offset_ray_origin(
-      ray_exit(&s->sd, a->p, a->ng, a->ns, a->prim, a->inst, a->b1, a->b2, d, &sa), sa);
+      ray_exit(&sa->sd, a->p, a->ng, a->ns, a->prim, a->inst, a->b1, a->b2, d, &na), na);
   const float3 e = offset_ray_origin(
-      ray_exit(&s->sd, b->p, b->ng, b->ns, b->prim, b->inst, b->b1, b->b2, -d, &sb), sb);
+      ray_exit(&sb->sd, b->p, b->ng, b->ns, b->prim, b->inst, b->b1, b->b2, -d, &nb), nb);
   return make_ray(o, e - o, 0.0f, 1.0f);
+}
+
+PR_INLINE Ray surface_segment(const SceneData* s, const SurfaceHit* a, const SurfaceHit* b) {
+  return surface_segment_between(s, a, s, b);
 }
 
 // A shading frame: ns and ng flipped to the side of wo for reflective surfaces; glass (smooth or
