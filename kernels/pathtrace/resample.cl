@@ -48,7 +48,7 @@ PR_INLINE float rs_target_at(const SceneData* s, const RsPrimary* x,
   const float p = luminance(*f);
   if (!(p > 0.0f) || !(p < PR_INF_F)) return 0.0f;
   *traced += 1u;
-  if (trace_occluded(s, seg)) return 0.0f;
+  if (rs_occluded(s, x, seg)) return 0.0f;
   *jac = reconnection_jacobian(*g, r->g_src);
   return p;
 }
@@ -212,24 +212,41 @@ PR_INLINE int rs_same_eye(const EyeVertex* a, const EyeVertex* b) {
          a->wx == b->wx && a->wy == b->wy && a->wz == b->wz;
 }
 
-// The previous frame's record that this pixel's x_1 (at p) continues, or PR_INVALID_INDEX.
-PR_INLINE uint rs_history_pixel(const CameraParams* prev_cam, float3 p, uint first, uint end,
-                                __global const PathHistory* history, uint stamp) {
-  const uint q = camera_pixel(prev_cam, p);
-  if (q == PR_INVALID_INDEX || q < first || q >= end || history[q].stamp + 1u != stamp ||
-      history[q].prim == PR_INVALID_INDEX)
-    return PR_INVALID_INDEX;
-  return q;
+// Whether the previous frame's record h continues x_1 at x (whose point was p then, seen from
+// the previous camera at c): the same instance, its shapes then known where it moved (prev_known,
+// sp), within a tenth of the camera's distance of p and seen about the same way (shading normals
+// within 26 degrees). Another surface's paths would come in at the record's full confidence.
+PR_INLINE int rs_history_similar(const SceneData* s, const SceneData* sp, const RsPrimary* x,
+                                 float3 p, float3 c, uint prev_known,
+                                 __global const PathHistory* h) {
+  if (h->inst != x->h.inst || (!prev_known && !rs_unmoved(s, h->inst))) return 0;
+  const SurfaceHit then = surface_at(&sp->sd, h->prim, h->inst, h->b1, h->b2);
+  const float3 d = then.p - p, v = p - c;
+  return dot(then.ns, x->h.ns) > 0.9f && dot(d, d) <= 0.01f * dot(v, v);
 }
 
-// Whether the previous frame's record h continues x_1 at x where either lies on what moved: the
-// same instance, its shapes then known (prev_known, sp), seen about the same way (shading normals
-// within 26 degrees). Another surface's paths would come in at the record's full confidence.
-PR_INLINE int rs_history_similar(const SceneData* sp, const RsPrimary* x, uint prev_known,
-                                 __global const PathHistory* h) {
-  if (!prev_known || h->inst != x->h.inst) return 0;
-  const SurfaceHit then = surface_at(&sp->sd, h->prim, h->inst, h->b1, h->b2);
-  return dot(then.ns, x->h.ns) > 0.9f;
+// The previous frame's record that pixel sample x (its x_1 at p then) continues, or
+// PR_INVALID_INDEX: the one where the previous camera saw p where it is similar
+// (rs_history_similar), else the first similar one of that pixel's 8 neighbours, the 4 nearest
+// first (an edge or a thin part misses one pixel's record about as often as it meets it).
+PR_INLINE uint rs_history_pixel(const SceneData* s, const SceneData* sp, const RsPrimary* x,
+                                const ResampleParams* rsp, const CameraParams* prev_cam, float3 p,
+                                uint first, uint end, __global const PathHistory* history,
+                                uint stamp) {
+  const uint q0 = camera_pixel(prev_cam, p);
+  if (q0 == PR_INVALID_INDEX) return PR_INVALID_INDEX;
+  const float3 c = camera_position(prev_cam);
+  const int dx[9] = {0, 1, -1, 0, 0, 1, -1, 1, -1}, dy[9] = {0, 0, 0, 1, -1, 1, 1, -1, -1};
+  for (int n = 0; n < 9; ++n) {
+    const int qx = (int)(q0 % prev_cam->width) + dx[n], qy = (int)(q0 / prev_cam->width) + dy[n];
+    if (qx < 0 || qy < 0 || qx >= (int)prev_cam->width || qy >= (int)prev_cam->height) continue;
+    const uint q = (uint)qy * prev_cam->width + (uint)qx;
+    if (q < first || q >= end || history[q].stamp + 1u != stamp ||
+        history[q].prim == PR_INVALID_INDEX)
+      continue;
+    if (rs_history_similar(s, sp, x, p, c, rsp->prev_known, history + q)) return q;
+  }
+  return PR_INVALID_INDEX;
 }
 
 PR_KERNEL void pt_resample(PR_PARAMS(PR_ARGS_PT_RESAMPLE_SPATIAL)) {
@@ -270,11 +287,9 @@ PR_KERNEL void pt_resample(PR_PARAMS(PR_ARGS_PT_RESAMPLE_SPATIAL)) {
   const int x_moved = !rs_unmoved(&s, e.inst);
   const float3 p_then =
       x_moved && rsp.prev_known ? surface_at(&sp.sd, e.prim, e.inst, e.b1, e.b2).p : x.h.p;
-  uint q =
-      temporal ? rs_history_pixel(&prev_cam, p_then, first, end, history, stamp) : PR_INVALID_INDEX;
-  if (q != PR_INVALID_INDEX && (x_moved || !rs_unmoved(&s, history[q].inst)) &&
-      !rs_history_similar(&sp, &x, rsp.prev_known, history + q))
-    q = PR_INVALID_INDEX;
+  const uint q =
+      temporal ? rs_history_pixel(&s, &sp, &x, &rsp, &prev_cam, p_then, first, end, history, stamp)
+               : PR_INVALID_INDEX;
   // Each reservoir's confidence of the previous frame (0: not a domain of that reservoir).
   const float c_t = q != PR_INVALID_INDEX ? fmin(history[q].r.m, rsp.max_m) : 0.0f;
   const float c_td = q != PR_INVALID_INDEX ? fmin(history[q].d.m, rsp.max_m) : 0.0f;
@@ -293,6 +308,7 @@ PR_KERNEL void pt_resample(PR_PARAMS(PR_ARGS_PT_RESAMPLE_SPATIAL)) {
       xi = x;
     else if (has_c || has_dc || past)
       xi = rs_primary(past ? &sp : &s, &ei, &rsp, &cam);
+    xi.then_moved = past && !same && !rs_unmoved(&s, ei.inst);
     const float u_d = rng_next(&rng_d);
     if (!past || c_t > 0.0f)
       rs_merge_path(&s, &x, &xi, rc, past ? &history[q].r : rs_res + nb[d], past, same,

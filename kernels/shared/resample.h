@@ -83,6 +83,7 @@ typedef struct {
   int ok;
   float cam;
   const SceneData* own;
+  int then_moved;  // the previous frame's x_1 on what moved since (its segments: rs_occluded)
 } RsPrimary;
 
 // The x_1 of EyeVertex e in scene s, seen by camera c (an x_1 of the previous frame: depth 0,
@@ -91,6 +92,7 @@ PR_INLINE RsPrimary rs_primary(const SceneData* s, const EyeVertex* e, const Res
                                const CameraParams* c) {
   RsPrimary x;
   x.own = s;
+  x.then_moved = 0;
   x.h = surface_at(&s->sd, e->prim, e->inst, e->b1, e->b2);
   x.cam = e->depth == 1u && rp->lt_scale > 0.0f
               ? eye_paths_camera_factor(rp->lt_scale, camera_cos3_d2(c, x.h.p))
@@ -272,13 +274,15 @@ PR_INLINE int rs_box_hit(PR_GLOBAL const float* b, float3 o, float3 d, float tma
   return 1;
 }
 
-// Whether the ray o + t d, 0 <= t <= tmax, meets instance m then or now: its boxes, and then its
-// triangles, each frame's shape (its mesh's BVH, in object space) at that frame's transform.
+// Whether the ray o + t d, 0 <= t <= tmax, meets instance m then or now (then_only: then): its
+// boxes, and then its triangles, each frame's shape (its mesh's BVH, in object space) at that
+// frame's transform.
 PR_INLINE int rs_meets(const SceneData* s, PR_GLOBAL const MovedInstance* m, float3 o, float3 d,
-                       float tmax) {
-  if (!rs_box_hit(m->box, o, d, tmax) && !rs_box_hit(m->box + 6, o, d, tmax)) return 0;
+                       float tmax, int then_only) {
+  if (!rs_box_hit(m->box, o, d, tmax) && (then_only || !rs_box_hit(m->box + 6, o, d, tmax)))
+    return 0;
   if (m->root == PR_INVALID_INDEX) return 1;
-  for (int k = 0; k < 2; ++k) {
+  for (int k = 0; k < (then_only ? 1 : 2); ++k) {
     PR_GLOBAL const float* w = k ? m->after : m->before;
     BvhRay r = bvh_ray(xform_point(w, o), xform_vector(w, d), 0.0f, tmax);
     Hit h = hit_none();
@@ -295,15 +299,21 @@ PR_INLINE u32 rs_moved_next(PR_GLOBAL const MovedInstance* m, u32 k, int hit) {
   return hit || !m->node ? k + 1u : max(m->skip, k + 1u);
 }
 
-// Whether the ray (segment: tmax 1 and d the far end minus o) meets none of the moved instances.
-PR_INLINE int rs_clear(const SceneData* s, PR_GLOBAL const MovedInstance* moved, u32 count,
-                       float3 o, float3 d, float tmax) {
+// Whether the ray (segment: tmax 1 and d the far end minus o) meets none of the moved instances
+// then or now (then_only: then).
+PR_INLINE int rs_clear_as(const SceneData* s, PR_GLOBAL const MovedInstance* moved, u32 count,
+                          float3 o, float3 d, float tmax, int then_only) {
   for (u32 k = 0u; k < count;) {
     PR_GLOBAL const MovedInstance* m = moved + k;
-    if (!m->node && rs_meets(s, m, o, d, tmax)) return 0;
+    if (!m->node && rs_meets(s, m, o, d, tmax, then_only)) return 0;
     k = rs_moved_next(m, k, m->node && rs_box_hit(m->box, o, d, tmax));
   }
   return 1;
+}
+
+PR_INLINE int rs_clear(const SceneData* s, PR_GLOBAL const MovedInstance* moved, u32 count,
+                       float3 o, float3 d, float tmax) {
+  return rs_clear_as(s, moved, count, o, d, tmax, 0);
 }
 
 // Whether point p lies outside every moved instance's boxes (a path's point known by position
@@ -336,20 +346,44 @@ PR_INLINE int rs_x1_ok(const SceneData* s, const RsPrimary* x, u32 prev_known) {
   return rs_unmoved(s, x->h.inst) || (prev_known && !bsdf_transmits(&x->f.bsdf));
 }
 
-// Whether ray r, o + t d for 0 <= t <= tmax, meets none of the moved instances.
-PR_INLINE int rs_clear_ray(const SceneData* s, PR_GLOBAL const MovedInstance* moved, u32 count,
-                           Ray r) {
-  return rs_clear(s, moved, count, make_float3(r.ox, r.oy, r.oz), make_float3(r.dx, r.dy, r.dz),
-                  r.tmax);
+// Whether ray r (o + t d, 0 <= t <= tmax) meets none of the moved instances as they were in the
+// previous frame.
+PR_INLINE int rs_clear_then(const SceneData* s, PR_GLOBAL const MovedInstance* moved, u32 count,
+                            Ray r) {
+  return rs_clear_as(s, moved, count, make_float3(r.ox, r.oy, r.oz), make_float3(r.dx, r.dy, r.dz),
+                     r.tmax, 1);
 }
 
-// Whether the segment from x_1 at x to x_2 (h2) meets nothing that moved: from x itself where x
-// did not move; else the shadow ray's own segment, which leaves x's shape of x's frame (a segment
-// from x itself would meet that shape at once).
+// Whether the segment from the previous frame's x_1 at x to x_2 (h2) is seen in that frame by a
+// shadow ray traced in this one (rs_occluded): from x itself, meeting nothing that moved then or
+// now, where x did not move; else the shadow ray's own segment, which leaves x's shape of then
+// (a segment from x itself would meet it at once), meeting nothing that moved as it was then.
 PR_INLINE int rs_reconnection_clear(const SceneData* s, PR_GLOBAL const MovedInstance* moved,
                                     u32 count, const RsPrimary* x, const SurfaceHit* h2) {
-  if (rs_unmoved(s, x->h.inst)) return rs_clear(s, moved, count, x->h.p, h2->p - x->h.p, 1.0f);
-  return rs_clear_ray(s, moved, count, surface_segment_between(x->own, &x->h, s, h2));
+  if (!x->then_moved) return rs_clear(s, moved, count, x->h.p, h2->p - x->h.p, 1.0f);
+  return rs_clear_then(s, moved, count, surface_segment_between(x->own, &x->h, s, h2));
+}
+
+// Whether anything opaque lies on ray r in the scene of x's frame. For the previous frame's x_1
+// on what moved, whose segments meet nothing that moved as it was then (rs_reconnection_clear,
+// di_segment_clear), that is this frame's scene with what moved passed through, as alpha is (the
+// same bound on layers).
+PR_INLINE int rs_occluded(const SceneData* s, const RsPrimary* x, Ray r) {
+  if (!x->then_moved) return trace_occluded(s, r);
+  for (int layer = 0; layer < PR_MAX_ALPHA_LAYERS; ++layer) {
+    Hit hit;
+    if (!intersect_scene(&s->geom, r, &hit)) return 0;
+    if (hit.inst == PR_INVALID_INDEX || !s->sd.instances[hit.inst].moved) {
+#ifdef PR_HAS_ALPHA
+      const SurfaceHit h = surface_interp(&s->sd, hit.prim, hit.inst, hit.u, hit.v, 0);
+      if (!surface_passes(s, &h)) return 1;
+#else
+      return 1;
+#endif
+    }
+    r.tmin = hit.t;
+  }
+  return 1;
 }
 
 // Whether path r can be taken between frames, reconnected to x_1 at xa in one and at xb in the

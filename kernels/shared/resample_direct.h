@@ -78,18 +78,19 @@ PR_INLINE float di_target_at(const SceneData* s, const RsPrimary* x,
   const float p = luminance(*f);
   if (!(p > 0.0f) || !(p < PR_INF_F)) return 0.0f;
   *traced += 1u;
-  return trace_occluded(s, shadow) ? 0.0f : p;
+  return rs_occluded(s, x, shadow) ? 0.0f : p;
 }
 
-// Whether the segment from x_1 at x to reservoir r's light (a ray, towards a light at infinity)
-// meets nothing that moved: from x itself where x did not move; else the segment of its shadow
-// ray (di_eval's, which leaves x's shape of x's frame), where x sees the light at all.
+// Whether the segment from the previous frame's x_1 at x to reservoir r's light (a ray, towards a
+// light at infinity) is seen in that frame by a shadow ray traced in this one (rs_occluded), as
+// rs_reconnection_clear: from x itself where x did not move; else the segment of its shadow ray
+// (di_eval's, which leaves x's shape of then), where x sees the light at all.
 PR_INLINE int di_segment_clear(const SceneData* s, PR_GLOBAL const MovedInstance* moved, u32 count,
                                PR_GLOBAL const DirectReservoir* r, const RsPrimary* x) {
-  if (!rs_unmoved(s, x->h.inst)) {
+  if (x->then_moved) {
     Ray shadow;
     const float3 f = di_eval(s, x, r, &shadow);
-    return luminance(f) > 0.0f && rs_clear_ray(s, moved, count, shadow);
+    return luminance(f) > 0.0f && rs_clear_then(s, moved, count, shadow);
   }
   const float3 p = x->h.p;
   const Light l = s->lights.lights[r->light];
