@@ -269,8 +269,13 @@ std::string bsdfTablesHeader(const BsdfTables& t) {
       "// PR_BSDF_TABLE_COS points uniform in roughness = sqrt(alpha) from\n"
       "// PR_TABLE_MIN_ROUGHNESS to 1 and in sqrt(cos) from 0 to 1.\n"
       "#pragma once\n\n#include \"shared/common.h\"\n\nPR_NAMESPACE_BEGIN\n\n";
-  s += "#define PR_BSDF_TABLE_COS " + std::to_string(t.cosines) + "\n";
-  s += "#define PR_BSDF_TABLE_R " + std::to_string(t.roughnesses) + "\n\n";
+  // A table's grid: one #define per axis, then a blank line.
+  auto grid = [&](const std::vector<std::pair<const char*, int>>& axes) {
+    for (const auto& [name, n] : axes)
+      s += std::string("#define ") + name + " " + std::to_string(n) + "\n";
+    s += "\n";
+  };
+  grid({{"PR_BSDF_TABLE_COS", t.cosines}, {"PR_BSDF_TABLE_R", t.roughnesses}});
   auto table = [&](const char* name, const char* what, const std::vector<float>& v) {
     s += std::string("// ") + what + "\n";
     s += std::string("PR_TABLE float ") + name + "[" + std::to_string(v.size()) + "] = {\n";
@@ -290,9 +295,9 @@ std::string bsdfTablesHeader(const BsdfTables& t) {
        "// grid uniform in sqrt(cos) (PR_BSDF_ANISO_COS points from 0 to 1), in the larger\n"
        "// roughness and in the ratio of the smaller to it (PR_BSDF_ANISO_R and\n"
        "// PR_BSDF_ANISO_Q points from PR_TABLE_MIN_ROUGHNESS to 1).\n";
-  s += "#define PR_BSDF_ANISO_COS " + std::to_string(t.anisoCosines) + "\n";
-  s += "#define PR_BSDF_ANISO_R " + std::to_string(t.anisoRoughnesses) + "\n";
-  s += "#define PR_BSDF_ANISO_Q " + std::to_string(t.anisoRatios) + "\n\n";
+  grid({{"PR_BSDF_ANISO_COS", t.anisoCosines},
+        {"PR_BSDF_ANISO_R", t.anisoRoughnesses},
+        {"PR_BSDF_ANISO_Q", t.anisoRatios}});
   table("pr_ggx_e_aniso", "GGX albedo with F = 1.", t.anisoE);
   table("pr_ggx_es_aniso", "GGX albedo weighted by Schlick's (1 - v.h)^5.", t.anisoEs);
   table("pr_ggx_eavg_aniso", "GGX albedo averaged over the hemisphere: [ratio][roughness].",
@@ -303,9 +308,9 @@ std::string bsdfTablesHeader(const BsdfTables& t) {
        "// uniform in sqrt(cos) from 0 to 1 (PR_BSDF_GLASS_COS points), in roughness from\n"
        "// PR_TABLE_MIN_ROUGHNESS to 1 (PR_BSDF_GLASS_R) and in (ior - 1) / (ior + 1) from\n"
        "// PR_GLASS_TABLE_MIN_IOR to PR_GLASS_TABLE_MAX_IOR (PR_BSDF_GLASS_IOR).\n";
-  s += "#define PR_BSDF_GLASS_COS " + std::to_string(t.glassCosines) + "\n";
-  s += "#define PR_BSDF_GLASS_R " + std::to_string(t.glassRoughnesses) + "\n";
-  s += "#define PR_BSDF_GLASS_IOR " + std::to_string(t.glassIors) + "\n\n";
+  grid({{"PR_BSDF_GLASS_COS", t.glassCosines},
+        {"PR_BSDF_GLASS_R", t.glassRoughnesses},
+        {"PR_BSDF_GLASS_IOR", t.glassIors}});
   table("pr_glass_e", "Rough glass albedo.", t.glassE);
   table("pr_glass_eavg", "Rough glass albedo averaged over the hemisphere: [side][ior][roughness].",
         t.glassEavg);
@@ -314,9 +319,9 @@ std::string bsdfTablesHeader(const BsdfTables& t) {
       "// (fresnel_dielectric_weight): index [ior][roughness][cos] on a grid uniform in sqrt(cos)\n"
       "// (PR_BSDF_DIELECTRIC_COS points), in roughness (PR_BSDF_DIELECTRIC_R) and in\n"
       "// (ior - 1) / (ior + 1) (PR_BSDF_DIELECTRIC_IOR) as the glass tables.\n";
-  s += "#define PR_BSDF_DIELECTRIC_COS " + std::to_string(t.dielectricCosines) + "\n";
-  s += "#define PR_BSDF_DIELECTRIC_R " + std::to_string(t.dielectricRoughnesses) + "\n";
-  s += "#define PR_BSDF_DIELECTRIC_IOR " + std::to_string(t.dielectricIors) + "\n\n";
+  grid({{"PR_BSDF_DIELECTRIC_COS", t.dielectricCosines},
+        {"PR_BSDF_DIELECTRIC_R", t.dielectricRoughnesses},
+        {"PR_BSDF_DIELECTRIC_IOR", t.dielectricIors}});
   table("pr_ggx_ed", "GGX albedo weighted by the dielectric Fresnel's shape.", t.dielectricE);
   table("pr_fresnel_wavg", "The shape averaged over the hemisphere (cosine-weighted): [ior].",
         t.dielectricWeight);

@@ -235,9 +235,9 @@ void GpuScene::keepPrevious() {
   if (keepPrevious_) return;
   keepPrevious_ = true;
   previousKnown_ = false;
-  const bool deforms = std::any_of(
-      scene_.dynamicMeshes.begin(), scene_.dynamicMeshes.end(),
-      [&](const TriangleMesh& m) { return scene_.meshDeforms(&m - scene_.dynamicMeshes.data()); });
+  bool deforms = false;
+  for (size_t m = 0; m < scene_.dynamicMeshes.size(); ++m)
+    deforms = deforms || scene_.meshDeforms(m);
   if (deforms) {
     const uint64_t bytes = std::max<uint64_t>(vertexCount_, 1) * sizeof(dev::ShadingVertex);
     prevVertices_ = ctx_.allocate("previous shading vertices", bytes, CL_MEM_READ_ONLY);

@@ -108,8 +108,8 @@ class GpuScene {
   // Deforming meshes at t: their BVHs built again and shading vertices uploaded where their
   // shape changed (*changed, per dynamic mesh). Returns whether any did.
   bool deformMeshes(double t, std::vector<bool>* changed);
-  // Copies the current shapes to the previous ones: vertex range [first, first + count) (all
-  // where count is 0) and the instance transforms.
+  // Copies the current shapes to the previous ones: vertex range [first, first + count) and,
+  // with `instances`, the instance transforms.
   void copyToPrevious(uint64_t firstVertex, uint64_t vertexCount, bool instances);
   void buildLights(double t);
   // moved_ from the instances' bounds and transforms before this frame's setInstances and after

@@ -366,24 +366,10 @@ PR_INLINE int rs_reconnection_clear(const SceneData* s, PR_GLOBAL const MovedIns
 
 // Whether anything opaque lies on ray r in the scene of x's frame. For the previous frame's x_1
 // on what moved, whose segments meet nothing that moved as it was then (rs_reconnection_clear,
-// di_segment_clear), that is this frame's scene with what moved passed through, as alpha is (the
-// same bound on layers).
+// di_segment_clear), that is this frame's scene with what moved passed through
+// (trace_occluded_layers).
 PR_INLINE int rs_occluded(const SceneData* s, const RsPrimary* x, Ray r) {
-  if (!x->then_moved) return trace_occluded(s, r);
-  for (int layer = 0; layer < PR_MAX_ALPHA_LAYERS; ++layer) {
-    Hit hit;
-    if (!intersect_scene(&s->geom, r, &hit)) return 0;
-    if (hit.inst == PR_INVALID_INDEX || !s->sd.instances[hit.inst].moved) {
-#ifdef PR_HAS_ALPHA
-      const SurfaceHit h = surface_interp(&s->sd, hit.prim, hit.inst, hit.u, hit.v, 0);
-      if (!surface_passes(s, &h)) return 1;
-#else
-      return 1;
-#endif
-    }
-    r.tmin = hit.t;
-  }
-  return 1;
+  return x->then_moved ? trace_occluded_layers(s, r, 1) : trace_occluded(s, r);
 }
 
 // Whether path r can be taken between frames, reconnected to x_1 at xa in one and at xb in the

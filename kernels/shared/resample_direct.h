@@ -108,7 +108,8 @@ PR_INLINE int di_segment_clear(const SceneData* s, PR_GLOBAL const MovedInstance
 }
 
 // Whether reservoir r's light can be taken between frames, seen from x_1 at xa in one and at xb
-// in the other: each x_1 where it may be (rs_x1_ok), and neither segment meeting what moved.
+// in the other: each x_1 where it may be (rs_x1_ok), and the previous frame's segment seen alike
+// in both (di_segment_clear; this frame's is its shadow ray, traced now).
 PR_INLINE int di_temporal_ok(const SceneData* s, PR_GLOBAL const MovedInstance* moved, u32 count,
                              PR_GLOBAL const DirectReservoir* r, const RsPrimary* pa,
                              const RsPrimary* pb, u32 prev_known) {

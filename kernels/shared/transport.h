@@ -47,17 +47,30 @@ PR_CALLABLE int trace_closest(const SceneData* s, Ray ray, Hit* hit) {
 #endif
 }
 
-// Whether anything opaque lies on the segment (tmin, tmax) of the ray.
-PR_CALLABLE int trace_occluded(const SceneData* s, Ray ray) {
-#ifdef PR_HAS_ALPHA
+// Whether anything opaque lies on the segment (tmin, tmax) of the ray, hit by hit: cut-out and
+// uncovered points are passed through, and with pass_moved every instance that moved since the
+// previous frame (a bounded number of layers).
+PR_INLINE int trace_occluded_layers(const SceneData* s, Ray ray, int pass_moved) {
   for (int layer = 0; layer < PR_MAX_ALPHA_LAYERS; ++layer) {
     Hit hit;
     if (!intersect_scene(&s->geom, ray, &hit)) return 0;
-    const SurfaceHit h = surface_interp(&s->sd, hit.prim, hit.inst, hit.u, hit.v, 0);
-    if (!surface_passes(s, &h)) return 1;
+    if (!pass_moved || hit.inst == PR_INVALID_INDEX || !s->sd.instances[hit.inst].moved) {
+#ifdef PR_HAS_ALPHA
+      const SurfaceHit h = surface_interp(&s->sd, hit.prim, hit.inst, hit.u, hit.v, 0);
+      if (!surface_passes(s, &h)) return 1;
+#else
+      return 1;
+#endif
+    }
     ray.tmin = hit.t;
   }
   return 1;
+}
+
+// Whether anything opaque lies on the segment (tmin, tmax) of the ray.
+PR_CALLABLE int trace_occluded(const SceneData* s, Ray ray) {
+#ifdef PR_HAS_ALPHA
+  return trace_occluded_layers(s, ray, 0);
 #else
   return occluded_scene(&s->geom, ray);
 #endif
