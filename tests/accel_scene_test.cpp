@@ -119,7 +119,7 @@ void expectSceneMatchesBruteForce(const std::string& path, const std::vector<dou
       bruteForce(ssg, wo, wd, 0.0f, PR_INVALID_INDEX, &want);
       const dev::BvhRay world = dev::bvh_ray_from(ray);
       for (const dev::BvhInstance& rec : da.instances()) {
-        const dev::BvhRay local = dev::instance_ray(&rec, &world);
+        const dev::BvhRay local = dev::instance_ray(&g, &rec, &world);
         bruteForce(meshes[rec.mesh], local.o, local.d, 0.0f, rec.instance_id, &want);
       }
       hits += want.prim != PR_INVALID_INDEX;

@@ -541,8 +541,10 @@ Hit bruteForceDynamic(const DynamicScene& d, const std::vector<std::vector<BvhTr
                       Ray ray) {
   Hit best = dev::hit_none();
   const dev::BvhRay world = dev::bvh_ray_from(ray);
+  dev::SceneGeom still{};  // no motion: the records' own transforms
+  still.motion_steps = 1;
   for (const dev::BvhInstance& rec : d.accel.instances()) {
-    const dev::BvhRay local = dev::instance_ray(&rec, &world);
+    const dev::BvhRay local = dev::instance_ray(&still, &rec, &world);
     Ray r = makeRay({local.o.x, local.o.y, local.o.z}, {local.d.x, local.d.y, local.d.z}, ray.tmin,
                     ray.tmax);
     r.tmax = best.prim == PR_INVALID_INDEX ? ray.tmax : best.t;

@@ -158,6 +158,7 @@ const std::map<std::string, std::string> kSampleValues = {
     {"--animation", "1"},
     {"--frames", "2-3"},
     {"--fps", "25"},
+    {"--shutter", "0.5"},
     {"--camera", "1"},
     {"--width", "33"},
     {"--height", "21"},

@@ -55,11 +55,15 @@ void DeviceAccel::uploadFrame(Context& ctx, const DynamicAccel& dsg) {
   upload(ctx, instances_, "dynamic instances", dsg.instances().data(), byteSize(dsg.instances()),
          true);
   instanceCount_ = uint32_t(dsg.instances().size());
+  motionSteps_ = dsg.motionSteps();
+  if (motionSteps_ > 1)
+    upload(ctx, motion_, "instance motion steps", dsg.motion().data(), byteSize(dsg.motion()),
+           true);
 }
 
 void DeviceAccel::fillArgs(Context& ctx, kargs::SceneArgs* a) {
   if (staticNodes_.bytes == 0) throw RuntimeError("DeviceAccel: static geometry not uploaded");
-  for (Slot* s : {&tlasNodes_, &instances_, &meshNodes_, &meshTris_})
+  for (Slot* s : {&tlasNodes_, &instances_, &meshNodes_, &meshTris_, &motion_})
     if (s->bytes == 0) upload(ctx, *s, "dynamic geometry placeholder", nullptr, 0, false);
   a->pr_g_static_nodes = staticNodes_.buffer;
   a->pr_g_static_tris = staticTris_.buffer;
@@ -68,6 +72,9 @@ void DeviceAccel::fillArgs(Context& ctx, kargs::SceneArgs* a) {
   a->pr_g_mesh_nodes = meshNodes_.buffer;
   a->pr_g_mesh_tris = meshTris_.buffer;
   a->pr_g_instance_count = instanceCount_;
+  a->pr_g_motion = motion_.buffer;
+  a->pr_g_motion_steps = motionSteps_;
+  a->pr_g_time = 0.5f;  // the frame's own time; kernels set each path's (scene_at_sample)
 }
 
 cl_uint DeviceAccel::setKernelArgs(Context& ctx, cl::Kernel& kernel, cl_uint first) {
@@ -75,7 +82,7 @@ cl_uint DeviceAccel::setKernelArgs(Context& ctx, cl::Kernel& kernel, cl_uint fir
   fillArgs(ctx, &a);
   return pr::setKernelArgs(kernel, first, a.pr_g_static_nodes, a.pr_g_static_tris,
                            a.pr_g_tlas_nodes, a.pr_g_instances, a.pr_g_mesh_nodes, a.pr_g_mesh_tris,
-                           a.pr_g_instance_count);
+                           a.pr_g_instance_count, a.pr_g_motion, a.pr_g_motion_steps, a.pr_g_time);
 }
 
 }  // namespace pr::accel

@@ -20,7 +20,7 @@ class DeviceAccel {
   // The meshes' BVHs (after the last addMesh, and again after replaceMesh: grow leaves room
   // for a deforming mesh's BVH to grow).
   void uploadMeshes(Context& ctx, const DynamicAccel& dsg, bool grow = false);
-  // This frame's TLAS and instance records; buffers grow as needed and are reused.
+  // This frame's TLAS, instance records and motion steps; buffers grow as needed and are reused.
   void uploadFrame(Context& ctx, const DynamicAccel& dsg);
 
   // The geometry's kernel arguments (PR_ARGS_SCENE_GEOM) into `args`. Needs uploadStatic;
@@ -34,7 +34,7 @@ class DeviceAccel {
   // Device bytes held: static part, meshes, per-frame part.
   uint64_t staticBytes() const { return staticNodes_.bytes + staticTris_.bytes; }
   uint64_t meshBytes() const { return meshNodes_.bytes + meshTris_.bytes; }
-  uint64_t frameBytes() const { return tlasNodes_.bytes + instances_.bytes; }
+  uint64_t frameBytes() const { return tlasNodes_.bytes + instances_.bytes + motion_.bytes; }
 
  private:
   struct Slot {
@@ -47,8 +47,9 @@ class DeviceAccel {
                      bool grow);
 
   int width_;
-  Slot staticNodes_, staticTris_, meshNodes_, meshTris_, tlasNodes_, instances_;
+  Slot staticNodes_, staticTris_, meshNodes_, meshTris_, tlasNodes_, instances_, motion_;
   uint32_t instanceCount_ = 0;
+  uint32_t motionSteps_ = 1;
 };
 
 }  // namespace pr::accel

@@ -202,7 +202,18 @@ bool finite(const glm::mat4& m) {
 
 }  // namespace
 
-void DynamicAccel::setInstances(const std::vector<InstanceInput>& instances) {
+void DynamicAccel::setInstances(const std::vector<InstanceInput>& instances,
+                                const std::vector<std::vector<glm::mat4>>& motion) {
+  motionSteps_ = motion.empty() ? 1u : uint32_t(motion.front().size());
+  if (!motion.empty() && (motion.size() != instances.size() || motionSteps_ < 2 ||
+                          std::any_of(motion.begin(), motion.end(),
+                                      [&](const auto& m) { return m.size() != motionSteps_; })))
+    throw InputError("motion steps: not one count of at least 2 for each of " +
+                     std::to_string(instances.size()) + " instances");
+  motion_.assign(motion.empty() ? 0 : size_t(motionSteps_) * instances.size() * 12, 0.0f);
+  for (size_t i = 0; i < motion.size(); ++i)
+    for (uint32_t k = 0; k < motionSteps_; ++k)
+      store3x4(motion[i][k], &motion_[(i * motionSteps_ + k) * 12]);
   worldBounds_.assign(instances.size(), Aabb{});
   std::vector<Aabb> boxes;
   std::vector<uint32_t> kept;
@@ -214,15 +225,22 @@ void DynamicAccel::setInstances(const std::vector<InstanceInput>& instances) {
                        std::to_string(in.mesh) + " of " + std::to_string(meshes_.size()));
     const Mesh& mesh = meshes_[in.mesh];
     if (mesh.triangleCount == 0 || !finite(in.objectToWorld)) continue;
+    const std::vector<glm::mat4> placements =
+        motion.empty() ? std::vector<glm::mat4>{in.objectToWorld} : motion[i];
+    if (!std::all_of(placements.begin(), placements.end(),
+                     [](const glm::mat4& m) { return finite(m); }))
+      continue;
     const float det = glm::determinant(glm::mat3(in.objectToWorld));
     const glm::mat4 inv = glm::inverse(in.objectToWorld);
     if (!(std::fabs(det) > 0.0f) || !finite(inv)) continue;
     Aabb box;
-    for (int c = 0; c < 8; ++c) {
-      const glm::vec3 corner((c & 1) ? mesh.bounds.hi.x : mesh.bounds.lo.x,
-                             (c & 2) ? mesh.bounds.hi.y : mesh.bounds.lo.y,
-                             (c & 4) ? mesh.bounds.hi.z : mesh.bounds.lo.z);
-      box.grow(glm::vec3(in.objectToWorld * glm::vec4(corner, 1.0f)));
+    for (const glm::mat4& m : placements) {
+      for (int c = 0; c < 8; ++c) {
+        const glm::vec3 corner((c & 1) ? mesh.bounds.hi.x : mesh.bounds.lo.x,
+                               (c & 2) ? mesh.bounds.hi.y : mesh.bounds.lo.y,
+                               (c & 4) ? mesh.bounds.hi.z : mesh.bounds.lo.z);
+        box.grow(glm::vec3(m * glm::vec4(corner, 1.0f)));
+      }
     }
     // Rays are tested in object space; pad the world box by a few ulps of its coordinates so
     // the transform's rounding never culls a hit at the box's edge.
@@ -275,6 +293,7 @@ HostGeom::HostGeom(const StaticAccel& ssg, const DynamicAccel* dsg) {
   staticNodes_ = toNodes(ssg.wide().words, ssg.wide().width);
   geom_.static_nodes = staticNodes_.data();
   geom_.static_tris = ssg.packets().data();
+  geom_.motion_steps = 1;
   if (dsg) {
     tlasNodes_ = toNodes(dsg->tlas().words, dsg->width());
     meshNodes_ = toNodes(dsg->meshNodes(), dsg->width());
@@ -283,7 +302,10 @@ HostGeom::HostGeom(const StaticAccel& ssg, const DynamicAccel* dsg) {
     geom_.mesh_nodes = meshNodes_.data();
     geom_.mesh_tris = dsg->meshPackets().data();
     geom_.instance_count = uint32_t(dsg->instances().size());
+    geom_.motion = dsg->motion().empty() ? nullptr : dsg->motion().data();
+    geom_.motion_steps = dsg->motionSteps();
   }
+  geom_.time = 0.5f;
 }
 
 }  // namespace pr::accel

@@ -94,8 +94,11 @@ class DynamicAccel {
 
   // This frame: world bounds of every instance and the top-level BVH over them. Instances of
   // empty meshes or with a singular or non-finite transform cannot be hit and are left out.
-  // Throws InputError on a mesh index out of range.
-  void setInstances(const std::vector<InstanceInput>& instances);
+  // With `motion` (--shutter: per instance, its transforms at the motion steps, all as many;
+  // kernels/shared/motion.h) each box holds its instance at every step. Throws InputError on a
+  // mesh index out of range, or on motion not of one step count per instance.
+  void setInstances(const std::vector<InstanceInput>& instances,
+                    const std::vector<std::vector<glm::mat4>>& motion = {});
 
   uint32_t meshCount() const { return uint32_t(meshes_.size()); }
   // Mesh m's BVH root in meshNodes().
@@ -116,6 +119,10 @@ class DynamicAccel {
   const BvhStats& tlasStats() const { return tlasStats_; }
   // World bounds of instance i of the last setInstances (empty when left out).
   const std::vector<Aabb>& instanceBounds() const { return worldBounds_; }
+  // Motion steps of every instance (1: none) and their transforms, 12 floats each (3x4 rows),
+  // instance by instance (kernels/shared/motion.h).
+  uint32_t motionSteps() const { return motionSteps_; }
+  const std::vector<float>& motion() const { return motion_; }
 
  private:
   struct Mesh {
@@ -143,6 +150,8 @@ class DynamicAccel {
   std::vector<dev::BvhInstance> records_;
   std::vector<Aabb> worldBounds_;
   BvhStats tlasStats_;
+  uint32_t motionSteps_ = 1;
+  std::vector<float> motion_;
 };
 
 // The CPU reference's view of both structures (kernels/shared/bvh.h compiled for the host), for

@@ -102,6 +102,11 @@ std::vector<Row> sceneAndOutputRows() {
           "Frames per second: frame f is at time f / fps"}
           .range(0.001, 1000)
           .withDefault(),
+      Row{"--shutter", kScene, kEveryday, kEstimator, PR_FIELD(ro.shutter),
+          "Motion blur: the shutter stays open this many frames, centred on each frame's time "
+          "(0: none; --mode pathtrace)"}
+          .range(0, 2)
+          .withDefault(),
       Row{"--camera", kScene, kEveryday, kEstimator, PR_FIELD(ro.camera),
           "Camera index (default: the scene's first)"}
           .range(0, 1 << 20),

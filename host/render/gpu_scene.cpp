@@ -155,6 +155,9 @@ GpuScene::GpuScene(Context& ctx, const Scene& scene, const GpuSceneOptions& opti
     CL_CHECK(ctx_.queue().enqueueWriteBuffer(traceCdfBuffer_, CL_TRUE, 0,
                                              traceCdf_.size() * sizeof(float), traceCdf_.data()));
   shadingBytes_ += n * sizeof(float);
+  cameraStepBytes_ = sizeof(dev::CameraParams);  // a placeholder until a shutter opens
+  cameraSteps_ = ctx_.allocate("camera motion steps", cameraStepBytes_, CL_MEM_READ_ONLY);
+  ctx_.zero(cameraSteps_, cameraStepBytes_);
 }
 
 cl::Buffer GpuScene::upload(const char* name, const void* data, uint64_t bytes, uint64_t* counter) {
@@ -279,6 +282,10 @@ void GpuScene::setTime(double t) {
   if (lastTransforms_.size() != n) lastTransforms_.assign(n, glm::mat4(0.0f));
   const std::vector<glm::mat4> was = lastTransforms_;
   std::vector<bool> reshapedInstance(n);
+  const std::vector<double> times = shutter_ > 0.0 ? motionTimes(t) : std::vector<double>{};
+  std::vector<std::vector<glm::mat4>> motion;
+  if (!times.empty()) placeOverShutter(times, &motion);
+  motionSteps_ = times.empty() ? 1u : uint32_t(times.size());
   for (size_t i = 0; i < n; ++i) {
     const glm::mat4 m = scene_.instanceTransform(i, t);
     inputs[i].mesh = scene_.instances[i].mesh;
@@ -297,14 +304,14 @@ void GpuScene::setTime(double t) {
     anyMoved_ = anyMoved_ || moved;
     lastTransforms_[i] = m;
   }
-  if (anyMoved_) {
+  // Under a shutter the boxes hold each instance over its interval, which moves with the frame.
+  if (anyMoved_ || shutter_ > 0.0) {
     const std::vector<accel::Aabb> before = dsg_.instanceBounds();
-    dsg_.setInstances(inputs);
+    dsg_.setInstances(inputs, motion);
     deviceAccel_.uploadFrame(ctx_, dsg_);
-    collectMoved(before, was, reshapedInstance);
-  } else {
-    moved_.clear();
+    if (anyMoved_) collectMoved(before, was, reshapedInstance);
   }
+  if (!anyMoved_) moved_.clear();
   // The moved flags change even when no transform does (all back to 0), so always upload.
   const uint64_t bytes = std::max<size_t>(n, 1) * sizeof(dev::ShadingInstance);
   if (n > instanceCapacity_ || !shadingInstances_()) {
@@ -482,6 +489,82 @@ void GpuScene::buildLights(double t) {
   }
 }
 
+void GpuScene::setShutter(double seconds, int cameraIndex, int width, int height) {
+  shutter_ = seconds > 0.0 ? seconds : 0.0;
+  shutterCamera_ = cameraIndex;
+  shutterWidth_ = width;
+  shutterHeight_ = height;
+  meshBounds_.assign(scene_.dynamicMeshes.size(), accel::Aabb{});
+  for (size_t m = 0; m < scene_.dynamicMeshes.size(); ++m)
+    for (const glm::vec3& p : scene_.dynamicMeshes[m].positions) meshBounds_[m].grow(p);
+}
+
+std::vector<double> GpuScene::motionTimes(double t) const {
+  auto timesOf = [&](int steps) {
+    std::vector<double> times(static_cast<size_t>(steps));
+    for (int k = 0; k < steps; ++k)
+      times[size_t(k)] = t + shutter_ * (double(k) / double(steps - 1) - 0.5);
+    return times;
+  };
+  constexpr float kTolerance = 1e-3f;
+  // How far the blend of a and b lies from `mid` at the mesh box's corners, over its size.
+  auto instanceError = [&](const accel::Aabb& box, const glm::mat4& a, const glm::mat4& b,
+                           const glm::mat4& mid) {
+    float worst = 0.0f, size = 0.0f;
+    for (int c = 0; c < 8; ++c) {
+      const glm::vec4 corner((c & 1) ? box.hi.x : box.lo.x, (c & 2) ? box.hi.y : box.lo.y,
+                             (c & 4) ? box.hi.z : box.lo.z, 1.0f);
+      const glm::vec3 exact(mid * corner);
+      const glm::vec3 blend(0.5f * (a * corner + b * corner));
+      worst = std::max(worst, glm::length(blend - exact));
+      size = std::max(size, glm::length(exact - glm::vec3(mid * glm::vec4(box.centre(), 1.0f))));
+    }
+    return worst / std::max(size, 1e-6f * sceneRadius_);
+  };
+  auto cameraError = [&](const CameraPose& a, const CameraPose& b, const CameraPose& mid) {
+    const float moved = glm::length(0.5f * (a.position + b.position) - mid.position) / sceneRadius_;
+    const float turned =
+        glm::length(glm::normalize(a.forward + b.forward) - glm::normalize(mid.forward)) +
+        glm::length(glm::normalize(a.up + b.up) - glm::normalize(mid.up));
+    return std::max(moved, turned);
+  };
+  for (int steps = 3;; steps = 2 * steps - 1) {
+    const std::vector<double> times = timesOf(steps);
+    if (steps >= 33) return times;
+    bool fine = true;
+    for (size_t k = 0; fine && k + 1 < times.size(); ++k) {
+      const double mid = 0.5 * (times[k] + times[k + 1]);
+      // (A non-finite error, a degenerate placement, asks for no more steps.)
+      fine = !(cameraError(scene_.cameraAt(shutterCamera_, times[k]),
+                           scene_.cameraAt(shutterCamera_, times[k + 1]),
+                           scene_.cameraAt(shutterCamera_, mid)) > kTolerance);
+      for (size_t i = 0; fine && i < scene_.instances.size(); ++i) {
+        const accel::Aabb& box = meshBounds_[scene_.instances[i].mesh];
+        fine = box.empty() || !(instanceError(box, scene_.instanceTransform(i, times[k]),
+                                              scene_.instanceTransform(i, times[k + 1]),
+                                              scene_.instanceTransform(i, mid)) > kTolerance);
+      }
+    }
+    if (fine) return times;
+  }
+}
+
+void GpuScene::placeOverShutter(const std::vector<double>& times,
+                                std::vector<std::vector<glm::mat4>>* motion) {
+  motion->assign(scene_.instances.size(), {});
+  for (size_t i = 0; i < motion->size(); ++i)
+    for (double at : times) (*motion)[i].push_back(scene_.instanceTransform(i, at));
+  std::vector<dev::CameraParams> cams;
+  for (double at : times) cams.push_back(camera(shutterCamera_, at, shutterWidth_, shutterHeight_));
+  const uint64_t bytes = cams.size() * sizeof(dev::CameraParams);
+  if (bytes > cameraStepBytes_) {
+    if (cameraStepBytes_) ctx_.release("camera motion steps", cameraStepBytes_);
+    cameraSteps_ = ctx_.allocate("camera motion steps", bytes, CL_MEM_READ_ONLY);
+    cameraStepBytes_ = bytes;
+  }
+  CL_CHECK(ctx_.queue().enqueueWriteBuffer(cameraSteps_, CL_TRUE, 0, bytes, cams.data()));
+}
+
 dev::CameraParams GpuScene::camera(int cameraIndex, double t, int width, int height) const {
   return toCameraParams(scene_.cameraAt(cameraIndex, t), width, height);
 }
@@ -495,6 +578,9 @@ kargs::SceneArgs GpuScene::kernelArgs() {
   a.pr_sd_materials = materials_;
   a.pr_sd_textures = textures_;
   a.pr_sd_texels = texels_;
+  a.pr_sd_motion = a.pr_g_motion;
+  a.pr_sd_motion_steps = a.pr_g_motion_steps;
+  a.pr_sd_time = a.pr_g_time;
   a.pr_l_lights = lightBuffer_;
   a.pr_l_cdf = cdfBuffer_;
   a.pr_l_nodes = lightNodeBuffer_;
@@ -533,7 +619,7 @@ std::string GpuScene::buildOptions() const {
 
 uint64_t GpuScene::deviceBytes() const {
   return deviceAccel_.staticBytes() + deviceAccel_.meshBytes() + deviceAccel_.frameBytes() +
-         shadingBytes_ + instanceBytes_ + lightBytes_ + lightNodeBytes_;
+         shadingBytes_ + instanceBytes_ + lightBytes_ + lightNodeBytes_ + cameraStepBytes_;
 }
 
 }  // namespace pr

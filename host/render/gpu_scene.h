@@ -49,6 +49,13 @@ class GpuScene {
 
   // The camera at time t for an image of width x height.
   dev::CameraParams camera(int cameraIndex, double t, int width, int height) const;
+  // Motion blur: from now on each setTime(t) also places the instances and camera `cameraIndex`
+  // (for width x height) at motionSteps() times over [t - seconds / 2, t + seconds / 2]
+  // (kernels/shared/motion.h); 0 seconds: none. Deforming meshes and punctual lights stay at t.
+  void setShutter(double seconds, int cameraIndex, int width, int height);
+  // The last setTime's motion steps (1: none) and the camera at each (a placeholder at 1).
+  uint32_t motionSteps() const { return motionSteps_; }
+  const cl::Buffer& cameraSteps() const { return cameraSteps_; }
 
   // The scene's kernel arguments (PR_ARGS_SCENE) as they are now; copy them into a kernel's
   // argument struct with kargs::setScene after each setTime.
@@ -112,6 +119,14 @@ class GpuScene {
   // with `instances`, the instance transforms.
   void copyToPrevious(uint64_t firstVertex, uint64_t vertexCount, bool instances);
   void buildLights(double t);
+  // The fewest motion steps (3, 5, 9, 17, 33) at which a blend of two steps places every moving
+  // instance's box and the camera within a thousandth of their size of where the animation puts
+  // them midway; the times of those steps around t.
+  std::vector<double> motionTimes(double t) const;
+  // Under a shutter: each instance's transforms at `times` (*motion) and the camera's, uploaded
+  // to cameraSteps_.
+  void placeOverShutter(const std::vector<double>& times,
+                        std::vector<std::vector<glm::mat4>>* motion);
   // moved_ from the instances' bounds and transforms before this frame's setInstances and after
   // (reshaped: per instance, its mesh deformed this frame).
   void collectMoved(const std::vector<accel::Aabb>& before, const std::vector<glm::mat4>& was,
@@ -166,6 +181,12 @@ class GpuScene {
   float sceneRadius_ = 1.0f;
   glm::vec3 sceneCentre_{0.0f};
   bool lightsAnimated_ = false;
+  double shutter_ = 0.0;  // seconds (setShutter)
+  int shutterCamera_ = 0, shutterWidth_ = 1, shutterHeight_ = 1;
+  std::vector<accel::Aabb> meshBounds_;  // per dynamic mesh, object space (motionTimes)
+  uint32_t motionSteps_ = 1;
+  cl::Buffer cameraSteps_;
+  uint64_t cameraStepBytes_ = 0;
 
   cl::Buffer vertices_, triangles_, shadingInstances_, materials_, textures_, texels_;
   cl::Buffer prevVertices_, prevInstances_;  // keepPrevious

@@ -93,6 +93,9 @@ struct RenderOptions {
   FrameRange frames;
   bool framesGiven = false;
   double fps = 24.0;
+  // --shutter: frames the shutter stays open, centred on each frame's time (motion blur,
+  // kernels/shared/motion.h); 0 = none.
+  double shutter = 0.0;
   int width = 0;  // 0: the camera's aspect with height, else 640x480
   int height = 0;
   int spp = 4;

@@ -197,6 +197,8 @@ void PathTracer::beginFrame(int64_t frame, const dev::CameraParams& camera,
   extendArgs_.states = states_;
   extendArgs_.hits = hits_;
   extendArgs_.rays = rays_;
+  extendArgs_.seed = settings_.seed;
+  extendArgs_.frame = rngFrame;
   extendArgs_.set(extend_, kargs::kScene | kargs::kFrame);
   kargs::setScene(&shadeArgs_, sceneArgs);
   shadeArgs_.states = states_;
@@ -265,6 +267,8 @@ void PathTracer::beginFrame(int64_t frame, const dev::CameraParams& camera,
   generateArgs_.queue = queues_[0];
   generateArgs_.queue_size = queueSizes_;
   generateArgs_.budget = film_.budget();
+  generateArgs_.cam_steps = scene_.cameraSteps();
+  generateArgs_.cam_step_count = scene_.motionSteps();
   generateArgs_.set(generate_);
 }
 
@@ -311,7 +315,8 @@ void PathTracer::traceBand(cl_uint first, cl_uint end, cl_uint masked, StageTime
 
 void PathTracer::tracePass(int sample, cl_uint masked, StageTimer* timer) {
   const cl_uint first = film_.first(), n = film_.end();
-  generateArgs_.sample = shadeArgs_.sample = shadowArgs_.sample = cl_uint(sample);
+  generateArgs_.sample = extendArgs_.sample = shadeArgs_.sample = shadowArgs_.sample =
+      cl_uint(sample);
   for (cl_uint a = first; a < n; a += band_)
     traceBand(a, std::min<cl_uint>(n, a + band_), masked, timer);
   if (settings_.resample.enabled) {

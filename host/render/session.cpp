@@ -84,6 +84,10 @@ void validateRenderOptions(const RenderOptions& o) {
           "--noise-threshold: cannot be combined with --connection-history, whose "
           "reservoirs follow every pass of every pixel");
   }
+  if (o.shutter > 0.0 && o.mode != RenderMode::PathTrace)
+    throw InputError(
+        "--shutter: motion blur is built for --mode pathtrace only (light paths kept over the "
+        "shutter interval are not yet)");
   if (!o.envColor.empty()) {
     float rgb[3];
     parseColor(o.envColor, rgb);
@@ -118,6 +122,9 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
     throw InputError(
         "--light-tracing: weighs its paths against the eye paths, which --no-eye-paths "
         "turns off");
+  if (o.shutter > 0.0 && resample.enabled)
+    throw InputError("--shutter: cannot be combined with --resample yet");
+  if (o.shutter > 0.0) gpu_->setShutter(o.shutter / o.fps, camera_, width_, height_);
   if (!(resample.distance > 0.0f)) resample.distance = 0.01f * gpu_->sceneRadius();
   if (o.mode == RenderMode::PathTrace) {
     PathTracerSettings p;

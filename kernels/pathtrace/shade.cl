@@ -186,10 +186,9 @@ PR_INLINE void queue_append(__global uint* queue, __global uint* size, int take,
 }
 
 // One live path i: PR_SHADE_* of what it goes on with.
-
-// One live path i: PR_SHADE_* of what it goes on with.
 PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
-  const SceneData s = PR_SCENE();
+  SceneData s = PR_SCENE();
+  scene_at_sample(&s, seed, frame, i, sample);
   const uint k = i - base;  // the path's own state in the band; the frame's at pixel i
   PathState p = states[k];
   uint out = 0u;

@@ -13,7 +13,8 @@ PR_KERNEL void pt_shadow(PR_PARAMS(PR_ARGS_PT_SHADOW)) {
   const uint i = shadow_queue[j];
   const uint k = i - base;  // the path's own state in the band
   const ShadowRay r = shadows[k];
-  const SceneData s = PR_SCENE();
+  SceneData s = PR_SCENE();
+  scene_at_sample(&s, seed, frame, i, sample);
   atomic_inc(rays + PR_PT_SHADOW);
   if (trace_occluded(&s, r.ray)) return;
   if (resample && r.op) {

@@ -27,6 +27,8 @@
 #pragma OPENCL FP_CONTRACT OFF
 #endif
 
+#include "shared/motion.h"  // (after the pragma: instance transforms round as the host's)
+
 #define PR_BVH_STACK_SIZE 64
 
 // Slab distances are scaled by this before the overlap test so rounding never culls a box
@@ -46,6 +48,9 @@ typedef struct {
   PR_GLOBAL const BvhNode* mesh_nodes;     // all meshes' BVHs, absolute indices
   PR_GLOBAL const BvhTriPacket* mesh_tris;
   u32 instance_count;
+  PR_GLOBAL const float* motion;  // --shutter: each instance's transforms (shared/motion.h)
+  u32 motion_steps;               // 1: no motion blur (`instances` hold the transforms)
+  float time;                     // the path's time in the shutter interval (scene_at_sample)
 } SceneGeom;
 
 // A ray prepared for traversal (private, never in a buffer). near_* / far_* are the offsets of
@@ -339,8 +344,16 @@ PR_INLINE float3 xform_vector(PR_GLOBAL const float* m, float3 v) {
                      m[8] * v.x + m[9] * v.y + m[10] * v.z);
 }
 
-// The ray in the instance's object space; same t, direction not renormalised.
-PR_INLINE BvhRay instance_ray(PR_GLOBAL const BvhInstance* inst, const BvhRay* world) {
+// The ray in the instance's object space; same t, direction not renormalised. Under motion blur,
+// in the instance's space at the ray's time.
+PR_INLINE BvhRay instance_ray(const SceneGeom* g, PR_GLOBAL const BvhInstance* inst,
+                              const BvhRay* world) {
+  if (g->motion_steps > 1u) {
+    Affine o2w, w2o;
+    motion_transform(g->motion, g->motion_steps, inst->instance_id, g->time, &o2w, &w2o);
+    return bvh_ray(affine_point(&w2o, world->o), affine_vector(&w2o, world->d), world->tmin,
+                   world->tmax);
+  }
   return bvh_ray(xform_point(inst->world_to_object, world->o),
                  xform_vector(inst->world_to_object, world->d), world->tmin, world->tmax);
 }
@@ -362,7 +375,7 @@ PR_INLINE int tlas_traverse(const SceneGeom* g, BvhRay* r, Hit* hit, int any_hit
       }
     } else {
       PR_GLOBAL const BvhInstance* inst = g->instances + (ref & ~PR_BVH_LEAF_BIT);
-      BvhRay obj = instance_ray(inst, r);  // ("local" is an OpenCL keyword)
+      BvhRay obj = instance_ray(g, inst, r);  // ("local" is an OpenCL keyword)
       if (bvh_traverse(g->mesh_nodes, g->mesh_tris, inst->root_node, &obj, hit, inst->instance_id,
                        any_hit)) {
         if (any_hit) return 1;

@@ -26,7 +26,10 @@
   X(GEOM, IN, BvhInstance, instances)    \
   X(GEOM, IN, BvhNode, mesh_nodes)       \
   X(GEOM, IN, BvhTriPacket, mesh_tris)   \
-  X(GEOM, VAL, uint, instance_count)
+  X(GEOM, VAL, uint, instance_count)     \
+  X(GEOM, IN, float, motion)             \
+  X(GEOM, VAL, uint, motion_steps)       \
+  X(GEOM, VAL, float, time)
 
 // What shading reads: vertices, triangles, per-instance records, materials, textures.
 #define PR_ARGS_SHADING(F, X)                \
@@ -35,7 +38,10 @@
   X(SHADING, IN, ShadingInstance, instances) \
   X(SHADING, IN, Material, materials)        \
   X(SHADING, IN, TextureInfo, textures)      \
-  X(SHADING, IN, uint, texels)
+  X(SHADING, IN, uint, texels)               \
+  X(SHADING, IN, float, motion)              \
+  X(SHADING, VAL, uint, motion_steps)        \
+  X(SHADING, VAL, float, time)
 
 // The light table, its light BVH and the environment.
 #define PR_ARGS_LIGHTS(F, X)         \
@@ -172,6 +178,8 @@
   X(FRAME, OUT, PathReservoir, rs_res)   \
   X(FRAME, OUT, DirectReservoir, di_res) \
   X(FRAME, OUT, uint, queue_size)        \
+  X(FRAME, IN, CameraParams, cam_steps)  \
+  X(FRAME, VAL, uint, cam_step_count)    \
   PR_ARGS_PIXEL_MASK(X, X)
 
 #define PR_ARGS_PT_EXTEND(F, X)   \
@@ -181,7 +189,10 @@
   X(FRAME, OUT, uint, rays)       \
   X(PASS, IN, uint, queue)        \
   X(PASS, VAL, uint, count)       \
-  X(PASS, VAL, uint, base)
+  X(PASS, VAL, uint, base)        \
+  X(FRAME, VAL, uint, seed)       \
+  X(FRAME, VAL, uint, frame)      \
+  X(PASS, VAL, uint, sample)
 
 #define PR_ARGS_PT_SHADE(F, X)         \
   PR_ARGS_SCENE(F, X)                  \

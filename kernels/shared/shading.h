@@ -6,6 +6,7 @@
 #include "shared/geometry.h"
 #include "shared/material.h"
 #include "shared/math.h"
+#include "shared/motion.h"
 #include "shared/rng.h"
 #include "shared/srgb.h"
 #include "shared/types.h"
@@ -19,7 +20,10 @@ typedef struct {
   PR_GLOBAL const ShadingInstance* instances;  // by instance id
   PR_GLOBAL const Material* materials;
   PR_GLOBAL const TextureInfo* textures;
-  PR_GLOBAL const u32* texels;  // RGBA8
+  PR_GLOBAL const u32* texels;    // RGBA8
+  PR_GLOBAL const float* motion;  // --shutter, as SceneGeom's
+  u32 motion_steps;
+  float time;
 } ShadingData;
 
 typedef struct {
@@ -40,11 +44,24 @@ PR_INLINE float3 xform_point12(PR_GLOBAL const float* m, float3 p) {
                      m[8] * p.x + m[9] * p.y + m[10] * p.z + m[11]);
 }
 
-// Normals transform by the inverse transpose: n_world = (world_to_object)^T n_object.
-PR_INLINE float3 xform_normal12(PR_GLOBAL const float* w2o, float3 n) {
-  return make_float3(w2o[0] * n.x + w2o[4] * n.y + w2o[8] * n.z,
-                     w2o[1] * n.x + w2o[5] * n.y + w2o[9] * n.z,
-                     w2o[2] * n.x + w2o[6] * n.y + w2o[10] * n.z);
+// DSG instance inst's transforms at the path's time (this frame's where there is no motion blur).
+PR_INLINE void instance_transforms(const ShadingData* sd, u32 inst, Affine* o2w, Affine* w2o) {
+  if (sd->motion_steps > 1u) {
+    motion_transform(sd->motion, sd->motion_steps, inst, sd->time, o2w, w2o);
+    return;
+  }
+  affine_load(sd->instances[inst].object_to_world, o2w);
+  affine_load(sd->instances[inst].world_to_object, w2o);
+}
+
+// A DSG triangle's corners placed by instance inst; *w2o, for its normals.
+PR_INLINE void place_corners(const ShadingData* sd, u32 inst, float3* pa, float3* pb, float3* pc,
+                             Affine* w2o) {
+  Affine o2w;
+  instance_transforms(sd, inst, &o2w, w2o);
+  *pa = affine_point(&o2w, *pa);
+  *pb = affine_point(&o2w, *pb);
+  *pc = affine_point(&o2w, *pc);
 }
 
 // The world-space corners of a surface's triangle: v0 and the edges to v1 and v2.
@@ -55,10 +72,8 @@ PR_INLINE void triangle_world(const ShadingData* sd, u32 prim, u32 inst, float3*
   float3 pa = make_float3(a.px, a.py, a.pz), pb = make_float3(b.px, b.py, b.pz),
          pc = make_float3(c.px, c.py, c.pz);
   if (inst != PR_INVALID_INDEX) {
-    PR_GLOBAL const ShadingInstance* in = sd->instances + inst;
-    pa = xform_point12(in->object_to_world, pa);
-    pb = xform_point12(in->object_to_world, pb);
-    pc = xform_point12(in->object_to_world, pc);
+    Affine w2o;
+    place_corners(sd, inst, &pa, &pb, &pc, &w2o);
   }
   *v0 = pa;
   *e1 = pb - pa;
@@ -112,16 +127,6 @@ PR_CALLABLE float4 texture_sample(const ShadingData* sd, i32 index, float2 uv) {
 // A texture's coordinates under its KHR_texture_transform matrix m (2x3, rows first).
 PR_INLINE float2 texture_uv(PR_GLOBAL const float* m, float2 uv) {
   return make_float2(m[0] * uv.x + m[1] * uv.y + m[2], m[3] * uv.x + m[4] * uv.y + m[5]);
-}
-
-PR_INLINE float3 xform_vector12(PR_GLOBAL const float* m, float3 v) {
-  return make_float3(m[0] * v.x + m[1] * v.y + m[2] * v.z, m[4] * v.x + m[5] * v.y + m[6] * v.z,
-                     m[8] * v.x + m[9] * v.y + m[10] * v.z);
-}
-
-PR_INLINE float det12(PR_GLOBAL const float* m) {
-  return m[0] * (m[5] * m[10] - m[6] * m[9]) - m[1] * (m[4] * m[10] - m[6] * m[8]) +
-         m[2] * (m[4] * m[9] - m[5] * m[8]);
 }
 
 // A texture's coordinates at the surface: its uv set (bit `set` of the material's uv_sets
@@ -187,13 +192,11 @@ PR_INLINE float3 surface_lift(const ShadingData* sd, u32 prim, u32 inst, float b
   if (a.nx == b.nx && a.ny == b.ny && a.nz == b.nz && a.nx == c.nx && a.ny == c.ny && a.nz == c.nz)
     return make_float3(0.0f, 0.0f, 0.0f);
   if (inst != PR_INVALID_INDEX) {
-    PR_GLOBAL const ShadingInstance* in = sd->instances + inst;
-    pa = xform_point12(in->object_to_world, pa);
-    pb = xform_point12(in->object_to_world, pb);
-    pc = xform_point12(in->object_to_world, pc);
-    na = xform_normal12(in->world_to_object, na);
-    nb = xform_normal12(in->world_to_object, nb);
-    nc = xform_normal12(in->world_to_object, nc);
+    Affine w2o;
+    place_corners(sd, inst, &pa, &pb, &pc, &w2o);
+    na = affine_normal(&w2o, na);
+    nb = affine_normal(&w2o, nb);
+    nc = affine_normal(&w2o, nc);
   }
   const float3 p = pa * b0 + pb * b1 + pc * b2;
   const float3 n = na * b0 + nb * b1 + nc * b2;
@@ -212,10 +215,11 @@ PR_INLINE float3 surface_tangent(const ShadingData* sd, const SurfaceHit* s, flo
              make_float3(b.tx, b.ty, b.tz) * s->b1 + make_float3(c.tx, c.ty, c.tz) * s->b2;
   *tw = a.tw;
   if (s->inst != PR_INVALID_INDEX) {
-    PR_GLOBAL const ShadingInstance* in = sd->instances + s->inst;
-    t = xform_vector12(in->object_to_world, t);
+    Affine o2w, w2o;
+    instance_transforms(sd, s->inst, &o2w, &w2o);
+    t = affine_vector(&o2w, t);
     // A mirroring transform turns the bitangent's handedness around.
-    if (det12(in->object_to_world) < 0.0f) *tw = -*tw;
+    if (affine_det(&o2w) < 0.0f) *tw = -*tw;
   }
   return t;
 }
@@ -237,11 +241,9 @@ PR_INLINE SurfaceHit surface_interp(const ShadingData* sd, u32 prim, u32 inst, f
   float3 n = make_float3(a.nx, a.ny, a.nz) * b0 + make_float3(b.nx, b.ny, b.nz) * b1 +
              make_float3(c.nx, c.ny, c.nz) * b2;
   if (inst != PR_INVALID_INDEX) {
-    PR_GLOBAL const ShadingInstance* in = sd->instances + inst;
-    pa = xform_point12(in->object_to_world, pa);
-    pb = xform_point12(in->object_to_world, pb);
-    pc = xform_point12(in->object_to_world, pc);
-    n = xform_normal12(in->world_to_object, n);
+    Affine w2o;
+    place_corners(sd, inst, &pa, &pb, &pc, &w2o);
+    n = affine_normal(&w2o, n);
   }
   s.p = pa * b0 + pb * b1 + pc * b2;
   const float3 cr = cross(pb - pa, pc - pa);
@@ -274,7 +276,11 @@ PR_INLINE float3 surface_coat_normal(const ShadingData* sd, const SurfaceHit* s)
   const ShadingVertex a = sd->vertices[tri.v0], b = sd->vertices[tri.v1], c = sd->vertices[tri.v2];
   float3 n = make_float3(a.nx, a.ny, a.nz) * (1.0f - s->b1 - s->b2) +
              make_float3(b.nx, b.ny, b.nz) * s->b1 + make_float3(c.nx, c.ny, c.nz) * s->b2;
-  if (s->inst != PR_INVALID_INDEX) n = xform_normal12(sd->instances[s->inst].world_to_object, n);
+  if (s->inst != PR_INVALID_INDEX) {
+    Affine o2w, w2o;
+    instance_transforms(sd, s->inst, &o2w, &w2o);
+    n = affine_normal(&w2o, n);
+  }
   const float nl = length(n);
   n = nl > 0.0f && isfinite_f(nl) ? n / nl : s->ng;
   if (m->coat_normal_texture != PR_NO_TEXTURE) {

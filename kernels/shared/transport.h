@@ -17,6 +17,13 @@ typedef struct {
   LightData lights;
 } SceneData;
 
+// The scene as the path of camera sample (pixel, sample) sees it: under --shutter, at the
+// sample's time (shared/motion.h); otherwise at the frame's.
+PR_INLINE void scene_at_sample(SceneData* s, u32 seed, u32 frame, u32 pixel, u32 sample) {
+  if (s->geom.motion_steps <= 1u) return;
+  s->geom.time = s->sd.time = shutter_time(seed, frame, pixel, sample);
+}
+
 // Alpha coverage: MASK cuts out below the cutoff; BLEND lets a ray pass with probability
 // 1 - alpha, decided by a hash of the point so that the same point always answers the same.
 PR_INLINE int surface_passes(const SceneData* s, const SurfaceHit* h) {
@@ -297,6 +304,19 @@ PR_INLINE float3 surface_emission(const SceneData* s, const SurfaceHit* h) {
   return material_emission(&s->sd, h);
 }
 
+// An emissive triangle of the DSG where it is at the path's time: the light table holds it at the
+// frame's (motion blur; emitter_pdf reads the same triangle).
+PR_INLINE void light_at_time(const SceneData* s, Light* l) {
+  if (s->sd.motion_steps <= 1u || !light_is_triangle(l->type) || l->inst == PR_INVALID_INDEX)
+    return;
+  float3 v0, e1, e2;
+  triangle_world(&s->sd, l->prim, l->inst, &v0, &e1, &e2);
+  l->p0x = v0.x, l->p0y = v0.y, l->p0z = v0.z;
+  l->e1x = e1.x, l->e1y = e1.y, l->e1z = e1.z;
+  l->e2x = e2.x, l->e2y = e2.y, l->e2z = e2.z;
+  l->area = 0.5f * length(cross(e1, e2));
+}
+
 // The light that the emissive triangle of hit h is in the light table.
 PR_INLINE u32 emitter_light(const SceneData* s, const SurfaceHit* h) {
   const u32 k = s->lights.prim_light[h->prim];
@@ -388,7 +408,8 @@ PR_INLINE int next_event(const SceneData* s, const SurfaceHit* h, const ShadingF
   const float3 n_l = frame_light_normal(f);
   const u32 idx = light_choose(&s->lights, h->p, n_l, us.x, us.y, &pmf, &mis_pmf);
   if (idx == PR_INVALID_INDEX || !(pmf > 0.0f)) return 0;
-  const Light l = s->lights.lights[idx];
+  Light l = s->lights.lights[idx];
+  light_at_time(s, &l);
   LightSample ls;
   float b1, b2;
   if (!light_sample_towards(&l, s->lights.env, pmf, h->p, n_l, u1, u2, &ls, &b1, &b2)) return 0;

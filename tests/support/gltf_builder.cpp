@@ -246,6 +246,19 @@ void GltfBuilder::animateTranslation(int node, const std::vector<float>& times,
         json::array({{{"sampler", 0}, {"target", {{"node", node}, {"path", "translation"}}}}})}});
 }
 
+void GltfBuilder::animateRotation(int node, const std::vector<float>& times,
+                                  const std::vector<glm::quat>& keys) {
+  const int in = addAccessor(times.data(), times.size() * 4, 5126, times.size(), "SCALAR", false,
+                             json::array({{times.front()}, {times.back()}}));
+  std::vector<float> xyzw;
+  for (const glm::quat& q : keys) xyzw.insert(xyzw.end(), {q.x, q.y, q.z, q.w});
+  const int out = addAccessor(xyzw.data(), xyzw.size() * 4, 5126, keys.size(), "VEC4", false);
+  animations_.push_back(
+      {{"samplers", json::array({{{"input", in}, {"output", out}, {"interpolation", "LINEAR"}}})},
+       {"channels",
+        json::array({{{"sampler", 0}, {"target", {{"node", node}, {"path", "rotation"}}}}})}});
+}
+
 std::string GltfBuilder::write(const std::string& dir, const std::string& name) const {
   json root = {{"asset", {{"version", "2.0"}}}};
   json sceneNodes = json::array();

@@ -70,6 +70,9 @@ class GltfBuilder {
   // A LINEAR translation animation of `node` through `keys` at `times`.
   void animateTranslation(int node, const std::vector<float>& times,
                           const std::vector<glm::vec3>& keys);
+  // A LINEAR rotation animation of `node` through `keys` at `times` (slerped, as glTF says).
+  void animateRotation(int node, const std::vector<float>& times,
+                       const std::vector<glm::quat>& keys);
   // A LINEAR animation of `node`'s morph weights: keys[k] holds every target's weight at times[k].
   void animateWeights(int node, const std::vector<float>& times,
                       const std::vector<std::vector<float>>& keys);

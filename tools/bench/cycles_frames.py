@@ -4,15 +4,18 @@
 
   VENV/bin/python tools/bench/cycles_frames.py SCENE.gltf OUTDIR --frames A-B --spp N \\
       --width W --height H --max-depth D [--seed S] [--threads T] [--camera NAME] [--world R,G,B]
+      [--shutter S] [--fps F]
 
 The scene goes through Blender's own glTF importer with its materials as imported (Principled
 BSDF; colour textures read as sRGB), lights unconverted (a sun's intensity is its irradiance, as
 pathreuse reads it), a black world or one of --world R,G,B, the first camera or the one --camera
-names, frame f at time f / 24 s (pathreuse's default --fps).
+names, frame f at time f / 24 s (pathreuse's default --fps; --fps changes it).
 Cycles on the CPU: a box pixel filter one pixel wide, no adaptive sampling, denoising, clamping or
 path guiding, light tree on, max bounces = D - 2 (pathreuse counts the camera's hit and the light's
 vertex in --max-depth), a fixed seed per run (Cycles' seed is not animated: each frame's noise
-pattern is the same, as Blender's default). Writes OUTDIR/f_%04d.exr (linear float) and prints
+pattern is the same, as Blender's default). --shutter S turns motion blur on: the shutter open S
+frames centred on the frame (Blender's default position), every object's transform and deformation
+blurred with 4 motion steps. Writes OUTDIR/f_%04d.exr (linear float) and prints
 one JSON line per frame: {"frame": f, "render_s": seconds of bpy.ops.render.render}.
 """
 
@@ -25,8 +28,13 @@ import bpy
 from peer_args import peer_args
 
 
+def extra_args(ap):
+    ap.add_argument("--shutter", type=float, default=0.0, help="motion blur: frames it is open")
+    ap.add_argument("--fps", type=int, default=24, help="frame f is at time f / fps")
+
+
 def parse_args():
-    return peer_args("cycles_frames.py", "scene")
+    return peer_args("cycles_frames.py", "scene", extra=extra_args)
 
 
 def first_camera(path, scene, name=None):
@@ -74,10 +82,22 @@ def world(scene, rgb):
     scene.world = w
 
 
+def motion_blur(scene, shutter):
+    scene.render.use_motion_blur = shutter > 0.0
+    if shutter <= 0.0:
+        return
+    scene.render.motion_blur_shutter = shutter
+    scene.render.motion_blur_position = "CENTER"
+    for ob in scene.objects:
+        ob.cycles.use_motion_blur = True
+        ob.cycles.use_deform_motion = True
+        ob.cycles.motion_steps = 4
+
+
 def setup(a):
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
-    scene.render.fps = 24
+    scene.render.fps = a.fps
     scene.render.fps_base = 1.0
     # RAW: a sun's intensity is its irradiance, as pathreuse reads it
     bpy.ops.import_scene.gltf(filepath=a.scene, export_import_convert_lighting_mode="RAW")
@@ -118,6 +138,7 @@ def setup(a):
     scene.view_settings.look = "None"
     scene.view_settings.exposure = 0.0
     scene.view_settings.gamma = 1.0
+    motion_blur(scene, a.shutter)
     img = scene.render.image_settings
     img.file_format = "OPEN_EXR"
     img.color_depth = "32"

@@ -1,0 +1,165 @@
+// Motion blur (--shutter; kernels/shared/motion.h, docs/design.md section 3): a frame whose
+// shutter is open equals the average of sharp instants over its interval.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <glm/gtc/quaternion.hpp>
+
+#include "render/gpu_scene.h"
+#include "scene/gltf_loader.h"
+#include "support/gltf_builder.h"
+#include "support/render_helpers.h"
+#include "support/test_env.h"
+
+namespace pr {
+namespace {
+
+enum class Moving { Object, Rotating, Camera, Lamp };
+
+// A grey back wall and floor lit by a point light, a dark quad before the wall; one thing moves
+// fast over t in [0, 2] (at fps 1 a half-frame shutter sweeps a quarter of it): the quad across
+// the view (Lamp: an emitting one, which lights the wall), a bar turning a whole turn about the
+// view axis, or the camera sideways.
+std::string movingScene(Moving what, const std::string& tag) {
+  test::GltfBuilder b;
+  test::MaterialSpec grey;
+  grey.baseColor = glm::vec4(0.6f, 0.6f, 0.6f, 1.0f);
+  const int g = b.addMaterial(grey);
+  b.addNode(b.addQuad({-4, -3, 0}, {4, -3, 0}, {4, 3, 0}, {-4, 3, 0}, g));
+  b.addNode(b.addQuad({-4, -3, 0}, {-4, -3, 4}, {4, -3, 4}, {4, -3, 0}, g));
+  test::MaterialSpec dark;
+  dark.baseColor = glm::vec4(0.05f, 0.02f, 0.02f, 1.0f);  // dark against the wall
+  if (what == Moving::Lamp) {  // a lamp a little before the wall, which it lights
+    dark.emissive = glm::vec3(1.0f, 0.75f, 0.5f);
+    dark.emissiveStrength = 8.0f;
+  }
+  const int r = b.addMaterial(dark);
+  b.addPointLight({0, 2, 4}, {1, 1, 1}, 60.0f);
+  const int cam = b.addCamera({0, 0, 6}, {0, 0, 0}, 0.9f, 4.0f / 3.0f);
+  if (what == Moving::Rotating) {
+    const int bar =
+        b.addNode(b.addQuad({-2, -0.5f, 0}, {2, -0.5f, 0}, {2, 0.5f, 0}, {-2, 0.5f, 0}, r),
+                  glm::vec3(0, 0, 0.5f));
+    std::vector<float> times;
+    std::vector<glm::quat> keys;
+    for (int k = 0; k <= 4; ++k) {  // a quarter turn each half second
+      times.push_back(0.5f * float(k));
+      keys.push_back(glm::angleAxis(0.5f * PR_PI * float(k), glm::vec3(0, 0, 1)));
+    }
+    b.animateRotation(bar, times, keys);
+  } else {
+    const float depth = what == Moving::Lamp ? 1.5f : 0.5f;
+    const int quad = b.addNode(b.addQuad({-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}, r),
+                               glm::vec3(0, 0, depth));
+    if (what == Moving::Object || what == Moving::Lamp)
+      b.animateTranslation(quad, {0.0f, 2.0f}, {{-4, 0, depth}, {4, 0, depth}});
+    else
+      b.animateTranslation(cam, {0.0f, 2.0f}, {{-2, 0, 6}, {2, 0, 6}});
+  }
+  return b.write(test::tempDir(tag), "moving");
+}
+
+constexpr int kW = 32, kH = 24, kBlock = 4;
+const char* const kArgs = "--mode pathtrace --env none --max-depth 3 --width 32 --height 24";
+
+// Per pixel, a - b.
+Image difference(const Image& a, const Image& b) {
+  Image d(a.width, a.height);
+  for (size_t k = 0; k < d.rgba.size(); ++k) d.rgba[k] = a.rgba[k] - b.rgba[k];
+  return d;
+}
+
+// Frame 1 (t = 1) with the shutter open half a frame equals the mean of 16 sharp instants at
+// the middles of the interval's sixteenths (frames 49, 51, ... 79 at 64 fps), block by block
+// within the noise (the blocks' means of the per-pixel difference, whose spread is the noise
+// alone); and the sharp frame at t = 1 is farther from that mean, where the thing moves.
+void expectBlurIsTheMeanOfInstants(Moving what, const std::string& tag) {
+  const std::string scene = movingScene(what, tag);
+  const Image blurred = test::frameImage(
+      test::renderFrames(scene, "1", std::string(kArgs) + " --fps 1 --spp 128 --shutter 0.5",
+                         tag + "-blur"),
+      1);
+  const Image sharp = test::frameImage(
+      test::renderFrames(scene, "1", std::string(kArgs) + " --fps 1 --spp 128", tag + "-sharp"), 1);
+  const std::string dir =
+      test::renderFrames(scene, "49-79", std::string(kArgs) + " --fps 64 --spp 8", tag + "-inst");
+  Image mean(kW, kH);
+  for (int f = 49; f <= 79; f += 2) {
+    const Image instant = test::frameImage(dir, f);
+    for (size_t k = 0; k < mean.rgba.size(); ++k) mean.rgba[k] += instant.rgba[k] / 16.0f;
+  }
+  const Image blur = difference(blurred, mean), still = difference(sharp, mean);
+  double blurOff = 0.0, sharpOff = 0.0;  // summed over the blocks: how far from the mean
+  for (int y = 0; y < kH; y += kBlock)
+    for (int x = 0; x < kW; x += kBlock)
+      for (int c = 0; c < 3; ++c) {
+        const double level = test::regionMean(mean, x, y, x + kBlock, y + kBlock, c).mean;
+        const test::Moments d = test::regionMean(blur, x, y, x + kBlock, y + kBlock, c);
+        // The noise, and sixteen instants standing for the interval's continuum.
+        EXPECT_NEAR(d.mean, 0.0, 4.5 * d.stderr_ + 0.02 * level + 1e-3)
+            << "block " << x << "," << y << " channel " << c;
+        const test::Moments e = test::regionMean(still, x, y, x + kBlock, y + kBlock, c);
+        blurOff += std::fabs(d.mean);
+        sharpOff += std::fabs(e.mean);
+      }
+  // A shutter that did nothing would leave the two alike.
+  EXPECT_GT(sharpOff, 3.0 * blurOff) << "the sharp frame should be farther from the mean";
+}
+
+TEST(MotionBlur, AMovingObjectIsTheMeanOfItsInstants) {
+  expectBlurIsTheMeanOfInstants(Moving::Object, "mb-object");
+}
+
+TEST(MotionBlur, ATurningObjectIsTheMeanOfItsInstants) {
+  expectBlurIsTheMeanOfInstants(Moving::Rotating, "mb-turning");
+}
+
+// Next-event estimation finds the lamp where it is at the sample's time, as its rays do.
+TEST(MotionBlur, AMovingLampIsTheMeanOfItsInstants) {
+  expectBlurIsTheMeanOfInstants(Moving::Lamp, "mb-lamp");
+}
+
+TEST(MotionBlur, AMovingCameraIsTheMeanOfItsInstants) {
+  expectBlurIsTheMeanOfInstants(Moving::Camera, "mb-camera");
+}
+
+// The motion steps: none without a shutter, the fewest (3) for motion that blends exactly (a
+// translation, a still scene), more for a turn, as many for the same turn each frame.
+TEST(MotionBlur, StepsFollowTheMotion) {
+  Context& ctx = test::testContext();
+  auto stepsOf = [&](Moving what, const std::string& tag, double shutter) {
+    const Scene scene = loadScene(movingScene(what, tag));
+    GpuScene gpu(ctx, scene);
+    gpu.setShutter(shutter, 0, 16, 12);
+    gpu.setTime(1.0);
+    return gpu.motionSteps();
+  };
+  EXPECT_EQ(stepsOf(Moving::Object, "mb-steps-none", 0.0), 1u);
+  EXPECT_EQ(stepsOf(Moving::Object, "mb-steps-slide", 0.5), 3u);
+  EXPECT_EQ(stepsOf(Moving::Camera, "mb-steps-camera", 0.5), 3u);
+  const uint32_t turn = stepsOf(Moving::Rotating, "mb-steps-turn", 0.5);
+  EXPECT_GT(turn, 3u);
+  EXPECT_LE(turn, 33u);
+}
+
+// Modes that keep light paths across frames refuse an open shutter: one line, exit 2.
+TEST(MotionBlur, ReuseRefusesAnOpenShutter) {
+  const std::string scene = movingScene(Moving::Object, "mb-refuse");
+  for (const char* mode : {"reuse", "retrace"}) {
+    const test::CommandResult r = test::runPathreuse(
+        "render " + scene + " --mode " + std::string(mode) + " --shutter 0.5 --frames 0 --out " +
+        test::tempDir("mb-refuse-out") + "/f_%04d.exr");
+    EXPECT_EQ(r.exitCode, 2) << r.err;
+    EXPECT_NE(r.err.find("--shutter"), std::string::npos) << r.err;
+  }
+  const test::CommandResult r = test::runPathreuse(
+      "render " + scene + " --mode pathtrace --resample --shutter 0.5 --frames 0 --out " +
+      test::tempDir("mb-refuse-pt") + "/f_%04d.exr");
+  EXPECT_EQ(r.exitCode, 2) << r.err;
+}
+
+}  // namespace
+}  // namespace pr
