@@ -3,11 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
 #include <glm/gtc/quaternion.hpp>
 
+#include "io/image.h"
 #include "render/gpu_scene.h"
 #include "scene/gltf_loader.h"
 #include "support/gltf_builder.h"
@@ -17,12 +19,12 @@
 namespace pr {
 namespace {
 
-enum class Moving { Object, Rotating, Camera, Lamp };
+enum class Moving { Object, Rotating, Camera, Lamp, Light };
 
 // A grey back wall and floor lit by a point light, a dark quad before the wall; one thing moves
 // fast over t in [0, 2] (at fps 1 a half-frame shutter sweeps a quarter of it): the quad across
 // the view (Lamp: an emitting one, which lights the wall), a bar turning a whole turn about the
-// view axis, or the camera sideways.
+// view axis, the camera sideways, or the point light along the wall.
 std::string movingScene(Moving what, const std::string& tag) {
   test::GltfBuilder b;
   test::MaterialSpec grey;
@@ -37,7 +39,9 @@ std::string movingScene(Moving what, const std::string& tag) {
     dark.emissiveStrength = 8.0f;
   }
   const int r = b.addMaterial(dark);
-  b.addPointLight({0, 2, 4}, {1, 1, 1}, 60.0f);
+  const int light = b.addPointLight({0, 2, 4}, {1, 1, 1}, 60.0f);
+  if (what == Moving::Light)  // close to the wall, where its pool of light moves with it
+    b.animateTranslation(light, {0.0f, 2.0f}, {{-4, 1, 1.5f}, {4, 1, 1.5f}});
   const int cam = b.addCamera({0, 0, 6}, {0, 0, 0}, 0.9f, 4.0f / 3.0f);
   if (what == Moving::Rotating) {
     const int bar =
@@ -56,7 +60,7 @@ std::string movingScene(Moving what, const std::string& tag) {
                                glm::vec3(0, 0, depth));
     if (what == Moving::Object || what == Moving::Lamp)
       b.animateTranslation(quad, {0.0f, 2.0f}, {{-4, 0, depth}, {4, 0, depth}});
-    else
+    else if (what == Moving::Camera)
       b.animateTranslation(cam, {0.0f, 2.0f}, {{-2, 0, 6}, {2, 0, 6}});
   }
   return b.write(test::tempDir(tag), "moving");
@@ -122,8 +126,59 @@ TEST(MotionBlur, AMovingLampIsTheMeanOfItsInstants) {
   expectBlurIsTheMeanOfInstants(Moving::Lamp, "mb-lamp");
 }
 
+// A punctual light is blended between its motion steps as instances are.
+TEST(MotionBlur, AMovingPointLightIsTheMeanOfItsInstants) {
+  expectBlurIsTheMeanOfInstants(Moving::Light, "mb-light");
+}
+
 TEST(MotionBlur, AMovingCameraIsTheMeanOfItsInstants) {
   expectBlurIsTheMeanOfInstants(Moving::Camera, "mb-camera");
+}
+
+// The auxiliary images under a shutter: albedo blurred as the colour is (the mean of the instants'
+// albedo, block by block), Z and object ids of the frame's own time (the sharp frame's).
+TEST(MotionBlur, AlbedoIsBlurredAndZIsTheFramesOwn) {
+  const std::string scene = movingScene(Moving::Object, "mb-aov");
+  const std::string args = std::string(kArgs) + " --aov albedo,depth,object";
+  const std::string blur =
+      test::renderFrames(scene, "1", args + " --fps 1 --spp 64 --shutter 0.5", "mb-aov-blur");
+  const std::string sharp = test::renderFrames(scene, "1", args + " --fps 1 --spp 64", "mb-aov-s");
+  const std::string inst =
+      test::renderFrames(scene, "49-79", args + " --fps 64 --spp 4", "mb-aov-inst");
+  auto channel = [](const std::string& dir, int f, const char* name) {
+    char file[32];
+    std::snprintf(file, sizeof file, "/f_%04d.exr", f);
+    return readExrChannel(dir + file, name);
+  };
+  const std::vector<float> zb = channel(blur, 1, "Z"), zs = channel(sharp, 1, "Z");
+  const std::vector<float> ob = channel(blur, 1, "object.ID"), os = channel(sharp, 1, "object.ID");
+  ASSERT_EQ(zb.size(), zs.size());
+  for (size_t p = 0; p < zb.size(); ++p) {
+    EXPECT_NEAR(zb[p], zs[p], 1e-4f * zs[p]) << "pixel " << p;
+    EXPECT_EQ(ob[p], os[p]) << "pixel " << p;
+  }
+  const std::vector<float> ab = channel(blur, 1, "albedo.R"), as = channel(sharp, 1, "albedo.R");
+  std::vector<float> am(ab.size(), 0.0f);
+  for (int f = 49; f <= 79; f += 2) {
+    const std::vector<float> a = channel(inst, f, "albedo.R");
+    for (size_t p = 0; p < am.size(); ++p) am[p] += a[p] / 16.0f;
+  }
+  double blurOff = 0.0, sharpOff = 0.0;
+  for (int y = 0; y < kH; y += kBlock)
+    for (int x = 0; x < kW; x += kBlock) {
+      double b = 0.0, s = 0.0, m = 0.0;
+      for (int v = y; v < y + kBlock; ++v)
+        for (int u = x; u < x + kBlock; ++u) {
+          const size_t p = size_t(v) * kW + u;
+          b += ab[p], s += as[p], m += am[p];
+        }
+      const double n = kBlock * kBlock;
+      // Albedo is noiseless but for the pixel's jitter and the passes' times: a few per cent.
+      EXPECT_NEAR(b / n, m / n, 0.05 * m / n + 0.01) << "block " << x << "," << y;
+      blurOff += std::fabs(b - m) / n;
+      sharpOff += std::fabs(s - m) / n;
+    }
+  EXPECT_GT(sharpOff, 3.0 * blurOff);
 }
 
 // The motion steps: none without a shutter, the fewest (3) for motion that blends exactly (a

@@ -104,6 +104,8 @@ std::pair<double, double> AovRenderer::render(int64_t frame, double fps, int cam
   kargs::AovArgs a;
   kargs::setScene(&a, gpu_.kernelArgs());
   a.cam = gpu_.camera(camera, frame / fps, w, h);
+  a.cam_steps = gpu_.cameraSteps();
+  a.cam_step_count = gpu_.motionSteps();
   a.prev_cam = toCameraParams(scene_.cameraAt(camera, then), w, h);
   a.prev_inst = prevInst_;
   a.prev_pos = prevPos_;

@@ -155,9 +155,12 @@ GpuScene::GpuScene(Context& ctx, const Scene& scene, const GpuSceneOptions& opti
     CL_CHECK(ctx_.queue().enqueueWriteBuffer(traceCdfBuffer_, CL_TRUE, 0,
                                              traceCdf_.size() * sizeof(float), traceCdf_.data()));
   shadingBytes_ += n * sizeof(float);
-  cameraStepBytes_ = sizeof(dev::CameraParams);  // a placeholder until a shutter opens
+  cameraStepBytes_ = sizeof(dev::CameraParams);  // placeholders until a shutter opens
   cameraSteps_ = ctx_.allocate("camera motion steps", cameraStepBytes_, CL_MEM_READ_ONLY);
   ctx_.zero(cameraSteps_, cameraStepBytes_);
+  lightStepBytes_ = sizeof(dev::Light);
+  lightSteps_ = ctx_.allocate("light motion steps", lightStepBytes_, CL_MEM_READ_ONLY);
+  ctx_.zero(lightSteps_, lightStepBytes_);
 }
 
 cl::Buffer GpuScene::upload(const char* name, const void* data, uint64_t bytes, uint64_t* counter) {
@@ -422,16 +425,21 @@ std::vector<dev::Light> GpuScene::lightsAt(double t) const {
     if (!(l.area > 0.0f) || !std::isfinite(l.power)) l.power = 0.0f, l.area = 0.0f;
     lights.push_back(l);
   }
-  // Directional lights and the environment last: the light BVH holds the lights before them.
-  std::vector<size_t> punctual;
-  for (int directional = 0; directional < 2; ++directional)
-    for (size_t i = 0; i < scene_.lights.size(); ++i)
-      if ((scene_.lights[i].type == LightType::Directional) == (directional == 1))
-        punctual.push_back(i);
-  for (size_t i : punctual) lights.push_back(punctualLight(scene_.lightAt(i, t), sceneRadius_));
+  for (size_t i : punctualOrder())
+    lights.push_back(punctualLight(scene_.lightAt(i, t), sceneRadius_));
   if (options_.environment.present())
     lights.push_back(pr::environmentLight(options_.environment, envMeanLuminance_, sceneRadius_));
   return lights;
+}
+
+std::vector<size_t> GpuScene::punctualOrder() const {
+  // Directional lights and the environment last: the light BVH holds the lights before them.
+  std::vector<size_t> order;
+  for (int directional = 0; directional < 2; ++directional)
+    for (size_t i = 0; i < scene_.lights.size(); ++i)
+      if ((scene_.lights[i].type == LightType::Directional) == (directional == 1))
+        order.push_back(i);
+  return order;
 }
 
 uint32_t GpuScene::environmentLight() const {
@@ -494,6 +502,9 @@ void GpuScene::setShutter(double seconds, int cameraIndex, int width, int height
   shutterCamera_ = cameraIndex;
   shutterWidth_ = width;
   shutterHeight_ = height;
+  // A moving delta light must keep a chance wherever it may be during the interval; the tree's
+  // and the exhaustive weights are of where it is at the frame's time, power's of no place.
+  if (shutter_ > 0.0 && punctualMoves()) lightChoice_ = LightSampler::Power;
   meshBounds_.assign(scene_.dynamicMeshes.size(), accel::Aabb{});
   for (size_t m = 0; m < scene_.dynamicMeshes.size(); ++m)
     for (const glm::vec3& p : scene_.dynamicMeshes[m].positions) meshBounds_[m].grow(p);
@@ -528,6 +539,14 @@ std::vector<double> GpuScene::motionTimes(double t) const {
         glm::length(glm::normalize(a.up + b.up) - glm::normalize(mid.up));
     return std::max(moved, turned);
   };
+  auto lightError = [&](const PunctualLight& a, const PunctualLight& b, const PunctualLight& mid) {
+    const float moved = glm::length(0.5f * (a.position + b.position) - mid.position) / sceneRadius_;
+    const glm::vec3 axis = a.direction + b.direction;
+    const float turned = glm::length(axis) > 0.0f
+                             ? glm::length(glm::normalize(axis) - glm::normalize(mid.direction))
+                             : 2.0f;
+    return std::max(moved, turned);
+  };
   for (int steps = 3;; steps = 2 * steps - 1) {
     const std::vector<double> times = timesOf(steps);
     if (steps >= 33) return times;
@@ -538,6 +557,10 @@ std::vector<double> GpuScene::motionTimes(double t) const {
       fine = !(cameraError(scene_.cameraAt(shutterCamera_, times[k]),
                            scene_.cameraAt(shutterCamera_, times[k + 1]),
                            scene_.cameraAt(shutterCamera_, mid)) > kTolerance);
+      for (size_t i = 0; fine && i < scene_.lights.size(); ++i)
+        fine = !scene_.lights[i].dynamic ||
+               !(lightError(scene_.lightAt(i, times[k]), scene_.lightAt(i, times[k + 1]),
+                            scene_.lightAt(i, mid)) > kTolerance);
       for (size_t i = 0; fine && i < scene_.instances.size(); ++i) {
         const accel::Aabb& box = meshBounds_[scene_.instances[i].mesh];
         fine = box.empty() || !(instanceError(box, scene_.instanceTransform(i, times[k]),
@@ -554,6 +577,20 @@ void GpuScene::placeOverShutter(const std::vector<double>& times,
   motion->assign(scene_.instances.size(), {});
   for (size_t i = 0; i < motion->size(); ++i)
     for (double at : times) (*motion)[i].push_back(scene_.instanceTransform(i, at));
+  lightMotionSteps_ = 1;
+  if (punctualMoves()) {
+    std::vector<dev::Light> steps;
+    for (size_t i : punctualOrder())
+      for (double at : times) steps.push_back(punctualLight(scene_.lightAt(i, at), sceneRadius_));
+    const uint64_t bytes = steps.size() * sizeof(dev::Light);
+    if (bytes > lightStepBytes_) {
+      ctx_.release("light motion steps", lightStepBytes_);
+      lightSteps_ = ctx_.allocate("light motion steps", bytes, CL_MEM_READ_ONLY);
+      lightStepBytes_ = bytes;
+    }
+    CL_CHECK(ctx_.queue().enqueueWriteBuffer(lightSteps_, CL_TRUE, 0, bytes, steps.data()));
+    lightMotionSteps_ = uint32_t(times.size());
+  }
   std::vector<dev::CameraParams> cams;
   for (double at : times) cams.push_back(camera(shutterCamera_, at, shutterWidth_, shutterHeight_));
   const uint64_t bytes = cams.size() * sizeof(dev::CameraParams);
@@ -590,6 +627,10 @@ kargs::SceneArgs GpuScene::kernelArgs() {
   a.pr_l_tree_count = static_cast<cl_uint>(treeLights_);
   a.pr_l_total_power = totalPower_;
   a.pr_l_env_light = static_cast<cl_uint>(environmentLight());
+  a.pr_l_motion = lightSteps_;
+  a.pr_l_motion_first = static_cast<cl_uint>(staticEmitters_.size() + dynamicEmitters_.size());
+  a.pr_l_motion_count = static_cast<cl_uint>(scene_.lights.size());
+  a.pr_l_motion_steps = lightMotionSteps_;
   return a;
 }
 
@@ -619,7 +660,8 @@ std::string GpuScene::buildOptions() const {
 
 uint64_t GpuScene::deviceBytes() const {
   return deviceAccel_.staticBytes() + deviceAccel_.meshBytes() + deviceAccel_.frameBytes() +
-         shadingBytes_ + instanceBytes_ + lightBytes_ + lightNodeBytes_ + cameraStepBytes_;
+         shadingBytes_ + instanceBytes_ + lightBytes_ + lightNodeBytes_ + cameraStepBytes_ +
+         lightStepBytes_;
 }
 
 }  // namespace pr

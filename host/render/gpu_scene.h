@@ -51,7 +51,8 @@ class GpuScene {
   dev::CameraParams camera(int cameraIndex, double t, int width, int height) const;
   // Motion blur: from now on each setTime(t) also places the instances and camera `cameraIndex`
   // (for width x height) at motionSteps() times over [t - seconds / 2, t + seconds / 2]
-  // (kernels/shared/motion.h); 0 seconds: none. Deforming meshes and punctual lights stay at t.
+  // (kernels/shared/motion.h), and the punctual lights (then chosen by power); 0 seconds: none.
+  // Deforming meshes stay at t.
   void setShutter(double seconds, int cameraIndex, int width, int height);
   // The last setTime's motion steps (1: none) and the camera at each (a placeholder at 1).
   uint32_t motionSteps() const { return motionSteps_; }
@@ -132,6 +133,13 @@ class GpuScene {
   void collectMoved(const std::vector<accel::Aabb>& before, const std::vector<glm::mat4>& was,
                     const std::vector<bool>& reshaped);
   std::vector<dev::Light> lightsAt(double t) const;
+  // The scene's punctual lights in light-table order (directional ones last).
+  std::vector<size_t> punctualOrder() const;
+  bool punctualMoves() const {
+    for (const auto& l : scene_.lights)
+      if (l.dynamic) return true;
+    return false;
+  }
   cl::Buffer upload(const char* name, const void* data, uint64_t bytes, uint64_t* counter);
 
   Context& ctx_;
@@ -187,6 +195,9 @@ class GpuScene {
   uint32_t motionSteps_ = 1;
   cl::Buffer cameraSteps_;
   uint64_t cameraStepBytes_ = 0;
+  cl::Buffer lightSteps_;  // each punctual light at the motion steps (LightData.motion)
+  uint64_t lightStepBytes_ = 0;
+  uint32_t lightMotionSteps_ = 1;
 
   cl::Buffer vertices_, triangles_, shadingInstances_, materials_, textures_, texels_;
   cl::Buffer prevVertices_, prevInstances_;  // keepPrevious

@@ -179,17 +179,13 @@ void noteUnlitScene(const Scene& scene, const RenderOptions& o) {
 // What an open shutter does not blur yet (docs/design.md section 3, "Motion blur"), said once.
 void noteUnblurred(const Scene& scene, const RenderOptions& o) {
   if (!(o.shutter > 0.0)) return;
-  bool deforms = false, lightMoves = false;
-  for (size_t m = 0; m < scene.dynamicMeshes.size(); ++m) deforms = deforms || scene.meshDeforms(m);
-  for (const auto& l : scene.lights) lightMoves = lightMoves || l.dynamic;
-  if (deforms)
-    std::cerr << "warning: " << o.scene
-              << ": --shutter does not blur deforming meshes yet; they are shown at each frame's "
-                 "time\n";
-  if (lightMoves)
-    std::cerr << "warning: " << o.scene
-              << ": --shutter does not move punctual lights over the interval yet; they light "
-                 "from where they are at each frame's time\n";
+  for (size_t m = 0; m < scene.dynamicMeshes.size(); ++m)
+    if (scene.meshDeforms(m)) {
+      std::cerr << "warning: " << o.scene
+                << ": --shutter does not blur deforming meshes yet; they are shown at each "
+                   "frame's time\n";
+      return;
+    }
 }
 
 void printStart(const RenderOptions& o, MultiDeviceSession& session, const FrameRange& range) {

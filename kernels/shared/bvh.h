@@ -27,7 +27,7 @@
 #pragma OPENCL FP_CONTRACT OFF
 #endif
 
-#include "shared/motion.h"  // (after the pragma: instance transforms round as the host's)
+#include "shared/motion.h"
 
 #define PR_BVH_STACK_SIZE 64
 

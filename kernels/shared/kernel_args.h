@@ -53,7 +53,11 @@
   X(LIGHTS, VAL, uint, count)        \
   X(LIGHTS, VAL, uint, tree_count)   \
   X(LIGHTS, VAL, float, total_power) \
-  X(LIGHTS, VAL, uint, env_light)
+  X(LIGHTS, VAL, uint, env_light)    \
+  X(LIGHTS, IN, Light, motion)       \
+  X(LIGHTS, VAL, uint, motion_first) \
+  X(LIGHTS, VAL, uint, motion_count) \
+  X(LIGHTS, VAL, uint, motion_steps)
 
 #define PR_ARGS_SCENE(F, X) PR_ARGS_SCENE_GEOM(F, X) PR_ARGS_SHADING(X, X) PR_ARGS_LIGHTS(X, X)
 
@@ -319,6 +323,8 @@
 #define PR_ARGS_AOV(F, X)               \
   PR_ARGS_SCENE(F, X)                   \
   X(FRAME, VAL, CameraParams, cam)      \
+  X(FRAME, IN, CameraParams, cam_steps) \
+  X(FRAME, VAL, uint, cam_step_count)   \
   X(FRAME, VAL, CameraParams, prev_cam) \
   X(FRAME, IN, float, prev_inst)        \
   X(FRAME, IN, float4, prev_pos)        \

@@ -805,6 +805,10 @@ typedef struct {
   u32 tree_count;  // directional lights and the environment come after the tree's
   float total_power;
   u32 env_light;  // the environment's index, or PR_INVALID_INDEX
+  // --shutter: the punctual lights [motion_first, motion_first + motion_count) at each of
+  // motion_steps times over the interval (shared/motion.h), light by light.
+  PR_GLOBAL const Light* motion;
+  u32 motion_first, motion_count, motion_steps;
 } LightData;
 
 // The receiver-aware choice among lights [0, tree_count) with ut (and ur, the tree's

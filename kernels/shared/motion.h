@@ -11,6 +11,12 @@
 #include "shared/math.h"
 #include "shared/rng.h"
 
+#ifdef PR_DEVICE_CODE
+// Transforms round as the host's and as they did before motion blur (shared/bvh.h): no fused
+// multiply-adds, whichever header a kernel includes first.
+#pragma OPENCL FP_CONTRACT OFF
+#endif
+
 PR_NAMESPACE_BEGIN
 
 // A 3x4 row-major affine transform in private memory: row r is (m[4r], m[4r+1], m[4r+2] | m[4r+3]).

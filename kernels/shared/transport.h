@@ -20,7 +20,7 @@ typedef struct {
 // The scene as the path of camera sample (pixel, sample) sees it: under --shutter, at the
 // sample's time (shared/motion.h); otherwise at the frame's.
 PR_INLINE void scene_at_sample(SceneData* s, u32 seed, u32 frame, u32 pixel, u32 sample) {
-  if (s->geom.motion_steps <= 1u) return;
+  if (s->geom.motion_steps <= 1u && s->lights.motion_steps <= 1u) return;
   s->geom.time = s->sd.time = shutter_time(seed, frame, pixel, sample);
 }
 
@@ -304,17 +304,33 @@ PR_INLINE float3 surface_emission(const SceneData* s, const SurfaceHit* h) {
   return material_emission(&s->sd, h);
 }
 
-// An emissive triangle of the DSG where it is at the path's time: the light table holds it at the
-// frame's (motion blur; emitter_pdf reads the same triangle).
-PR_INLINE void light_at_time(const SceneData* s, Light* l) {
-  if (s->sd.motion_steps <= 1u || !light_is_triangle(l->type) || l->inst == PR_INVALID_INDEX)
+// Light idx where it is at the path's time: the light table holds the lights at the frame's
+// (motion blur). An emissive DSG triangle is placed as its instance is (emitter_pdf reads the same
+// triangle); a punctual light's position and axis are blended between its motion steps.
+PR_INLINE void light_at_time(const SceneData* s, u32 idx, Light* l) {
+  if (s->sd.motion_steps <= 1u && s->lights.motion_steps <= 1u) return;
+  if (light_is_triangle(l->type) && l->inst != PR_INVALID_INDEX) {
+    float3 v0, e1, e2;
+    triangle_world(&s->sd, l->prim, l->inst, &v0, &e1, &e2);
+    l->p0x = v0.x, l->p0y = v0.y, l->p0z = v0.z;
+    l->e1x = e1.x, l->e1y = e1.y, l->e1z = e1.z;
+    l->e2x = e2.x, l->e2y = e2.y, l->e2z = e2.z;
+    l->area = 0.5f * length(cross(e1, e2));
     return;
-  float3 v0, e1, e2;
-  triangle_world(&s->sd, l->prim, l->inst, &v0, &e1, &e2);
-  l->p0x = v0.x, l->p0y = v0.y, l->p0z = v0.z;
-  l->e1x = e1.x, l->e1y = e1.y, l->e1z = e1.z;
-  l->e2x = e2.x, l->e2y = e2.y, l->e2z = e2.z;
-  l->area = 0.5f * length(cross(e1, e2));
+  }
+  const LightData* d = &s->lights;
+  if (d->motion_steps <= 1u || idx < d->motion_first || idx - d->motion_first >= d->motion_count)
+    return;
+  float a;
+  const u32 k = motion_step(d->motion_steps, s->sd.time, &a);
+  PR_GLOBAL const Light* l0 = d->motion + (size_t)(idx - d->motion_first) * d->motion_steps + k;
+  PR_GLOBAL const Light* l1 = l0 + 1;
+  const float3 p0 = make_float3(l0->p0x, l0->p0y, l0->p0z);
+  const float3 p = p0 + (make_float3(l1->p0x, l1->p0y, l1->p0z) - p0) * a;
+  const float3 x0 = make_float3(l0->e1x, l0->e1y, l0->e1z);
+  const float3 x = normalize(x0 + (make_float3(l1->e1x, l1->e1y, l1->e1z) - x0) * a);
+  l->p0x = p.x, l->p0y = p.y, l->p0z = p.z;
+  l->e1x = x.x, l->e1y = x.y, l->e1z = x.z;
 }
 
 // The light that the emissive triangle of hit h is in the light table.
@@ -409,7 +425,7 @@ PR_INLINE int next_event(const SceneData* s, const SurfaceHit* h, const ShadingF
   const u32 idx = light_choose(&s->lights, h->p, n_l, us.x, us.y, &pmf, &mis_pmf);
   if (idx == PR_INVALID_INDEX || !(pmf > 0.0f)) return 0;
   Light l = s->lights.lights[idx];
-  light_at_time(s, &l);
+  light_at_time(s, idx, &l);
   LightSample ls;
   float b1, b2;
   if (!light_sample_towards(&l, s->lights.env, pmf, h->p, n_l, u1, u2, &ls, &b1, &b2)) return 0;
