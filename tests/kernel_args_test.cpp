@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <map>
 #include <set>
 #include <string>
 
@@ -137,6 +138,26 @@ TEST(KernelArgs, EveryStructATableNamesIsInTheLayoutTest) {
     }
   }
   EXPECT_GT(structs, 10u);
+}
+
+// Every kernel's parameters fit in 1024 bytes, the least CL_DEVICE_MAX_PARAMETER_SIZE a device
+// may report (OpenCL 1.2, 4.2), pointers counted as 8 bytes: a table that grew past it would
+// build here and fail to launch on some device.
+TEST(KernelArgs, EveryKernelsParametersFitTheLeastADeviceTakes) {
+  std::map<std::string, size_t> bytesOf = {{"uint", 4}, {"float", 4}, {"float4", 16}};
+#define PR_SIZE_OF(T) bytesOf[#T] = sizeof(dev::T);
+  PR_SHARED_STRUCTS(PR_SIZE_OF)
+#undef PR_SIZE_OF
+  for (const kargs::TableEntry& t : kargs::kTables) {
+    size_t bytes = 0;
+    for (size_t i = 0; i < t.count; ++i) {
+      const std::string type = t.specs[i].type;
+      ASSERT_TRUE(type.back() == '*' || bytesOf.count(type)) << t.kernel << ": " << type;
+      bytes += type.back() == '*' ? 8 : bytesOf.at(type);
+    }
+    EXPECT_LE(bytes, 1024u) << t.kernel;
+    EXPECT_GT(bytes, 0u) << t.kernel;
+  }
 }
 
 }  // namespace

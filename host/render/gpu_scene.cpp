@@ -553,19 +553,19 @@ std::vector<double> GpuScene::motionTimes(double t) const {
     bool fine = true;
     for (size_t k = 0; fine && k + 1 < times.size(); ++k) {
       const double mid = 0.5 * (times[k] + times[k + 1]);
-      // (A non-finite error, a degenerate placement, asks for no more steps.)
-      fine = !(cameraError(scene_.cameraAt(shutterCamera_, times[k]),
-                           scene_.cameraAt(shutterCamera_, times[k + 1]),
-                           scene_.cameraAt(shutterCamera_, mid)) > kTolerance);
+      // (A non-finite error, a degenerate placement, asks for more steps, up to the most.)
+      fine = cameraError(scene_.cameraAt(shutterCamera_, times[k]),
+                         scene_.cameraAt(shutterCamera_, times[k + 1]),
+                         scene_.cameraAt(shutterCamera_, mid)) <= kTolerance;
       for (size_t i = 0; fine && i < scene_.lights.size(); ++i)
         fine = !scene_.lights[i].dynamic ||
-               !(lightError(scene_.lightAt(i, times[k]), scene_.lightAt(i, times[k + 1]),
-                            scene_.lightAt(i, mid)) > kTolerance);
+               lightError(scene_.lightAt(i, times[k]), scene_.lightAt(i, times[k + 1]),
+                          scene_.lightAt(i, mid)) <= kTolerance;
       for (size_t i = 0; fine && i < scene_.instances.size(); ++i) {
         const accel::Aabb& box = meshBounds_[scene_.instances[i].mesh];
-        fine = box.empty() || !(instanceError(box, scene_.instanceTransform(i, times[k]),
-                                              scene_.instanceTransform(i, times[k + 1]),
-                                              scene_.instanceTransform(i, mid)) > kTolerance);
+        fine = box.empty() || instanceError(box, scene_.instanceTransform(i, times[k]),
+                                            scene_.instanceTransform(i, times[k + 1]),
+                                            scene_.instanceTransform(i, mid)) <= kTolerance;
       }
     }
     if (fine) return times;
