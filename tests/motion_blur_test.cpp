@@ -137,36 +137,26 @@ void expectBlurIsTheMeanOfInstants(Moving what, const std::string& tag) {
   EXPECT_GT(sharpOff, 3.0 * blurOff) << "the sharp frame should be farther from the mean";
 }
 
-TEST(MotionBlur, AMovingObjectIsTheMeanOfItsInstants) {
-  expectBlurIsTheMeanOfInstants(Moving::Object, "mb-object");
+// Each kind of motion: the quad sliding, the bar turning, next-event estimation finding the lamp
+// where it is at the sample's time, the point light blended between its steps, a deforming
+// mesh's triangles and vertices blended (morph, skin), the camera moving.
+class MeanOfInstants : public ::testing::TestWithParam<Moving> {};
+
+std::string motionName(const ::testing::TestParamInfo<Moving>& info) {
+  static const char* const kNames[] = {"Sliding",    "Turning",  "Camera", "Lamp",
+                                       "PointLight", "Morphing", "Skinned"};
+  return kNames[int(info.param)];
 }
 
-TEST(MotionBlur, ATurningObjectIsTheMeanOfItsInstants) {
-  expectBlurIsTheMeanOfInstants(Moving::Rotating, "mb-turning");
+TEST_P(MeanOfInstants, TheBlurredFrameIsTheMeanOfItsInstants) {
+  expectBlurIsTheMeanOfInstants(GetParam(), "mb-" + motionName({GetParam(), 0}));
 }
 
-// Next-event estimation finds the lamp where it is at the sample's time, as its rays do.
-TEST(MotionBlur, AMovingLampIsTheMeanOfItsInstants) {
-  expectBlurIsTheMeanOfInstants(Moving::Lamp, "mb-lamp");
-}
-
-// A punctual light is blended between its motion steps as instances are.
-TEST(MotionBlur, AMovingPointLightIsTheMeanOfItsInstants) {
-  expectBlurIsTheMeanOfInstants(Moving::Light, "mb-light");
-}
-
-// Deformation blur: a deforming mesh's triangles and vertices blended between its motion steps.
-TEST(MotionBlur, AMorphingQuadIsTheMeanOfItsInstants) {
-  expectBlurIsTheMeanOfInstants(Moving::Morph, "mb-morph");
-}
-
-TEST(MotionBlur, ASkinnedQuadIsTheMeanOfItsInstants) {
-  expectBlurIsTheMeanOfInstants(Moving::Skin, "mb-skin");
-}
-
-TEST(MotionBlur, AMovingCameraIsTheMeanOfItsInstants) {
-  expectBlurIsTheMeanOfInstants(Moving::Camera, "mb-camera");
-}
+INSTANTIATE_TEST_SUITE_P(MotionBlur, MeanOfInstants,
+                         ::testing::Values(Moving::Object, Moving::Rotating, Moving::Lamp,
+                                           Moving::Light, Moving::Morph, Moving::Skin,
+                                           Moving::Camera),
+                         motionName);
 
 // The auxiliary images under a shutter: albedo blurred as the colour is (the mean of the instants'
 // albedo, block by block), Z and object ids of the frame's own time (the sharp frame's).

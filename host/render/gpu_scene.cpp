@@ -243,10 +243,16 @@ bool GpuScene::deformMeshes(double t, const std::vector<double>& times,
     if (previousKnown_) copyToPrevious(meshFirstVertex_[m], shape.vertexCount(), false);
     std::vector<std::vector<glm::vec3>> steps;
     for (double at : times) {
-      TriangleMesh s = scene_.dynamicMeshes[m];
-      scene_.deformMesh(m, at, &s);
-      steps.push_back(s.positions);
-      for (size_t v = 0; v < s.vertexCount(); ++v) stepVertices.push_back(shadingVertex(s, v));
+      // The middle step is the frame's time itself (an odd count): its shape is `shape`.
+      TriangleMesh deformed;
+      const TriangleMesh* s = &shape;
+      if (at != t) {
+        deformed = scene_.dynamicMeshes[m];
+        scene_.deformMesh(m, at, &deformed);
+        s = &deformed;
+      }
+      steps.push_back(s->positions);
+      for (size_t v = 0; v < s->vertexCount(); ++v) stepVertices.push_back(shadingVertex(*s, v));
     }
     if (!times.empty()) vm[3] = uint32_t(times.size());
     accel::BuildOptions build;
