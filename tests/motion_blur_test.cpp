@@ -19,12 +19,13 @@
 namespace pr {
 namespace {
 
-enum class Moving { Object, Rotating, Camera, Lamp, Light };
+enum class Moving { Object, Rotating, Camera, Lamp, Light, Morph, Skin };
 
 // A grey back wall and floor lit by a point light, a dark quad before the wall; one thing moves
 // fast over t in [0, 2] (at fps 1 a half-frame shutter sweeps a quarter of it): the quad across
 // the view (Lamp: an emitting one, which lights the wall), a bar turning a whole turn about the
-// view axis, the camera sideways, or the point light along the wall.
+// view axis, the camera sideways, the point light along the wall, or the quad again deformed (a
+// morph target, a skin).
 std::string movingScene(Moving what, const std::string& tag) {
   test::GltfBuilder b;
   test::MaterialSpec grey;
@@ -38,8 +39,12 @@ std::string movingScene(Moving what, const std::string& tag) {
     dark.emissive = glm::vec3(1.0f, 0.75f, 0.5f);
     dark.emissiveStrength = 8.0f;
   }
+  const bool deforms = what == Moving::Morph || what == Moving::Skin;
+  // A deformed quad is bright and lit from close by, so that where its points are shows.
+  if (deforms) dark.baseColor = glm::vec4(0.8f, 0.8f, 0.8f, 1.0f);
   const int r = b.addMaterial(dark);
-  const int light = b.addPointLight({0, 2, 4}, {1, 1, 1}, 60.0f);
+  const int light = deforms ? b.addPointLight({0, 0, 1.6f}, {1, 1, 1}, 6.0f)
+                            : b.addPointLight({0, 2, 4}, {1, 1, 1}, 60.0f);
   if (what == Moving::Light)  // close to the wall, where its pool of light moves with it
     b.animateTranslation(light, {0.0f, 2.0f}, {{-4, 1, 1.5f}, {4, 1, 1.5f}});
   const int cam = b.addCamera({0, 0, 6}, {0, 0, 0}, 0.9f, 4.0f / 3.0f);
@@ -54,6 +59,25 @@ std::string movingScene(Moving what, const std::string& tag) {
       keys.push_back(glm::angleAxis(0.5f * PR_PI * float(k), glm::vec3(0, 0, 1)));
     }
     b.animateRotation(bar, times, keys);
+  } else if (deforms) {
+    // The quad of Object, moved by a morph target (weight 0 to 1) or by the joint of its skin.
+    const std::vector<glm::vec3> corners = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
+    test::MeshAttributes a;
+    if (what == Moving::Morph) {
+      a.targetPositions.emplace_back(4, glm::vec3(8, 0, 0));
+    } else {
+      a.joints.assign(4, {0, 0, 0, 0});
+      a.weights.assign(4, glm::vec4(1, 0, 0, 0));
+    }
+    const int node =
+        b.addNode(b.addMesh(corners, {0, 1, 2, 0, 2, 3}, r, a), glm::vec3(-4, 0, 0.5f));
+    if (what == Moving::Morph) {
+      b.animateWeights(node, {0.0f, 2.0f}, {{0.0f}, {1.0f}});
+    } else {
+      const int joint = b.addNode(-1);
+      b.addSkin(node, {joint});
+      b.animateTranslation(joint, {0.0f, 2.0f}, {{-4, 0, 0.5f}, {4, 0, 0.5f}});
+    }
   } else {
     const float depth = what == Moving::Lamp ? 1.5f : 0.5f;
     const int quad = b.addNode(b.addQuad({-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}, r),
@@ -113,27 +137,26 @@ void expectBlurIsTheMeanOfInstants(Moving what, const std::string& tag) {
   EXPECT_GT(sharpOff, 3.0 * blurOff) << "the sharp frame should be farther from the mean";
 }
 
-TEST(MotionBlur, AMovingObjectIsTheMeanOfItsInstants) {
-  expectBlurIsTheMeanOfInstants(Moving::Object, "mb-object");
+// Each kind of motion: the quad sliding, the bar turning, next-event estimation finding the lamp
+// where it is at the sample's time, the point light blended between its steps, a deforming
+// mesh's triangles and vertices blended (morph, skin), the camera moving.
+class MeanOfInstants : public ::testing::TestWithParam<Moving> {};
+
+std::string motionName(const ::testing::TestParamInfo<Moving>& info) {
+  static const char* const kNames[] = {"Sliding",    "Turning",  "Camera", "Lamp",
+                                       "PointLight", "Morphing", "Skinned"};
+  return kNames[int(info.param)];
 }
 
-TEST(MotionBlur, ATurningObjectIsTheMeanOfItsInstants) {
-  expectBlurIsTheMeanOfInstants(Moving::Rotating, "mb-turning");
+TEST_P(MeanOfInstants, TheBlurredFrameIsTheMeanOfItsInstants) {
+  expectBlurIsTheMeanOfInstants(GetParam(), "mb-" + motionName({GetParam(), 0}));
 }
 
-// Next-event estimation finds the lamp where it is at the sample's time, as its rays do.
-TEST(MotionBlur, AMovingLampIsTheMeanOfItsInstants) {
-  expectBlurIsTheMeanOfInstants(Moving::Lamp, "mb-lamp");
-}
-
-// A punctual light is blended between its motion steps as instances are.
-TEST(MotionBlur, AMovingPointLightIsTheMeanOfItsInstants) {
-  expectBlurIsTheMeanOfInstants(Moving::Light, "mb-light");
-}
-
-TEST(MotionBlur, AMovingCameraIsTheMeanOfItsInstants) {
-  expectBlurIsTheMeanOfInstants(Moving::Camera, "mb-camera");
-}
+INSTANTIATE_TEST_SUITE_P(MotionBlur, MeanOfInstants,
+                         ::testing::Values(Moving::Object, Moving::Rotating, Moving::Lamp,
+                                           Moving::Light, Moving::Morph, Moving::Skin,
+                                           Moving::Camera),
+                         motionName);
 
 // The auxiliary images under a shutter: albedo blurred as the colour is (the mean of the instants'
 // albedo, block by block), Z and object ids of the frame's own time (the sharp frame's).

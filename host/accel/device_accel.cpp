@@ -46,6 +46,11 @@ void DeviceAccel::uploadMeshes(Context& ctx, const DynamicAccel& dsg, bool grow)
          byteSize(dsg.meshNodes()), grow);
   upload(ctx, meshTris_, "dynamic mesh triangles", dsg.meshPackets().data(),
          byteSize(dsg.meshPackets()), grow);
+  upload(ctx, meshMotion_, "dynamic mesh motion table", dsg.meshMotion().data(),
+         byteSize(dsg.meshMotion()), grow);
+  if (!dsg.motionPackets().empty())
+    upload(ctx, motionTris_, "deforming mesh motion steps", dsg.motionPackets().data(),
+           byteSize(dsg.motionPackets()), grow);
 }
 
 void DeviceAccel::uploadFrame(Context& ctx, const DynamicAccel& dsg) {
@@ -63,7 +68,8 @@ void DeviceAccel::uploadFrame(Context& ctx, const DynamicAccel& dsg) {
 
 void DeviceAccel::fillArgs(Context& ctx, kargs::SceneArgs* a) {
   if (staticNodes_.bytes == 0) throw RuntimeError("DeviceAccel: static geometry not uploaded");
-  for (Slot* s : {&tlasNodes_, &instances_, &meshNodes_, &meshTris_, &motion_})
+  for (Slot* s :
+       {&tlasNodes_, &instances_, &meshNodes_, &meshTris_, &motion_, &motionTris_, &meshMotion_})
     if (s->bytes == 0) upload(ctx, *s, "dynamic geometry placeholder", nullptr, 0, false);
   a->pr_g_static_nodes = staticNodes_.buffer;
   a->pr_g_static_tris = staticTris_.buffer;
@@ -75,14 +81,20 @@ void DeviceAccel::fillArgs(Context& ctx, kargs::SceneArgs* a) {
   a->pr_g_motion = motion_.buffer;
   a->pr_g_motion_steps = motionSteps_;
   a->pr_g_time = 0.5f;  // the frame's own time; kernels set each path's (scene_at_sample)
+  a->pr_g_motion_tris = motionTris_.buffer;
+  a->pr_g_mesh_motion = meshMotion_.buffer;
 }
 
 cl_uint DeviceAccel::setKernelArgs(Context& ctx, cl::Kernel& kernel, cl_uint first) {
   kargs::SceneArgs a;
   fillArgs(ctx, &a);
-  return pr::setKernelArgs(kernel, first, a.pr_g_static_nodes, a.pr_g_static_tris,
-                           a.pr_g_tlas_nodes, a.pr_g_instances, a.pr_g_mesh_nodes, a.pr_g_mesh_tris,
-                           a.pr_g_instance_count, a.pr_g_motion, a.pr_g_motion_steps, a.pr_g_time);
+  // Every geometry entry of the table, in its order.
+  cl_uint index = first;
+#define PR_SET_GEOM_(role, kind, type, name) \
+  CL_CHECK(kernel.setArg(index++, a.PR_ARG_NAME(role, name)));
+  PR_ARGS_SCENE_GEOM(PR_SET_GEOM_, PR_SET_GEOM_)
+#undef PR_SET_GEOM_
+  return index;
 }
 
 }  // namespace pr::accel

@@ -33,7 +33,9 @@ class DeviceAccel {
   uint32_t instanceCount() const { return instanceCount_; }
   // Device bytes held: static part, meshes, per-frame part.
   uint64_t staticBytes() const { return staticNodes_.bytes + staticTris_.bytes; }
-  uint64_t meshBytes() const { return meshNodes_.bytes + meshTris_.bytes; }
+  uint64_t meshBytes() const {
+    return meshNodes_.bytes + meshTris_.bytes + motionTris_.bytes + meshMotion_.bytes;
+  }
   uint64_t frameBytes() const { return tlasNodes_.bytes + instances_.bytes + motion_.bytes; }
 
  private:
@@ -47,7 +49,8 @@ class DeviceAccel {
                      bool grow);
 
   int width_;
-  Slot staticNodes_, staticTris_, meshNodes_, meshTris_, tlasNodes_, instances_, motion_;
+  Slot staticNodes_, staticTris_, meshNodes_, meshTris_, tlasNodes_, instances_, motion_,
+      motionTris_, meshMotion_;
   uint32_t instanceCount_ = 0;
   uint32_t motionSteps_ = 1;
 };

@@ -49,7 +49,14 @@ dev::BvhTriPacket packTriangles(const dev::BvhTriangle* first, uint32_t count) {
 
 TriangleBvh buildTriangleBvh(const std::vector<glm::vec3>& positions,
                              const std::vector<uint32_t>& indices, uint32_t primBase,
-                             const BuildOptions& options, const char* what) {
+                             const BuildOptions& options, const char* what,
+                             const std::vector<std::vector<glm::vec3>>* steps) {
+  const size_t stepCount = steps ? steps->size() : 0;
+  for (size_t k = 0; k < stepCount; ++k)
+    if ((*steps)[k].size() != positions.size())
+      throw InputError(std::string(what) + ": motion step " + std::to_string(k) + " has " +
+                       std::to_string((*steps)[k].size()) + " positions of " +
+                       std::to_string(positions.size()));
   if (indices.size() % 3 != 0)
     throw InputError(std::string(what) + ": " + std::to_string(indices.size()) +
                      " indices is not a whole number of triangles");
@@ -60,6 +67,7 @@ TriangleBvh buildTriangleBvh(const std::vector<glm::vec3>& positions,
   }
   const size_t count = indices.size() / 3;
   std::vector<dev::BvhTriangle> packed;
+  std::vector<std::vector<dev::BvhTriangle>> stepPacked(stepCount);
   std::vector<Aabb> boxes;
   packed.reserve(count);
   boxes.reserve(count);
@@ -76,6 +84,18 @@ TriangleBvh buildTriangleBvh(const std::vector<glm::vec3>& positions,
         packTriangle(positions[indices[3 * t]], positions[indices[3 * t + 1]],
                      positions[indices[3 * t + 2]], primBase + uint32_t(t));
     if (zeroArea(tri)) continue;
+    for (size_t k = 0; k < stepCount; ++k) {
+      const std::vector<glm::vec3>& at = (*steps)[k];
+      for (int c = 0; c < 3; ++c) {
+        const glm::vec3& p = at[indices[3 * t + size_t(c)]];
+        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+          throw InputError(std::string(what) + ": motion step " + std::to_string(k) +
+                           ": a position is not finite");
+        box.grow(p);
+      }
+      stepPacked[k].push_back(packTriangle(at[indices[3 * t]], at[indices[3 * t + 1]],
+                                           at[indices[3 * t + 2]], primBase + uint32_t(t)));
+    }
     packed.push_back(tri);
     boxes.push_back(box);
   }
@@ -97,6 +117,15 @@ TriangleBvh buildTriangleBvh(const std::vector<glm::vec3>& positions,
     const uint32_t count = leaf.meta & ~PR_BVH_LEAF_BIT;
     PR_CHECK(count <= PR_BVH_PACKET && size_t(leaf.index) + count <= out.triangles.size());
     out.packets.push_back(packTriangles(out.triangles.data() + leaf.index, count));
+  }
+  for (size_t k = 0; k < stepCount; ++k) {
+    std::vector<dev::BvhTriangle> ordered;
+    ordered.reserve(bvh.order.size());
+    for (uint32_t i : bvh.order) ordered.push_back(stepPacked[k][i]);
+    std::vector<dev::BvhTriPacket> packets;
+    for (const BinaryNode& leaf : out.wide.leaves)
+      packets.push_back(packTriangles(ordered.data() + leaf.index, leaf.meta & ~PR_BVH_LEAF_BIT));
+    out.stepPackets.push_back(std::move(packets));
   }
   return out;
 }
@@ -129,9 +158,12 @@ uint32_t DynamicAccel::addMesh(const std::vector<glm::vec3>& positions,
   m.primBase = primBase;
   m.bounds = bvh.bounds;
   m.stats = bvh.stats;
-  parts_.push_back({bvh.wide.words, bvh.packets, bvh.triangles});
+  parts_.push_back({bvh.wide.words, bvh.packets, bvh.triangles, {}});
   previous_.emplace_back();
   // Rebase to absolute indices in the concatenated buffers.
+  meshMotion_.insert(meshMotion_.end(),
+                     {uint32_t(meshPackets_.size()), uint32_t(bvh.packets.size()),
+                      uint32_t(motionPackets_.size()), 1u});
   rebaseWide(bvh.wide.words, width_, m.rootNode, uint32_t(meshPackets_.size()));
   meshNodes_.insert(meshNodes_.end(), bvh.wide.words.begin(), bvh.wide.words.end());
   meshPackets_.insert(meshPackets_.end(), bvh.packets.begin(), bvh.packets.end());
@@ -142,18 +174,20 @@ uint32_t DynamicAccel::addMesh(const std::vector<glm::vec3>& positions,
 }
 
 void DynamicAccel::replaceMesh(uint32_t index, const std::vector<glm::vec3>& positions,
-                               const std::vector<uint32_t>& indices, const BuildOptions& options) {
+                               const std::vector<uint32_t>& indices, const BuildOptions& options,
+                               const std::vector<std::vector<glm::vec3>>* steps) {
   PR_CHECK(index < meshes_.size());
   const std::string what = "dynamic mesh " + std::to_string(index);
   BuildOptions o = options;
   o.width = width_;
   Mesh& m = meshes_[index];
-  TriangleBvh bvh = buildTriangleBvh(positions, indices, m.primBase, o, what.c_str());
+  TriangleBvh bvh = buildTriangleBvh(positions, indices, m.primBase, o, what.c_str(), steps);
   m.triangleCount = uint32_t(bvh.triangles.size());
   m.bounds = bvh.bounds;
   m.stats = bvh.stats;
   previous_[index] = std::move(parts_[index]);
-  parts_[index] = {std::move(bvh.wide.words), std::move(bvh.packets), std::move(bvh.triangles)};
+  parts_[index] = {std::move(bvh.wide.words), std::move(bvh.packets), std::move(bvh.triangles),
+                   std::move(bvh.stepPackets)};
   concatenate();
 }
 
@@ -161,11 +195,20 @@ void DynamicAccel::concatenate() {
   meshNodes_.clear();
   meshPackets_.clear();
   meshTris_.clear();
+  motionPackets_.clear();
+  meshMotion_.assign(meshes_.size() * 4, 0u);
   for (size_t i = 0; i < meshes_.size(); ++i) {
     Mesh& m = meshes_[i];
     const Part& p = parts_[i];
     m.rootNode = meshNodeCount();
     m.firstTriangle = uint32_t(meshTris_.size());
+    uint32_t* mm = &meshMotion_[i * 4];
+    mm[0] = uint32_t(meshPackets_.size()), mm[1] = uint32_t(p.packets.size());
+    mm[2] = uint32_t(motionPackets_.size());
+    mm[3] = std::max<uint32_t>(uint32_t(p.steps.size()), 1);
+    // Packet by packet, its steps side by side: a leaf reads two neighbours.
+    for (size_t j = 0; j < p.packets.size() && !p.steps.empty(); ++j)
+      for (const auto& step : p.steps) motionPackets_.push_back(step[j]);
     std::vector<uint32_t> words = p.words;
     rebaseWide(words, width_, m.rootNode, uint32_t(meshPackets_.size()));
     meshNodes_.insert(meshNodes_.end(), words.begin(), words.end());
@@ -304,6 +347,8 @@ HostGeom::HostGeom(const StaticAccel& ssg, const DynamicAccel* dsg) {
     geom_.instance_count = uint32_t(dsg->instances().size());
     geom_.motion = dsg->motion().empty() ? nullptr : dsg->motion().data();
     geom_.motion_steps = dsg->motionSteps();
+    geom_.motion_tris = dsg->motionPackets().empty() ? nullptr : dsg->motionPackets().data();
+    geom_.mesh_motion = dsg->meshMotion().empty() ? nullptr : dsg->meshMotion().data();
   }
   geom_.time = 0.5f;
 }

@@ -29,6 +29,8 @@ bool zeroArea(const dev::BvhTriangle& t);
 struct TriangleBvh {
   WideBvh wide;
   std::vector<dev::BvhTriPacket> packets;
+  // With motion steps: the packets at each step, leaf for leaf as `packets`.
+  std::vector<std::vector<dev::BvhTriPacket>> stepPackets;
   std::vector<BinaryNode> binary;
   std::vector<dev::BvhTriangle> triangles;
   Aabb bounds;
@@ -42,9 +44,12 @@ dev::BvhTriPacket packTriangles(const dev::BvhTriangle* first, uint32_t count);
 // they have no surface, and Moller-Trumbore's rounding could report stray hits on them.
 // Throws InputError (naming `what`) on an index out of range, a non-finite position or an
 // index count that is not a multiple of 3.
+// With `steps` (the positions at each motion step, kernels/shared/motion.h), each triangle's box
+// holds it at every step, and stepPackets hold the steps' triangles.
 TriangleBvh buildTriangleBvh(const std::vector<glm::vec3>& positions,
                              const std::vector<uint32_t>& indices, uint32_t primBase,
-                             const BuildOptions& options, const char* what);
+                             const BuildOptions& options, const char* what,
+                             const std::vector<std::vector<glm::vec3>>* steps = nullptr);
 
 // SSG: hits report prim = the triangle's index in the input (indices[3*prim ...]).
 class StaticAccel {
@@ -89,8 +94,10 @@ class DynamicAccel {
   // prim numbers). The concatenated arrays are rebuilt; setInstances must follow. The BVH it
   // replaces stays in meshNodes() (previousRoot), for what tests a segment against the shape the
   // mesh had in the previous frame; no instance refers to it.
+  // With `steps` (its positions at each motion step) it deforms under a shutter.
   void replaceMesh(uint32_t m, const std::vector<glm::vec3>& positions,
-                   const std::vector<uint32_t>& indices, const BuildOptions& options = {});
+                   const std::vector<uint32_t>& indices, const BuildOptions& options = {},
+                   const std::vector<std::vector<glm::vec3>>* steps = nullptr);
 
   // This frame: world bounds of every instance and the top-level BVH over them. Instances of
   // empty meshes or with a singular or non-finite transform cannot be hit and are left out.
@@ -123,6 +130,9 @@ class DynamicAccel {
   // instance by instance (kernels/shared/motion.h).
   uint32_t motionSteps() const { return motionSteps_; }
   const std::vector<float>& motion() const { return motion_; }
+  // Deforming meshes' packets at their motion steps, and per mesh 4 words (SceneGeom.mesh_motion).
+  const std::vector<dev::BvhTriPacket>& motionPackets() const { return motionPackets_; }
+  const std::vector<uint32_t>& meshMotion() const { return meshMotion_; }
 
  private:
   struct Mesh {
@@ -136,6 +146,7 @@ class DynamicAccel {
     std::vector<uint32_t> words;
     std::vector<dev::BvhTriPacket> packets;
     std::vector<dev::BvhTriangle> triangles;
+    std::vector<std::vector<dev::BvhTriPacket>> steps;  // under a shutter (replaceMesh)
   };
   void concatenate();
   int width_;
@@ -152,6 +163,8 @@ class DynamicAccel {
   BvhStats tlasStats_;
   uint32_t motionSteps_ = 1;
   std::vector<float> motion_;
+  std::vector<dev::BvhTriPacket> motionPackets_;
+  std::vector<uint32_t> meshMotion_;
 };
 
 // The CPU reference's view of both structures (kernels/shared/bvh.h compiled for the host), for

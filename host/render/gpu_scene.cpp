@@ -161,6 +161,16 @@ GpuScene::GpuScene(Context& ctx, const Scene& scene, const GpuSceneOptions& opti
   lightStepBytes_ = sizeof(dev::Light);
   lightSteps_ = ctx_.allocate("light motion steps", lightStepBytes_, CL_MEM_READ_ONLY);
   ctx_.zero(lightSteps_, lightStepBytes_);
+  motionVertexBytes_ = sizeof(dev::ShadingVertex);
+  motionVertices_ =
+      ctx_.allocate("deforming mesh vertex motion steps", motionVertexBytes_, CL_MEM_READ_ONLY);
+  ctx_.zero(motionVertices_, motionVertexBytes_);
+  // Every dynamic mesh without motion steps (4 words each, the last 1).
+  std::vector<uint32_t> still(std::max<size_t>(scene.dynamicMeshes.size(), 1) * 4, 1u);
+  vertexMotionBytes_ = still.size() * sizeof(uint32_t);
+  uint64_t unused = 0;
+  vertexMotion_ =
+      upload("dynamic mesh vertex motion table", still.data(), vertexMotionBytes_, &unused);
 }
 
 cl::Buffer GpuScene::upload(const char* name, const void* data, uint64_t bytes, uint64_t* counter) {
@@ -207,24 +217,48 @@ void GpuScene::uploadShading() {
   texels_ = upload("texels", packed.texels.data(), packed.texels.size() * 4, &shadingBytes_);
 }
 
-bool GpuScene::deformMeshes(double t, std::vector<bool>* changed) {
+bool GpuScene::deformMeshes(double t, const std::vector<double>& times,
+                            std::vector<bool>* changed) {
   const auto start = std::chrono::steady_clock::now();
   bool any = false;
   changed->assign(scene_.dynamicMeshes.size(), false);
+  std::vector<dev::ShadingVertex> stepVertices;  // under a shutter (uploadVertexMotion)
+  std::vector<uint32_t> table(scene_.dynamicMeshes.size() * 4, 0u);
   for (size_t m = 0; m < scene_.dynamicMeshes.size(); ++m) {
+    uint32_t* vm = &table[m * 4];
+    vm[0] = uint32_t(meshFirstVertex_[m]);
+    vm[1] = uint32_t(scene_.dynamicMeshes[m].vertexCount());
+    vm[2] = uint32_t(stepVertices.size());
+    vm[3] = 1u;
     if (!scene_.meshDeforms(m)) continue;
     TriangleMesh& shape = deformed_[m];
     scene_.deformMesh(m, t, &shape);
-    const bool same =
-        !firstFrame_ && shape.positions == lastPositions_[m] && shape.normals == lastNormals_[m];
+    // Under a shutter the shapes over the interval change even where the frame's does not.
+    const bool same = !firstFrame_ && times.empty() && shape.positions == lastPositions_[m] &&
+                      shape.normals == lastNormals_[m];
     if (same) continue;
     lastPositions_[m] = shape.positions;
     lastNormals_[m] = shape.normals;
     (*changed)[m] = any = true;
     if (previousKnown_) copyToPrevious(meshFirstVertex_[m], shape.vertexCount(), false);
+    std::vector<std::vector<glm::vec3>> steps;
+    for (double at : times) {
+      // The middle step is the frame's time itself (an odd count): its shape is `shape`.
+      TriangleMesh deformed;
+      const TriangleMesh* s = &shape;
+      if (at != t) {
+        deformed = scene_.dynamicMeshes[m];
+        scene_.deformMesh(m, at, &deformed);
+        s = &deformed;
+      }
+      steps.push_back(s->positions);
+      for (size_t v = 0; v < s->vertexCount(); ++v) stepVertices.push_back(shadingVertex(*s, v));
+    }
+    if (!times.empty()) vm[3] = uint32_t(times.size());
     accel::BuildOptions build;
     build.width = bvhWidth_;
-    dsg_.replaceMesh(static_cast<uint32_t>(m), shape.positions, shape.indices, build);
+    dsg_.replaceMesh(static_cast<uint32_t>(m), shape.positions, shape.indices, build,
+                     times.empty() ? nullptr : &steps);
     std::vector<dev::ShadingVertex> verts(shape.vertexCount());
     for (size_t v = 0; v < verts.size(); ++v) verts[v] = shadingVertex(shape, v);
     CL_CHECK(ctx_.queue().enqueueWriteBuffer(
@@ -233,8 +267,27 @@ bool GpuScene::deformMeshes(double t, std::vector<bool>* changed) {
   }
   deformedAt_ = t;
   if (any) deviceAccel_.uploadMeshes(ctx_, dsg_, true);
+  if (!times.empty()) uploadVertexMotion(stepVertices, table);
   deformSeconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return any;
+}
+
+void GpuScene::uploadVertexMotion(const std::vector<dev::ShadingVertex>& steps,
+                                  const std::vector<uint32_t>& table) {
+  auto write = [&](cl::Buffer* buffer, uint64_t* capacity, const char* name, const void* data,
+                   uint64_t bytes) {
+    if (bytes == 0) return;
+    if (bytes > *capacity) {
+      ctx_.release(name, *capacity);
+      *buffer = ctx_.allocate(name, bytes, CL_MEM_READ_ONLY);
+      *capacity = bytes;
+    }
+    CL_CHECK(ctx_.queue().enqueueWriteBuffer(*buffer, CL_TRUE, 0, bytes, data));
+  };
+  write(&motionVertices_, &motionVertexBytes_, "deforming mesh vertex motion steps", steps.data(),
+        steps.size() * sizeof(dev::ShadingVertex));
+  write(&vertexMotion_, &vertexMotionBytes_, "dynamic mesh vertex motion table", table.data(),
+        table.size() * sizeof(uint32_t));
 }
 
 void GpuScene::keepPrevious() {
@@ -276,8 +329,9 @@ void GpuScene::setTime(double t) {
   // queue runs in order).
   previousKnown_ = keepPrevious_ && !firstFrame_;
   if (previousKnown_) copyToPrevious(0, 0, true);
+  const std::vector<double> times = shutter_ > 0.0 ? motionTimes(t) : std::vector<double>{};
   std::vector<bool> reshaped;
-  deformMeshes(t, &reshaped);
+  deformMeshes(t, times, &reshaped);
   const size_t n = scene_.instances.size();
   std::vector<accel::InstanceInput> inputs(n);
   instances_.resize(n);
@@ -285,7 +339,6 @@ void GpuScene::setTime(double t) {
   if (lastTransforms_.size() != n) lastTransforms_.assign(n, glm::mat4(0.0f));
   const std::vector<glm::mat4> was = lastTransforms_;
   std::vector<bool> reshapedInstance(n);
-  const std::vector<double> times = shutter_ > 0.0 ? motionTimes(t) : std::vector<double>{};
   std::vector<std::vector<glm::mat4>> motion;
   if (!times.empty()) placeOverShutter(times, &motion);
   motionSteps_ = times.empty() ? 1u : uint32_t(times.size());
@@ -618,6 +671,8 @@ kargs::SceneArgs GpuScene::kernelArgs() {
   a.pr_sd_motion = a.pr_g_motion;
   a.pr_sd_motion_steps = a.pr_g_motion_steps;
   a.pr_sd_time = a.pr_g_time;
+  a.pr_sd_motion_vertices = motionVertices_;
+  a.pr_sd_vertex_motion = vertexMotion_;
   a.pr_l_lights = lightBuffer_;
   a.pr_l_cdf = cdfBuffer_;
   a.pr_l_nodes = lightNodeBuffer_;
@@ -661,7 +716,7 @@ std::string GpuScene::buildOptions() const {
 uint64_t GpuScene::deviceBytes() const {
   return deviceAccel_.staticBytes() + deviceAccel_.meshBytes() + deviceAccel_.frameBytes() +
          shadingBytes_ + instanceBytes_ + lightBytes_ + lightNodeBytes_ + cameraStepBytes_ +
-         lightStepBytes_;
+         lightStepBytes_ + motionVertexBytes_ + vertexMotionBytes_;
 }
 
 }  // namespace pr

@@ -51,8 +51,8 @@ class GpuScene {
   dev::CameraParams camera(int cameraIndex, double t, int width, int height) const;
   // Motion blur: from now on each setTime(t) also places the instances and camera `cameraIndex`
   // (for width x height) at motionSteps() times over [t - seconds / 2, t + seconds / 2]
-  // (kernels/shared/motion.h), and the punctual lights (then chosen by power); 0 seconds: none.
-  // Deforming meshes stay at t.
+  // (kernels/shared/motion.h), and the punctual lights (then chosen by power) and deforming
+  // meshes; 0 seconds: none.
   void setShutter(double seconds, int cameraIndex, int width, int height);
   // The last setTime's motion steps (1: none) and the camera at each (a placeholder at 1).
   uint32_t motionSteps() const { return motionSteps_; }
@@ -114,8 +114,13 @@ class GpuScene {
  private:
   void uploadShading();
   // Deforming meshes at t: their BVHs built again and shading vertices uploaded where their
-  // shape changed (*changed, per dynamic mesh). Returns whether any did.
-  bool deformMeshes(double t, std::vector<bool>* changed);
+  // shape changed (*changed, per dynamic mesh); under a shutter, also their shapes at `times`
+  // (motion steps). Returns whether any changed.
+  bool deformMeshes(double t, const std::vector<double>& times, std::vector<bool>* changed);
+  // Under a shutter: the deforming meshes' vertices at the motion steps and the table of where
+  // each dynamic mesh's are (ShadingData.motion_vertices, vertex_motion).
+  void uploadVertexMotion(const std::vector<dev::ShadingVertex>& steps,
+                          const std::vector<uint32_t>& table);
   // Copies the current shapes to the previous ones: vertex range [first, first + count) and,
   // with `instances`, the instance transforms.
   void copyToPrevious(uint64_t firstVertex, uint64_t vertexCount, bool instances);
@@ -195,6 +200,8 @@ class GpuScene {
   uint32_t motionSteps_ = 1;
   cl::Buffer cameraSteps_;
   uint64_t cameraStepBytes_ = 0;
+  cl::Buffer motionVertices_, vertexMotion_;  // ShadingData.motion_vertices, vertex_motion
+  uint64_t motionVertexBytes_ = 0, vertexMotionBytes_ = 0;
   cl::Buffer lightSteps_;  // each punctual light at the motion steps (LightData.motion)
   uint64_t lightStepBytes_ = 0;
   uint32_t lightMotionSteps_ = 1;

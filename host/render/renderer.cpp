@@ -176,18 +176,6 @@ void noteUnlitScene(const Scene& scene, const RenderOptions& o) {
     std::cerr << "warning: " << o.scene << ": no lights and --env none; frames will be black\n";
 }
 
-// What an open shutter does not blur yet (docs/design.md section 3, "Motion blur"), said once.
-void noteUnblurred(const Scene& scene, const RenderOptions& o) {
-  if (!(o.shutter > 0.0)) return;
-  for (size_t m = 0; m < scene.dynamicMeshes.size(); ++m)
-    if (scene.meshDeforms(m)) {
-      std::cerr << "warning: " << o.scene
-                << ": --shutter does not blur deforming meshes yet; they are shown at each "
-                   "frame's time\n";
-      return;
-    }
-}
-
 void printStart(const RenderOptions& o, MultiDeviceSession& session, const FrameRange& range) {
   std::cerr << "rendering " << o.scene << " frames " << range.first << "-" << range.last << " at "
             << session.width() << "x" << session.height() << ", " << o.spp << " spp, mode "
@@ -553,7 +541,6 @@ int runRender(const RenderOptions& o) {
   loadOptions.digestInputs = keepsHistory(o);
   const Scene scene = loadScene(o.scene, loadOptions);
   noteUnlitScene(scene, o);
-  noteUnblurred(scene, o);
   const InputFiles inputs(scene, o);
   const int64_t first = o.framesGiven ? o.frames.first : 0;
   inputs.refuseFrame(o, first, keepsHistory(o));

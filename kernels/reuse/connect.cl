@@ -394,7 +394,7 @@ PR_INLINE void history_resolve(Connector* cn, const EyeVertex* e, __global Conne
   float w_cur = hr->slot != PR_INVALID_INDEX ? hr->p_sum / mc : 0.0f, w_prev = 0.0f, m_prev = 0.0f;
   const float w_e = cn->he.slot != PR_INVALID_INDEX ? cn->he.p_sum / mc : 0.0f;
   float3 c_prev = make_float3(0.0f, 0.0f, 0.0f);
-  Ray ray_prev;
+  Ray ray_prev = make_ray(c_prev, c_prev, 0.0f, 0.0f);  // never left unset (kernel-conformance.sh)
   if (have_prev) {
     m_prev = fmin(prev.m, (float)cn->history_cap * mc);
     const int prev_kept = prev.slot != PR_INVALID_INDEX && changed[prev.slot] <= prev.frame;
@@ -429,7 +429,7 @@ PR_INLINE void history_resolve(Connector* cn, const EyeVertex* e, __global Conne
   next.frame = frame;
   // The merged reservoir's vertex y, with contribution c_l and weight total / p(y).
   float3 c_l = make_float3(0.0f, 0.0f, 0.0f);
-  Ray ray_l;
+  Ray ray_l = ray_prev;
   if (total > 0.0f) {
     const int take_prev = ris_accept(rng_next(&cn->rr), total, w_prev);
     c_l = take_prev ? c_prev : hr->c;

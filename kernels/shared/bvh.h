@@ -51,7 +51,32 @@ typedef struct {
   PR_GLOBAL const float* motion;  // --shutter: each instance's transforms (shared/motion.h)
   u32 motion_steps;               // 1: no motion blur (`instances` hold the transforms)
   float time;                     // the path's time in the shutter interval (scene_at_sample)
+  // Deforming meshes under a shutter: their packets at each step, and per mesh 4 words (its
+  // first packet in mesh_tris, its packet count, its steps' first packet here, its steps; 1:
+  // none).
+  PR_GLOBAL const BvhTriPacket* motion_tris;
+  PR_GLOBAL const u32* mesh_motion;
 } SceneGeom;
+
+// A deforming mesh's packets at the ray's time: packet p of mesh_tris is, at step k, motion_tris
+// [base + (p - first) * steps + k]; a leaf blends steps k and k + 1 by a. Always written whole
+// (stride 1: nothing deforms): with its fields unwritten where unused, PoCL's compiler made a
+// traversal that missed hits at random (depending on its threads' stacks).
+typedef struct {
+  PR_GLOBAL const BvhTriPacket* steps;
+  u32 first, stride, k;  // stride: the steps of a packet
+  float a;
+} PacketBlend;
+
+PR_INLINE PacketBlend packet_blend_none(PR_GLOBAL const BvhTriPacket* packets) {
+  PacketBlend b;
+  b.steps = packets;
+  b.first = 0u;
+  b.stride = 1u;
+  b.k = 0u;
+  b.a = 0.0f;
+  return b;
+}
 
 // A ray prepared for traversal (private, never in a buffer). near_* / far_* are the offsets of
 // the slab planes the ray meets first / last in BvhNode.bounds, chosen by the direction's signs.
@@ -205,17 +230,16 @@ PR_INLINE int intersect_triangle(PR_GLOBAL const BvhTriangle* tri, float3 o, flo
 // The ray against a leaf's triangles: the lane of the nearest hit in (tmin, tmax) (the lowest
 // lane among equal distances) with its t, u, v, or -1. The device runs intersect_triangle's
 // operations on all lanes at once with float4s; the host runs intersect_triangle lane by lane.
-PR_INLINE int intersect_packet(PR_GLOBAL const BvhTriPacket* p, const BvhRay* r, float* t, float* u,
-                               float* v) {
 #ifdef PR_DEVICE_CODE
+// intersect_packet on the lanes already loaded (v0, e1, e2 of each of the 4 triangles).
+PR_INLINE int intersect_lanes(float4 v0x, float4 v0y, float4 v0z, float4 e1x, float4 e1y,
+                              float4 e1z, float4 e2x, float4 e2y, float4 e2z, const BvhRay* r,
+                              float* t, float* u, float* v) {
   const float3 d = r->d;
-  const float4 e1x = vload4(0, p->e1x), e1y = vload4(0, p->e1y), e1z = vload4(0, p->e1z);
-  const float4 e2x = vload4(0, p->e2x), e2y = vload4(0, p->e2y), e2z = vload4(0, p->e2z);
   const float4 px = d.y * e2z - d.z * e2y, py = d.z * e2x - d.x * e2z, pz = d.x * e2y - d.y * e2x;
   const float4 det = e1x * px + e1y * py + e1z * pz;
   const float4 inv_det = 1.0f / det;
-  const float4 sx = r->o.x - vload4(0, p->v0x), sy = r->o.y - vload4(0, p->v0y),
-               sz = r->o.z - vload4(0, p->v0z);
+  const float4 sx = r->o.x - v0x, sy = r->o.y - v0y, sz = r->o.z - v0z;
   const float4 uu = (sx * px + sy * py + sz * pz) * inv_det;
   const float4 qx = sy * e1z - sz * e1y, qy = sz * e1x - sx * e1z, qz = sx * e1y - sy * e1x;
   const float4 vv = (d.x * qx + d.y * qy + d.z * qz) * inv_det;
@@ -239,6 +263,15 @@ PR_INLINE int intersect_packet(PR_GLOBAL const BvhTriPacket* p, const BvhRay* r,
   *u = ua[lane];
   *v = va[lane];
   return lane;
+}
+#endif
+
+PR_INLINE int intersect_packet(PR_GLOBAL const BvhTriPacket* p, const BvhRay* r, float* t, float* u,
+                               float* v) {
+#ifdef PR_DEVICE_CODE
+  return intersect_lanes(vload4(0, p->v0x), vload4(0, p->v0y), vload4(0, p->v0z), vload4(0, p->e1x),
+                         vload4(0, p->e1y), vload4(0, p->e1z), vload4(0, p->e2x), vload4(0, p->e2y),
+                         vload4(0, p->e2z), r, t, u, v);
 #else
   int lane = -1;
   float tmax = r->tmax;
@@ -253,6 +286,31 @@ PR_INLINE int intersect_packet(PR_GLOBAL const BvhTriPacket* p, const BvhRay* r,
     }
   }
   return lane;
+#endif
+}
+
+// The ray against leaf packet p of a deforming mesh at the ray's time: its two steps' triangles
+// blended (a blend of corners is the blend of edges).
+PR_INLINE int intersect_packet_blend(const PacketBlend* b, u32 p, const BvhRay* r, float* t,
+                                     float* u, float* v) {
+  PR_GLOBAL const BvhTriPacket* p0 = b->steps + (size_t)(p - b->first) * b->stride + b->k;
+  PR_GLOBAL const BvhTriPacket* p1 = p0 + 1;
+  const float a = b->a;
+#ifdef PR_DEVICE_CODE
+#define PR_LANES(f) (vload4(0, p0->f) + (vload4(0, p1->f) - vload4(0, p0->f)) * a)
+  return intersect_lanes(PR_LANES(v0x), PR_LANES(v0y), PR_LANES(v0z), PR_LANES(e1x), PR_LANES(e1y),
+                         PR_LANES(e1z), PR_LANES(e2x), PR_LANES(e2y), PR_LANES(e2z), r, t, u, v);
+#undef PR_LANES
+#else
+  BvhTriPacket q = *p0;
+  for (int i = 0; i < PR_BVH_PACKET; ++i) {
+    q.v0x[i] += (p1->v0x[i] - p0->v0x[i]) * a, q.v0y[i] += (p1->v0y[i] - p0->v0y[i]) * a;
+    q.v0z[i] += (p1->v0z[i] - p0->v0z[i]) * a, q.e1x[i] += (p1->e1x[i] - p0->e1x[i]) * a;
+    q.e1y[i] += (p1->e1y[i] - p0->e1y[i]) * a, q.e1z[i] += (p1->e1z[i] - p0->e1z[i]) * a;
+    q.e2x[i] += (p1->e2x[i] - p0->e2x[i]) * a, q.e2y[i] += (p1->e2y[i] - p0->e2y[i]) * a;
+    q.e2z[i] += (p1->e2z[i] - p0->e2z[i]) * a;
+  }
+  return intersect_packet(&q, r, t, u, v);
 #endif
 }
 
@@ -301,8 +359,9 @@ PR_INLINE int bvh_pop(const u32* stack, const float* stack_t, int* sp, float tma
 
 // Traverses one BVH from node `root`. Closest hit (any_hit == 0): shrinks r->tmax to each
 // nearer hit and fills *hit with inst = `inst`. Any hit: returns at the first one, *hit untouched.
-PR_INLINE int bvh_traverse(PR_GLOBAL const BvhNode* nodes, PR_GLOBAL const BvhTriPacket* packets,
-                           u32 root, BvhRay* r, Hit* hit, u32 inst, int any_hit) {
+PR_INLINE int bvh_traverse_blend(PR_GLOBAL const BvhNode* nodes,
+                                 PR_GLOBAL const BvhTriPacket* packets, u32 root, BvhRay* r,
+                                 Hit* hit, u32 inst, int any_hit, const PacketBlend* blend) {
   u32 stack[PR_BVH_STACK_SIZE];
   float stack_t[PR_BVH_STACK_SIZE];
   int sp = 0;
@@ -317,7 +376,9 @@ PR_INLINE int bvh_traverse(PR_GLOBAL const BvhNode* nodes, PR_GLOBAL const BvhTr
     } else {
       PR_GLOBAL const BvhTriPacket* p = packets + (ref & ~PR_BVH_LEAF_BIT);
       float t, u, v;
-      const int lane = intersect_packet(p, r, &t, &u, &v);
+      const int lane = blend->stride > 1u
+                           ? intersect_packet_blend(blend, ref & ~PR_BVH_LEAF_BIT, r, &t, &u, &v)
+                           : intersect_packet(p, r, &t, &u, &v);
       if (lane >= 0) {
         if (any_hit) return 1;
         found = 1;
@@ -331,6 +392,12 @@ PR_INLINE int bvh_traverse(PR_GLOBAL const BvhNode* nodes, PR_GLOBAL const BvhTr
     }
     if (!bvh_pop(stack, stack_t, &sp, r->tmax, &ref)) return found;
   }
+}
+
+PR_INLINE int bvh_traverse(PR_GLOBAL const BvhNode* nodes, PR_GLOBAL const BvhTriPacket* packets,
+                           u32 root, BvhRay* r, Hit* hit, u32 inst, int any_hit) {
+  const PacketBlend none = packet_blend_none(packets);
+  return bvh_traverse_blend(nodes, packets, root, r, hit, inst, any_hit, &none);
 }
 
 PR_INLINE float3 xform_point(PR_GLOBAL const float* m, float3 p) {
@@ -376,8 +443,16 @@ PR_INLINE int tlas_traverse(const SceneGeom* g, BvhRay* r, Hit* hit, int any_hit
     } else {
       PR_GLOBAL const BvhInstance* inst = g->instances + (ref & ~PR_BVH_LEAF_BIT);
       BvhRay obj = instance_ray(g, inst, r);  // ("local" is an OpenCL keyword)
-      if (bvh_traverse(g->mesh_nodes, g->mesh_tris, inst->root_node, &obj, hit, inst->instance_id,
-                       any_hit)) {
+      PacketBlend blend = packet_blend_none(g->mesh_tris);
+      if (g->motion_steps > 1u && g->mesh_motion[4u * inst->mesh + 3u] > 1u) {
+        PR_GLOBAL const u32* mm = g->mesh_motion + 4u * inst->mesh;
+        blend.steps = g->motion_tris + mm[2];
+        blend.first = mm[0];
+        blend.stride = mm[3];
+        blend.k = motion_step(mm[3], g->time, &blend.a);
+      }
+      if (bvh_traverse_blend(g->mesh_nodes, g->mesh_tris, inst->root_node, &obj, hit,
+                             inst->instance_id, any_hit, &blend)) {
         if (any_hit) return 1;
         found = 1;
         r->tmax = obj.tmax;

@@ -18,6 +18,13 @@
 // code only through PR_SCENE() / PR_SCENE_GEOM().
 #pragma once
 
+// Motion blur's instance transforms and the path's time (shared/motion.h), which both the
+// geometry and shading read: entries of group `role`.
+#define PR_ARGS_MOTION(role, X)    \
+  X(role, IN, float, motion)       \
+  X(role, VAL, uint, motion_steps) \
+  X(role, VAL, float, time)
+
 // The scene's geometry: the two BVHs (SSG, and DSG's top level over instances of mesh BVHs).
 #define PR_ARGS_SCENE_GEOM(F, X)         \
   F(GEOM, IN, BvhNode, static_nodes)     \
@@ -27,21 +34,21 @@
   X(GEOM, IN, BvhNode, mesh_nodes)       \
   X(GEOM, IN, BvhTriPacket, mesh_tris)   \
   X(GEOM, VAL, uint, instance_count)     \
-  X(GEOM, IN, float, motion)             \
-  X(GEOM, VAL, uint, motion_steps)       \
-  X(GEOM, VAL, float, time)
+  PR_ARGS_MOTION(GEOM, X)                \
+  X(GEOM, IN, BvhTriPacket, motion_tris) \
+  X(GEOM, IN, uint, mesh_motion)
 
 // What shading reads: vertices, triangles, per-instance records, materials, textures.
-#define PR_ARGS_SHADING(F, X)                \
-  F(SHADING, IN, ShadingVertex, vertices)    \
-  X(SHADING, IN, ShadingTriangle, triangles) \
-  X(SHADING, IN, ShadingInstance, instances) \
-  X(SHADING, IN, Material, materials)        \
-  X(SHADING, IN, TextureInfo, textures)      \
-  X(SHADING, IN, uint, texels)               \
-  X(SHADING, IN, float, motion)              \
-  X(SHADING, VAL, uint, motion_steps)        \
-  X(SHADING, VAL, float, time)
+#define PR_ARGS_SHADING(F, X)                    \
+  F(SHADING, IN, ShadingVertex, vertices)        \
+  X(SHADING, IN, ShadingTriangle, triangles)     \
+  X(SHADING, IN, ShadingInstance, instances)     \
+  X(SHADING, IN, Material, materials)            \
+  X(SHADING, IN, TextureInfo, textures)          \
+  X(SHADING, IN, uint, texels)                   \
+  PR_ARGS_MOTION(SHADING, X)                     \
+  X(SHADING, IN, ShadingVertex, motion_vertices) \
+  X(SHADING, IN, uint, vertex_motion)
 
 // The light table, its light BVH and the environment.
 #define PR_ARGS_LIGHTS(F, X)         \

@@ -24,6 +24,10 @@ typedef struct {
   PR_GLOBAL const float* motion;  // --shutter, as SceneGeom's
   u32 motion_steps;
   float time;
+  // Deforming meshes under a shutter: their vertices at each step, and per dynamic mesh 4 words
+  // (its first vertex, vertex count, its steps' first vertex here, its steps; 1: none).
+  PR_GLOBAL const ShadingVertex* motion_vertices;
+  PR_GLOBAL const u32* vertex_motion;
 } ShadingData;
 
 typedef struct {
@@ -54,6 +58,31 @@ PR_INLINE void instance_transforms(const ShadingData* sd, u32 inst, Affine* o2w,
   affine_load(sd->instances[inst].world_to_object, w2o);
 }
 
+// Vertex v of a triangle of instance inst (PR_INVALID_INDEX: the SSG) at the path's time: a
+// deforming mesh's is the blend of its two motion steps around it.
+PR_INLINE ShadingVertex vertex_at(const ShadingData* sd, u32 inst, u32 v) {
+  if (sd->motion_steps <= 1u || inst == PR_INVALID_INDEX) return sd->vertices[v];
+  PR_GLOBAL const u32* vm = sd->vertex_motion + 4u * sd->instances[inst].mesh;
+  if (vm[3] <= 1u) return sd->vertices[v];
+  float a;
+  const u32 k = motion_step(vm[3], sd->time, &a);
+  PR_GLOBAL const ShadingVertex* s0 = sd->motion_vertices + vm[2] + (size_t)k * vm[1] + (v - vm[0]);
+  const ShadingVertex v0 = s0[0], v1 = s0[vm[1]];
+  ShadingVertex x = v0;
+  x.px += (v1.px - v0.px) * a, x.py += (v1.py - v0.py) * a, x.pz += (v1.pz - v0.pz) * a;
+  x.nx += (v1.nx - v0.nx) * a, x.ny += (v1.ny - v0.ny) * a, x.nz += (v1.nz - v0.nz) * a;
+  x.tx += (v1.tx - v0.tx) * a, x.ty += (v1.ty - v0.ty) * a, x.tz += (v1.tz - v0.tz) * a;
+  return x;
+}
+
+// The three vertices of triangle tri of instance inst, at the path's time.
+PR_INLINE void triangle_vertices(const ShadingData* sd, ShadingTriangle tri, u32 inst,
+                                 ShadingVertex* a, ShadingVertex* b, ShadingVertex* c) {
+  *a = vertex_at(sd, inst, tri.v0);
+  *b = vertex_at(sd, inst, tri.v1);
+  *c = vertex_at(sd, inst, tri.v2);
+}
+
 // A DSG triangle's corners placed by instance inst; *w2o, for its normals.
 PR_INLINE void place_corners(const ShadingData* sd, u32 inst, float3* pa, float3* pb, float3* pc,
                              Affine* w2o) {
@@ -68,7 +97,8 @@ PR_INLINE void place_corners(const ShadingData* sd, u32 inst, float3* pa, float3
 PR_INLINE void triangle_world(const ShadingData* sd, u32 prim, u32 inst, float3* v0, float3* e1,
                               float3* e2) {
   const ShadingTriangle tri = sd->triangles[prim];
-  const ShadingVertex a = sd->vertices[tri.v0], b = sd->vertices[tri.v1], c = sd->vertices[tri.v2];
+  ShadingVertex a, b, c;
+  triangle_vertices(sd, tri, inst, &a, &b, &c);
   float3 pa = make_float3(a.px, a.py, a.pz), pb = make_float3(b.px, b.py, b.pz),
          pc = make_float3(c.px, c.py, c.pz);
   if (inst != PR_INVALID_INDEX) {
@@ -182,7 +212,8 @@ PR_INLINE float3 lift_to_tangent_plane(float3 pv, float3 nv, float3 p, float b, 
 
 PR_INLINE float3 surface_lift(const ShadingData* sd, u32 prim, u32 inst, float b1, float b2) {
   const ShadingTriangle tri = sd->triangles[prim];
-  const ShadingVertex a = sd->vertices[tri.v0], b = sd->vertices[tri.v1], c = sd->vertices[tri.v2];
+  ShadingVertex a, b, c;
+  triangle_vertices(sd, tri, inst, &a, &b, &c);
   const float b0 = 1.0f - b1 - b2;
   float3 pa = make_float3(a.px, a.py, a.pz), pb = make_float3(b.px, b.py, b.pz),
          pc = make_float3(c.px, c.py, c.pz);
@@ -210,7 +241,8 @@ PR_INLINE float3 surface_lift(const ShadingData* sd, u32 prim, u32 inst, float b
 // mesh has none) and in *tw the bitangent's sign: b = tw cross(n, t).
 PR_INLINE float3 surface_tangent(const ShadingData* sd, const SurfaceHit* s, float* tw) {
   const ShadingTriangle tri = sd->triangles[s->prim];
-  const ShadingVertex a = sd->vertices[tri.v0], b = sd->vertices[tri.v1], c = sd->vertices[tri.v2];
+  ShadingVertex a, b, c;
+  triangle_vertices(sd, tri, s->inst, &a, &b, &c);
   float3 t = make_float3(a.tx, a.ty, a.tz) * (1.0f - s->b1 - s->b2) +
              make_float3(b.tx, b.ty, b.tz) * s->b1 + make_float3(c.tx, c.ty, c.tz) * s->b2;
   *tw = a.tw;
@@ -234,7 +266,8 @@ PR_INLINE SurfaceHit surface_interp(const ShadingData* sd, u32 prim, u32 inst, f
   s.inst = inst;
   const ShadingTriangle tri = sd->triangles[s.prim];
   s.material = tri.material;
-  const ShadingVertex a = sd->vertices[tri.v0], b = sd->vertices[tri.v1], c = sd->vertices[tri.v2];
+  ShadingVertex a, b, c;
+  triangle_vertices(sd, tri, inst, &a, &b, &c);
   const float b0 = 1.0f - b1 - b2;
   float3 pa = make_float3(a.px, a.py, a.pz), pb = make_float3(b.px, b.py, b.pz),
          pc = make_float3(c.px, c.py, c.pz);
@@ -273,7 +306,8 @@ PR_INLINE SurfaceHit surface_interp(const ShadingData* sd, u32 prim, u32 inst, f
 PR_INLINE float3 surface_coat_normal(const ShadingData* sd, const SurfaceHit* s) {
   PR_GLOBAL const Material* m = sd->materials + s->material;
   const ShadingTriangle tri = sd->triangles[s->prim];
-  const ShadingVertex a = sd->vertices[tri.v0], b = sd->vertices[tri.v1], c = sd->vertices[tri.v2];
+  ShadingVertex a, b, c;
+  triangle_vertices(sd, tri, s->inst, &a, &b, &c);
   float3 n = make_float3(a.nx, a.ny, a.nz) * (1.0f - s->b1 - s->b2) +
              make_float3(b.nx, b.ny, b.nz) * s->b1 + make_float3(c.nx, c.ny, c.nz) * s->b2;
   if (s->inst != PR_INVALID_INDEX) {

@@ -2,9 +2,9 @@
 
   /usr/bin/python3 -m tools.bench.bench_motion_blur --build build --cycles BPY/bin/python
 
-The scenes (rigid motion: deformation blur is not built): the Virtual City's camera 6 at frame
-204 (45 moving cars and a moving camera; tools/scenes/gen_real_scenes.py vc, as bench_animations
-makes it), and the same at 2 fps. Both renderers path trace the frame at --spp with the shutter open
+The scenes: the Virtual City's camera 6 at frame 204 (45 moving cars and a moving camera;
+tools/scenes/gen_real_scenes.py vc, as bench_animations makes it), the same at 2 fps, and
+CesiumMan walking (skinned; gen_real_scenes framed) at 2 fps. Both renderers path trace the frame at --spp with the shutter open
 each of --shutters frames, centred (Blender's default). Per shutter: our mean over Cycles', and
 over 16x16 blocks the share within 2% of Cycles' and the median and 95th-percentile deviation, for
 the blurred pair and, as the control that shows the blur is measured at all, our sharp frame
@@ -31,6 +31,9 @@ SCENES = {
     "vc-cam6": ("vc", "VC/VC.gltf", 6, "camera6", 204, 24, "0.5,0.6,0.8", (160, 96)),
     # The same moment at 2 fps: a shutter of half a frame is a quarter second, metres of motion.
     "vc-cam6-2fps": ("vc", "VC/VC.gltf", 6, "camera6", 17, 2, "0.5,0.6,0.8", (160, 96)),
+    # Deformation blur: CesiumMan walking (a skin), framed from the front, a quarter second open.
+    "cesiumman-2fps": ("framed", "CesiumMan/CesiumMan.gltf", 0, "front", 1, 2, "1,1,1",
+                       (128, 128)),
 }
 
 

@@ -14,7 +14,10 @@ for c in clang clang-16 clang-15 clang-14; do
   if command -v "$c" >/dev/null; then clang=$c; break; fi
 done
 [ -n "$clang" ] || { echo "kernel-conformance: clang is not installed (tools/setup/install-deps.sh installs it)" >&2; exit 1; }
-flags=(-x cl -cl-std=CL1.2 -fsyntax-only -pedantic -Werror -ferror-limit=5)
+# Also clang's uninitialised-variable analysis: a private value left unset on some path is what
+# one compiler forgives and another turns into wrong images (kernels/shared/bvh.h, PacketBlend).
+flags=(-x cl -cl-std=CL1.2 -fsyntax-only -pedantic -Werror -ferror-limit=5 -Wuninitialized
+  -Wsometimes-uninitialized -Wconditional-uninitialized)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 

@@ -100,11 +100,13 @@ done
 python3 -m tools.scenes.gen_atrium --size 0.02 --light lanterns --out "$work/lanterns/atrium.gltf" >/dev/null
 run "lanterns-pathtrace" "$work/lanterns/atrium.gltf" --frames 0-1 --mode pathtrace --light-sampler bvh
 # Motion blur: the camera's and the instances' motion steps, emitters where they are at each
-# sample's time, the auxiliary images at the frame's.
+# sample's time, the auxiliary images at the frame's, a skinned mesh's steps blended.
 run "lanterns-pathtrace-shutter" "$work/lanterns/atrium.gltf" --frames 0-1 --mode pathtrace \
   --light-sampler bvh --shutter 1
 run "cornell-orbit-pathtrace-shutter" scenes/cornell-orbit.gltf --frames 0-1 --mode pathtrace \
   --shutter 0.5 --aov all
+run "cornell-skinned-pathtrace-shutter" scenes/cornell-skinned.gltf --frames 0-1 \
+  --mode pathtrace --shutter 0.5
 run "lanterns-reuse-connections" "$work/lanterns/atrium.gltf" --frames 0-1 --mode reuse \
   --light-sampler bvh --no-eye-paths
 # Eye paths weighted against the connections: with a history on the demo, and among many
