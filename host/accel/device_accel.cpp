@@ -48,9 +48,12 @@ void DeviceAccel::uploadMeshes(Context& ctx, const DynamicAccel& dsg, bool grow)
          byteSize(dsg.meshPackets()), grow);
   upload(ctx, meshMotion_, "dynamic mesh motion table", dsg.meshMotion().data(),
          byteSize(dsg.meshMotion()), grow);
-  if (!dsg.motionPackets().empty())
+  if (!dsg.motionPackets().empty()) {
     upload(ctx, motionTris_, "deforming mesh motion steps", dsg.motionPackets().data(),
            byteSize(dsg.motionPackets()), grow);
+    upload(ctx, motionBounds_, "deforming mesh node boxes at the motion steps",
+           dsg.motionBounds().data(), byteSize(dsg.motionBounds()), grow);
+  }
 }
 
 void DeviceAccel::uploadFrame(Context& ctx, const DynamicAccel& dsg) {
@@ -68,8 +71,8 @@ void DeviceAccel::uploadFrame(Context& ctx, const DynamicAccel& dsg) {
 
 void DeviceAccel::fillArgs(Context& ctx, kargs::SceneArgs* a) {
   if (staticNodes_.bytes == 0) throw RuntimeError("DeviceAccel: static geometry not uploaded");
-  for (Slot* s :
-       {&tlasNodes_, &instances_, &meshNodes_, &meshTris_, &motion_, &motionTris_, &meshMotion_})
+  for (Slot* s : {&tlasNodes_, &instances_, &meshNodes_, &meshTris_, &motion_, &motionTris_,
+                  &meshMotion_, &motionBounds_})
     if (s->bytes == 0) upload(ctx, *s, "dynamic geometry placeholder", nullptr, 0, false);
   a->pr_g_static_nodes = staticNodes_.buffer;
   a->pr_g_static_tris = staticTris_.buffer;
@@ -83,6 +86,7 @@ void DeviceAccel::fillArgs(Context& ctx, kargs::SceneArgs* a) {
   a->pr_g_time = 0.5f;  // the frame's own time; kernels set each path's (scene_at_sample)
   a->pr_g_motion_tris = motionTris_.buffer;
   a->pr_g_mesh_motion = meshMotion_.buffer;
+  a->pr_g_motion_bounds = motionBounds_.buffer;
 }
 
 cl_uint DeviceAccel::setKernelArgs(Context& ctx, cl::Kernel& kernel, cl_uint first) {

@@ -34,7 +34,8 @@ class DeviceAccel {
   // Device bytes held: static part, meshes, per-frame part.
   uint64_t staticBytes() const { return staticNodes_.bytes + staticTris_.bytes; }
   uint64_t meshBytes() const {
-    return meshNodes_.bytes + meshTris_.bytes + motionTris_.bytes + meshMotion_.bytes;
+    return meshNodes_.bytes + meshTris_.bytes + motionTris_.bytes + meshMotion_.bytes +
+           motionBounds_.bytes;
   }
   uint64_t frameBytes() const { return tlasNodes_.bytes + instances_.bytes + motion_.bytes; }
 
@@ -50,7 +51,7 @@ class DeviceAccel {
 
   int width_;
   Slot staticNodes_, staticTris_, meshNodes_, meshTris_, tlasNodes_, instances_, motion_,
-      motionTris_, meshMotion_;
+      motionTris_, meshMotion_, motionBounds_;
   uint32_t instanceCount_ = 0;
   uint32_t motionSteps_ = 1;
 };

@@ -47,6 +47,48 @@ dev::BvhTriPacket packTriangles(const dev::BvhTriangle* first, uint32_t count) {
   return p;
 }
 
+namespace {
+
+// Child i's box of wide node `node` over `packets` (one motion step's), written to `bounds` (node
+// by node, 6 * width floats each) for the whole subtree; returns the node's box. Boxes grow by
+// a few ulps, as a blended triangle's rounding may step outside the blend of exact boxes.
+Aabb refitNode(const WideBvh& wide, const std::vector<dev::BvhTriPacket>& packets, uint32_t node,
+               float* bounds) {
+  const int w = wide.width;
+  Aabb all;
+  for (int i = 0; i < w; ++i) {
+    const uint32_t ref = wide.words[wideChild(w, node, i)];
+    Aabb box;
+    if (ref == PR_INVALID_INDEX) {
+    } else if (ref & PR_BVH_LEAF_BIT) {
+      const dev::BvhTriPacket& p = packets[ref & ~PR_BVH_LEAF_BIT];
+      for (int l = 0; l < PR_BVH_PACKET; ++l) {
+        if (p.prim[l] == PR_INVALID_INDEX) continue;
+        const glm::vec3 v0(p.v0x[l], p.v0y[l], p.v0z[l]);
+        box.grow(v0);
+        box.grow(v0 + glm::vec3(p.e1x[l], p.e1y[l], p.e1z[l]));
+        box.grow(v0 + glm::vec3(p.e2x[l], p.e2y[l], p.e2z[l]));
+      }
+    } else {
+      box = refitNode(wide, packets, ref, bounds);
+    }
+    float b[6] = {1e30f, -1e30f, 1e30f, -1e30f, 1e30f, -1e30f};  // finite: blends stay inverted
+    if (!box.empty()) {
+      const glm::vec3 pad =
+          (glm::abs(box.lo) + glm::abs(box.hi)) * 1e-6f + (box.hi - box.lo) * 1e-5f;
+      box.lo -= pad, box.hi += pad;
+      const float got[6] = {box.lo.x, box.hi.x, box.lo.y, box.hi.y, box.lo.z, box.hi.z};
+      std::copy(got, got + 6, b);
+      all.grow(box);
+    }
+    for (int k = 0; k < 6; ++k)
+      bounds[(size_t(node) * 6 + size_t(k)) * size_t(w) + size_t(i)] = b[k];
+  }
+  return all;
+}
+
+}  // namespace
+
 TriangleBvh buildTriangleBvh(const std::vector<glm::vec3>& positions,
                              const std::vector<uint32_t>& indices, uint32_t primBase,
                              const BuildOptions& options, const char* what,
@@ -127,6 +169,17 @@ TriangleBvh buildTriangleBvh(const std::vector<glm::vec3>& positions,
       packets.push_back(packTriangles(ordered.data() + leaf.index, leaf.meta & ~PR_BVH_LEAF_BIT));
     out.stepPackets.push_back(std::move(packets));
   }
+  // Node by node, its steps side by side: a node reads two neighbours.
+  const size_t nodeFloats = 6 * size_t(out.wide.width), nodes = out.wide.nodeCount();
+  out.stepBounds.assign(nodes * stepCount * nodeFloats, 0.0f);
+  std::vector<float> step(nodes * nodeFloats);
+  for (size_t k = 0; k < stepCount && nodes > 0; ++k) {
+    std::fill(step.begin(), step.end(), 0.0f);
+    refitNode(out.wide, out.stepPackets[k], 0, step.data());
+    for (size_t n = 0; n < nodes; ++n)
+      std::copy_n(step.data() + n * nodeFloats, nodeFloats,
+                  out.stepBounds.data() + (n * stepCount + k) * nodeFloats);
+  }
   return out;
 }
 
@@ -158,12 +211,12 @@ uint32_t DynamicAccel::addMesh(const std::vector<glm::vec3>& positions,
   m.primBase = primBase;
   m.bounds = bvh.bounds;
   m.stats = bvh.stats;
-  parts_.push_back({bvh.wide.words, bvh.packets, bvh.triangles, {}});
+  parts_.push_back({bvh.wide.words, bvh.packets, bvh.triangles, {}, {}});
   previous_.emplace_back();
   // Rebase to absolute indices in the concatenated buffers.
   meshMotion_.insert(meshMotion_.end(),
                      {uint32_t(meshPackets_.size()), uint32_t(bvh.packets.size()),
-                      uint32_t(motionPackets_.size()), 1u});
+                      uint32_t(motionPackets_.size()), 1u, m.rootNode, 0u, 0u, 0u});
   rebaseWide(bvh.wide.words, width_, m.rootNode, uint32_t(meshPackets_.size()));
   meshNodes_.insert(meshNodes_.end(), bvh.wide.words.begin(), bvh.wide.words.end());
   meshPackets_.insert(meshPackets_.end(), bvh.packets.begin(), bvh.packets.end());
@@ -187,7 +240,7 @@ void DynamicAccel::replaceMesh(uint32_t index, const std::vector<glm::vec3>& pos
   m.stats = bvh.stats;
   previous_[index] = std::move(parts_[index]);
   parts_[index] = {std::move(bvh.wide.words), std::move(bvh.packets), std::move(bvh.triangles),
-                   std::move(bvh.stepPackets)};
+                   std::move(bvh.stepPackets), std::move(bvh.stepBounds)};
   concatenate();
 }
 
@@ -196,16 +249,20 @@ void DynamicAccel::concatenate() {
   meshPackets_.clear();
   meshTris_.clear();
   motionPackets_.clear();
-  meshMotion_.assign(meshes_.size() * 4, 0u);
+  motionBounds_.clear();
+  meshMotion_.assign(meshes_.size() * PR_MESH_MOTION_WORDS, 0u);
   for (size_t i = 0; i < meshes_.size(); ++i) {
     Mesh& m = meshes_[i];
     const Part& p = parts_[i];
     m.rootNode = meshNodeCount();
     m.firstTriangle = uint32_t(meshTris_.size());
-    uint32_t* mm = &meshMotion_[i * 4];
+    uint32_t* mm = &meshMotion_[i * PR_MESH_MOTION_WORDS];
     mm[0] = uint32_t(meshPackets_.size()), mm[1] = uint32_t(p.packets.size());
     mm[2] = uint32_t(motionPackets_.size());
     mm[3] = std::max<uint32_t>(uint32_t(p.steps.size()), 1);
+    mm[4] = m.rootNode;
+    mm[5] = uint32_t(motionBounds_.size() / (6 * size_t(width_)));
+    motionBounds_.insert(motionBounds_.end(), p.stepBounds.begin(), p.stepBounds.end());
     // Packet by packet, its steps side by side: a leaf reads two neighbours.
     for (size_t j = 0; j < p.packets.size() && !p.steps.empty(); ++j)
       for (const auto& step : p.steps) motionPackets_.push_back(step[j]);
@@ -349,6 +406,7 @@ HostGeom::HostGeom(const StaticAccel& ssg, const DynamicAccel* dsg) {
     geom_.motion_steps = dsg->motionSteps();
     geom_.motion_tris = dsg->motionPackets().empty() ? nullptr : dsg->motionPackets().data();
     geom_.mesh_motion = dsg->meshMotion().empty() ? nullptr : dsg->meshMotion().data();
+    geom_.motion_bounds = dsg->motionBounds().empty() ? nullptr : dsg->motionBounds().data();
   }
   geom_.time = 0.5f;
 }

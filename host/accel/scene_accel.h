@@ -29,8 +29,11 @@ bool zeroArea(const dev::BvhTriangle& t);
 struct TriangleBvh {
   WideBvh wide;
   std::vector<dev::BvhTriPacket> packets;
-  // With motion steps: the packets at each step, leaf for leaf as `packets`.
+  // With motion steps: the packets at each step, leaf for leaf as `packets`, and the wide nodes'
+  // child boxes refitted to each step (node by node, its steps side by side, 6 * width floats
+  // each as BvhNode.bounds): a box blended between two steps holds the blended triangles.
   std::vector<std::vector<dev::BvhTriPacket>> stepPackets;
+  std::vector<float> stepBounds;
   std::vector<BinaryNode> binary;
   std::vector<dev::BvhTriangle> triangles;
   Aabb bounds;
@@ -44,8 +47,8 @@ dev::BvhTriPacket packTriangles(const dev::BvhTriangle* first, uint32_t count);
 // they have no surface, and Moller-Trumbore's rounding could report stray hits on them.
 // Throws InputError (naming `what`) on an index out of range, a non-finite position or an
 // index count that is not a multiple of 3.
-// With `steps` (the positions at each motion step, kernels/shared/motion.h), each triangle's box
-// holds it at every step, and stepPackets hold the steps' triangles.
+// With `steps` (the positions at each motion step, kernels/shared/motion.h), the tree is built on
+// boxes holding each triangle at every step; stepPackets and stepBounds hold each step's.
 TriangleBvh buildTriangleBvh(const std::vector<glm::vec3>& positions,
                              const std::vector<uint32_t>& indices, uint32_t primBase,
                              const BuildOptions& options, const char* what,
@@ -130,8 +133,10 @@ class DynamicAccel {
   // instance by instance (kernels/shared/motion.h).
   uint32_t motionSteps() const { return motionSteps_; }
   const std::vector<float>& motion() const { return motion_; }
-  // Deforming meshes' packets at their motion steps, and per mesh 4 words (SceneGeom.mesh_motion).
+  // Deforming meshes' packets and node boxes at their motion steps, and per mesh
+  // PR_MESH_MOTION_WORDS words (SceneGeom.mesh_motion).
   const std::vector<dev::BvhTriPacket>& motionPackets() const { return motionPackets_; }
+  const std::vector<float>& motionBounds() const { return motionBounds_; }
   const std::vector<uint32_t>& meshMotion() const { return meshMotion_; }
 
  private:
@@ -147,6 +152,7 @@ class DynamicAccel {
     std::vector<dev::BvhTriPacket> packets;
     std::vector<dev::BvhTriangle> triangles;
     std::vector<std::vector<dev::BvhTriPacket>> steps;  // under a shutter (replaceMesh)
+    std::vector<float> stepBounds;                      // TriangleBvh.stepBounds
   };
   void concatenate();
   int width_;
@@ -164,6 +170,7 @@ class DynamicAccel {
   uint32_t motionSteps_ = 1;
   std::vector<float> motion_;
   std::vector<dev::BvhTriPacket> motionPackets_;
+  std::vector<float> motionBounds_;
   std::vector<uint32_t> meshMotion_;
 };
 

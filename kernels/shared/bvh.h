@@ -51,27 +51,34 @@ typedef struct {
   PR_GLOBAL const float* motion;  // --shutter: each instance's transforms (shared/motion.h)
   u32 motion_steps;               // 1: no motion blur (`instances` hold the transforms)
   float time;                     // the path's time in the shutter interval (scene_at_sample)
-  // Deforming meshes under a shutter: their packets at each step, and per mesh 4 words (its
-  // first packet in mesh_tris, its packet count, its steps' first packet here, its steps; 1:
-  // none).
+  // Deforming meshes under a shutter: their packets and node boxes at each step, and per mesh
+  // PR_MESH_MOTION_WORDS words: its first packet in mesh_tris, its packet count, its steps' first
+  // packet in motion_tris, its steps (1: none), its root node, its steps' first node record in
+  // motion_bounds (6 * PR_BVH_WIDTH floats each), two unused.
   PR_GLOBAL const BvhTriPacket* motion_tris;
   PR_GLOBAL const u32* mesh_motion;
+  PR_GLOBAL const float* motion_bounds;
 } SceneGeom;
 
-// A deforming mesh's packets at the ray's time: packet p of mesh_tris is, at step k, motion_tris
-// [base + (p - first) * steps + k]; a leaf blends steps k and k + 1 by a. Always written whole
-// (stride 1: nothing deforms): with its fields unwritten where unused, PoCL's compiler made a
-// traversal that missed hits at random (depending on its threads' stacks).
+#define PR_MESH_MOTION_WORDS 8u
+
+// A deforming mesh at the ray's time: packet p of mesh_tris is, at step k, steps[(p - first) *
+// stride + k], and node n's child boxes bounds[((n - first_node) * stride + k) * 6 *
+// PR_BVH_WIDTH ...]; a ray blends steps k and k + 1 by a. Always written whole (stride 1:
+// nothing deforms): with its fields unwritten where unused, PoCL's compiler made a traversal
+// that missed hits at random (depending on its threads' stacks).
 typedef struct {
   PR_GLOBAL const BvhTriPacket* steps;
-  u32 first, stride, k;  // stride: the steps of a packet
+  PR_GLOBAL const float* bounds;
+  u32 first, first_node, stride, k;  // stride: the steps of a packet or node
   float a;
 } PacketBlend;
 
-PR_INLINE PacketBlend packet_blend_none(PR_GLOBAL const BvhTriPacket* packets) {
+PR_INLINE PacketBlend packet_blend_none(void) {
   PacketBlend b;
-  b.steps = packets;
-  b.first = 0u;
+  b.steps = 0;
+  b.bounds = 0;
+  b.first = b.first_node = 0u;
   b.stride = 1u;
   b.k = 0u;
   b.a = 0.0f;
@@ -158,15 +165,16 @@ PR_INLINE u32 bvh_bits(int8 m) {
 // scaled by PR_BVH_FAR_SCALE so rounding never culls a box that holds a hit. The device tests
 // all children at once with one float vector per slab; the host runs the same operations lane
 // by lane (bit for bit the same results).
-PR_INLINE u32 bvh_node_entries(PR_GLOBAL const BvhNode* n, const BvhRay* r, float* entry) {
-  PR_GLOBAL const float* b = n->bounds;
 #ifdef PR_DEVICE_CODE
-  const bvh_fw x0 = (bvh_loadw(b + r->near_x) - r->o.x) * r->inv_d.x;
-  const bvh_fw y0 = (bvh_loadw(b + r->near_y) - r->o.y) * r->inv_d.y;
-  const bvh_fw z0 = (bvh_loadw(b + r->near_z) - r->o.z) * r->inv_d.z;
-  const bvh_fw x1 = (bvh_loadw(b + r->far_x) - r->o.x) * r->inv_d.x;
-  const bvh_fw y1 = (bvh_loadw(b + r->far_y) - r->o.y) * r->inv_d.y;
-  const bvh_fw z1 = (bvh_loadw(b + r->far_z) - r->o.z) * r->inv_d.z;
+// The slab test on the children's near planes (ax, ay, az) and far planes (bx, by, bz).
+PR_INLINE u32 bvh_slab_entries(bvh_fw ax, bvh_fw ay, bvh_fw az, bvh_fw bx, bvh_fw by, bvh_fw bz,
+                               const BvhRay* r, float* entry) {
+  const bvh_fw x0 = (ax - r->o.x) * r->inv_d.x;
+  const bvh_fw y0 = (ay - r->o.y) * r->inv_d.y;
+  const bvh_fw z0 = (az - r->o.z) * r->inv_d.z;
+  const bvh_fw x1 = (bx - r->o.x) * r->inv_d.x;
+  const bvh_fw y1 = (by - r->o.y) * r->inv_d.y;
+  const bvh_fw z1 = (bz - r->o.z) * r->inv_d.z;
   const bvh_fw tmin = (bvh_fw)(r->tmin);
   // select(b, a, a > b) is a > b ? a : b per lane: bvh_max, as the host computes it.
   const bvh_fw nxy = select(y0, x0, x0 > y0), nz = select(tmin, z0, z0 > tmin);
@@ -176,6 +184,15 @@ PR_INLINE u32 bvh_node_entries(PR_GLOBAL const BvhNode* n, const BvhRay* r, floa
   const u32 bits = bvh_bits((tnear <= tfar) & (tnear <= r->tmax));
   if (bits != 0u) bvh_storew(tnear, entry);
   return bits;
+}
+#endif
+
+// bvh_node_entries on child boxes b (BvhNode.bounds' layout).
+PR_INLINE u32 bvh_bounds_entries(PR_GLOBAL const float* b, const BvhRay* r, float* entry) {
+#ifdef PR_DEVICE_CODE
+  return bvh_slab_entries(bvh_loadw(b + r->near_x), bvh_loadw(b + r->near_y),
+                          bvh_loadw(b + r->near_z), bvh_loadw(b + r->far_x),
+                          bvh_loadw(b + r->far_y), bvh_loadw(b + r->far_z), r, entry);
 #else
   u32 mask = 0u;
   for (int i = 0; i < PR_BVH_WIDTH; ++i) {
@@ -191,6 +208,26 @@ PR_INLINE u32 bvh_node_entries(PR_GLOBAL const BvhNode* n, const BvhRay* r, floa
     if (tnear <= tfar && tnear <= r->tmax) mask |= 1u << i;
   }
   return mask;
+#endif
+}
+
+PR_INLINE u32 bvh_node_entries(PR_GLOBAL const BvhNode* n, const BvhRay* r, float* entry) {
+  return bvh_bounds_entries(n->bounds, r, entry);
+}
+
+// The same on the child boxes blended between two motion steps' (b0, b1) by a: boxes that hold
+// the triangles blended alike (a blend of points in two boxes lies in the blend of the boxes).
+PR_INLINE u32 bvh_blend_entries(PR_GLOBAL const float* b0, PR_GLOBAL const float* b1, float a,
+                                const BvhRay* r, float* entry) {
+#ifdef PR_DEVICE_CODE
+#define PR_PLANE(o) (bvh_loadw(b0 + (o)) + (bvh_loadw(b1 + (o)) - bvh_loadw(b0 + (o))) * a)
+  return bvh_slab_entries(PR_PLANE(r->near_x), PR_PLANE(r->near_y), PR_PLANE(r->near_z),
+                          PR_PLANE(r->far_x), PR_PLANE(r->far_y), PR_PLANE(r->far_z), r, entry);
+#undef PR_PLANE
+#else
+  float b[6 * PR_BVH_WIDTH];
+  for (int i = 0; i < 6 * PR_BVH_WIDTH; ++i) b[i] = b0[i] + (b1[i] - b0[i]) * a;
+  return bvh_bounds_entries(b, r, entry);
 #endif
 }
 
@@ -317,10 +354,8 @@ PR_INLINE int intersect_packet_blend(const PacketBlend* b, u32 p, const BvhRay* 
 // Pushes the children of n that the ray enters; closest hit keeps the pushed ones sorted
 // farthest first (equal distances in child order), so the nearest is popped next. Returns
 // whether any was pushed.
-PR_INLINE int bvh_push_children(PR_GLOBAL const BvhNode* n, const BvhRay* r, u32* stack,
-                                float* stack_t, int* sp, int any_hit) {
-  float entry[PR_BVH_WIDTH];
-  u32 mask = bvh_node_entries(n, r, entry);
+PR_INLINE int bvh_push_children(PR_GLOBAL const BvhNode* n, u32 mask, const float* entry,
+                                u32* stack, float* stack_t, int* sp, int any_hit) {
   const int base = *sp;
   int top = base;
   for (; mask != 0u; mask &= mask - 1u) {
@@ -369,7 +404,17 @@ PR_INLINE int bvh_traverse_blend(PR_GLOBAL const BvhNode* nodes,
   u32 ref = root;
   for (;;) {
     if (!(ref & PR_BVH_LEAF_BIT)) {
-      if (bvh_push_children(nodes + ref, r, stack, stack_t, &sp, any_hit)) {
+      float entry[PR_BVH_WIDTH];
+      u32 mask;
+      if (blend->stride > 1u) {
+        PR_GLOBAL const float* b0 =
+            blend->bounds +
+            ((size_t)(ref - blend->first_node) * blend->stride + blend->k) * (6 * PR_BVH_WIDTH);
+        mask = bvh_blend_entries(b0, b0 + 6 * PR_BVH_WIDTH, blend->a, r, entry);
+      } else {
+        mask = bvh_node_entries(nodes + ref, r, entry);
+      }
+      if (bvh_push_children(nodes + ref, mask, entry, stack, stack_t, &sp, any_hit)) {
         ref = stack[--sp];
         continue;
       }
@@ -396,7 +441,7 @@ PR_INLINE int bvh_traverse_blend(PR_GLOBAL const BvhNode* nodes,
 
 PR_INLINE int bvh_traverse(PR_GLOBAL const BvhNode* nodes, PR_GLOBAL const BvhTriPacket* packets,
                            u32 root, BvhRay* r, Hit* hit, u32 inst, int any_hit) {
-  const PacketBlend none = packet_blend_none(packets);
+  const PacketBlend none = packet_blend_none();
   return bvh_traverse_blend(nodes, packets, root, r, hit, inst, any_hit, &none);
 }
 
@@ -436,23 +481,32 @@ PR_INLINE int tlas_traverse(const SceneGeom* g, BvhRay* r, Hit* hit, int any_hit
   u32 ref = 0;
   for (;;) {
     if (!(ref & PR_BVH_LEAF_BIT)) {
-      if (bvh_push_children(g->tlas_nodes + ref, r, stack, stack_t, &sp, any_hit)) {
+      float entry[PR_BVH_WIDTH];
+      const u32 mask = bvh_node_entries(g->tlas_nodes + ref, r, entry);
+      if (bvh_push_children(g->tlas_nodes + ref, mask, entry, stack, stack_t, &sp, any_hit)) {
         ref = stack[--sp];
         continue;
       }
     } else {
       PR_GLOBAL const BvhInstance* inst = g->instances + (ref & ~PR_BVH_LEAF_BIT);
       BvhRay obj = instance_ray(g, inst, r);  // ("local" is an OpenCL keyword)
-      PacketBlend blend = packet_blend_none(g->mesh_tris);
-      if (g->motion_steps > 1u && g->mesh_motion[4u * inst->mesh + 3u] > 1u) {
-        PR_GLOBAL const u32* mm = g->mesh_motion + 4u * inst->mesh;
+      PacketBlend blend = packet_blend_none();
+      if (g->motion_steps > 1u && g->mesh_motion[PR_MESH_MOTION_WORDS * inst->mesh + 3u] > 1u) {
+        PR_GLOBAL const u32* mm = g->mesh_motion + PR_MESH_MOTION_WORDS * inst->mesh;
         blend.steps = g->motion_tris + mm[2];
+        blend.bounds = g->motion_bounds + (size_t)mm[5] * (6 * PR_BVH_WIDTH);
         blend.first = mm[0];
+        blend.first_node = mm[4];
         blend.stride = mm[3];
         blend.k = motion_step(mm[3], g->time, &blend.a);
       }
-      if (bvh_traverse_blend(g->mesh_nodes, g->mesh_tris, inst->root_node, &obj, hit,
-                             inst->instance_id, any_hit, &blend)) {
+      // Two copies of the traversal: the one without motion tests no blend at each node.
+      const int in_mesh = blend.stride > 1u
+                              ? bvh_traverse_blend(g->mesh_nodes, g->mesh_tris, inst->root_node,
+                                                   &obj, hit, inst->instance_id, any_hit, &blend)
+                              : bvh_traverse(g->mesh_nodes, g->mesh_tris, inst->root_node, &obj,
+                                             hit, inst->instance_id, any_hit);
+      if (in_mesh) {
         if (any_hit) return 1;
         found = 1;
         r->tmax = obj.tmax;

@@ -36,7 +36,8 @@
   X(GEOM, VAL, uint, instance_count)     \
   PR_ARGS_MOTION(GEOM, X)                \
   X(GEOM, IN, BvhTriPacket, motion_tris) \
-  X(GEOM, IN, uint, mesh_motion)
+  X(GEOM, IN, uint, mesh_motion)         \
+  X(GEOM, IN, float, motion_bounds)
 
 // What shading reads: vertices, triangles, per-instance records, materials, textures.
 #define PR_ARGS_SHADING(F, X)                    \
