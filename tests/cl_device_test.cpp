@@ -217,6 +217,36 @@ TEST_F(ProgramTest, SecondBuildComesFromCacheAndCorruptEntryIsRebuilt) {
   EXPECT_TRUE(ctx.buildProgram("test/smoke.cl", "-DPR_CACHE_PROBE=1").fromCache);
 }
 
+// A driver setting that changes the code a binary holds is in the key: a binary built under
+// another PoCL work-group method is not loaded. Settings that only log or place work are not.
+TEST_F(ProgramTest, DriverCodeSettingsAreInTheKey) {
+  Context& ctx = test::testContext();
+  const char* saved = std::getenv("POCL_WORK_GROUP_METHOD");
+  const std::string before = saved ? saved : "";
+  const ProgramBuild first = ctx.buildProgram("test/smoke.cl", "-DPR_CACHE_PROBE=3");
+  ASSERT_FALSE(first.cacheFile.empty());
+  setenv("POCL_WORK_GROUP_METHOD", before == "cbs" ? "loops" : "cbs", 1);
+  const std::string otherMethod = driverEnvironmentTag();
+  const ProgramBuild other = ctx.buildProgram("test/smoke.cl", "-DPR_CACHE_PROBE=3");
+  if (saved)
+    setenv("POCL_WORK_GROUP_METHOD", before.c_str(), 1);
+  else
+    unsetenv("POCL_WORK_GROUP_METHOD");
+  EXPECT_FALSE(other.fromCache);
+  EXPECT_NE(other.cacheFile, first.cacheFile);
+  EXPECT_NE(otherMethod.find("POCL_WORK_GROUP_METHOD="), std::string::npos) << otherMethod;
+  const std::string tag = driverEnvironmentTag();
+  setenv("POCL_DEBUG", "all", 1);
+  setenv("CL_CONFIG_USE_VECTORIZER", "0", 1);
+  const std::string withDebug = driverEnvironmentTag();
+  unsetenv("POCL_DEBUG");
+  unsetenv("CL_CONFIG_USE_VECTORIZER");
+  EXPECT_EQ(withDebug.find("POCL_DEBUG"), std::string::npos) << withDebug;
+  EXPECT_NE(withDebug.find("CL_CONFIG_USE_VECTORIZER=0\n"), std::string::npos) << withDebug;
+  EXPECT_EQ(driverEnvironmentTag(), tag);
+  EXPECT_TRUE(ctx.buildProgram("test/smoke.cl", "-DPR_CACHE_PROBE=3").fromCache);
+}
+
 // A program whose kernel `scale` writes y[i] = factor * x[i].
 std::string scaleSource(int factor) {
   return "__kernel void scale(__global const float* x, __global float* y) {\n"

@@ -8,9 +8,11 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdint>
 #include <cstring>
+#include <vector>
 
 #include "util/check.h"
 #include "util/files.h"
@@ -73,6 +75,26 @@ bool makeSecret(const std::string& file) {
 
 std::string cacheFormatTag() {
   return std::string(kCacheMagic, sizeof kCacheMagic);
+}
+
+std::string driverEnvironmentTag() {
+  // Variables of these prefixes that place, log or limit work, and leave the code alone.
+  static const char* const kRuntimeOnly[] = {
+      "POCL_AFFINITY",     "POCL_CACHE_DIR",         "POCL_DEBUG",        "POCL_DEVICES",
+      "POCL_KERNEL_CACHE", "POCL_MAX_PTHREAD_COUNT", "POCL_MEMORY_LIMIT", "POCL_TRACING"};
+  std::vector<std::string> lines;
+  for (char** e = environ; e && *e; ++e) {
+    const std::string entry = *e;
+    if (entry.rfind("POCL_", 0) != 0 && entry.rfind("CL_CONFIG_", 0) != 0) continue;
+    const std::string name = entry.substr(0, entry.find('='));
+    const bool runtimeOnly = std::any_of(std::begin(kRuntimeOnly), std::end(kRuntimeOnly),
+                                         [&](const char* r) { return name.rfind(r, 0) == 0; });
+    if (!runtimeOnly) lines.push_back(entry);
+  }
+  std::sort(lines.begin(), lines.end());
+  std::string tag;
+  for (const std::string& l : lines) tag += l + "\n";
+  return tag;
 }
 
 std::string cacheFileMac(const std::string& secret, const std::string& key,

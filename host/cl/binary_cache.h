@@ -11,7 +11,8 @@
 
 namespace pr {
 
-// A key: Hash128 hex of source, options, platform, device, driver and device version.
+// A key: Hash128 hex of source, options, platform, device, driver and device version, and the
+// driver's code-generation environment (driverEnvironmentTag).
 constexpr size_t kCacheKeyChars = 32;
 
 // The cache secret's size in bytes (the HMAC key, kept beside the cache files).
@@ -19,6 +20,13 @@ constexpr size_t kCacheSecretBytes = 32;
 
 // The format's version, hashed into every key (another version's files have other names).
 std::string cacheFormatTag();
+
+// The environment variables that steer a driver's compiler, as NAME=VALUE lines sorted by name:
+// PoCL's (POCL_*) and Intel's CPU runtime's (CL_CONFIG_*), less those that only place or log
+// work (POCL_CACHE_DIR, POCL_DEBUG*, POCL_MAX_PTHREAD_COUNT, ...). POCL_WORK_GROUP_METHOD
+// changes the code a program binary holds, so a binary built under another value is not this
+// run's program.
+std::string driverEnvironmentTag();
 
 // The MAC a file of `key` and `binary` carries under `secret` (32 bytes).
 std::string cacheFileMac(const std::string& secret, const std::string& key,

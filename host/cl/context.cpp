@@ -132,6 +132,7 @@ ProgramBuild Context::buildProgramFromSource(const std::string& source, const st
                               .add(device_.name)
                               .add(device_.driverVersion)
                               .add(device_.deviceVersion)
+                              .add(driverEnvironmentTag())
                               .hex();
   const std::string dir = programCacheDir();
   const std::string secret = cacheSecretFor(dir);

@@ -65,8 +65,7 @@ typedef struct {
 // A deforming mesh at the ray's time: packet p of mesh_tris is, at step k, steps[(p - first) *
 // stride + k], and node n's child boxes bounds[((n - first_node) * stride + k) * 6 *
 // PR_BVH_WIDTH ...]; a ray blends steps k and k + 1 by a. Always written whole (stride 1:
-// nothing deforms). Where one traversal served both blended and sharp meshes, PoCL's compiled
-// code missed hits at random (design.md section 7, "Open"): tlas_traverse keeps two copies.
+// nothing deforms).
 typedef struct {
   PR_GLOBAL const BvhTriPacket* steps;
   PR_GLOBAL const float* bounds;
@@ -501,7 +500,6 @@ PR_INLINE int tlas_traverse(const SceneGeom* g, BvhRay* r, Hit* hit, int any_hit
         blend.k = motion_step(mm[3], g->time, &blend.a);
       }
       // Two copies of the traversal: the one without motion tests no blend at each node.
-      // Two copies, not one testing the stride at every node: see PacketBlend.
       const int in_mesh = blend.stride > 1u
                               ? bvh_traverse_blend(g->mesh_nodes, g->mesh_tris, inst->root_node,
                                                    &obj, hit, inst->instance_id, any_hit, &blend)
