@@ -19,13 +19,13 @@
 namespace pr {
 namespace {
 
-enum class Moving { Object, Rotating, Camera, Lamp, Light, Morph, Skin };
+enum class Moving { Object, Rotating, Camera, Lamp, Light, Morph, Skin, SkinTurning };
 
 // A grey back wall and floor lit by a point light, a dark quad before the wall; one thing moves
 // fast over t in [0, 2] (at fps 1 a half-frame shutter sweeps a quarter of it): the quad across
 // the view (Lamp: an emitting one, which lights the wall), a bar turning a whole turn about the
 // view axis, the camera sideways, the point light along the wall, or the quad again deformed (a
-// morph target, a skin).
+// morph target, a skin; SkinTurning: a skin whose joint turns as the bar does).
 std::string movingScene(Moving what, const std::string& tag) {
   test::GltfBuilder b;
   test::MaterialSpec grey;
@@ -39,7 +39,7 @@ std::string movingScene(Moving what, const std::string& tag) {
     dark.emissive = glm::vec3(1.0f, 0.75f, 0.5f);
     dark.emissiveStrength = 8.0f;
   }
-  const bool deforms = what == Moving::Morph || what == Moving::Skin;
+  const bool deforms = what == Moving::Morph || what == Moving::Skin || what == Moving::SkinTurning;
   // A deformed quad is bright and lit from close by, so that where its points are shows.
   if (deforms) dark.baseColor = glm::vec4(0.8f, 0.8f, 0.8f, 1.0f);
   const int r = b.addMaterial(dark);
@@ -48,17 +48,17 @@ std::string movingScene(Moving what, const std::string& tag) {
   if (what == Moving::Light)  // close to the wall, where its pool of light moves with it
     b.animateTranslation(light, {0.0f, 2.0f}, {{-4, 1, 1.5f}, {4, 1, 1.5f}});
   const int cam = b.addCamera({0, 0, 6}, {0, 0, 0}, 0.9f, 4.0f / 3.0f);
+  std::vector<float> turnTimes;
+  std::vector<glm::quat> turnKeys;
+  for (int k = 0; k <= 4; ++k) {  // a quarter turn each half second
+    turnTimes.push_back(0.5f * float(k));
+    turnKeys.push_back(glm::angleAxis(0.5f * PR_PI * float(k), glm::vec3(0, 0, 1)));
+  }
   if (what == Moving::Rotating) {
     const int bar =
         b.addNode(b.addQuad({-2, -0.5f, 0}, {2, -0.5f, 0}, {2, 0.5f, 0}, {-2, 0.5f, 0}, r),
                   glm::vec3(0, 0, 0.5f));
-    std::vector<float> times;
-    std::vector<glm::quat> keys;
-    for (int k = 0; k <= 4; ++k) {  // a quarter turn each half second
-      times.push_back(0.5f * float(k));
-      keys.push_back(glm::angleAxis(0.5f * PR_PI * float(k), glm::vec3(0, 0, 1)));
-    }
-    b.animateRotation(bar, times, keys);
+    b.animateRotation(bar, turnTimes, turnKeys);
   } else if (deforms) {
     // The quad of Object, moved by a morph target (weight 0 to 1) or by the joint of its skin.
     const std::vector<glm::vec3> corners = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
@@ -76,7 +76,10 @@ std::string movingScene(Moving what, const std::string& tag) {
     } else {
       const int joint = b.addNode(-1);
       b.addSkin(node, {joint});
-      b.animateTranslation(joint, {0.0f, 2.0f}, {{-4, 0, 0.5f}, {4, 0, 0.5f}});
+      if (what == Moving::SkinTurning)
+        b.animateRotation(joint, turnTimes, turnKeys);
+      else
+        b.animateTranslation(joint, {0.0f, 2.0f}, {{-4, 0, 0.5f}, {4, 0, 0.5f}});
     }
   } else {
     const float depth = what == Moving::Lamp ? 1.5f : 0.5f;
@@ -205,7 +208,9 @@ TEST(MotionBlur, AlbedoIsBlurredAndZIsTheFramesOwn) {
 }
 
 // The motion steps: none without a shutter, the fewest (3) for motion that blends exactly (a
-// translation, a still scene), more for a turn, as many for the same turn each frame.
+// translation, a still scene, a skin's joint sliding), more for a turn, of an instance or of a
+// skin's joint (its vertices sweep arcs: a mesh placed by its joints alone, whose own transform
+// never moves).
 TEST(MotionBlur, StepsFollowTheMotion) {
   Context& ctx = test::testContext();
   auto stepsOf = [&](Moving what, const std::string& tag, double shutter) {
@@ -221,6 +226,10 @@ TEST(MotionBlur, StepsFollowTheMotion) {
   const uint32_t turn = stepsOf(Moving::Rotating, "mb-steps-turn", 0.5);
   EXPECT_GT(turn, 3u);
   EXPECT_LE(turn, 33u);
+  EXPECT_EQ(stepsOf(Moving::Skin, "mb-steps-skin-slide", 0.5), 3u);
+  const uint32_t skinTurn = stepsOf(Moving::SkinTurning, "mb-steps-skin-turn", 0.5);
+  EXPECT_GT(skinTurn, 3u);
+  EXPECT_LE(skinTurn, 33u);
 }
 
 // Modes that keep light paths across frames refuse an open shutter: one line, exit 2.

@@ -87,6 +87,25 @@ Aabb refitNode(const WideBvh& wide, const std::vector<dev::BvhTriPacket>& packet
   return all;
 }
 
+// Widens each child box of `wide` to hold the child at every motion step (`stepBounds`, node by
+// node, its steps side by side), so that a traversal without the blend still finds every hit.
+void holdEveryStep(WideBvh* wide, const std::vector<float>& stepBounds, size_t stepCount) {
+  const int w = wide->width;
+  const size_t nodeFloats = 6 * size_t(w);
+  for (uint32_t n = 0; n < wide->nodeCount(); ++n)
+    for (int i = 0; i < w; ++i) {
+      if (wide->words[wideChild(w, n, i)] == PR_INVALID_INDEX) continue;
+      for (int b = 0; b < 6; ++b) {
+        float v = stepBounds[n * stepCount * nodeFloats + size_t(b * w + i)];
+        for (size_t k = 1; k < stepCount; ++k) {
+          const float at = stepBounds[(n * stepCount + k) * nodeFloats + size_t(b * w + i)];
+          v = (b % 2 == 0) ? std::min(v, at) : std::max(v, at);  // lo, hi, lo, ...
+        }
+        std::memcpy(&wide->words[wideBound(w, n, b, i)], &v, sizeof v);
+      }
+    }
+}
+
 }  // namespace
 
 TriangleBvh buildTriangleBvh(const std::vector<glm::vec3>& positions,
@@ -110,7 +129,7 @@ TriangleBvh buildTriangleBvh(const std::vector<glm::vec3>& positions,
   const size_t count = indices.size() / 3;
   std::vector<dev::BvhTriangle> packed;
   std::vector<std::vector<dev::BvhTriangle>> stepPacked(stepCount);
-  std::vector<Aabb> boxes;
+  std::vector<Aabb> boxes, swept;  // at the frame's time; over every step
   packed.reserve(count);
   boxes.reserve(count);
   for (size_t t = 0; t < count; ++t) {
@@ -122,6 +141,7 @@ TriangleBvh buildTriangleBvh(const std::vector<glm::vec3>& positions,
                          std::to_string(i) + " of " + std::to_string(positions.size()));
       box.grow(positions[i]);
     }
+    Aabb sweep = box;
     const dev::BvhTriangle tri =
         packTriangle(positions[indices[3 * t]], positions[indices[3 * t + 1]],
                      positions[indices[3 * t + 2]], primBase + uint32_t(t));
@@ -133,13 +153,14 @@ TriangleBvh buildTriangleBvh(const std::vector<glm::vec3>& positions,
         if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
           throw InputError(std::string(what) + ": motion step " + std::to_string(k) +
                            ": a position is not finite");
-        box.grow(p);
+        sweep.grow(p);
       }
       stepPacked[k].push_back(packTriangle(at[indices[3 * t]], at[indices[3 * t + 1]],
                                            at[indices[3 * t + 2]], primBase + uint32_t(t)));
     }
     packed.push_back(tri);
     boxes.push_back(box);
+    swept.push_back(sweep);
   }
   BuildOptions o = options;
   o.leafPacket = PR_BVH_PACKET;
@@ -152,7 +173,7 @@ TriangleBvh buildTriangleBvh(const std::vector<glm::vec3>& positions,
   out.triangles.reserve(packed.size());
   for (uint32_t k : bvh.order) {
     out.triangles.push_back(packed[k]);
-    out.bounds.grow(boxes[k]);
+    out.bounds.grow(swept[k]);
   }
   out.packets.reserve(out.wide.leaves.size());
   for (const BinaryNode& leaf : out.wide.leaves) {
@@ -180,6 +201,7 @@ TriangleBvh buildTriangleBvh(const std::vector<glm::vec3>& positions,
       std::copy_n(step.data() + n * nodeFloats, nodeFloats,
                   out.stepBounds.data() + (n * stepCount + k) * nodeFloats);
   }
+  if (stepCount > 0) holdEveryStep(&out.wide, out.stepBounds, stepCount);
   return out;
 }
 

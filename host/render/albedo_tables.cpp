@@ -1,13 +1,12 @@
 #include "render/albedo_tables.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdio>
-#include <thread>
 
 #include "shared/microfacet.h"
 #include "shared/sampling.h"
+#include "util/parallel.h"
 
 namespace pr {
 
@@ -83,19 +82,6 @@ double hemisphereAverage(int points, Albedo albedo) {
     avg += 2.0 * albedo(mu) * mu / points;
   }
   return avg;
-}
-
-// Runs task(0 .. count - 1) on every core: each is a pure function of its index.
-template <class Task>
-void parallelFor(int count, Task task) {
-  std::atomic<int> next{0};
-  std::vector<std::thread> workers;
-  const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
-  for (unsigned w = 0; w < threads; ++w)
-    workers.emplace_back([&] {
-      for (int j; (j = next++) < count;) task(j);
-    });
-  for (std::thread& w : workers) w.join();
 }
 
 // The white sheen lobe's albedo from cos mu, by the midpoint rule in (cos, azimuth): the lobe

@@ -17,6 +17,7 @@
 #include "scene/emission_power.h"
 #include "util/error.h"
 #include "util/hash.h"
+#include "util/parallel.h"
 
 namespace pr {
 
@@ -241,19 +242,25 @@ bool GpuScene::deformMeshes(double t, const std::vector<double>& times,
     lastNormals_[m] = shape.normals;
     (*changed)[m] = any = true;
     if (previousKnown_) copyToPrevious(meshFirstVertex_[m], shape.vertexCount(), false);
-    std::vector<std::vector<glm::vec3>> steps;
-    for (double at : times) {
+    // Each step's shape on its own core (deformMesh only reads the scene).
+    std::vector<std::vector<glm::vec3>> steps(times.size());
+    std::vector<std::vector<dev::ShadingVertex>> stepShading(times.size());
+    parallelFor(int(times.size()), [&](int k) {
       // The middle step is the frame's time itself (an odd count): its shape is `shape`.
       TriangleMesh deformed;
       const TriangleMesh* s = &shape;
-      if (at != t) {
+      if (times[size_t(k)] != t) {
         deformed = scene_.dynamicMeshes[m];
-        scene_.deformMesh(m, at, &deformed);
+        scene_.deformMesh(m, times[size_t(k)], &deformed);
         s = &deformed;
       }
-      steps.push_back(s->positions);
-      for (size_t v = 0; v < s->vertexCount(); ++v) stepVertices.push_back(shadingVertex(*s, v));
-    }
+      steps[size_t(k)] = s->positions;
+      stepShading[size_t(k)].reserve(s->vertexCount());
+      for (size_t v = 0; v < s->vertexCount(); ++v)
+        stepShading[size_t(k)].push_back(shadingVertex(*s, v));
+    });
+    for (const std::vector<dev::ShadingVertex>& step : stepShading)
+      stepVertices.insert(stepVertices.end(), step.begin(), step.end());
     if (!times.empty()) vm[3] = uint32_t(times.size());
     accel::BuildOptions build;
     build.width = bvhWidth_;
@@ -563,6 +570,98 @@ void GpuScene::setShutter(double seconds, int cameraIndex, int width, int height
     for (const glm::vec3& p : scene_.dynamicMeshes[m].positions) meshBounds_[m].grow(p);
 }
 
+namespace {
+
+// How far the blend of a and b lies from `mid` at the box's corners; *size: the box's size under
+// mid (the largest corner's distance from its centre).
+float blendError(const accel::Aabb& box, const glm::mat4& a, const glm::mat4& b,
+                 const glm::mat4& mid, float* size) {
+  float worst = 0.0f;
+  *size = 0.0f;
+  for (int c = 0; c < 8; ++c) {
+    const glm::vec4 corner((c & 1) ? box.hi.x : box.lo.x, (c & 2) ? box.hi.y : box.lo.y,
+                           (c & 4) ? box.hi.z : box.lo.z, 1.0f);
+    const glm::vec3 exact(mid * corner);
+    const glm::vec3 blend(0.5f * (a * corner + b * corner));
+    worst = std::max(worst, glm::length(blend - exact));
+    *size = std::max(*size, glm::length(exact - glm::vec3(mid * glm::vec4(box.centre(), 1.0f))));
+  }
+  return worst;
+}
+
+// A deforming mesh's shape blended between two steps against its shape midway, over the mesh's
+// size: each joint's skinning matrix blended, at the box of the bind-pose vertices it moves (a
+// skinned vertex is a weighted sum of them), and each morph weight blended, times its target's
+// largest displacement.
+class DeformationError {
+ public:
+  DeformationError(const Scene& scene, const std::vector<accel::Aabb>& meshBounds, float tiny)
+      : scene_(scene), meshBounds_(meshBounds), tiny_(tiny) {
+    morphReach_.resize(scene.dynamicMeshes.size());
+    jointBoxes_.resize(scene.dynamicMeshes.size());
+    for (size_t m = 0; m < morphReach_.size(); ++m) {
+      if (!scene.meshDeforms(m)) continue;
+      const TriangleMesh& base = scene.dynamicMeshes[m];
+      for (const std::vector<glm::vec3>& target : base.morphPositions) {
+        float reach = 0.0f;
+        for (const glm::vec3& d : target) reach = std::max(reach, glm::length(d));
+        morphReach_[m].push_back(reach);
+      }
+      const int skin = scene.deformers[m].skin;
+      if (skin < 0 || base.influences <= 0) continue;
+      std::vector<accel::Aabb>& boxes = jointBoxes_[m];
+      boxes.resize(scene.skins[size_t(skin)].joints.size());
+      const size_t k = size_t(base.influences);
+      for (size_t v = 0; v < base.vertexCount(); ++v)
+        for (size_t i = 0; i < k; ++i)
+          if (base.jointWeights[v * k + i] != 0.0f && base.joints[v * k + i] < boxes.size())
+            boxes[base.joints[v * k + i]].grow(base.positions[v]);
+    }
+  }
+
+  float operator()(size_t m, double a, double b, double mid) const {
+    const Deformer& d = scene_.deformers[m];
+    const accel::Aabb& box = meshBounds_[m];
+    if (box.empty()) return 0.0f;
+    float worst = 0.0f;
+    if (!jointBoxes_[m].empty()) {
+      const Skin& skin = scene_.skins[size_t(d.skin)];
+      auto at = [&](size_t j, double u) {
+        return scene_.nodeWorldTransform(skin.joints[j], u) * skin.inverseBind[j];
+      };
+      // The mesh's size: its bind box under the first joint.
+      float size = 0.0f, unused = 0.0f;
+      const glm::mat4 first = at(0, mid);
+      blendError(box, first, first, first, &size);
+      size = std::max(size, tiny_);
+      for (size_t j = 0; j < jointBoxes_[m].size(); ++j)
+        if (!jointBoxes_[m][j].empty())
+          worst = std::max(
+              worst, blendError(jointBoxes_[m][j], at(j, a), at(j, b), at(j, mid), &unused) / size);
+    }
+    if (!morphReach_[m].empty()) {
+      const TriangleMesh& base = scene_.dynamicMeshes[m];
+      const std::vector<float> wa = scene_.morphWeightsAt(d.node, base, a),
+                               wb = scene_.morphWeightsAt(d.node, base, b),
+                               wm = scene_.morphWeightsAt(d.node, base, mid);
+      float off = 0.0f;
+      for (size_t k = 0; k < wm.size() && k < morphReach_[m].size(); ++k)
+        off += std::abs(0.5f * (wa[k] + wb[k]) - wm[k]) * morphReach_[m][k];
+      worst = std::max(worst, off / std::max(0.5f * glm::length(box.hi - box.lo), tiny_));
+    }
+    return worst;
+  }
+
+ private:
+  const Scene& scene_;
+  const std::vector<accel::Aabb>& meshBounds_;
+  float tiny_;
+  std::vector<std::vector<float>> morphReach_;
+  std::vector<std::vector<accel::Aabb>> jointBoxes_;
+};
+
+}  // namespace
+
 std::vector<double> GpuScene::motionTimes(double t) const {
   auto timesOf = [&](int steps) {
     std::vector<double> times(static_cast<size_t>(steps));
@@ -571,18 +670,14 @@ std::vector<double> GpuScene::motionTimes(double t) const {
     return times;
   };
   constexpr float kTolerance = 1e-3f;
-  // How far the blend of a and b lies from `mid` at the mesh box's corners, over its size.
+  // Deforming meshes get three times as much: under a pixel for a mesh that fills the frame's
+  // height at 720 lines, and 1e-3 took BrainStem at 24 fps to 5-17 steps (3-5 now) and a shutter of
+  // half a frame from 1.22x a sharp frame's time to 1.6x (docs/experiments/motion-blur.md).
+  constexpr float kDeformTolerance = 3e-3f;
   auto instanceError = [&](const accel::Aabb& box, const glm::mat4& a, const glm::mat4& b,
                            const glm::mat4& mid) {
-    float worst = 0.0f, size = 0.0f;
-    for (int c = 0; c < 8; ++c) {
-      const glm::vec4 corner((c & 1) ? box.hi.x : box.lo.x, (c & 2) ? box.hi.y : box.lo.y,
-                             (c & 4) ? box.hi.z : box.lo.z, 1.0f);
-      const glm::vec3 exact(mid * corner);
-      const glm::vec3 blend(0.5f * (a * corner + b * corner));
-      worst = std::max(worst, glm::length(blend - exact));
-      size = std::max(size, glm::length(exact - glm::vec3(mid * glm::vec4(box.centre(), 1.0f))));
-    }
+    float size = 0.0f;
+    const float worst = blendError(box, a, b, mid, &size);
     return worst / std::max(size, 1e-6f * sceneRadius_);
   };
   auto cameraError = [&](const CameraPose& a, const CameraPose& b, const CameraPose& mid) {
@@ -600,6 +695,7 @@ std::vector<double> GpuScene::motionTimes(double t) const {
                              : 2.0f;
     return std::max(moved, turned);
   };
+  const DeformationError deformError(scene_, meshBounds_, 1e-6f * sceneRadius_);
   for (int steps = 3;; steps = 2 * steps - 1) {
     const std::vector<double> times = timesOf(steps);
     if (steps >= 33) return times;
@@ -620,6 +716,9 @@ std::vector<double> GpuScene::motionTimes(double t) const {
                                             scene_.instanceTransform(i, times[k + 1]),
                                             scene_.instanceTransform(i, mid)) <= kTolerance;
       }
+      for (size_t m = 0; fine && m < scene_.dynamicMeshes.size(); ++m)
+        fine = !scene_.meshDeforms(m) ||
+               deformError(m, times[k], times[k + 1], mid) <= kDeformTolerance;
     }
     if (fine) return times;
   }

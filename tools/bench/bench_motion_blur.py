@@ -4,8 +4,10 @@
 
 The scenes: the Virtual City's camera 6 at frame 204 (45 moving cars and a moving camera;
 tools/scenes/gen_real_scenes.py vc, as bench_animations makes it), the same at 2 fps, and
-CesiumMan walking (skinned; gen_real_scenes framed) at 2 fps. Both renderers path trace the frame at --spp with the shutter open
-each of --shutters frames, centred (Blender's default). Per shutter: our mean over Cycles', and
+CesiumMan walking and the Fox looking round (skinned; gen_real_scenes framed) and BrainStem on its
+stage under the orbiting camera, at 2 fps. Both
+renderers path trace the frame at --spp with the shutter open each of --shutters frames, centred
+(Blender's default). Per shutter: our mean over Cycles', and
 over 16x16 blocks the share within 2% of Cycles' and the median and 95th-percentile deviation, for
 the blurred pair and, as the control that shows the blur is measured at all, our sharp frame
 against Cycles' blurred one; then the cost of the shutter over a sharp frame at 4 spp (median
@@ -34,6 +36,11 @@ SCENES = {
     # Deformation blur: CesiumMan walking (a skin), framed from the front, a quarter second open.
     "cesiumman-2fps": ("framed", "CesiumMan/CesiumMan.gltf", 0, "front", 1, 2, "1,1,1",
                        (128, 128)),
+    # The Fox looking round (its first animation, "Survey"; skinned), a second in.
+    "fox-2fps": ("framed", "Fox/Fox.gltf", 0, "front", 2, 2, "1,1,1", (128, 128)),
+    # BrainStem (61,666 skinned triangles) on its stage, the orbiting camera, two seconds in.
+    "brainstem-2fps": ("brainstem", "BrainStem/BrainStem.gltf", 1, "orbit", 4, 2, "0.8,0.85,1.0",
+                       (160, 120)),
 }
 
 
