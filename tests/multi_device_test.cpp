@@ -152,11 +152,11 @@ std::vector<int> checkStats(const std::string& file, int frames, int spp = 0) {
 
 // Frames of a scene with moving objects, two devices against one, byte for byte, each device
 // rendering its rows (without path resampling, which splits the passes instead:
-// TwoDevicesEqualOneWithResampling).
+// TwoDevicesEqualOneWithResampling), also with the shutter open.
 TEST(MultiDeviceCli, TwoDevicesEqualOne) {
   const std::string two = test::twoPoclDevices();
   const std::string range = " --frames 0-" + std::to_string(kFrames - 1);
-  for (const char* mode : {"reuse --no-resample", "pathtrace"}) {
+  for (const char* mode : {"reuse --no-resample", "pathtrace", "pathtrace --shutter 0.5"}) {
     SCOPED_TRACE(mode);
     const std::string dir = test::tempDir("multi");
     auto r = test::runPathreuse(

@@ -130,9 +130,10 @@ bool samePixels(const std::string& a, const std::string& b) {
 
 // A run cut short after frame 2 with frame 1 truncated (as by a crash of some other tool), then
 // resumed: frame 0 and 2 are kept, 1 and 3-5 are rendered, and every frame equals the
-// uninterrupted run's bit for bit, in both reuse and path-tracing modes.
+// uninterrupted run's bit for bit, in both reuse and path-tracing modes, also with the shutter
+// open.
 TEST(Resume, FinishesARunBitForBitAsAnUninterruptedOne) {
-  for (const char* mode : {"reuse --no-resample", "pathtrace"}) {
+  for (const char* mode : {"reuse --no-resample", "pathtrace", "pathtrace --shutter 0.5"}) {
     SCOPED_TRACE(mode);
     const std::string dir = test::tempDir("resume");
     const std::string common =
