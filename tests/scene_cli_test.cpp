@@ -81,8 +81,8 @@ TEST(SceneCli, InfoBoxAnimated) {
 
 // The benchmark's lit wrappers of shared assets (tools/scenes/gen_real_scenes.py) load as the
 // generator says: the city's dome walls emit (its roof cut away), a sun and a held camera added;
-// BrainStem gains a stage and two cameras. They name the assets' files outside their own folder,
-// which a render allows only when asked.
+// BrainStem gains a stage and two cameras; `framed` adds a camera to any asset. They name the
+// assets' files outside their own folder, which a render allows only when asked.
 TEST(SceneCli, LitWrappersOfSharedAssetsLoadAsTheirGeneratorSays) {
   PR_SHARED_SCENE(vc, "VC/VC.gltf");
   PR_SHARED_SCENE(brainstem, "BrainStem/BrainStem.gltf");
@@ -142,6 +142,14 @@ TEST(SceneCli, LitWrappersOfSharedAssetsLoadAsTheirGeneratorSays) {
     }
   EXPECT_GT(asset, 32 * 32 / 20) << "the asset is in view";
   EXPECT_EQ(border, 0) << "and all of it";
+
+  // An asset whose buffers are base64 data URIs (BoxAnimated's) is framed as well: they stay in
+  // the wrapper as they are.
+  PR_SHARED_SCENE(box, "BoxAnimated/BoxAnimated.gltf");
+  const auto x = info(box), y = info(make("framed", box));
+  EXPECT_EQ(y["triangles"], x["triangles"]);
+  EXPECT_EQ(y["cameras"].get<int>(), x["cameras"].get<int>() + 1);
+  EXPECT_EQ(y["animation"]["frames"], x["animation"]["frames"]);
 }
 
 TEST(SceneCli, BrokenFileIsOneLineExitTwo) {

@@ -3,7 +3,7 @@
   /usr/bin/python3 -m tools.bench.bench_motion_blur --build build --cycles BPY/bin/python
 
 The scenes: the Virtual City's camera 6 at frame 204 (45 moving cars and a moving camera;
-tools/scenes/gen_real_scenes.py vc, as bench_animations makes it), the same at 2 fps, and
+tools/scenes/gen_real_scenes.py vc, as bench_animations makes it), the same at 2 fps,
 CesiumMan walking and the Fox looking round (skinned; gen_real_scenes framed) and BrainStem on its
 stage under the orbiting camera, at 2 fps. Both
 renderers path trace the frame at --spp with the shutter open each of --shutters frames, centred

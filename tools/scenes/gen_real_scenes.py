@@ -21,6 +21,7 @@ framed     Any asset as it is, with a camera "front" added that frames its bound
 """
 
 import argparse
+import base64
 import json
 import math
 import os
@@ -35,7 +36,8 @@ FORMATS = {5126: "f", 5125: "I", 5123: "H", 5121: "B"}
 
 
 class Asset:
-    """A .gltf whose buffers are files: its JSON, and accessors read from its buffers."""
+    """A .gltf whose buffers are files or base64 data URIs: its JSON, and accessors read from
+    its buffers."""
 
     def __init__(self, path):
         self.path = os.path.abspath(path)
@@ -44,9 +46,16 @@ class Asset:
             self.doc = json.load(f)
         self.buffers = []
         for b in self.doc["buffers"]:
-            if b.get("uri", "").startswith("data:") or "uri" not in b:
-                raise gw.Invalid(f"{path}: buffers must be files")
-            with open(os.path.join(self.dir, b["uri"]), "rb") as f:
+            uri = b.get("uri", "")
+            if uri.startswith("data:"):
+                head, _, payload = uri.partition(",")
+                if not head.endswith(";base64"):
+                    raise gw.Invalid(f"{path}: a buffer's data URI is not base64")
+                self.buffers.append(base64.b64decode(payload))
+                continue
+            if not uri:
+                raise gw.Invalid(f"{path}: a buffer has no uri (a .glb's)")
+            with open(os.path.join(self.dir, uri), "rb") as f:
                 self.buffers.append(f.read())
 
     def read(self, index):
@@ -64,7 +73,8 @@ class Asset:
     def rebase(self, out_dir):
         """Buffer and image URIs relative to out_dir, where the wrapper is written."""
         for b in self.doc["buffers"]:
-            b["uri"] = os.path.relpath(os.path.join(self.dir, b["uri"]), out_dir)
+            if not b["uri"].startswith("data:"):
+                b["uri"] = os.path.relpath(os.path.join(self.dir, b["uri"]), out_dir)
         for im in self.doc.get("images", []):
             if "uri" in im and not im["uri"].startswith("data:"):
                 im["uri"] = os.path.relpath(os.path.join(self.dir, im["uri"]), out_dir)
