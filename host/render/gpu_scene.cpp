@@ -670,9 +670,9 @@ std::vector<double> GpuScene::motionTimes(double t) const {
     return times;
   };
   constexpr float kTolerance = 1e-3f;
-  // Deforming meshes get three times as much: under a pixel for a mesh that fills the frame's
-  // height at 720 lines, and 1e-3 took BrainStem at 24 fps to 5-17 steps (3-5 now) and a shutter of
-  // half a frame from 1.22x a sharp frame's time to 1.6x (docs/experiments/motion-blur.md).
+  // Deforming meshes get three times as much: about a pixel for a mesh that fills the frame's
+  // height at 720 lines, and 1e-3 took BrainStem at 24 fps to 5-17 steps (3-5 now) and a shutter
+  // of half a frame from 1.2x a sharp frame's time to 1.6x (docs/experiments/motion-blur.md).
   constexpr float kDeformTolerance = 3e-3f;
   auto instanceError = [&](const accel::Aabb& box, const glm::mat4& a, const glm::mat4& b,
                            const glm::mat4& mid) {
