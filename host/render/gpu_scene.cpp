@@ -557,19 +557,6 @@ void GpuScene::buildLights(double t) {
   }
 }
 
-void GpuScene::setShutter(double seconds, int cameraIndex, int width, int height) {
-  shutter_ = seconds > 0.0 ? seconds : 0.0;
-  shutterCamera_ = cameraIndex;
-  shutterWidth_ = width;
-  shutterHeight_ = height;
-  // A moving delta light must keep a chance wherever it may be during the interval; the tree's
-  // and the exhaustive weights are of where it is at the frame's time, power's of no place.
-  if (shutter_ > 0.0 && punctualMoves()) lightChoice_ = LightSampler::Power;
-  meshBounds_.assign(scene_.dynamicMeshes.size(), accel::Aabb{});
-  for (size_t m = 0; m < scene_.dynamicMeshes.size(); ++m)
-    for (const glm::vec3& p : scene_.dynamicMeshes[m].positions) meshBounds_[m].grow(p);
-}
-
 namespace {
 
 // How far the blend of a and b lies from `mid` at the box's corners; *size: the box's size under
@@ -593,31 +580,45 @@ float blendError(const accel::Aabb& box, const glm::mat4& a, const glm::mat4& b,
 // size: each joint's skinning matrix blended, at the box of the bind-pose vertices it moves (a
 // skinned vertex is a weighted sum of them), and each morph weight blended, times its target's
 // largest displacement.
+// What a deforming mesh's deformation is measured by (GpuScene::setShutter, once): each morph
+// target's largest displacement, and each joint's box of the bind-pose vertices it moves.
+void deformationReach(const Scene& scene, std::vector<std::vector<float>>* morphReach,
+                      std::vector<std::vector<accel::Aabb>>* jointBoxes) {
+  morphReach->assign(scene.dynamicMeshes.size(), {});
+  jointBoxes->assign(scene.dynamicMeshes.size(), {});
+  for (size_t m = 0; m < morphReach->size(); ++m) {
+    if (!scene.meshDeforms(m)) continue;
+    const TriangleMesh& base = scene.dynamicMeshes[m];
+    for (const std::vector<glm::vec3>& target : base.morphPositions) {
+      float reach = 0.0f;
+      for (const glm::vec3& d : target) reach = std::max(reach, glm::length(d));
+      (*morphReach)[m].push_back(reach);
+    }
+    const int skin = scene.deformers[m].skin;
+    if (skin < 0 || base.influences <= 0) continue;
+    std::vector<accel::Aabb>& boxes = (*jointBoxes)[m];
+    boxes.resize(scene.skins[size_t(skin)].joints.size());
+    const size_t k = size_t(base.influences);
+    for (size_t v = 0; v < base.vertexCount(); ++v)
+      for (size_t i = 0; i < k; ++i)
+        if (base.jointWeights[v * k + i] != 0.0f && base.joints[v * k + i] < boxes.size())
+          boxes[base.joints[v * k + i]].grow(base.positions[v]);
+  }
+}
+
+// A deforming mesh's shape blended between two steps against its shape midway, over the mesh's
+// size: each joint's skinning matrix blended, at its box (a skinned vertex is a weighted sum of
+// them), and each morph weight blended, times its target's reach.
 class DeformationError {
  public:
-  DeformationError(const Scene& scene, const std::vector<accel::Aabb>& meshBounds, float tiny)
-      : scene_(scene), meshBounds_(meshBounds), tiny_(tiny) {
-    morphReach_.resize(scene.dynamicMeshes.size());
-    jointBoxes_.resize(scene.dynamicMeshes.size());
-    for (size_t m = 0; m < morphReach_.size(); ++m) {
-      if (!scene.meshDeforms(m)) continue;
-      const TriangleMesh& base = scene.dynamicMeshes[m];
-      for (const std::vector<glm::vec3>& target : base.morphPositions) {
-        float reach = 0.0f;
-        for (const glm::vec3& d : target) reach = std::max(reach, glm::length(d));
-        morphReach_[m].push_back(reach);
-      }
-      const int skin = scene.deformers[m].skin;
-      if (skin < 0 || base.influences <= 0) continue;
-      std::vector<accel::Aabb>& boxes = jointBoxes_[m];
-      boxes.resize(scene.skins[size_t(skin)].joints.size());
-      const size_t k = size_t(base.influences);
-      for (size_t v = 0; v < base.vertexCount(); ++v)
-        for (size_t i = 0; i < k; ++i)
-          if (base.jointWeights[v * k + i] != 0.0f && base.joints[v * k + i] < boxes.size())
-            boxes[base.joints[v * k + i]].grow(base.positions[v]);
-    }
-  }
+  DeformationError(const Scene& scene, const std::vector<accel::Aabb>& meshBounds,
+                   const std::vector<std::vector<float>>& morphReach,
+                   const std::vector<std::vector<accel::Aabb>>& jointBoxes, float tiny)
+      : scene_(scene),
+        meshBounds_(meshBounds),
+        morphReach_(morphReach),
+        jointBoxes_(jointBoxes),
+        tiny_(tiny) {}
 
   float operator()(size_t m, double a, double b, double mid) const {
     const Deformer& d = scene_.deformers[m];
@@ -655,12 +656,26 @@ class DeformationError {
  private:
   const Scene& scene_;
   const std::vector<accel::Aabb>& meshBounds_;
+  const std::vector<std::vector<float>>& morphReach_;
+  const std::vector<std::vector<accel::Aabb>>& jointBoxes_;
   float tiny_;
-  std::vector<std::vector<float>> morphReach_;
-  std::vector<std::vector<accel::Aabb>> jointBoxes_;
 };
 
 }  // namespace
+
+void GpuScene::setShutter(double seconds, int cameraIndex, int width, int height) {
+  shutter_ = seconds > 0.0 ? seconds : 0.0;
+  shutterCamera_ = cameraIndex;
+  shutterWidth_ = width;
+  shutterHeight_ = height;
+  // A moving delta light must keep a chance wherever it may be during the interval; the tree's
+  // and the exhaustive weights are of where it is at the frame's time, power's of no place.
+  if (shutter_ > 0.0 && punctualMoves()) lightChoice_ = LightSampler::Power;
+  meshBounds_.assign(scene_.dynamicMeshes.size(), accel::Aabb{});
+  for (size_t m = 0; m < scene_.dynamicMeshes.size(); ++m)
+    for (const glm::vec3& p : scene_.dynamicMeshes[m].positions) meshBounds_[m].grow(p);
+  if (shutter_ > 0.0) deformationReach(scene_, &morphReach_, &jointBoxes_);
+}
 
 std::vector<double> GpuScene::motionTimes(double t) const {
   auto timesOf = [&](int steps) {
@@ -695,7 +710,8 @@ std::vector<double> GpuScene::motionTimes(double t) const {
                              : 2.0f;
     return std::max(moved, turned);
   };
-  const DeformationError deformError(scene_, meshBounds_, 1e-6f * sceneRadius_);
+  const DeformationError deformError(scene_, meshBounds_, morphReach_, jointBoxes_,
+                                     1e-6f * sceneRadius_);
   for (int steps = 3;; steps = 2 * steps - 1) {
     const std::vector<double> times = timesOf(steps);
     if (steps >= 33) return times;

@@ -197,6 +197,10 @@ class GpuScene {
   double shutter_ = 0.0;  // seconds (setShutter)
   int shutterCamera_ = 0, shutterWidth_ = 1, shutterHeight_ = 1;
   std::vector<accel::Aabb> meshBounds_;  // per dynamic mesh, object space (motionTimes)
+  // Per deforming mesh, what motionTimes measures its deformation by (setShutter): each morph
+  // target's largest displacement, each joint's box of the bind-pose vertices it moves.
+  std::vector<std::vector<float>> morphReach_;
+  std::vector<std::vector<accel::Aabb>> jointBoxes_;
   uint32_t motionSteps_ = 1;
   cl::Buffer cameraSteps_;
   uint64_t cameraStepBytes_ = 0;
