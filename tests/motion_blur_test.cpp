@@ -19,7 +19,29 @@
 namespace pr {
 namespace {
 
-enum class Moving { Object, Rotating, Camera, Lamp, Light, Morph, Skin, SkinTurning };
+enum class Moving { Object, Rotating, Camera, Lamp, Light, Morph, Skin, SkinTurning, Blinds };
+
+// A ceiling lit only by the pool of light that a spot casts on the floor below, and a dark slab
+// just under the spot that covers it at t = 0.75 and 1.25 and is far aside at t = 1: frame 1's
+// light paths (traced at t = 1) pass where the slab is for about half of a half-frame shutter.
+// The camera sees the ceiling beside the slab's path (x < -3), lit from the floor alone.
+std::string blindsScene(const std::string& tag) {
+  test::GltfBuilder b;
+  test::MaterialSpec grey;
+  grey.baseColor = glm::vec4(0.8f, 0.8f, 0.8f, 1.0f);
+  const int g = b.addMaterial(grey);
+  b.addNode(b.addQuad({-8, 0, -8}, {-8, 0, 8}, {8, 0, 8}, {8, 0, -8}, g));
+  b.addNode(b.addQuad({-8, 3, -8}, {8, 3, -8}, {8, 3, 8}, {-8, 3, 8}, g));
+  test::MaterialSpec dark;
+  dark.baseColor = glm::vec4(0.02f, 0.02f, 0.02f, 1.0f);
+  const int d = b.addMaterial(dark);
+  b.addSpotLight({0, 2.9f, 0}, {0, 0, 0}, {1, 1, 1}, 40.0f, 0.3f, 0.5f);
+  const int slab =
+      b.addNode(b.addBox({-2.5f, -0.05f, -2.5f}, {2.5f, 0.05f, 2.5f}, d), glm::vec3(0, 2.5f, 0));
+  b.animateTranslation(slab, {0.75f, 1.0f, 1.25f}, {{0, 2.5f, 0}, {6, 2.5f, 0}, {0, 2.5f, 0}});
+  b.addCamera({-2, 1, 0.5f}, {-5, 3, -0.5f}, 0.9f, 4.0f / 3.0f);
+  return b.write(test::tempDir(tag), "blinds");
+}
 
 // A grey back wall and floor lit by a point light, a dark quad before the wall; one thing moves
 // fast over t in [0, 2] (at fps 1 a half-frame shutter sweeps a quarter of it): the quad across
@@ -27,6 +49,7 @@ enum class Moving { Object, Rotating, Camera, Lamp, Light, Morph, Skin, SkinTurn
 // view axis, the camera sideways, the point light along the wall, or the quad again deformed (a
 // morph target, a skin; SkinTurning: a skin whose joint turns as the bar does).
 std::string movingScene(Moving what, const std::string& tag) {
+  if (what == Moving::Blinds) return blindsScene(tag);
   test::GltfBuilder b;
   test::MaterialSpec grey;
   grey.baseColor = glm::vec4(0.6f, 0.6f, 0.6f, 1.0f);
@@ -94,7 +117,8 @@ std::string movingScene(Moving what, const std::string& tag) {
 }
 
 constexpr int kW = 32, kH = 24, kBlock = 4;
-const char* const kArgs = "--mode pathtrace --env none --max-depth 3 --width 32 --height 24";
+// Depth 4: strategy T (--light-tracing) takes part (paths of x_1 and two vertices before a light).
+const char* const kArgs = "--env none --max-depth 4 --width 32 --height 24";
 
 // Per pixel, a - b.
 Image difference(const Image& a, const Image& b) {
@@ -104,19 +128,26 @@ Image difference(const Image& a, const Image& b) {
 }
 
 // Frame 1 (t = 1) with the shutter open half a frame equals the mean of 16 sharp instants at
-// the middles of the interval's sixteenths (frames 49, 51, ... 79 at 64 fps), block by block
-// within the noise (the blocks' means of the per-pixel difference, whose spread is the noise
-// alone); and the sharp frame at t = 1 is farther from that mean, where the thing moves.
-void expectBlurIsTheMeanOfInstants(Moving what, const std::string& tag) {
+// the middles of the interval's sixteenths (frames 49, 51, ... 79 at 64 fps, path traced), block
+// by block within the noise (the blocks' means of the per-pixel difference, whose spread is the
+// noise alone); and the sharp frame at t = 1 is farther from that mean, where the thing moves.
+// In `mode`; path reuse renders frames 0 and 1, so that frame 1 keeps frame 0's still paths, with
+// a light path of its own for every pixel sample (their noise then in the blocks' spread).
+void expectBlurIsTheMeanOfInstants(Moving what, const std::string& tag,
+                                   const std::string& mode = "pathtrace") {
   const std::string scene = movingScene(what, tag);
+  auto args = [](const std::string& m, int spp) {
+    return std::string(kArgs) + " --mode " + m + " --spp " + std::to_string(spp) +
+           (m != "pathtrace" ? " --light-paths " + std::to_string(kW * kH * spp) : "");
+  };
+  const char* frames = mode != "pathtrace" ? "0-1" : "1";
   const Image blurred = test::frameImage(
-      test::renderFrames(scene, "1", std::string(kArgs) + " --fps 1 --spp 128 --shutter 0.5",
-                         tag + "-blur"),
+      test::renderFrames(scene, frames, args(mode, 128) + " --fps 1 --shutter 0.5", tag + "-blur"),
       1);
   const Image sharp = test::frameImage(
-      test::renderFrames(scene, "1", std::string(kArgs) + " --fps 1 --spp 128", tag + "-sharp"), 1);
+      test::renderFrames(scene, "1", args("pathtrace", 128) + " --fps 1", tag + "-sharp"), 1);
   const std::string dir =
-      test::renderFrames(scene, "49-79", std::string(kArgs) + " --fps 64 --spp 8", tag + "-inst");
+      test::renderFrames(scene, "49-79", args("pathtrace", 8) + " --fps 64", tag + "-inst");
   Image mean(kW, kH);
   for (int f = 49; f <= 79; f += 2) {
     const Image instant = test::frameImage(dir, f);
@@ -146,8 +177,8 @@ void expectBlurIsTheMeanOfInstants(Moving what, const std::string& tag) {
 class MeanOfInstants : public ::testing::TestWithParam<Moving> {};
 
 std::string motionName(const ::testing::TestParamInfo<Moving>& info) {
-  static const char* const kNames[] = {"Sliding",    "Turning",  "Camera", "Lamp",
-                                       "PointLight", "Morphing", "Skinned"};
+  static const char* const kNames[] = {"Sliding",  "Turning", "Camera",      "Lamp",  "PointLight",
+                                       "Morphing", "Skinned", "SkinTurning", "Blinds"};
   return kNames[int(info.param)];
 }
 
@@ -155,17 +186,24 @@ TEST_P(MeanOfInstants, TheBlurredFrameIsTheMeanOfItsInstants) {
   expectBlurIsTheMeanOfInstants(GetParam(), "mb-" + motionName({GetParam(), 0}));
 }
 
+// The same with path reuse: light paths traced at the frame's time and joined to samples at
+// other times (strategies L and T) only where they meet nothing that moves while the shutter is
+// open, and the eye paths' weights saying the same of the same segments.
+TEST_P(MeanOfInstants, PathReuseGivesTheMeanOfItsInstants) {
+  expectBlurIsTheMeanOfInstants(GetParam(), "mb-reuse-" + motionName({GetParam(), 0}), "reuse");
+}
+
 INSTANTIATE_TEST_SUITE_P(MotionBlur, MeanOfInstants,
                          ::testing::Values(Moving::Object, Moving::Rotating, Moving::Lamp,
                                            Moving::Light, Moving::Morph, Moving::Skin,
-                                           Moving::Camera),
+                                           Moving::Camera, Moving::Blinds),
                          motionName);
 
 // The auxiliary images under a shutter: albedo blurred as the colour is (the mean of the instants'
 // albedo, block by block), Z and object ids of the frame's own time (the sharp frame's).
 TEST(MotionBlur, AlbedoIsBlurredAndZIsTheFramesOwn) {
   const std::string scene = movingScene(Moving::Object, "mb-aov");
-  const std::string args = std::string(kArgs) + " --aov albedo,depth,object";
+  const std::string args = std::string(kArgs) + " --mode pathtrace --aov albedo,depth,object";
   const std::string blur =
       test::renderFrames(scene, "1", args + " --fps 1 --spp 64 --shutter 0.5", "mb-aov-blur");
   const std::string sharp = test::renderFrames(scene, "1", args + " --fps 1 --spp 64", "mb-aov-s");
@@ -232,20 +270,20 @@ TEST(MotionBlur, StepsFollowTheMotion) {
   EXPECT_LE(skinTurn, 33u);
 }
 
-// Modes that keep light paths across frames refuse an open shutter: one line, exit 2.
-TEST(MotionBlur, ReuseRefusesAnOpenShutter) {
+// What is not built for an open shutter is refused in one line, exit 2: resampling, the
+// connection history, and path reuse without the eye paths it weighs its connections against.
+TEST(MotionBlur, RefusesWhatIsNotBuiltForAnOpenShutter) {
   const std::string scene = movingScene(Moving::Object, "mb-refuse");
-  for (const char* mode : {"reuse", "retrace"}) {
-    const test::CommandResult r = test::runPathreuse(
-        "render " + scene + " --mode " + std::string(mode) + " --shutter 0.5 --frames 0 --out " +
-        test::tempDir("mb-refuse-out") + "/f_%04d.exr");
+  for (const char* extra :
+       {"--mode pathtrace --resample", "--mode reuse --resample", "--mode reuse --no-eye-paths",
+        "--mode retrace --connection-history 4"}) {
+    SCOPED_TRACE(extra);
+    const test::CommandResult r =
+        test::runPathreuse("render " + scene + " " + extra + " --shutter 0.5 --frames 0 --out " +
+                           test::tempDir("mb-refuse-out") + "/f_%04d.exr");
     EXPECT_EQ(r.exitCode, 2) << r.err;
     EXPECT_NE(r.err.find("--shutter"), std::string::npos) << r.err;
   }
-  const test::CommandResult r = test::runPathreuse(
-      "render " + scene + " --mode pathtrace --resample --shutter 0.5 --frames 0 --out " +
-      test::tempDir("mb-refuse-pt") + "/f_%04d.exr");
-  EXPECT_EQ(r.exitCode, 2) << r.err;
 }
 
 }  // namespace

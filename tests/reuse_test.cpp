@@ -99,6 +99,14 @@ TEST(Reuse, EqualsRetraceWhenObjectsSweepThroughLightBeams) {
   expectReuseEqualsRetrace(sweepScene(), "0-7", 0, 7, "--fps 8");
 }
 
+// With the shutter open (motion blur): the kept paths are still the re-traced ones, and the
+// samples' times and the paths they may be joined to the same in both modes.
+TEST(Reuse, EqualsRetraceWithTheShutterOpen) {
+  expectReuseEqualsRetrace(sweepScene(), "0-7", 0, 7, "--fps 8 --shutter 0.5 --eye-paths");
+  expectReuseEqualsRetrace(test::sourcePath("scenes/cornell-dynamic.gltf"), "20-25", 20, 25,
+                           "--shutter 1 --eye-paths");
+}
+
 // Retrace learns the slots reuse traces again, so that carried reservoirs drop the same vertices
 // and the frames agree over 12 frames.
 TEST(Reuse, EqualsRetraceWithAConnectionHistory) {

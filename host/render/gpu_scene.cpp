@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstring>
+#include <limits>
 #include <map>
 
 #include <glm/gtc/matrix_inverse.hpp>
@@ -162,6 +163,9 @@ GpuScene::GpuScene(Context& ctx, const Scene& scene, const GpuSceneOptions& opti
   lightStepBytes_ = sizeof(dev::Light);
   lightSteps_ = ctx_.allocate("light motion steps", lightStepBytes_, CL_MEM_READ_ONLY);
   ctx_.zero(lightSteps_, lightStepBytes_);
+  sweepBytes_ = 6 * sizeof(float);
+  sweeps_ = ctx_.allocate("shutter sweeps", sweepBytes_, CL_MEM_READ_ONLY);
+  ctx_.zero(sweeps_, sweepBytes_);
   motionVertexBytes_ = sizeof(dev::ShadingVertex);
   motionVertices_ =
       ctx_.allocate("deforming mesh vertex motion steps", motionVertexBytes_, CL_MEM_READ_ONLY);
@@ -375,6 +379,7 @@ void GpuScene::setTime(double t) {
     if (anyMoved_) collectMoved(before, was, reshapedInstance);
   }
   if (!anyMoved_) moved_.clear();
+  if (shutter_ > 0.0) collectSweeps(times, motion);
   // The moved flags change even when no transform does (all back to 0), so always upload.
   const uint64_t bytes = std::max<size_t>(n, 1) * sizeof(dev::ShadingInstance);
   if (n > instanceCapacity_ || !shadingInstances_()) {
@@ -438,6 +443,52 @@ void GpuScene::collectMoved(const std::vector<accel::Aabb>& before,
     moved_.push_back(m);
   }
   moved_ = movedTree(std::move(moved_));
+}
+
+void GpuScene::collectSweeps(const std::vector<double>& times,
+                             const std::vector<std::vector<glm::mat4>>& motion) {
+  std::vector<float> boxes;
+  // Enlarged as moved_'s are, so that rounding in the kernels' tests cannot miss a face.
+  const float pad = 1e-4f * sceneRadius_;
+  auto add = [&](const glm::vec3& lo, const glm::vec3& hi) {
+    for (int a = 0; a < 3; ++a) boxes.push_back(lo[a] - pad - 1e-4f * std::fabs(lo[a]));
+    for (int a = 0; a < 3; ++a) boxes.push_back(hi[a] + pad + 1e-4f * std::fabs(hi[a]));
+  };
+  // The top level's boxes hold each instance at every time of the interval.
+  const std::vector<accel::Aabb>& bounds = dsg_.instanceBounds();
+  for (size_t i = 0; i < scene_.instances.size() && i < bounds.size(); ++i) {
+    bool moves = scene_.meshDeforms(scene_.instances[i].mesh);
+    for (size_t k = 1; !moves && i < motion.size() && k < motion[i].size(); ++k)
+      moves = motion[i][k] != motion[i][0];
+    if (moves && !bounds[i].empty()) add(bounds[i].lo, bounds[i].hi);
+  }
+  for (size_t i = 0; i < scene_.lights.size(); ++i) {
+    if (!scene_.lights[i].dynamic || times.empty()) continue;
+    const PunctualLight first = scene_.lightAt(i, times.front());
+    accel::Aabb box;
+    bool moves = false;
+    for (double at : times) {
+      const PunctualLight l = scene_.lightAt(i, at);
+      box.grow(l.position);
+      moves = moves || l.position != first.position || l.direction != first.direction;
+    }
+    if (!moves) continue;
+    // A turning sun shines along other lines at other times: no light path holds.
+    const float inf = std::numeric_limits<float>::infinity();
+    if (first.type == LightType::Directional)
+      add(glm::vec3(-inf), glm::vec3(inf));
+    else
+      add(box.lo, box.hi);
+  }
+  sweepCount_ = uint32_t(boxes.size() / 6);
+  if (boxes.empty()) return;
+  const uint64_t bytes = boxes.size() * sizeof(float);
+  if (bytes > sweepBytes_) {
+    ctx_.release("shutter sweeps", sweepBytes_);
+    sweeps_ = ctx_.allocate("shutter sweeps", bytes, CL_MEM_READ_ONLY);
+    sweepBytes_ = bytes;
+  }
+  CL_CHECK(ctx_.queue().enqueueWriteBuffer(sweeps_, CL_TRUE, 0, bytes, boxes.data()));
 }
 
 bool GpuScene::validSurface(uint32_t prim, uint32_t inst) const {
@@ -801,6 +852,8 @@ kargs::SceneArgs GpuScene::kernelArgs() {
   a.pr_l_motion_first = static_cast<cl_uint>(staticEmitters_.size() + dynamicEmitters_.size());
   a.pr_l_motion_count = static_cast<cl_uint>(scene_.lights.size());
   a.pr_l_motion_steps = lightMotionSteps_;
+  a.pr_l_sweeps = sweeps_;
+  a.pr_l_sweep_count = sweepCount_;
   return a;
 }
 

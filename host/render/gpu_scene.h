@@ -137,6 +137,11 @@ class GpuScene {
   // (reshaped: per instance, its mesh deformed this frame).
   void collectMoved(const std::vector<accel::Aabb>& before, const std::vector<glm::mat4>& was,
                     const std::vector<bool>& reshaped);
+  // Under a shutter: the boxes of what moves while it is open (LightData.sweeps), from the
+  // instances' transforms at the motion steps `times` (*motion as placeOverShutter gave them),
+  // the deforming meshes and the punctual lights.
+  void collectSweeps(const std::vector<double>& times,
+                     const std::vector<std::vector<glm::mat4>>& motion);
   std::vector<dev::Light> lightsAt(double t) const;
   // The scene's punctual lights in light-table order (directional ones last).
   std::vector<size_t> punctualOrder() const;
@@ -209,6 +214,9 @@ class GpuScene {
   cl::Buffer lightSteps_;  // each punctual light at the motion steps (LightData.motion)
   uint64_t lightStepBytes_ = 0;
   uint32_t lightMotionSteps_ = 1;
+  cl::Buffer sweeps_;  // LightData.sweeps (collectSweeps)
+  uint64_t sweepBytes_ = 0;
+  uint32_t sweepCount_ = 0;
 
   cl::Buffer vertices_, triangles_, shadingInstances_, materials_, textures_, texels_;
   cl::Buffer prevVertices_, prevInstances_;  // keepPrevious

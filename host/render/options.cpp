@@ -29,7 +29,8 @@ int defaultConnections(bool gpu) {
 ResampleSettings resolveResample(const RenderOptions& o) {
   ResampleSettings r = o.resample;
   const bool reuse = o.mode != RenderMode::PathTrace;
-  r.enabled = r.asked.value_or(reuse && o.connect.eyePaths);
+  // Off by default under a shutter, with which it is not built yet.
+  r.enabled = r.asked.value_or(reuse && o.connect.eyePaths && !(o.shutter > 0.0));
   if (r.neighbors < 0) r.neighbors = reuse ? 0 : 1;
   return r;
 }

@@ -235,6 +235,8 @@ void PathReuse::splatToCamera(const dev::CameraParams& camera, const dev::ReuseP
   a.end = film_.end();
   a.film_scale = float(settings_.spp);  // the film's mean divides by its samples
   a.counters = counters_;
+  a.cam_steps = scene_.cameraSteps();
+  a.cam_step_count = scene_.motionSteps();
   a.set(cameraSplat_);
   ctx_.launch1D(cameraSplat_, slots_, "camera_splat", timer);
   // Under --noise-threshold they wait for the pixels' counts (renderFrame).
@@ -273,6 +275,8 @@ int PathReuse::tracePasses(int64_t frame, const dev::CameraParams& camera,
   cn.records = records_;
   cn.record_counts = recordCounts_;
   cn.record_cap = recordCap_;
+  cn.cam_steps = scene_.cameraSteps();
+  cn.cam_step_count = scene_.motionSteps();
   cn.set(connect_, kargs::kScene | kargs::kFrame);
   kargs::ConnectShadowArgs cs;
   if (eyePaths_) {
@@ -282,6 +286,8 @@ int PathReuse::tracePasses(int64_t frame, const dev::CameraParams& camera,
     cs.record_cap = recordCap_;
     cs.radiance = radiance_;
     cs.counters = counters_;
+    cs.seed = rp.seed;  // the samples' times (--shutter), as connect keys them
+    cs.frame = rp.frame;
     cs.set(connectShadow_, kargs::kScene | kargs::kFrame);
   }
   if (eyePaths_) eyePaths_->beginFrame(frame, camera, sceneArgs, radiance_, eye_);
@@ -299,7 +305,7 @@ int PathReuse::tracePasses(int64_t frame, const dev::CameraParams& camera,
       eh.set(eyeHit_, kargs::kPass);
       ctx_.launch1D(eyeHit_, first, n, "eye_hit", timer);
     }
-    cn.sample = cl_uint(s);
+    cn.sample = cs.sample = cl_uint(s);
     // A masked pass connects its listed pixels alone.
     cn.pixels = cs.pixels = film_.pixelList();
     cn.listed = cs.listed = masked;

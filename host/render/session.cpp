@@ -84,10 +84,14 @@ void validateRenderOptions(const RenderOptions& o) {
           "--noise-threshold: cannot be combined with --connection-history, whose "
           "reservoirs follow every pass of every pixel");
   }
-  if (o.shutter > 0.0 && o.mode != RenderMode::PathTrace)
+  // Path reuse over the shutter joins still light paths to the eye paths' samples (design.md
+  // section 3, "Motion blur"); the connection history's reservoirs are not built for times.
+  if (o.shutter > 0.0 && o.mode != RenderMode::PathTrace && !o.connect.eyePaths)
     throw InputError(
-        "--shutter: motion blur is built for --mode pathtrace only (light paths kept over the "
-        "shutter interval are not yet)");
+        "--shutter: path reuse over the shutter weighs its connections against the eye paths, "
+        "which --no-eye-paths turns off");
+  if (o.shutter > 0.0 && o.connect.historyCap > 0)
+    throw InputError("--shutter: cannot be combined with --connection-history yet");
   if (!o.envColor.empty()) {
     float rgb[3];
     parseColor(o.envColor, rgb);

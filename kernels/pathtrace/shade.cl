@@ -83,7 +83,8 @@ PR_INLINE void pt_escape(const SceneData* s, const PathState* p, uint rel, const
   const float pdf_light =
       (p->flags & PR_PATH_SPECULAR) && !rel ? 0.0f : environment_pdf(s, prev, prev_n, d);
   EyeWeight ew;
-  const float w = pt_escape_weight(s, p, d, pdf_light, pt_joinable(p, 1u), em, max_depth, &ew);
+  const int joinable = pt_joinable(p, 1u) && ep_ray_still(s, prev, d, PR_INF_F);
+  const float w = pt_escape_weight(s, p, d, pdf_light, joinable, em, max_depth, &ew);
   if (PR_RESAMPLE && rel == 1u &&
       di_offer_hit(s, p, track, s->lights.env_light, 0.0f, 0.0f, d, le, 1.0f, w, di, key))
     return;
@@ -129,8 +130,8 @@ PR_INLINE void pt_write_eye(__global EyeVertex* out, const SurfaceHit* h, const 
 // until now, becomes its camera factor for strategy T. With eye paths, later vertices carry the
 // eye path's densities for the MIS weights against the connections.
 PR_INLINE void pt_eye_vertex(PathState* p, const SurfaceHit* h, const Hit* hit, float3 d,
-                             float dist2, float3 tp, int delta_here, uint max_depth, float lt_scale,
-                             __global EyeVertex* eye) {
+                             float dist2, float3 tp, int delta_here, int seg_still, uint max_depth,
+                             float lt_scale, __global EyeVertex* eye) {
   if (p->x1_depth == 0u) {
     if (!delta_here && p->depth < max_depth) {
       p->x1_depth = p->depth;
@@ -138,7 +139,7 @@ PR_INLINE void pt_eye_vertex(PathState* p, const SurfaceHit* h, const Hit* hit, 
       pt_write_eye(eye, h, hit, -d, tp, p->depth);
     }
   } else if (PR_EYE_PATHS) {
-    pt_eye_arrive(p, h, d, dist2, delta_here);
+    pt_eye_arrive(p, h, d, dist2, delta_here, seg_still);
   }
 }
 
@@ -218,11 +219,14 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
     rs_track_hit(track, rel, &hit, h.p, tr,
                  solid_angle_to_area_pdf(p.last_pdf, fabs(dot(h.ng, d)), dist2));
 
+  // Under a shutter, whether the segment just traced meets nothing that moves (shade_eye_paths.h).
+  const int seg_still = ep_ray_still(&s, make_float3(p.prev_x, p.prev_y, p.prev_z),
+                                     h.p - make_float3(p.prev_x, p.prev_y, p.prev_z), 1.0f);
   if (s.sd.materials[h.material].flags & PR_MAT_EMISSIVE) {
     EyeWeight ew;
     // Connections can make the paths that end after x_t, t >= 2 (x_t: the vertex `ray` left).
-    const float w =
-        pt_emission_weight(&s, &p, &h, d, dist2, pt_joinable(&p, 1u), &em, max_depth, &ew);
+    const float w = pt_emission_weight(&s, &p, &h, d, dist2, pt_joinable(&p, 1u) && seg_still, &em,
+                                       max_depth, &ew);
     pt_emission(&s, &p, &h, rel, d, dist2, w, &ew, tp, track, rs_res + i, di_res + i, &key,
                 radiance + i);
   }
@@ -230,7 +234,8 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
   const ShadingFrame f = shading_frame(&s, &h, wo);
   const int delta_here = bsdf_is_delta(&f.bsdf);
   if (PR_EYE_PATHS || PR_RESAMPLE)
-    pt_eye_vertex(&p, &h, &hit, d, dist2, tp, delta_here, max_depth, rsp.lt_scale, eye + p.pixel);
+    pt_eye_vertex(&p, &h, &hit, d, dist2, tp, delta_here, seg_still, max_depth, rsp.lt_scale,
+                  eye + p.pixel);
   // x_t with t >= 3: the light tracer's density of x_{t-1}, reached from this vertex.
   const int has_rev = pt_joinable(&p, 2u);
   if (p.depth >= max_depth) {
@@ -243,8 +248,9 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
       const int here_joinable = pt_joinable(&p, 1u);
       if (next_event(&s, &h, &f, wo, !here_joinable, &rng, &shadow, &c, &ch)) {
         EyeWeight ew;
-        const float w = pt_next_event_weight(&s, &p, &h, &f, &ch, here_joinable, has_rev, dist2,
-                                             &em, max_depth, &ew);
+        const int joins = here_joinable && ep_next_event_still(&s, &h, &ch);
+        const float w =
+            pt_next_event_weight(&s, &p, &h, &f, &ch, joins, has_rev, dist2, &em, max_depth, &ew);
         if (here_joinable) c = c * w;  // next_event left the weight to this
         const uint op = PR_RESAMPLE
                             ? rs_next_event_pending(&s, track, rs_pending + k, di_pending + k, &rsp,

@@ -52,6 +52,24 @@ PR_INLINE float pt_eye_share(const PathState* p, float w, float dens_n, float de
   return w;
 }
 
+// Under a shutter (--mode reuse): whether the ray o + t d, 0 <= t <= tmax, of the eye path meets
+// nothing that moves while the shutter is open. Where one of the segments a light path would hold
+// does, the connections (traced at the frame's time) cannot make the path at this sample's time:
+// L and T take no share of it (sweep_clear). 1 without a shutter or eye paths.
+PR_INLINE int ep_ray_still(const SceneData* s, float3 o, float3 d, float tmax) {
+  return !PR_EYE_PATHS || s->lights.sweep_count == 0u || sweep_clear(s, o, d, tmax);
+}
+
+// The same for a next-event sample's segment from h to the light (towards a light at infinity,
+// the ray from h), which is the first segment of the light path.
+PR_INLINE int ep_next_event_still(const SceneData* s, const SurfaceHit* h,
+                                  const NextEventChoice* ch) {
+  if (!PR_EYE_PATHS || s->lights.sweep_count == 0u) return 1;
+  if (light_at_infinity(s->lights.lights[ch->light].type))
+    return sweep_clear(s, h->p, ch->wi, PR_INF_F);
+  return sweep_clear(s, h->p, ch->pos - h->p, 1.0f);
+}
+
 // Whether the connections can make the paths that end after this path's last vertex x_t: x_2 is
 // non-delta and t >= x_1's depth + beyond.
 PR_INLINE int pt_joinable(const PathState* p, u32 beyond) {
@@ -130,10 +148,16 @@ PR_INLINE float ep_escape_share(const SceneData* s, const PathState* p, float3 d
 }
 
 // The eye path's density of this vertex x_t (t >= 2; 1 when sampled from a delta vertex) into
-// its running ratio, and whether x_2 is joinable.
+// its running ratio, and whether x_2 is joinable. Under a shutter a segment that meets what moves
+// (seg_still 0) ends T's share where it is x_1 x_2, and L's and T's from x_3 on.
 PR_INLINE void pt_eye_arrive(PathState* p, const SurfaceHit* h, float3 d, float dist2,
-                             int delta_here) {
-  if (p->depth == p->x1_depth + 1u) p->eye_flags = delta_here ? 0u : PR_EYE_JOINABLE;
+                             int delta_here, int seg_still) {
+  if (p->depth == p->x1_depth + 1u) {
+    p->eye_flags = delta_here ? 0u : PR_EYE_JOINABLE;
+    if (!seg_still) p->lt = 0.0f;
+  } else if (!seg_still) {
+    p->eye_flags &= ~PR_EYE_JOINABLE;
+  }
   p->eye_ratio = mis_ratio_arrive(p->eye_ratio,
                                   solid_angle_to_area_pdf(p->last_pdf, fabs(dot(h->ng, d)), dist2),
                                   (p->flags & PR_PATH_SPECULAR) != 0u);

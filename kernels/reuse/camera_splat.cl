@@ -52,29 +52,40 @@ PR_KERNEL void camera_splat(PR_PARAMS(PR_ARGS_CAMERA_SPLAT)) {
   if (slot >= rp.slots) return;
   const PathHeader hd = headers[slot];
   if (hd.light == PR_INVALID_INDEX || hd.vertex_count < 3u) return;
-  const SceneData s = PR_SCENE();
+  SceneData s = PR_SCENE();
   const Light l = s.lights.lights[hd.light];
   if (!eye_paths_light(&l)) return;
   __global const LightVertex* v = vertices + (size_t)slot * rp.stride;
   __global const EyePathRatio* r = ratios + (size_t)slot * rp.stride;
-  const float3 c = camera_position(&cam);
+  // Under a shutter the path meets the camera at a time of its own, uniform over the interval as
+  // the eye paths' are, and only as far as it holds at every time (light_segment_still).
+  CameraParams cam_t = cam;
+  if (s.geom.motion_steps > 1u) {
+    Rng tr = rng_make(rp.seed, PR_RNG_SPLAT, rp.frame, slot, 0u);
+    s.geom.time = s.sd.time = rng_next(&tr);
+    if (cam_step_count > 1u) cam_t = camera_at_time(cam_steps, cam_step_count, s.geom.time);
+  }
+  const int sweeps = s.lights.sweep_count > 0u;
+  if (sweeps && !light_segment_still(&s, l.type, v, 1u)) return;
+  const float3 c = camera_position(&cam_t);
   uint rays = 0u;
   LightPoint yp = light_point(&s, v + 1);
   for (uint k = 2u; k < hd.vertex_count && eye_paths_camera_len(k, rp.max_depth); ++k) {
+    if (sweeps && !light_segment_still(&s, l.type, v, k)) break;
     const LightPoint y = light_point(&s, v + k);
     const int skip = y.delta || yp.delta;
-    const uint px = skip ? PR_INVALID_INDEX : camera_pixel(&cam, y.h.p);
+    const uint px = skip ? PR_INVALID_INDEX : camera_pixel(&cam_t, y.h.p);
     if (px != PR_INVALID_INDEX && px >= first && px < end) {
       const float3 dc = y.h.p - c;
       const float d2 = dot(dc, dc);
       const float3 dir = dc * (1.0f / sqrt(d2));
       const float3 val =
-          camera_splat_value(&s, &rp, &cam, &y, &yp, v + k, r[k - 1u], k, dir) * film_scale;
+          camera_splat_value(&s, &rp, &cam_t, &y, &yp, v + k, r[k - 1u], k, dir) * film_scale;
       if (max3(val) > 0.0f) {
         ++rays;
         // Towards the camera as far as its near plane: nothing nearer is seen.
         const Ray ray = surface_ray(&s, &y.h, -dir,
-                                    sqrt(d2) * (1.0f - 1e-4f) - camera_near_distance(&cam, dir));
+                                    sqrt(d2) * (1.0f - 1e-4f) - camera_near_distance(&cam_t, dir));
         if (!trace_occluded(&s, ray)) splat_add(splat + (size_t)px * PR_SPLAT_WORDS, val);
       }
     }

@@ -269,8 +269,10 @@ PR_INLINE float3 light_vertex_value(const Connector* cn, const EyePoint* x, cons
       solid_angle_to_area_pdf(pdf_arrive, fabs(dot(y->f.ng, vertex_dir(vk))), vk->t * vk->t);
   const float p_e =
       pdf_arrive > 0.0f ? solid_angle_to_area_pdf(pdf_x, fabs(dot(y->f.ng, dir)), dist2) : 0.0f;
-  // T's density over L's: the path has k + 1 vertices before the light.
-  const float t = eye_paths_camera_len(k + 1u, cn->rp->max_depth)
+  // T's density over L's: the path has k + 1 vertices before the light. Under a shutter T's light
+  // path holds the segment x y too, which must then meet nothing that moves (sweep_clear).
+  const int t_still = cn->s->lights.sweep_count == 0u || sweep_clear(cn->s, x->h.p, dxy, 1.0f);
+  const float t = eye_paths_camera_len(k + 1u, cn->rp->max_depth) && t_still
                       ? eye_paths_camera_ratio(cn->cam_x, pdf_leave, dist2)
                       : 0.0f;
   const float mis = PR_EYE_PATHS
@@ -292,6 +294,7 @@ PR_INLINE float3 light_vertex_value_at(const Connector* cn, const EyePoint* x, u
   if (k < 1u || k >= cn->headers[slot].vertex_count || x->depth + k + 1u > cn->rp->max_depth)
     return zero;
   if (PR_EYE_PATHS && !eye_paths_slot(cn, slot)) return zero;
+  if (!light_prefix_still(s, cn->headers[slot].light, v, k)) return zero;
   const LightPoint y = light_point(s, v + k);
   if (y.delta) return zero;
   // The light tracer's pdf of the step to y_k, as strategy_light_vertices finds it.
@@ -342,6 +345,11 @@ PR_INLINE void strategy_light_vertices(Connector* cn, const EyePoint* x, int his
                          : 0.0f;
     if (PR_EYE_PATHS && !eye_paths_slot(cn, slot)) continue;  // the path tracer's alone
     for (uint k = 1u; k < count && x->depth + k + 1u <= rp->max_depth; ++k) {
+      // Under a shutter, z_k and what follows only where the path up to it meets nothing that
+      // moves: then it is the path of this sample's time too.
+      if (s->lights.sweep_count &&
+          !light_segment_still(s, s->lights.lights[cn->headers[slot].light].type, v, k))
+        break;
       const LightPoint y = light_point(s, v + k);
       const float pdf_arrive = pdf_step;
       pdf_step = 0.0f;
@@ -612,7 +620,13 @@ PR_KERNEL void connect(PR_PARAMS(PR_ARGS_CONNECT)) {
   record_counts[q - record_first] = 0u;  // until the terms are written
 #endif
   if (e.prim == PR_INVALID_INDEX) return;
-  const SceneData s = PR_SCENE();
+  // The scene and camera at the sample's time, as its eye path saw them (--shutter).
+  SceneData s = PR_SCENE();
+  scene_at_sample(&s, rp.seed, rp.frame, i, sample);
+  const CameraParams c =
+      cam_step_count > 1u
+          ? camera_at_time(cam_steps, cam_step_count, shutter_time(rp.seed, rp.frame, i, sample))
+          : cam;
   // Its own stream, apart from eye_hit's.
   Rng rng = rng_make(rp.seed, PR_RNG_CONNECT, rp.frame, i, sample);
   Connector cn;
@@ -620,7 +634,7 @@ PR_KERNEL void connect(PR_PARAMS(PR_ARGS_CONNECT)) {
                   records + (size_t)(q - record_first) * record_cap, record_cap);
   EyePoint x = eye_point_at(&s, e.prim, e.inst, e.b1, e.b2, make_float3(e.wx, e.wy, e.wz),
                             make_float3(e.tp_r, e.tp_g, e.tp_b), e.depth);
-  cn.cam_x = connect_camera_factor(&rp, &cam, &e, x.h.p);
+  cn.cam_x = connect_camera_factor(&rp, &c, &e, x.h.p);
   uint shadow_rays = 0u, bounce_rays = 0u;
   // The first eye vertex's connections go to the history, where there is one.
   int history_open = history_cap > 0u;

@@ -10,7 +10,8 @@ PR_KERNEL void connect_shadow(PR_PARAMS(PR_ARGS_CONNECT_SHADOW)) {
   const uint n = record_counts[q - record_first];
   if (n == 0u) return;
   const uint i = listed ? pixels[q] : q;
-  const SceneData s = PR_SCENE();
+  SceneData s = PR_SCENE();
+  scene_at_sample(&s, seed, frame, i, sample);  // the sample's time (--shutter)
   __global const ShadowRay* r = records + (size_t)(q - record_first) * record_cap;
   float3 L = make_float3(0.0f, 0.0f, 0.0f), g = L;
   uint unoccluded = 0u;

@@ -65,7 +65,9 @@
   X(LIGHTS, IN, Light, motion)       \
   X(LIGHTS, VAL, uint, motion_first) \
   X(LIGHTS, VAL, uint, motion_count) \
-  X(LIGHTS, VAL, uint, motion_steps)
+  X(LIGHTS, VAL, uint, motion_steps) \
+  X(LIGHTS, IN, float, sweeps)       \
+  X(LIGHTS, VAL, uint, sweep_count)
 
 #define PR_ARGS_SCENE(F, X) PR_ARGS_SCENE_GEOM(F, X) PR_ARGS_SHADING(X, X) PR_ARGS_LIGHTS(X, X)
 
@@ -133,6 +135,8 @@
   X(FRAME, IN, uint, changed)               \
   X(FRAME, OUT, ConnectionHistory, history) \
   X(FRAME, IN, EyePathRatio, ratios)        \
+  X(FRAME, IN, CameraParams, cam_steps)     \
+  X(FRAME, VAL, uint, cam_step_count)       \
   PR_ARGS_CONNECT_RECORDS(X, X, OUT)
 
 // The pixel samples [record_first, record_end) of one launch of connect and connect_shadow, and
@@ -147,24 +151,29 @@
 
 // camera_splat (strategy T): the arena's vertices joined to the camera, into `splat` (fixed
 // point per pixel of [first, end), shared/splat.h) times film_scale.
-#define PR_ARGS_CAMERA_SPLAT(F, X)    \
-  PR_ARGS_SCENE(F, X)                 \
-  X(FRAME, VAL, ReuseParams, rp)      \
-  X(FRAME, VAL, CameraParams, cam)    \
-  X(FRAME, IN, PathHeader, headers)   \
-  X(FRAME, IN, LightVertex, vertices) \
-  X(FRAME, IN, EyePathRatio, ratios)  \
-  X(FRAME, OUT, uint, splat)          \
-  X(FRAME, VAL, uint, first)          \
-  X(FRAME, VAL, uint, end)            \
-  X(FRAME, VAL, float, film_scale)    \
-  X(FRAME, OUT, uint, counters)
+#define PR_ARGS_CAMERA_SPLAT(F, X)      \
+  PR_ARGS_SCENE(F, X)                   \
+  X(FRAME, VAL, ReuseParams, rp)        \
+  X(FRAME, VAL, CameraParams, cam)      \
+  X(FRAME, IN, PathHeader, headers)     \
+  X(FRAME, IN, LightVertex, vertices)   \
+  X(FRAME, IN, EyePathRatio, ratios)    \
+  X(FRAME, OUT, uint, splat)            \
+  X(FRAME, VAL, uint, first)            \
+  X(FRAME, VAL, uint, end)              \
+  X(FRAME, VAL, float, film_scale)      \
+  X(FRAME, OUT, uint, counters)         \
+  X(FRAME, IN, CameraParams, cam_steps) \
+  X(FRAME, VAL, uint, cam_step_count)
 
 #define PR_ARGS_CONNECT_SHADOW(F, X) \
   PR_ARGS_SCENE(F, X)                \
   PR_ARGS_CONNECT_RECORDS(X, X, IN)  \
   X(FRAME, OUT, float4, radiance)    \
-  X(FRAME, OUT, uint, counters)
+  X(FRAME, OUT, uint, counters)      \
+  X(FRAME, VAL, uint, seed)          \
+  X(FRAME, VAL, uint, frame)         \
+  X(PASS, VAL, uint, sample)
 
 // ---- The wavefront path tracer (kernels/pathtrace/) ----
 // Paths are indexed by pixel; each bounce's stages run over queues of path indices (`queue`,

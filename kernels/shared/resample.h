@@ -257,29 +257,12 @@ PR_INLINE void rs_track_push(PR_GLOBAL PathTrack* t, float3 p, int on_dsg) {
   if (on_dsg) t->suffix |= 1u << (PR_RS_ON_DSG_SHIFT + n);
 }
 
-// Whether the ray o + t d, 0 <= t <= tmax, meets box b (6 floats).
-PR_INLINE int rs_box_hit(PR_GLOBAL const float* b, float3 o, float3 d, float tmax) {
-  float t0 = 0.0f, t1 = tmax;
-  const float oo[3] = {o.x, o.y, o.z}, dd[3] = {d.x, d.y, d.z};
-  for (int a = 0; a < 3; ++a) {
-    if (fabs(dd[a]) < 1e-30f) {
-      if (oo[a] < b[a] || oo[a] > b[3 + a]) return 0;
-      continue;
-    }
-    const float ta = (b[a] - oo[a]) / dd[a], tb = (b[3 + a] - oo[a]) / dd[a];
-    t0 = fmax(t0, fmin(ta, tb));
-    t1 = fmin(t1, fmax(ta, tb));
-    if (t0 > t1) return 0;
-  }
-  return 1;
-}
-
 // Whether the ray o + t d, 0 <= t <= tmax, meets instance m then or now (then_only: then): its
 // boxes, and then its triangles, each frame's shape (its mesh's BVH, in object space) at that
 // frame's transform.
 PR_INLINE int rs_meets(const SceneData* s, PR_GLOBAL const MovedInstance* m, float3 o, float3 d,
                        float tmax, int then_only) {
-  if (!rs_box_hit(m->box, o, d, tmax) && (then_only || !rs_box_hit(m->box + 6, o, d, tmax)))
+  if (!ray_meets_box(m->box, o, d, tmax) && (then_only || !ray_meets_box(m->box + 6, o, d, tmax)))
     return 0;
   if (m->root == PR_INVALID_INDEX) return 1;
   for (int k = 0; k < (then_only ? 1 : 2); ++k) {
@@ -306,7 +289,7 @@ PR_INLINE int rs_clear_as(const SceneData* s, PR_GLOBAL const MovedInstance* mov
   for (u32 k = 0u; k < count;) {
     PR_GLOBAL const MovedInstance* m = moved + k;
     if (!m->node && rs_meets(s, m, o, d, tmax, then_only)) return 0;
-    k = rs_moved_next(m, k, m->node && rs_box_hit(m->box, o, d, tmax));
+    k = rs_moved_next(m, k, m->node && ray_meets_box(m->box, o, d, tmax));
   }
   return 1;
 }
@@ -322,7 +305,7 @@ PR_INLINE int rs_apart(PR_GLOBAL const MovedInstance* moved, u32 count, float3 p
   const float3 z = make_float3(0.0f, 0.0f, 0.0f);
   for (u32 k = 0u; k < count;) {
     PR_GLOBAL const MovedInstance* m = moved + k;
-    const int in = rs_box_hit(m->box, p, z, 0.0f) || rs_box_hit(m->box + 6, p, z, 0.0f);
+    const int in = ray_meets_box(m->box, p, z, 0.0f) || ray_meets_box(m->box + 6, p, z, 0.0f);
     if (in && !m->node) return 0;
     k = rs_moved_next(m, k, in);
   }

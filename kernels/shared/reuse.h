@@ -131,6 +131,29 @@ PR_INLINE float3 vertex_dir(PR_GLOBAL const LightVertex* v) {
   return make_float3(v->wx, v->wy, v->wz);
 }
 
+// Whether segment k >= 1 of a stored light path (z_{k-1} to z_k; on a light of type light_type)
+// meets nothing that moves while the shutter is open (sweep_clear). The first, from a light at
+// infinity, is the ray from z_1 towards it, as the eye path sees it.
+PR_INLINE int light_segment_still(const SceneData* s, u32 light_type,
+                                  PR_GLOBAL const LightVertex* v, u32 k) {
+  const float3 b = vertex_pos(v + k);
+  if (k == 1u && light_at_infinity(light_type))
+    return sweep_clear(s, b, -vertex_dir(v + 1), PR_INF_F);
+  const float3 a = vertex_pos(v + k - 1u);
+  return sweep_clear(s, a, b - a, 1.0f);
+}
+
+// Whether z_0 .. z_k of the path on light `light` are the same at every time of the shutter
+// interval: none of its segments meets what moves (1 without a shutter).
+PR_INLINE int light_prefix_still(const SceneData* s, u32 light, PR_GLOBAL const LightVertex* v,
+                                 u32 k) {
+  if (s->lights.sweep_count == 0u) return 1;
+  const u32 type = s->lights.lights[light].type;
+  for (u32 j = 1u; j <= k; ++j)
+    if (!light_segment_still(s, type, v, j)) return 0;
+  return 1;
+}
+
 // Veach's correction for shading normals on light paths (importance transport), for light that
 // came from direction wo and leaves along wi: |wo.ns| |wi.ng| / (|wo.ng| |wi.ns|).
 PR_INLINE float shading_normal_correction(float3 wo, float3 wi, float3 ns, float3 ng) {

@@ -53,6 +53,7 @@ PR_INLINE u32 pr_hash_u32(u32 x) {
 #define PR_RNG_CONNECT 0x434f4e31u   // camera samples' draws in `connect`, apart from eye_hit's
 #define PR_RNG_RESAMPLE 0x52495331u  // `connect`'s reservoir decisions, apart from its path draws
 #define PR_RNG_PATH_RESAMPLE 0x50525331u  // --resample's reservoir decisions, apart from the paths'
+#define PR_RNG_SPLAT 0x53504c31u  // camera_splat's time in the shutter interval, per light path
 #define PR_RNG_TEST 0x54455354u
 #define PR_RNG_TEST_SOBOL 0x54455353u
 

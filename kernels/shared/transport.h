@@ -304,6 +304,35 @@ PR_INLINE float3 surface_emission(const SceneData* s, const SurfaceHit* h) {
   return material_emission(&s->sd, h);
 }
 
+// Whether the ray o + t d, 0 <= t <= tmax, meets box b (6 floats).
+PR_INLINE int ray_meets_box(PR_GLOBAL const float* b, float3 o, float3 d, float tmax) {
+  float t0 = 0.0f, t1 = tmax;
+  const float oo[3] = {o.x, o.y, o.z}, dd[3] = {d.x, d.y, d.z};
+  for (int a = 0; a < 3; ++a) {
+    if (fabs(dd[a]) < 1e-30f) {
+      if (oo[a] < b[a] || oo[a] > b[3 + a]) return 0;
+      continue;
+    }
+    const float ta = (b[a] - oo[a]) / dd[a], tb = (b[3 + a] - oo[a]) / dd[a];
+    t0 = fmax(t0, fmin(ta, tb));
+    t1 = fmin(t1, fmax(ta, tb));
+    if (t0 > t1) return 0;
+  }
+  return 1;
+}
+
+// --shutter with path reuse (docs/design.md section 5, "Motion blur"): whether the ray o + t d,
+// 0 <= t <= tmax, meets none of the boxes that hold what moves while the shutter is open (each
+// moving instance over the interval, each moving punctual light's positions; all space where a
+// directional light turns). A light sub-path whose segments all pass them is the same path at
+// every time of the interval, so a sample at any time may be joined to it (strategies L and T);
+// every weight of such paths asks this of the same segments, from either end.
+PR_INLINE int sweep_clear(const SceneData* s, float3 o, float3 d, float tmax) {
+  for (u32 k = 0u; k < s->lights.sweep_count; ++k)
+    if (ray_meets_box(s->lights.sweeps + 6u * k, o, d, tmax)) return 0;
+  return 1;
+}
+
 // Light idx where it is at the path's time: the light table holds the lights at the frame's
 // (motion blur). An emissive DSG triangle is placed as its instance is (emitter_pdf reads the same
 // triangle); a punctual light's position and axis are blended between its motion steps.

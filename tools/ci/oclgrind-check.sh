@@ -107,6 +107,11 @@ run "cornell-orbit-pathtrace-shutter" scenes/cornell-orbit.gltf --frames 0-1 --m
   --shutter 0.5 --aov all
 run "cornell-skinned-pathtrace-shutter" scenes/cornell-skinned.gltf --frames 0-1 \
   --mode pathtrace --shutter 0.5
+# Path reuse over the shutter: light paths joined at the samples' times where they meet nothing
+# that moves (the sweeps), strategy T at a time of its own with a moving camera.
+run "lanterns-reuse-shutter" "$work/lanterns/atrium.gltf" --frames 0-1 --mode reuse \
+  --light-sampler bvh --shutter 1
+run "cornell-orbit-reuse-shutter" scenes/cornell-orbit.gltf --frames 0-1 --mode reuse --shutter 0.5
 run "lanterns-reuse-connections" "$work/lanterns/atrium.gltf" --frames 0-1 --mode reuse \
   --light-sampler bvh --no-eye-paths
 # Eye paths weighted against the connections: with a history on the demo, and among many
@@ -135,6 +140,8 @@ run "atrium-normal-maps-env-eye" "$work/bumps/atrium.gltf" --frames 0-1 --mode r
 python3 -m tools.scenes.gen_atrium --size 0.02 --light sun --out "$work/sun/atrium.gltf" >/dev/null
 run "atrium-sun-sky-eye" "$work/sun/atrium.gltf" --frames 0-1 --mode reuse \
   --env-color 0.5,0.6,0.8
+run "atrium-sun-sky-reuse-shutter" "$work/sun/atrium.gltf" --frames 0-1 --mode reuse \
+  --env-color 0.5,0.6,0.8 --shutter 1
 # Every BSDF lobe and texture (sheen, a coat with its own normal map, anisotropy with a direction
 # texture) in both integrators, and the glTF specification's model.
 for mode in pathtrace reuse; do
