@@ -9,24 +9,12 @@
 #include <vector>
 
 #include "render/moved_tree.h"
+#include "support/segment_box.h"
 
 namespace pr {
 namespace {
 
-bool segmentMeetsBox(const float* b, const float o[3], const float d[3]) {
-  float t0 = 0.0f, t1 = 1.0f;
-  for (int a = 0; a < 3; ++a) {
-    if (std::fabs(d[a]) < 1e-30f) {
-      if (o[a] < b[a] || o[a] > b[3 + a]) return false;
-      continue;
-    }
-    const float ta = (b[a] - o[a]) / d[a], tb = (b[3 + a] - o[a]) / d[a];
-    t0 = std::max(t0, std::min(ta, tb));
-    t1 = std::min(t1, std::max(ta, tb));
-    if (t0 > t1) return false;
-  }
-  return true;
-}
+using test::segmentMeetsBox;
 
 // The instances (by root) whose boxes the segment meets, found as rs_clear walks the records.
 std::set<uint32_t> walk(const std::vector<dev::MovedInstance>& m, const float o[3],

@@ -156,7 +156,8 @@ std::vector<int> checkStats(const std::string& file, int frames, int spp = 0) {
 TEST(MultiDeviceCli, TwoDevicesEqualOne) {
   const std::string two = test::twoPoclDevices();
   const std::string range = " --frames 0-" + std::to_string(kFrames - 1);
-  for (const char* mode : {"reuse --no-resample", "pathtrace", "pathtrace --shutter 0.5"}) {
+  for (const char* mode :
+       {"reuse --no-resample", "pathtrace", "pathtrace --shutter 0.5", "reuse --shutter 0.5"}) {
     SCOPED_TRACE(mode);
     const std::string dir = test::tempDir("multi");
     auto r = test::runPathreuse(

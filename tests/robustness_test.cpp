@@ -133,7 +133,8 @@ bool samePixels(const std::string& a, const std::string& b) {
 // uninterrupted run's bit for bit, in both reuse and path-tracing modes, also with the shutter
 // open.
 TEST(Resume, FinishesARunBitForBitAsAnUninterruptedOne) {
-  for (const char* mode : {"reuse --no-resample", "pathtrace", "pathtrace --shutter 0.5"}) {
+  for (const char* mode :
+       {"reuse --no-resample", "pathtrace", "pathtrace --shutter 0.5", "reuse --shutter 0.5"}) {
     SCOPED_TRACE(mode);
     const std::string dir = test::tempDir("resume");
     const std::string common =

@@ -15,6 +15,7 @@
 #include "render/kernel_programs.h"
 #include "render/light_table.h"
 #include "render/moved_tree.h"
+#include "render/sweeps.h"
 #include "scene/emission_power.h"
 #include "util/error.h"
 #include "util/hash.h"
@@ -138,6 +139,7 @@ GpuScene::GpuScene(Context& ctx, const Scene& scene, const GpuSceneOptions& opti
   uploadShading();
   deformed_.resize(scene.dynamicMeshes.size());
   lastPositions_.resize(scene.dynamicMeshes.size());
+  stepPositions_.resize(scene.dynamicMeshes.size());
   lastNormals_.resize(scene.dynamicMeshes.size());
   for (size_t m = 0; m < scene.dynamicMeshes.size(); ++m)
     if (scene.meshDeforms(m)) deformed_[m] = scene.dynamicMeshes[m];
@@ -163,7 +165,7 @@ GpuScene::GpuScene(Context& ctx, const Scene& scene, const GpuSceneOptions& opti
   lightStepBytes_ = sizeof(dev::Light);
   lightSteps_ = ctx_.allocate("light motion steps", lightStepBytes_, CL_MEM_READ_ONLY);
   ctx_.zero(lightSteps_, lightStepBytes_);
-  sweepBytes_ = 6 * sizeof(float);
+  sweepBytes_ = kSweepRecordFloats * sizeof(float);
   sweeps_ = ctx_.allocate("shutter sweeps", sweepBytes_, CL_MEM_READ_ONLY);
   ctx_.zero(sweeps_, sweepBytes_);
   motionVertexBytes_ = sizeof(dev::ShadingVertex);
@@ -266,6 +268,7 @@ bool GpuScene::deformMeshes(double t, const std::vector<double>& times,
     for (const std::vector<dev::ShadingVertex>& step : stepShading)
       stepVertices.insert(stepVertices.end(), step.begin(), step.end());
     if (!times.empty()) vm[3] = uint32_t(times.size());
+    stepPositions_[m] = steps;  // the sweeps' parts at each step (collectSweeps)
     accel::BuildOptions build;
     build.width = bvhWidth_;
     dsg_.replaceMesh(static_cast<uint32_t>(m), shape.positions, shape.indices, build,
@@ -447,48 +450,54 @@ void GpuScene::collectMoved(const std::vector<accel::Aabb>& before,
 
 void GpuScene::collectSweeps(const std::vector<double>& times,
                              const std::vector<std::vector<glm::mat4>>& motion) {
-  std::vector<float> boxes;
+  std::vector<float> records;
   // Enlarged as moved_'s are, so that rounding in the kernels' tests cannot miss a face.
   const float pad = 1e-4f * sceneRadius_;
-  auto add = [&](const glm::vec3& lo, const glm::vec3& hi) {
-    for (int a = 0; a < 3; ++a) boxes.push_back(lo[a] - pad - 1e-4f * std::fabs(lo[a]));
-    for (int a = 0; a < 3; ++a) boxes.push_back(hi[a] + pad + 1e-4f * std::fabs(hi[a]));
-  };
-  // The top level's boxes hold each instance at every time of the interval.
-  const std::vector<accel::Aabb>& bounds = dsg_.instanceBounds();
-  for (size_t i = 0; i < scene_.instances.size() && i < bounds.size(); ++i) {
-    bool moves = scene_.meshDeforms(scene_.instances[i].mesh);
-    for (size_t k = 1; !moves && i < motion.size() && k < motion[i].size(); ++k)
-      moves = motion[i][k] != motion[i][0];
-    if (moves && !bounds[i].empty()) add(bounds[i].lo, bounds[i].hi);
+  if (sweepParts_.size() != scene_.dynamicMeshes.size())
+    sweepParts_.assign(scene_.dynamicMeshes.size(), {});
+  for (size_t i = 0; i < scene_.instances.size() && i < motion.size(); ++i) {
+    const uint32_t m = scene_.instances[i].mesh;
+    const bool deforms = scene_.meshDeforms(m);
+    bool moves = deforms;
+    for (size_t k = 1; !moves && k < motion[i].size(); ++k) moves = motion[i][k] != motion[i][0];
+    if (!moves) continue;
+    const TriangleMesh& mesh = scene_.dynamicMeshes[m];
+    if (sweepParts_[m].empty()) sweepParts_[m] = sweepParts(mesh.positions, mesh.indices);
+    std::vector<const std::vector<glm::vec3>*> at;
+    if (deforms && stepPositions_[m].size() == motion[i].size())
+      for (const std::vector<glm::vec3>& p : stepPositions_[m]) at.push_back(&p);
+    else
+      at.push_back(&mesh.positions);
+    appendInstanceSweep(sweepParts_[m], motion[i], at, pad, &records);
   }
   for (size_t i = 0; i < scene_.lights.size(); ++i) {
     if (!scene_.lights[i].dynamic || times.empty()) continue;
     const PunctualLight first = scene_.lightAt(i, times.front());
-    accel::Aabb box;
+    glm::vec3 lo = first.position, hi = first.position;
     bool moves = false;
     for (double at : times) {
       const PunctualLight l = scene_.lightAt(i, at);
-      box.grow(l.position);
+      lo = glm::min(lo, l.position);
+      hi = glm::max(hi, l.position);
       moves = moves || l.position != first.position || l.direction != first.direction;
     }
     if (!moves) continue;
     // A turning sun shines along other lines at other times: no light path holds.
     const float inf = std::numeric_limits<float>::infinity();
     if (first.type == LightType::Directional)
-      add(glm::vec3(-inf), glm::vec3(inf));
+      appendBoxSweep(glm::vec3(-inf), glm::vec3(inf), pad, &records);
     else
-      add(box.lo, box.hi);
+      appendBoxSweep(lo, hi, pad, &records);
   }
-  sweepCount_ = uint32_t(boxes.size() / 6);
-  if (boxes.empty()) return;
-  const uint64_t bytes = boxes.size() * sizeof(float);
+  sweepCount_ = uint32_t(records.size() / kSweepRecordFloats);
+  if (records.empty()) return;
+  const uint64_t bytes = records.size() * sizeof(float);
   if (bytes > sweepBytes_) {
     ctx_.release("shutter sweeps", sweepBytes_);
     sweeps_ = ctx_.allocate("shutter sweeps", bytes, CL_MEM_READ_ONLY);
     sweepBytes_ = bytes;
   }
-  CL_CHECK(ctx_.queue().enqueueWriteBuffer(sweeps_, CL_TRUE, 0, bytes, boxes.data()));
+  CL_CHECK(ctx_.queue().enqueueWriteBuffer(sweeps_, CL_TRUE, 0, bytes, records.data()));
 }
 
 bool GpuScene::validSurface(uint32_t prim, uint32_t inst) const {

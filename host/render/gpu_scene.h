@@ -214,7 +214,11 @@ class GpuScene {
   cl::Buffer lightSteps_;  // each punctual light at the motion steps (LightData.motion)
   uint64_t lightStepBytes_ = 0;
   uint32_t lightMotionSteps_ = 1;
-  cl::Buffer sweeps_;  // LightData.sweeps (collectSweeps)
+  cl::Buffer sweeps_;  // LightData.sweeps (collectSweeps; render/sweeps.h)
+  // Per dynamic mesh: its triangles' groups (sweepParts), and under a shutter a deforming mesh's
+  // positions at each motion step.
+  std::vector<std::vector<std::vector<uint32_t>>> sweepParts_;
+  std::vector<std::vector<std::vector<glm::vec3>>> stepPositions_;
   uint64_t sweepBytes_ = 0;
   uint32_t sweepCount_ = 0;
 

@@ -809,8 +809,9 @@ typedef struct {
   // motion_steps times over the interval (shared/motion.h), light by light.
   PR_GLOBAL const Light* motion;
   u32 motion_first, motion_count, motion_steps;
-  // --shutter: sweep_count boxes (lo xyz, hi xyz) that hold what moves while the shutter is
-  // open, which stored light paths must not meet to be joined at any time (sweep_clear).
+  // --shutter: sweep_count records (a box, lo xyz hi xyz, and its count of part records that
+  // follow; host/render/sweeps.h) that hold what moves while the shutter is open, which stored
+  // light paths must not meet to be joined at any time (sweep_clear).
   PR_GLOBAL const float* sweeps;
   u32 sweep_count;
 } LightData;
