@@ -60,10 +60,10 @@ PR_KERNEL void camera_splat(PR_PARAMS(PR_ARGS_CAMERA_SPLAT)) {
   // Under a shutter the path meets the camera at a time of its own, uniform over the interval as
   // the eye paths' are, and only as far as it holds at every time (light_segment_still).
   CameraParams cam_t = cam;
-  if (s.geom.motion_steps > 1u) {
+  if (cam_step_count > 1u) {  // the shutter is open (a scene without instances moves no mesh)
     Rng tr = rng_make(rp.seed, PR_RNG_SPLAT, rp.frame, slot, 0u);
     s.geom.time = s.sd.time = rng_next(&tr);
-    if (cam_step_count > 1u) cam_t = camera_at_time(cam_steps, cam_step_count, s.geom.time);
+    cam_t = camera_at_time(cam_steps, cam_step_count, s.geom.time);
   }
   const int sweeps = s.lights.sweep_count > 0u;
   if (sweeps && !light_segment_still(&s, l.type, v, 1u)) return;
