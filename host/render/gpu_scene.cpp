@@ -17,6 +17,7 @@
 #include "render/moved_tree.h"
 #include "render/sweeps.h"
 #include "scene/emission_power.h"
+#include "util/check.h"
 #include "util/error.h"
 #include "util/hash.h"
 #include "util/parallel.h"
@@ -140,6 +141,7 @@ GpuScene::GpuScene(Context& ctx, const Scene& scene, const GpuSceneOptions& opti
   deformed_.resize(scene.dynamicMeshes.size());
   lastPositions_.resize(scene.dynamicMeshes.size());
   stepPositions_.resize(scene.dynamicMeshes.size());
+  sweepParts_.resize(scene.dynamicMeshes.size());
   lastNormals_.resize(scene.dynamicMeshes.size());
   for (size_t m = 0; m < scene.dynamicMeshes.size(); ++m)
     if (scene.meshDeforms(m)) deformed_[m] = scene.dynamicMeshes[m];
@@ -268,11 +270,11 @@ bool GpuScene::deformMeshes(double t, const std::vector<double>& times,
     for (const std::vector<dev::ShadingVertex>& step : stepShading)
       stepVertices.insert(stepVertices.end(), step.begin(), step.end());
     if (!times.empty()) vm[3] = uint32_t(times.size());
-    stepPositions_[m] = steps;  // the sweeps' parts at each step (collectSweeps)
     accel::BuildOptions build;
     build.width = bvhWidth_;
     dsg_.replaceMesh(static_cast<uint32_t>(m), shape.positions, shape.indices, build,
                      times.empty() ? nullptr : &steps);
+    stepPositions_[m] = std::move(steps);  // the sweeps' parts at each step (collectSweeps)
     std::vector<dev::ShadingVertex> verts(shape.vertexCount());
     for (size_t v = 0; v < verts.size(); ++v) verts[v] = shadingVertex(shape, v);
     CL_CHECK(ctx_.queue().enqueueWriteBuffer(
@@ -453,8 +455,6 @@ void GpuScene::collectSweeps(const std::vector<double>& times,
   std::vector<float> records;
   // Enlarged as moved_'s are, so that rounding in the kernels' tests cannot miss a face.
   const float pad = 1e-4f * sceneRadius_;
-  if (sweepParts_.size() != scene_.dynamicMeshes.size())
-    sweepParts_.assign(scene_.dynamicMeshes.size(), {});
   for (size_t i = 0; i < scene_.instances.size() && i < motion.size(); ++i) {
     const uint32_t m = scene_.instances[i].mesh;
     const bool deforms = scene_.meshDeforms(m);
@@ -464,7 +464,9 @@ void GpuScene::collectSweeps(const std::vector<double>& times,
     const TriangleMesh& mesh = scene_.dynamicMeshes[m];
     if (sweepParts_[m].empty()) sweepParts_[m] = sweepParts(mesh.positions, mesh.indices);
     std::vector<const std::vector<glm::vec3>*> at;
-    if (deforms && stepPositions_[m].size() == motion[i].size())
+    // A deforming mesh's shapes at the same steps, from deformMeshes of this frame.
+    PR_CHECK(!deforms || stepPositions_[m].size() == motion[i].size());
+    if (deforms)
       for (const std::vector<glm::vec3>& p : stepPositions_[m]) at.push_back(&p);
     else
       at.push_back(&mesh.positions);

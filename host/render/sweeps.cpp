@@ -2,29 +2,18 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <numeric>
 #include <utility>
 
+#include "accel/bvh_builder.h"
+
 namespace pr {
+
+using accel::Aabb;
 
 namespace {
 
-struct Box {
-  glm::vec3 lo{std::numeric_limits<float>::infinity()};
-  glm::vec3 hi{-std::numeric_limits<float>::infinity()};
-  void grow(const glm::vec3& p) {
-    lo = glm::min(lo, p);
-    hi = glm::max(hi, p);
-  }
-  void grow(const Box& b) {
-    lo = glm::min(lo, b.lo);
-    hi = glm::max(hi, b.hi);
-  }
-  bool empty() const { return !(lo.x <= hi.x); }
-};
-
-void appendRecord(const Box& b, float pad, uint32_t parts, std::vector<float>* records) {
+void appendRecord(const Aabb& b, float pad, uint32_t parts, std::vector<float>* records) {
   for (int a = 0; a < 3; ++a) records->push_back(b.lo[a] - pad - 1e-4f * std::fabs(b.lo[a]));
   for (int a = 0; a < 3; ++a) records->push_back(b.hi[a] + pad + 1e-4f * std::fabs(b.hi[a]));
   records->push_back(float(parts));  // exact: parts < 2^24
@@ -50,7 +39,7 @@ std::vector<std::vector<uint32_t>> sweepParts(const std::vector<glm::vec3>& posi
         next.emplace_back(a, b);
         continue;
       }
-      Box box;
+      Aabb box;
       for (size_t i = a; i < b; ++i) box.grow(centre[tris[i]]);
       const glm::vec3 e = box.hi - box.lo;
       const int axis = e.x >= e.y && e.x >= e.z ? 0 : e.y >= e.z ? 1 : 2;
@@ -80,8 +69,8 @@ void appendInstanceSweep(const std::vector<std::vector<uint32_t>>& parts,
                          const std::vector<const std::vector<glm::vec3>*>& positions, float pad,
                          std::vector<float>* records) {
   if (parts.empty() || transforms.empty() || positions.empty()) return;
-  std::vector<Box> boxes(parts.size());
-  Box whole;
+  std::vector<Aabb> boxes(parts.size());
+  Aabb whole;
   for (size_t p = 0; p < parts.size(); ++p) {
     for (size_t k = 0; k < transforms.size(); ++k) {
       const std::vector<glm::vec3>& at = *positions[positions.size() == 1 ? 0 : k];
@@ -91,12 +80,12 @@ void appendInstanceSweep(const std::vector<std::vector<uint32_t>>& parts,
   }
   if (whole.empty()) return;
   appendRecord(whole, pad, uint32_t(parts.size()), records);
-  for (const Box& b : boxes) appendRecord(b, pad, 0, records);
+  for (const Aabb& b : boxes) appendRecord(b, pad, 0, records);
 }
 
 void appendBoxSweep(const glm::vec3& lo, const glm::vec3& hi, float pad,
                     std::vector<float>* records) {
-  Box b;
+  Aabb b;
   b.lo = lo;
   b.hi = hi;
   appendRecord(b, pad, 0, records);

@@ -219,9 +219,12 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
     rs_track_hit(track, rel, &hit, h.p, tr,
                  solid_angle_to_area_pdf(p.last_pdf, fabs(dot(h.ng, d)), dist2));
 
-  // Under a shutter, whether the segment just traced meets nothing that moves (shade_eye_paths.h).
-  const int seg_still = ep_ray_still(&s, make_float3(p.prev_x, p.prev_y, p.prev_z),
-                                     h.p - make_float3(p.prev_x, p.prev_y, p.prev_z), 1.0f);
+  // Under a shutter, whether the segment just traced meets nothing that moves (shade_eye_paths.h):
+  // asked only of x_1 x_2 and of the segments of paths the connections can still make.
+  const float3 prev = make_float3(p.prev_x, p.prev_y, p.prev_z);
+  const int seg_asked =
+      p.x1_depth > 0u && (p.depth == p.x1_depth || (p.eye_flags & PR_EYE_JOINABLE) != 0u);
+  const int seg_still = !seg_asked || ep_ray_still(&s, prev, h.p - prev, 1.0f);
   if (s.sd.materials[h.material].flags & PR_MAT_EMISSIVE) {
     EyeWeight ew;
     // Connections can make the paths that end after x_t, t >= 2 (x_t: the vertex `ray` left).
