@@ -1,9 +1,11 @@
 // The boxes of what moves while the shutter is open (host/render/sweeps.h): every triangle in one
 // part, every point of a moving mesh inside a part's box at every time between two motion steps
 // (not only at the steps), and the kernels' walk of the records (sweep_clear) finding what a test
-// of every part finds.
+// of every part finds, with and without the tree over them (sweepTree).
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
 #include <random>
 #include <set>
 #include <vector>
@@ -29,19 +31,50 @@ void grid(int n, std::vector<glm::vec3>* p, std::vector<uint32_t>* idx) {
     }
 }
 
-// Whether the segment meets the records as sweep_clear walks them: a record's parts only where
-// its box is met.
+// Whether the segment meets the records as sweep_clear walks them: into a record's subtree only
+// where its box is met, a leaf met deciding.
 bool walkMeets(const std::vector<float>& r, const float o[3], const float d[3]) {
   const size_t n = r.size() / kSweepRecordFloats;
   for (size_t k = 0; k < n;) {
     const float* rec = &r[k * kSweepRecordFloats];
-    const size_t parts = size_t(rec[6]);
-    if (segmentMeetsBox(rec, o, d)) {
-      if (parts == 0) return true;
-      for (size_t j = k + 1; j <= k + parts && j < n; ++j)
-        if (segmentMeetsBox(&r[j * kSweepRecordFloats], o, d)) return true;
-    }
-    k += 1 + parts;
+    const size_t below = size_t(rec[6]);
+    if (!segmentMeetsBox(rec, o, d))
+      k += 1 + below;
+    else if (below == 0)
+      return true;
+    else
+      ++k;
+  }
+  return false;
+}
+
+// Whether the records from k on form a subtree ending at `end` (its children's subtrees ending
+// exactly where it says it ends, each box inside its parent's); returns where it ends.
+size_t subtreeEnd(const std::vector<float>& r, size_t k, bool* ok) {
+  const float* rec = &r[k * kSweepRecordFloats];
+  const size_t end = k + 1 + size_t(rec[6]);
+  size_t c = k + 1;
+  while (c < end && *ok) {
+    const float* child = &r[c * kSweepRecordFloats];
+    for (int a = 0; a < 3; ++a) *ok = *ok && child[a] >= rec[a] && child[3 + a] <= rec[3 + a];
+    c = subtreeEnd(r, c, ok);
+  }
+  *ok = *ok && c == end && end <= r.size() / kSweepRecordFloats;
+  return end;
+}
+
+bool wellFormed(const std::vector<float>& r) {
+  bool ok = true;
+  size_t k = 0;
+  while (ok && k < r.size() / kSweepRecordFloats) k = subtreeEnd(r, k, &ok);
+  return ok && k == r.size() / kSweepRecordFloats;
+}
+
+// Whether the segment meets any leaf of the records (a record with nothing below it).
+bool anyLeafMeets(const std::vector<float>& r, const float o[3], const float d[3]) {
+  for (size_t k = 0; k < r.size() / kSweepRecordFloats; ++k) {
+    const float* rec = &r[k * kSweepRecordFloats];
+    if (rec[6] == 0.0f && segmentMeetsBox(rec, o, d)) return true;
   }
   return false;
 }
@@ -111,8 +144,9 @@ TEST(Sweeps, DeformedStepsAreHeld) {
   EXPECT_FALSE(walkMeets(records, above, d));
 }
 
-// The walk that skips a record's parts where its box is missed finds what testing every part
-// finds, over random segments and records of several instances and light boxes.
+// The walk that skips a record's subtree where its box is missed finds what testing every part
+// finds, over random segments and records of many instances and light boxes, as appended and
+// under the tree over them; the tree holds every record once.
 TEST(Sweeps, TheWalkFindsWhatEveryPartFinds) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> u(-5.0f, 5.0f);
@@ -121,7 +155,7 @@ TEST(Sweeps, TheWalkFindsWhatEveryPartFinds) {
   grid(6, &p, &idx);
   const auto parts = sweepParts(p, idx);
   std::vector<float> records;
-  for (int i = 0; i < 4; ++i) {
+  for (int i = 0; i < 12; ++i) {
     const glm::vec3 at(u(rng), u(rng), u(rng));
     appendInstanceSweep(parts,
                         {glm::translate(glm::scale(glm::mat4(1.0f), glm::vec3(0.3f)), at),
@@ -129,22 +163,46 @@ TEST(Sweeps, TheWalkFindsWhatEveryPartFinds) {
                         {&p}, 1e-4f, &records);
     appendBoxSweep(at, at + 0.2f, 1e-4f, &records);
   }
+  const std::vector<float> tree = sweepTree(records, 2);
+  auto leaves = [](const std::vector<float>& r) {
+    std::multiset<std::vector<float>> l;
+    for (size_t k = 0; k < r.size() / kSweepRecordFloats; ++k)
+      if (r[k * kSweepRecordFloats + 6] == 0.0f)
+        l.emplace(r.begin() + long(k * kSweepRecordFloats),
+                  r.begin() + long((k + 1) * kSweepRecordFloats));
+    return l;
+  };
+  EXPECT_EQ(leaves(tree), leaves(records));
+  EXPECT_GT(tree.size(), records.size());  // its inner nodes
+  EXPECT_TRUE(wellFormed(records));
+  EXPECT_TRUE(wellFormed(tree));
   int met = 0;
-  for (int s = 0; s < 2000; ++s) {
+  for (int s = 0; s < 4000; ++s) {
     const float o[3] = {u(rng), u(rng), u(rng)}, d[3] = {u(rng), u(rng), u(rng)};
-    bool any = false;
-    const size_t n = records.size() / kSweepRecordFloats;
-    for (size_t k = 0; k < n; ++k) {
-      const float* rec = &records[k * kSweepRecordFloats];
-      // An instance's own box holds its parts: a leaf (no parts of its own) decides.
-      const bool leaf = rec[6] == 0.0f;
-      any = any || (leaf && segmentMeetsBox(rec, o, d));
-    }
+    // An instance's own box holds its parts: a leaf (no parts of its own) decides.
+    const bool any = anyLeafMeets(records, o, d);
     EXPECT_EQ(walkMeets(records, o, d), any) << "segment " << s;
+    EXPECT_EQ(walkMeets(tree, o, d), any) << "segment " << s;
     met += any;
   }
-  EXPECT_GT(met, 50);
-  EXPECT_LT(met, 1900);
+  EXPECT_GT(met, 100);
+  EXPECT_LT(met, 3900);
+}
+
+// A turning sun's record (all space) stays a leaf that every segment meets, wherever the tree
+// puts it.
+TEST(Sweeps, AnUnboundedRecordInTheTreeMeetsEverySegment) {
+  std::vector<float> records;
+  for (int i = 0; i < 9; ++i)
+    appendBoxSweep(glm::vec3(float(i)), glm::vec3(float(i) + 0.5f), 1e-4f, &records);
+  const float inf = std::numeric_limits<float>::infinity();
+  appendBoxSweep(glm::vec3(-inf), glm::vec3(inf), 1e-4f, &records);
+  const std::vector<float> tree = sweepTree(records, 2);
+  const float o1[3] = {-50.0f, 3.0f, 7.0f}, d1[3] = {0.0f, 0.0f, 1.0f};
+  EXPECT_TRUE(walkMeets(tree, o1, d1));
+  const float o2[3] = {100.0f, -40.0f, 2.0f}, d2[3] = {1.0f, 0.0f, 0.0f};
+  EXPECT_TRUE(walkMeets(tree, o2, d2));
+  for (float v : tree) EXPECT_FALSE(std::isnan(v));
 }
 
 }  // namespace

@@ -491,6 +491,7 @@ void GpuScene::collectSweeps(const std::vector<double>& times,
     else
       appendBoxSweep(lo, hi, pad, &records);
   }
+  records = sweepTree(records);
   sweepCount_ = uint32_t(records.size() / kSweepRecordFloats);
   if (records.empty()) return;
   const uint64_t bytes = records.size() * sizeof(float);

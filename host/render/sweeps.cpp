@@ -91,4 +91,65 @@ void appendBoxSweep(const glm::vec3& lo, const glm::vec3& hi, float pad,
   appendRecord(b, pad, 0, records);
 }
 
+namespace {
+
+struct SweepTreeBuilder {
+  const std::vector<float>& in;
+  std::vector<size_t> tops;  // first record of each top-level subtree
+  std::vector<float> out;
+  size_t leafSize;
+
+  const float* record(size_t k) const { return &in[k * kSweepRecordFloats]; }
+  size_t size(size_t k) const { return 1 + size_t(record(k)[6]); }
+  // A finite stand-in for an unbounded box's centre (a turning sun's is all space).
+  float centre(size_t k, int a) const {
+    const float c = 0.5f * (std::clamp(record(k)[a], -1e30f, 1e30f) +
+                            std::clamp(record(k)[3 + a], -1e30f, 1e30f));
+    return std::isfinite(c) ? c : 0.0f;
+  }
+
+  void build(size_t first, size_t last) {  // tops[first, last)
+    if (last - first <= leafSize) {
+      for (size_t i = first; i < last; ++i) {
+        const float* r = record(tops[i]);
+        out.insert(out.end(), r, r + size(tops[i]) * kSweepRecordFloats);
+      }
+      return;
+    }
+    float box[6] = {1e30f, 1e30f, 1e30f, -1e30f, -1e30f, -1e30f};
+    float lo[3] = {1e30f, 1e30f, 1e30f}, hi[3] = {-1e30f, -1e30f, -1e30f};
+    for (size_t i = first; i < last; ++i)
+      for (int a = 0; a < 3; ++a) {
+        box[a] = std::min(box[a], record(tops[i])[a]);
+        box[3 + a] = std::max(box[3 + a], record(tops[i])[3 + a]);
+        lo[a] = std::min(lo[a], centre(tops[i], a));
+        hi[a] = std::max(hi[a], centre(tops[i], a));
+      }
+    int axis = 0;
+    for (int a = 1; a < 3; ++a)
+      if (hi[a] - lo[a] > hi[axis] - lo[axis]) axis = a;
+    const size_t mid = first + (last - first) / 2;
+    std::nth_element(tops.begin() + std::ptrdiff_t(first), tops.begin() + std::ptrdiff_t(mid),
+                     tops.begin() + std::ptrdiff_t(last),
+                     [&](size_t x, size_t y) { return centre(x, axis) < centre(y, axis); });
+    const size_t self = out.size();
+    out.insert(out.end(), box, box + 6);
+    out.push_back(0.0f);
+    build(first, mid);
+    build(mid, last);
+    out[self + 6] = float((out.size() - self) / kSweepRecordFloats - 1);  // exact below 2^24
+  }
+};
+
+}  // namespace
+
+std::vector<float> sweepTree(const std::vector<float>& records, size_t leafSize) {
+  SweepTreeBuilder b{records, {}, {}, std::max<size_t>(leafSize, 1)};
+  const size_t n = records.size() / kSweepRecordFloats;
+  for (size_t k = 0; k < n; k += b.size(k)) b.tops.push_back(k);
+  b.out.reserve(2 * records.size());
+  b.build(0, b.tops.size());
+  return std::move(b.out);
+}
+
 }  // namespace pr

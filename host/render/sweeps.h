@@ -1,7 +1,9 @@
 // What moves while the shutter is open, as boxes that kernels test light sub-paths against
 // (LightData.sweeps, kernels/shared/transport.h sweep_clear; docs/design.md section 3, "Path
-// reuse over the shutter"). A record is a box (lo xyz, hi xyz) and the number of part records
-// that follow it, 7 floats; the parts are tested only where a segment meets the record's box.
+// reuse over the shutter"). A record is a box (lo xyz, hi xyz) and the number of records that
+// follow it in its subtree, 7 floats: a segment that meets a record with none (a leaf) meets what
+// moves; the subtree of a record whose box it misses is skipped. Top level: a tree over the
+// moving instances and lights (sweepTree); below an instance's record, its parts.
 // A moving instance is a record over its parts: its triangles in spatially coherent groups,
 // each group's box holding the group at every motion step (a blend between two steps moves
 // every point along the segment between its placements, inside the union of the two boxes).
@@ -34,5 +36,11 @@ void appendInstanceSweep(const std::vector<std::vector<uint32_t>>& parts,
 // Appends a record without parts: the box [lo, hi] enlarged as appendInstanceSweep's.
 void appendBoxSweep(const glm::vec3& lo, const glm::vec3& hi, float pad,
                     std::vector<float>* records);
+
+// The records (each top-level record followed by its subtree, as the append functions leave
+// them) under a tree of boxes over the top-level ones, split at the median of their centres
+// along the widest axis down to leafSize records, so that a segment is tested against a few
+// boxes where the city has 45 moving instances.
+std::vector<float> sweepTree(const std::vector<float>& records, size_t leafSize = 4);
 
 }  // namespace pr

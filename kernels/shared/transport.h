@@ -327,19 +327,20 @@ PR_INLINE int ray_meets_box(PR_GLOBAL const float* b, float3 o, float3 d, float 
 // punctual light's positions; all space where a directional light turns). A light sub-path whose
 // segments all pass them is the same path at every time of the interval, so a sample at any time
 // may be joined to it (strategies L and T); every weight of such paths asks this of the same
-// segments, from either end. A record is a box and its count of parts, tested where it is met.
+// segments, from either end. A record is a box and the size of its subtree, walked in order:
+// into it where its box is met (a leaf met: not clear), past it where not.
 #define PR_SWEEP_FLOATS 7u
 PR_INLINE int sweep_clear(const SceneData* s, float3 o, float3 d, float tmax) {
   const u32 n = s->lights.sweep_count;
   for (u32 k = 0u; k < n;) {
     PR_GLOBAL const float* r = s->lights.sweeps + PR_SWEEP_FLOATS * k;
-    const u32 parts = (u32)r[6];
-    if (ray_meets_box(r, o, d, tmax)) {
-      if (parts == 0u) return 0;
-      for (u32 j = k + 1u; j <= k + parts && j < n; ++j)
-        if (ray_meets_box(s->lights.sweeps + PR_SWEEP_FLOATS * j, o, d, tmax)) return 0;
-    }
-    k += 1u + parts;
+    const u32 below = (u32)r[6];
+    if (!ray_meets_box(r, o, d, tmax))
+      k += 1u + below;
+    else if (below == 0u)
+      return 0;
+    else
+      ++k;
   }
   return 1;
 }
