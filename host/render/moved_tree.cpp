@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstdint>
 
+#include "render/median_split.h"
+
 namespace pr {
 namespace {
 
@@ -37,27 +39,14 @@ struct Builder {
     std::copy(n.box, n.box + 6, n.box + 6);
     n.root = n.root_before = PR_INVALID_INDEX;
     n.node = 1u;
-    // Split at the median along the longest extent of the boxes' centres.
-    float lo[3] = {1e30f, 1e30f, 1e30f}, hi[3] = {-1e30f, -1e30f, -1e30f};
     auto centre = [](const dev::MovedInstance& m, int a) {
       float b[6] = {1e30f, 1e30f, 1e30f, -1e30f, -1e30f, -1e30f};
       unionInto(m, b);
       return b[a] <= b[3 + a] ? 0.5f * (b[a] + b[3 + a]) : 0.0f;
     };
-    for (size_t i = first; i < last; ++i)
-      for (int a = 0; a < 3; ++a) {
-        lo[a] = std::min(lo[a], centre(in[i], a));
-        hi[a] = std::max(hi[a], centre(in[i], a));
-      }
-    int axis = 0;
-    for (int a = 1; a < 3; ++a)
-      if (hi[a] - lo[a] > hi[axis] - lo[axis]) axis = a;
-    const size_t mid = first + (last - first) / 2;
-    std::nth_element(in.begin() + std::ptrdiff_t(first), in.begin() + std::ptrdiff_t(mid),
-                     in.begin() + std::ptrdiff_t(last),
-                     [&](const dev::MovedInstance& x, const dev::MovedInstance& y) {
-                       return centre(x, axis) < centre(y, axis);
-                     });
+    const auto begin = in.begin();
+    const size_t mid = size_t(
+        medianSplit(begin + std::ptrdiff_t(first), begin + std::ptrdiff_t(last), centre) - begin);
     const size_t self = out.size();
     out.push_back(n);
     build(first, mid);

@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "accel/bvh_builder.h"
+#include "render/median_split.h"
 
 namespace pr {
 
@@ -39,13 +40,9 @@ std::vector<std::vector<uint32_t>> sweepParts(const std::vector<glm::vec3>& posi
         next.emplace_back(a, b);
         continue;
       }
-      Aabb box;
-      for (size_t i = a; i < b; ++i) box.grow(centre[tris[i]]);
-      const glm::vec3 e = box.hi - box.lo;
-      const int axis = e.x >= e.y && e.x >= e.z ? 0 : e.y >= e.z ? 1 : 2;
-      const size_t mid = (a + b) / 2;
-      std::nth_element(tris.begin() + long(a), tris.begin() + long(mid), tris.begin() + long(b),
-                       [&](uint32_t x, uint32_t y) { return centre[x][axis] < centre[y][axis]; });
+      const size_t mid = size_t(medianSplit(tris.begin() + long(a), tris.begin() + long(b),
+                                            [&](uint32_t t, int axis) { return centre[t][axis]; }) -
+                                tris.begin());
       next.emplace_back(a, mid);
       next.emplace_back(mid, b);
     }
@@ -117,21 +114,16 @@ struct SweepTreeBuilder {
       return;
     }
     float box[6] = {1e30f, 1e30f, 1e30f, -1e30f, -1e30f, -1e30f};
-    float lo[3] = {1e30f, 1e30f, 1e30f}, hi[3] = {-1e30f, -1e30f, -1e30f};
     for (size_t i = first; i < last; ++i)
       for (int a = 0; a < 3; ++a) {
         box[a] = std::min(box[a], record(tops[i])[a]);
         box[3 + a] = std::max(box[3 + a], record(tops[i])[3 + a]);
-        lo[a] = std::min(lo[a], centre(tops[i], a));
-        hi[a] = std::max(hi[a], centre(tops[i], a));
       }
-    int axis = 0;
-    for (int a = 1; a < 3; ++a)
-      if (hi[a] - lo[a] > hi[axis] - lo[axis]) axis = a;
-    const size_t mid = first + (last - first) / 2;
-    std::nth_element(tops.begin() + std::ptrdiff_t(first), tops.begin() + std::ptrdiff_t(mid),
-                     tops.begin() + std::ptrdiff_t(last),
-                     [&](size_t x, size_t y) { return centre(x, axis) < centre(y, axis); });
+    const auto begin = tops.begin();
+    const size_t mid =
+        size_t(medianSplit(begin + std::ptrdiff_t(first), begin + std::ptrdiff_t(last),
+                           [&](size_t k, int a) { return centre(k, a); }) -
+               begin);
     const size_t self = out.size();
     out.insert(out.end(), box, box + 6);
     out.push_back(0.0f);
