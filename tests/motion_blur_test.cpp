@@ -131,18 +131,21 @@ Image difference(const Image& a, const Image& b) {
 // the middles of the interval's sixteenths (frames 49, 51, ... 79 at 64 fps, path traced), block
 // by block within the noise (the blocks' means of the per-pixel difference, whose spread is the
 // noise alone); and the sharp frame at t = 1 is farther from that mean, where the thing moves.
-// In `mode`; path reuse renders frames 0 and 1, so that frame 1 keeps frame 0's still paths, with
-// a light path of its own for every pixel sample (their noise then in the blocks' spread).
+// In `mode` with `extra`; path reuse and resampling render frames 0 and 1, so that frame 1 keeps
+// frame 0's still paths (or reservoirs), with a light path of its own for every pixel sample
+// (their noise then in the blocks' spread).
 void expectBlurIsTheMeanOfInstants(Moving what, const std::string& tag,
-                                   const std::string& mode = "pathtrace") {
+                                   const std::string& mode = "pathtrace",
+                                   const std::string& extra = "") {
   const std::string scene = movingScene(what, tag);
   auto args = [](const std::string& m, int spp) {
     return std::string(kArgs) + " --mode " + m + " --spp " + std::to_string(spp) +
            (m != "pathtrace" ? " --light-paths " + std::to_string(kW * kH * spp) : "");
   };
-  const char* frames = mode != "pathtrace" ? "0-1" : "1";
+  const char* frames = mode != "pathtrace" || !extra.empty() ? "0-1" : "1";
   const Image blurred = test::frameImage(
-      test::renderFrames(scene, frames, args(mode, 128) + " --fps 1 --shutter 0.5", tag + "-blur"),
+      test::renderFrames(scene, frames, args(mode, 128) + " --fps 1 --shutter 0.5 " + extra,
+                         tag + "-blur"),
       1);
   const Image sharp = test::frameImage(
       test::renderFrames(scene, "1", args("pathtrace", 128) + " --fps 1", tag + "-sharp"), 1);
@@ -191,6 +194,18 @@ TEST_P(MeanOfInstants, TheBlurredFrameIsTheMeanOfItsInstants) {
 // open, and the eye paths' weights saying the same of the same segments.
 TEST_P(MeanOfInstants, PathReuseGivesTheMeanOfItsInstants) {
   expectBlurIsTheMeanOfInstants(GetParam(), "mb-reuse-" + motionName({GetParam(), 0}), "reuse");
+}
+
+// Resampling across pixels and frames (shared/resample.h, "Under a shutter"): a neighbour's or
+// the previous frame's path or light, sampled at another time, is taken only where it is the same
+// at every time of both frames' intervals, and its new segment is traced at this sample's time.
+// The path tracer's and path reuse's eye paths.
+TEST_P(MeanOfInstants, ResamplingGivesTheMeanOfItsInstants) {
+  const std::string name = motionName({GetParam(), 0});
+  expectBlurIsTheMeanOfInstants(GetParam(), "mb-rs-" + name, "pathtrace",
+                                "--resample --resample-neighbors 3");
+  expectBlurIsTheMeanOfInstants(GetParam(), "mb-rs-reuse-" + name, "reuse",
+                                "--resample --resample-neighbors 1");
 }
 
 INSTANTIATE_TEST_SUITE_P(MotionBlur, MeanOfInstants,
@@ -270,13 +285,12 @@ TEST(MotionBlur, StepsFollowTheMotion) {
   EXPECT_LE(skinTurn, 33u);
 }
 
-// What is not built for an open shutter is refused in one line, exit 2: resampling, the
-// connection history, and path reuse without the eye paths it weighs its connections against.
+// What is not built for an open shutter is refused in one line, exit 2: the connection history,
+// and path reuse without the eye paths it weighs its connections against.
 TEST(MotionBlur, RefusesWhatIsNotBuiltForAnOpenShutter) {
   const std::string scene = movingScene(Moving::Object, "mb-refuse");
   for (const char* extra :
-       {"--mode pathtrace --resample", "--mode reuse --resample", "--mode reuse --no-eye-paths",
-        "--mode retrace --connection-history 4"}) {
+       {"--mode reuse --no-eye-paths", "--mode retrace --connection-history 4"}) {
     SCOPED_TRACE(extra);
     const test::CommandResult r =
         test::runPathreuse("render " + scene + " " + extra + " --shutter 0.5 --frames 0 --out " +

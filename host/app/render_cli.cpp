@@ -104,7 +104,7 @@ std::vector<Row> sceneAndOutputRows() {
           .withDefault(),
       Row{"--shutter", kScene, kEveryday, kEstimator, PR_FIELD(ro.shutter),
           "Motion blur: the shutter stays open this many frames, centred on each frame's time "
-          "(0: none; not with --resample or --connection-history)"}
+          "(0: none; not with --connection-history)"}
           .range(0, 2)
           .withDefault(),
       Row{"--camera", kScene, kEveryday, kEstimator, PR_FIELD(ro.camera),

@@ -170,6 +170,9 @@ GpuScene::GpuScene(Context& ctx, const Scene& scene, const GpuSceneOptions& opti
   sweepBytes_ = kSweepRecordFloats * sizeof(float);
   sweeps_ = ctx_.allocate("shutter sweeps", sweepBytes_, CL_MEM_READ_ONLY);
   ctx_.zero(sweeps_, sweepBytes_);
+  prevSweepBytes_ = sweepBytes_;
+  prevSweeps_ = ctx_.allocate("shutter sweeps", prevSweepBytes_, CL_MEM_READ_ONLY);
+  ctx_.zero(prevSweeps_, prevSweepBytes_);
   motionVertexBytes_ = sizeof(dev::ShadingVertex);
   motionVertices_ =
       ctx_.allocate("deforming mesh vertex motion steps", motionVertexBytes_, CL_MEM_READ_ONLY);
@@ -452,6 +455,10 @@ void GpuScene::collectMoved(const std::vector<accel::Aabb>& before,
 
 void GpuScene::collectSweeps(const std::vector<double>& times,
                              const std::vector<std::vector<glm::mat4>>& motion) {
+  // This frame's records go where the frame before last's were (the queue runs in order).
+  std::swap(sweeps_, prevSweeps_);
+  std::swap(sweepBytes_, prevSweepBytes_);
+  std::swap(sweepCount_, prevSweepCount_);
   std::vector<float> records;
   // Enlarged as moved_'s are, so that rounding in the kernels' tests cannot miss a face.
   const float pad = 1e-4f * sceneRadius_;

@@ -102,6 +102,10 @@ class GpuScene {
   const cl::Buffer& previousInstances() const {
     return prevInstances_() ? prevInstances_ : shadingInstances_;
   }
+  // Under a shutter, the previous setTime's sweeps (pt_resample's temporal tests) and their count
+  // of records.
+  const cl::Buffer& previousSweeps() const { return prevSweeps_; }
+  uint32_t previousSweepCount() const { return prevSweepCount_; }
   // Host seconds the last setTime spent deforming meshes and rebuilding their BVHs.
   double lastDeformSeconds() const { return deformSeconds_; }
   bool hasAlphaMaterials() const { return hasAlpha_; }
@@ -221,6 +225,9 @@ class GpuScene {
   std::vector<std::vector<std::vector<glm::vec3>>> stepPositions_;
   uint64_t sweepBytes_ = 0;
   uint32_t sweepCount_ = 0;
+  cl::Buffer prevSweeps_;  // the previous setTime's sweeps_, swapped with it
+  uint64_t prevSweepBytes_ = 0;
+  uint32_t prevSweepCount_ = 0;
 
   cl::Buffer vertices_, triangles_, shadingInstances_, materials_, textures_, texels_;
   cl::Buffer prevVertices_, prevInstances_;  // keepPrevious

@@ -252,6 +252,10 @@ void PathTracer::beginFrame(int64_t frame, const dev::CameraParams& camera,
     resampleArgs_.prev_vertices = scene_.previousVertices();
     resampleArgs_.prev_instances = scene_.previousInstances();
     resampleArgs_.stamp = stamp_;
+    resampleArgs_.prev_sweeps = scene_.previousSweeps();
+    resampleArgs_.prev_sweep_count = scene_.previousSweepCount();
+    resampleArgs_.cam_steps = scene_.cameraSteps();
+    resampleArgs_.cam_step_count = scene_.motionSteps();
     resampleArgs_.set(resample_, kargs::kScene | kargs::kFrame);
   }
   generateArgs_.cam = camera;

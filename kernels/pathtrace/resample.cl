@@ -37,6 +37,12 @@ PR_INLINE uint rs_neighbor(const ResampleParams* rsp, uint j, uint first, uint e
   return i >= first && i < end ? i : PR_INVALID_INDEX;
 }
 
+// The camera that sample `sample` of pixel i sees through: under --shutter, at its time.
+PR_INLINE CameraParams rs_camera_at(const CameraParams* cam, __global const CameraParams* steps,
+                                    uint count, uint seed, uint frame, uint i, uint sample) {
+  return count > 1u ? camera_at_time(steps, count, shutter_time(seed, frame, i, sample)) : *cam;
+}
+
 // Path r moved to x by reconnection: its target there (shadow ray included), its f in *f, the
 // new segment's g in *g and the Jacobian in *jac (0 where the shift fails or is occluded).
 PR_INLINE float rs_target_at(const SceneData* s, const RsPrimary* x,
@@ -120,18 +126,31 @@ PR_INLINE void rs_merge_take(RsMerge* mg, float w, float u, float3 f, float p, f
   mg->kept = d;
 }
 
-// Domain d's path ri (confidence c_i; past: the previous frame's, seen from xi) into mg, and the
-// canonical path rc's MIS term against that domain. same: xi is x (the previous frame's x_1 is
-// this one's): the shift is then the identity both ways, and where the path meets nothing that
-// moved, its target, f and g are the ones it keeps (its segments seen clear when it was made).
-PR_INLINE void rs_merge_path(const SceneData* s, const RsPrimary* x, const RsPrimary* xi,
-                             __global const PathReservoir* rc, __global const PathReservoir* ri,
-                             int past, int same, float c_i, float kf, float total, float u, uint d,
+// Whether path r may move between x and the x_1 xi of another domain (past: the previous frame's;
+// under a shutter, another time: rs_path_still).
+PR_INLINE int rs_path_movable(const SceneData* s, const RsPrimary* x, const RsPrimary* xi,
+                              __global const PathReservoir* r, int past,
+                              __global const MovedInstance* moved, const ResampleParams* rsp,
+                              const RsSweeps* w) {
+  return (!past || rs_temporal_ok(s, moved, rsp->moved_count, r, xi, x, rsp->prev_known)) &&
+         (rs_sweeps_none(w, past) ||
+          rs_path_still(w, past, r, surface_at(&s->sd, r->prim, r->inst, r->b1, r->b2).p, past,
+                        xi->h.p));
+}
+
+// Domain d's path ri (confidence c_i; past: the previous frame's, seen from xi in scene si, at
+// its sample's time) into mg, and the canonical path rc's MIS term against that domain. same: xi
+// is x (the previous frame's x_1 is this one's): the shift is then the identity both ways, and
+// where the path meets nothing that moved, its target, f and g are the ones it keeps (its
+// segments seen clear when it was made).
+PR_INLINE void rs_merge_path(const SceneData* s, const SceneData* si, const RsPrimary* x,
+                             const RsPrimary* xi, __global const PathReservoir* rc,
+                             __global const PathReservoir* ri, int past, int same, float c_i,
+                             float kf, float total, float u, uint d,
                              __global const MovedInstance* moved, const ResampleParams* rsp,
-                             RsMerge* mg, uint* traced) {
+                             const RsSweeps* w, RsMerge* mg, uint* traced) {
   const int has_c = rs_has_path(rc);
-  if (rs_has_path(ri) &&
-      (!past || rs_temporal_ok(s, moved, rsp->moved_count, ri, xi, x, rsp->prev_known))) {
+  if (rs_has_path(ri) && rs_path_movable(s, x, xi, ri, past, moved, rsp, w)) {
     float3 f = make_float3(ri->f_r, ri->f_g, ri->f_b);
     float g = ri->g_src, jac = 1.0f;
     const float p = same ? ri->p_hat : rs_target_at(s, x, ri, rsp, &f, &g, &jac, traced);
@@ -141,24 +160,33 @@ PR_INLINE void rs_merge_path(const SceneData* s, const RsPrimary* x, const RsPri
     }
   }
   float p_back = 0.0f;
-  if (has_c && (!past || rs_temporal_ok(s, moved, rsp->moved_count, rc, xi, x, rsp->prev_known))) {
+  if (has_c && rs_path_movable(s, x, xi, rc, past, moved, rsp, w)) {
     float3 f;
     float g, jac = 1.0f;
-    const float p = same ? rc->p_hat : rs_target_at(s, xi, rc, rsp, &f, &g, &jac, traced);
+    const float p = same ? rc->p_hat : rs_target_at(si, xi, rc, rsp, &f, &g, &jac, traced);
     p_back = p * jac;
   }
   mg->canon += mis_pairwise_canonical_term(c_i, p_back, 1.0f, has_c ? rc->p_hat : 0.0f, kf, total);
 }
 
+// Whether light r may move between x and the x_1 xi of another domain, as rs_path_movable.
+PR_INLINE int di_movable(const SceneData* s, const RsPrimary* x, const RsPrimary* xi,
+                         __global const DirectReservoir* r, int past,
+                         __global const MovedInstance* moved, const ResampleParams* rsp,
+                         const RsSweeps* w) {
+  return (!past || di_temporal_ok(s, moved, rsp->moved_count, r, xi, x, rsp->prev_known)) &&
+         di_still(s, w, past, r, past, xi->h.p);
+}
+
 // The same for the direct light's reservoirs (Jacobian 1).
-PR_INLINE void rs_merge_direct(const SceneData* s, const RsPrimary* x, const RsPrimary* xi,
-                               __global const DirectReservoir* dc,
+PR_INLINE void rs_merge_direct(const SceneData* s, const SceneData* si, const RsPrimary* x,
+                               const RsPrimary* xi, __global const DirectReservoir* dc,
                                __global const DirectReservoir* di, int past, int same, float c_i,
                                float kf, float total, float u, uint d,
-                               __global const MovedInstance* moved, uint moved_count,
-                               uint prev_known, RsMerge* mg, uint* traced) {
+                               __global const MovedInstance* moved, const ResampleParams* rsp,
+                               const RsSweeps* w, RsMerge* mg, uint* traced) {
   const int has_c = di_has_light(dc);
-  if (di_has_light(di) && (!past || di_temporal_ok(s, moved, moved_count, di, xi, x, prev_known))) {
+  if (di_has_light(di) && di_movable(s, x, xi, di, past, moved, rsp, w)) {
     float3 f = make_float3(di->f_r, di->f_g, di->f_b);
     const float p = same ? di->p_hat : di_target_at(s, x, di, &f, traced);
     if (p > 0.0f) {
@@ -167,9 +195,9 @@ PR_INLINE void rs_merge_direct(const SceneData* s, const RsPrimary* x, const RsP
     }
   }
   float p_back = 0.0f;
-  if (has_c && (!past || di_temporal_ok(s, moved, moved_count, dc, xi, x, prev_known))) {
+  if (has_c && di_movable(s, x, xi, dc, past, moved, rsp, w)) {
     float3 f;
-    p_back = same ? dc->p_hat : di_target_at(s, xi, dc, &f, traced);
+    p_back = same ? dc->p_hat : di_target_at(si, xi, dc, &f, traced);
   }
   mg->canon += mis_pairwise_canonical_term(c_i, p_back, 1.0f, has_c ? dc->p_hat : 0.0f, kf, total);
 }
@@ -257,15 +285,25 @@ PR_KERNEL void pt_resample(PR_PARAMS(PR_ARGS_PT_RESAMPLE_SPATIAL)) {
   __global PathHistory* out = history_out + j;
   rs_history_start(out, &e, stamp);
   if (e.prim == PR_INVALID_INDEX) return;  // no x_1: nothing was resampled
-  const SceneData s = PR_SCENE();
-  // The previous frame's shapes, on which its x_1 are rebuilt (rsp.prev_known: they are known;
-  // they differ from this frame's only on what moved).
+  // The scene at this sample's time (--shutter; its x_1's and paths' time).
+  SceneData s = PR_SCENE();
+  const SceneData frame_scene = s;
+  scene_at_sample(&s, seed, frame, j, sample);
+  // The previous frame's shapes, at that frame's time, on which its x_1 are rebuilt
+  // (rsp.prev_known: they are known; they differ from this frame's only on what moved).
   SceneData sp = s;
   sp.sd.vertices = prev_vertices;
   sp.sd.instances = prev_instances;
+  sp.sd.motion_steps = 1u;
+  RsSweeps sw;
+  sw.now = s.lights.sweeps;
+  sw.now_count = s.lights.sweep_count;
+  sw.then = prev_sweeps;
+  sw.then_count = prev_sweep_count;
   __global const PathReservoir* rc = rs_res + j;
   __global const DirectReservoir* dc = di_res + j;
-  const RsPrimary x = rs_primary(&s, &e, &rsp, &cam);
+  const CameraParams cx = rs_camera_at(&cam, cam_steps, cam_step_count, seed, frame, j, sample);
+  const RsPrimary x = rs_primary(&s, &e, &rsp, &cx);
   Rng rng = rng_make(seed, PR_RNG_PATH_RESAMPLE, frame, j, sample);
   rng.dim = 0x10000u;  // apart from the paths' offers (PR_RS_DIM)
   Rng rng_d = rng;
@@ -303,21 +341,27 @@ PR_KERNEL void pt_resample(PR_PARAMS(PR_ARGS_PT_RESAMPLE_SPATIAL)) {
     const EyeVertex ei = past ? rs_history_eye(history + q) : eye[nb[d]];
     // The same x_1 seen the same way, where it did not move: the shift is the identity.
     const int same = past && !x_moved && rs_same_eye(&ei, &e);
+    // A neighbour's sample is at its own time: its scene and camera then.
+    SceneData si = past ? s : frame_scene;
+    if (!past) scene_at_sample(&si, seed, frame, nb[d], sample);
     RsPrimary xi;
-    if (same)
+    if (same) {
       xi = x;
-    else if (has_c || has_dc || past)
-      xi = rs_primary(past ? &sp : &s, &ei, &rsp, &cam);
+    } else if (has_c || has_dc || past) {
+      const CameraParams ci =
+          past ? cam : rs_camera_at(&cam, cam_steps, cam_step_count, seed, frame, nb[d], sample);
+      xi = rs_primary(past ? &sp : &si, &ei, &rsp, &ci);
+    }
     xi.then_moved = past && !same && !rs_unmoved(&s, ei.inst);
     const float u_d = rng_next(&rng_d);
     if (!past || c_t > 0.0f)
-      rs_merge_path(&s, &x, &xi, rc, past ? &history[q].r : rs_res + nb[d], past, same,
+      rs_merge_path(&s, &si, &x, &xi, rc, past ? &history[q].r : rs_res + nb[d], past, same,
                     past ? c_t : 1.0f, (float)dom_p, total_p, past ? u_t : un[d], d, moved, &rsp,
-                    &mp, &traced);
+                    &sw, &mp, &traced);
     if (!past || c_td > 0.0f)
-      rs_merge_direct(&s, &x, &xi, dc, past ? &history[q].d : di_res + nb[d], past, same,
-                      past ? c_td : 1.0f, (float)dom_d, total_d, u_d, d, moved, rsp.moved_count,
-                      rsp.prev_known, &md, &traced);
+      rs_merge_direct(&s, &si, &x, &xi, dc, past ? &history[q].d : di_res + nb[d], past, same,
+                      past ? c_td : 1.0f, (float)dom_d, total_d, u_d, d, moved, &rsp, &sw, &md,
+                      &traced);
   }
   const float u_c = rng_next(&rng), u_dc = rng_next(&rng_d);
   if (has_c)

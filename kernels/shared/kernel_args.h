@@ -268,7 +268,8 @@
 // reconnection, into its radiance and history_out (one pass over the film's pixels [first, end)).
 // temporal: `history` holds this pass's reservoirs of the previous frame, seen by prev_cam, and
 // `moved` (rsp.moved_count boxes) where the scene changed since, prev_vertices and prev_instances
-// the previous frame's shapes (GpuScene::previousVertices).
+// the previous frame's shapes (GpuScene::previousVertices), prev_sweeps its sweeps (--shutter);
+// cam_steps the camera over the shutter, as pt_generate's.
 #define PR_ARGS_PT_RESAMPLE_SPATIAL(F, X)       \
   PR_ARGS_SCENE(F, X)                           \
   X(FRAME, VAL, ResampleParams, rsp)            \
@@ -291,6 +292,10 @@
   X(FRAME, IN, ShadingVertex, prev_vertices)    \
   X(FRAME, IN, ShadingInstance, prev_instances) \
   X(FRAME, VAL, uint, stamp)                    \
+  X(FRAME, IN, float, prev_sweeps)              \
+  X(FRAME, VAL, uint, prev_sweep_count)         \
+  X(FRAME, IN, CameraParams, cam_steps)         \
+  X(FRAME, VAL, uint, cam_step_count)           \
   PR_ARGS_PIXEL_LIST(X, X)
 
 // ---- The film (kernels/accumulate.cl) ----

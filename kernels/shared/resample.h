@@ -128,7 +128,9 @@ PR_INLINE float3 rs_shift(const SceneData* s, const RsPrimary* x, PR_GLOBAL cons
   const float3 w2l = to_local(w2, f2.t, f2.b, f2.n);
   // T's density over L's here, where T can make the path: the light tracer's of x_1 from x_2
   // (x_2's reverse pdf, evaluated only then) against the camera's.
-  const int camera = (r->kind & PR_RS_CAMERA) && x->cam > 0.0f;
+  // (Under a shutter T joins the path only where x_1 x_2 meets nothing that moves: ep_ray_still.)
+  const int camera = (r->kind & PR_RS_CAMERA) && x->cam > 0.0f &&
+                     (s->lights.sweep_count == 0u || sweep_clear(s, x->h.p, d, 1.0f));
   const float3 wo2l = to_local(wo2, f2.t, f2.b, f2.n);
   pdf2_rev = 0.0f;
   const float3 fx2 = (camera ? bsdf_eval_both(&f2.bsdf, wo2l, w2l, &pdf2, &pdf2_rev)
@@ -279,7 +281,7 @@ PR_INLINE int rs_meets(const SceneData* s, PR_GLOBAL const MovedInstance* m, flo
 // The record after moved[k] for a test that does (hit) or does not meet its boxes: into a node's
 // subtree, or past it. Never backwards, whatever the records say.
 PR_INLINE u32 rs_moved_next(PR_GLOBAL const MovedInstance* m, u32 k, int hit) {
-  return hit || !m->node ? k + 1u : max(m->skip, k + 1u);
+  return hit || !m->node || m->skip <= k + 1u ? k + 1u : m->skip;
 }
 
 // Whether the ray (segment: tmax 1 and d the far end minus o) meets none of the moved instances
@@ -376,6 +378,52 @@ PR_INLINE int rs_temporal_ok(const SceneData* s, PR_GLOBAL const MovedInstance* 
     const int on_dsg = (r->suffix >> (PR_RS_ON_DSG_SHIFT + k)) & 1u;
     if ((on_dsg && !rs_apart(moved, count, p)) || !rs_clear(s, moved, count, a, p - a, 1.0f))
       return 0;
+    a = p;
+  }
+  return 1;
+}
+
+// --- Under a shutter (--shutter with --resample) -----------------------------------------------
+//
+// Each pixel sample's x_1 and paths are at its own time. A path moves to another sample's x_1, at
+// another time, where x_2 and the suffix are the same at every time: x_2 in no sweep (what moves
+// while the shutter is open, sweep_clear) and no segment of the suffix meeting one. The new
+// segment from x_1 is traced at that sample's time (only T asks more of it: rs_shift). A path of
+// the previous frame keeps clear of that frame's sweeps too, and so does the segment from its x_1:
+// then what it was at its time is what it was at that frame's, which rs_temporal_ok compares with
+// this one's. Each test is one function of the path (and the previous x_1), the same both ways.
+typedef struct {
+  PR_GLOBAL const float* now;   // this frame's (LightData.sweeps)
+  PR_GLOBAL const float* then;  // the previous frame's
+  u32 now_count, then_count;
+} RsSweeps;
+
+// Whether the ray o + t d, 0 <= t <= tmax, meets none of this frame's sweeps (past: nor the
+// previous frame's).
+PR_INLINE int rs_sweeps_clear(const RsSweeps* w, int past, float3 o, float3 d, float tmax) {
+  return sweeps_clear(w->now, w->now_count, o, d, tmax) &&
+         (!past || sweeps_clear(w->then, w->then_count, o, d, tmax));
+}
+
+PR_INLINE int rs_sweeps_none(const RsSweeps* w, int past) {
+  return w->now_count == 0u && (!past || w->then_count == 0u);
+}
+
+// Whether path r, its x_2 at p2, is the same path at every time of the sweeps' intervals: x_2 in
+// none and its suffix meeting none; with from (a previous x_1), the segment from it meeting none
+// either.
+PR_INLINE int rs_path_still(const RsSweeps* w, int past, PR_GLOBAL const PathReservoir* r,
+                            float3 p2, int has_from, float3 from) {
+  if (rs_sweeps_none(w, past)) return 1;
+  const u32 n = r->suffix & PR_RS_COUNT_MASK;
+  if ((r->suffix & PR_RS_LONG) || n == 0u) return 0;
+  float3 a = p2;
+  if (!rs_sweeps_clear(w, past, a, make_float3(0.0f, 0.0f, 0.0f), 0.0f)) return 0;
+  if (has_from && !rs_sweeps_clear(w, past, from, a - from, 1.0f)) return 0;
+  for (u32 k = 0u; k < n; ++k) {
+    const float3 p = make_float3(r->sp[3u * k], r->sp[3u * k + 1u], r->sp[3u * k + 2u]);
+    if (k + 1u == n && (r->suffix & PR_RS_ESCAPES)) return rs_sweeps_clear(w, past, a, p, PR_INF_F);
+    if (!rs_sweeps_clear(w, past, a, p - a, 1.0f)) return 0;
     a = p;
   }
   return 1;

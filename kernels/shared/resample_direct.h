@@ -81,6 +81,31 @@ PR_INLINE float di_target_at(const SceneData* s, const RsPrimary* x,
   return rs_occluded(s, x, shadow) ? 0.0f : p;
 }
 
+// The segment from p to reservoir r's light: p + t d, 0 <= t <= tmax (a ray towards a light at
+// infinity); 0 where a punctual light sends p nothing.
+PR_INLINE int di_light_segment(const SceneData* s, PR_GLOBAL const DirectReservoir* r, float3 p,
+                               float3* d, float* tmax) {
+  const Light l = s->lights.lights[r->light];
+  *tmax = 1.0f;
+  if (light_is_triangle(l.type)) {
+    *d = surface_at(&s->sd, l.prim, l.inst, r->b1, r->b2).p - p;
+    return 1;
+  }
+  *tmax = PR_INF_F;
+  if (r->light == s->lights.env_light) {
+    *d = make_float3(r->wx, r->wy, r->wz);
+    return 1;
+  }
+  LightSample ls;
+  float b1, b2;
+  if (!light_sample_towards(&l, s->lights.env, 1.0f, p, make_float3(0.0f, 0.0f, 0.0f), 0.0f, 0.0f,
+                            &ls, &b1, &b2))
+    return 0;
+  *d = ls.wi;
+  *tmax = ls.dist;
+  return 1;
+}
+
 // Whether the segment from the previous frame's x_1 at x to reservoir r's light (a ray, towards a
 // light at infinity) is seen in that frame by a shadow ray traced in this one (rs_occluded), as
 // rs_reconnection_clear: from x itself where x did not move; else the segment of its shadow ray
@@ -92,19 +117,9 @@ PR_INLINE int di_segment_clear(const SceneData* s, PR_GLOBAL const MovedInstance
     const float3 f = di_eval(s, x, r, &shadow);
     return luminance(f) > 0.0f && rs_clear_then(s, moved, count, shadow);
   }
-  const float3 p = x->h.p;
-  const Light l = s->lights.lights[r->light];
-  if (light_is_triangle(l.type)) {
-    const float3 y = surface_at(&s->sd, l.prim, l.inst, r->b1, r->b2).p;
-    return rs_clear(s, moved, count, p, y - p, 1.0f);
-  }
-  if (r->light == s->lights.env_light)
-    return rs_clear(s, moved, count, p, make_float3(r->wx, r->wy, r->wz), PR_INF_F);
-  LightSample ls;
-  float b1, b2;
-  return light_sample_towards(&l, s->lights.env, 1.0f, p, make_float3(0.0f, 0.0f, 0.0f), 0.0f, 0.0f,
-                              &ls, &b1, &b2) &&
-         rs_clear(s, moved, count, p, ls.wi, ls.dist);
+  float3 d;
+  float tmax;
+  return di_light_segment(s, r, x->h.p, &d, &tmax) && rs_clear(s, moved, count, x->h.p, d, tmax);
 }
 
 // Whether reservoir r's light can be taken between frames, seen from x_1 at xa in one and at xb
@@ -116,6 +131,29 @@ PR_INLINE int di_temporal_ok(const SceneData* s, PR_GLOBAL const MovedInstance* 
   if (r->light == PR_INVALID_INDEX || !rs_x1_ok(s, pa, prev_known) || !rs_x1_ok(s, pb, prev_known))
     return 0;
   return di_segment_clear(s, moved, count, r, pa);
+}
+
+// Under a shutter (shared/resample.h, RsSweeps): whether reservoir r's light is where it is at
+// every time of the sweeps' intervals, so that moving it to an x_1 at another time is the
+// identity: a triangle's point in no sweep, a punctual light's position in none, a light at
+// infinity other than the environment in no sweep over all space (a turning sun's); with from (a
+// previous x_1), the segment from it to the light meeting none either.
+PR_INLINE int di_still(const SceneData* s, const RsSweeps* w, int past,
+                       PR_GLOBAL const DirectReservoir* r, int has_from, float3 from) {
+  if (rs_sweeps_none(w, past)) return 1;
+  const Light l = s->lights.lights[r->light];
+  float3 y = make_float3(l.p0x, l.p0y, l.p0z);
+  if (light_is_triangle(l.type))
+    y = surface_at(&s->sd, l.prim, l.inst, r->b1, r->b2).p;
+  else if (light_at_infinity(l.type))
+    y = make_float3(PR_INF_F, PR_INF_F, PR_INF_F);  // in no bounded sweep
+  if (r->light != s->lights.env_light &&
+      !rs_sweeps_clear(w, past, y, make_float3(0.0f, 0.0f, 0.0f), 0.0f))
+    return 0;
+  float3 d;
+  float tmax;
+  return !has_from ||
+         (di_light_segment(s, r, from, &d, &tmax) && rs_sweeps_clear(w, past, from, d, tmax));
 }
 
 // A candidate into *c: light li at (b1, b2) or along dir, its f at its own x_1, resampling

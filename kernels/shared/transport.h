@@ -330,10 +330,9 @@ PR_INLINE int ray_meets_box(PR_GLOBAL const float* b, float3 o, float3 d, float 
 // segments, from either end. A record is a box and the size of its subtree, walked in order:
 // into it where its box is met (a leaf met: not clear), past it where not.
 #define PR_SWEEP_FLOATS 7u
-PR_INLINE int sweep_clear(const SceneData* s, float3 o, float3 d, float tmax) {
-  const u32 n = s->lights.sweep_count;
+PR_INLINE int sweeps_clear(PR_GLOBAL const float* sweeps, u32 n, float3 o, float3 d, float tmax) {
   for (u32 k = 0u; k < n;) {
-    PR_GLOBAL const float* r = s->lights.sweeps + PR_SWEEP_FLOATS * k;
+    PR_GLOBAL const float* r = sweeps + PR_SWEEP_FLOATS * k;
     const u32 below = (u32)r[6];
     if (!ray_meets_box(r, o, d, tmax))
       k += 1u + below;
@@ -343,6 +342,10 @@ PR_INLINE int sweep_clear(const SceneData* s, float3 o, float3 d, float tmax) {
       ++k;
   }
   return 1;
+}
+
+PR_INLINE int sweep_clear(const SceneData* s, float3 o, float3 d, float tmax) {
+  return sweeps_clear(s->lights.sweeps, s->lights.sweep_count, o, d, tmax);
 }
 
 // Light idx where it is at the path's time: the light table holds the lights at the frame's

@@ -108,10 +108,13 @@ run "cornell-orbit-pathtrace-shutter" scenes/cornell-orbit.gltf --frames 0-1 --m
 run "cornell-skinned-pathtrace-shutter" scenes/cornell-skinned.gltf --frames 0-1 \
   --mode pathtrace --shutter 0.5
 # Path reuse over the shutter: light paths joined at the samples' times where they meet nothing
-# that moves (the sweeps), strategy T at a time of its own with a moving camera.
+# that moves (the sweeps), strategy T at a time of its own with a moving camera; the eye paths
+# resampled from the previous frame (its sweeps too), and with neighbours at their own times.
 run "lanterns-reuse-shutter" "$work/lanterns/atrium.gltf" --frames 0-1 --mode reuse \
   --light-sampler bvh --shutter 1
 run "cornell-orbit-reuse-shutter" scenes/cornell-orbit.gltf --frames 0-1 --mode reuse --shutter 0.5
+run "cornell-skinned-resample-shutter" scenes/cornell-skinned.gltf --frames 0-2 --mode pathtrace \
+  --resample --resample-neighbors 2 --shutter 0.5
 run "lanterns-reuse-connections" "$work/lanterns/atrium.gltf" --frames 0-1 --mode reuse \
   --light-sampler bvh --no-eye-paths
 # Eye paths weighted against the connections: with a history on the demo, and among many
