@@ -387,7 +387,7 @@ void GpuScene::setTime(double t) {
     if (anyMoved_) collectMoved(before, was, reshapedInstance);
   }
   if (!anyMoved_) moved_.clear();
-  if (shutter_ > 0.0) collectSweeps(times, motion);
+  if (shutter_ > 0.0 && sweepsWanted_) collectSweeps(times, motion);
   // The moved flags change even when no transform does (all back to 0), so always upload.
   const uint64_t bytes = std::max<size_t>(n, 1) * sizeof(dev::ShadingInstance);
   if (n > instanceCapacity_ || !shadingInstances_()) {
@@ -733,8 +733,9 @@ class DeformationError {
 
 }  // namespace
 
-void GpuScene::setShutter(double seconds, int cameraIndex, int width, int height) {
+void GpuScene::setShutter(double seconds, int cameraIndex, int width, int height, bool sweeps) {
   shutter_ = seconds > 0.0 ? seconds : 0.0;
+  sweepsWanted_ = sweeps;
   shutterCamera_ = cameraIndex;
   shutterWidth_ = width;
   shutterHeight_ = height;

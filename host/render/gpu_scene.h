@@ -52,8 +52,9 @@ class GpuScene {
   // Motion blur: from now on each setTime(t) also places the instances and camera `cameraIndex`
   // (for width x height) at motionSteps() times over [t - seconds / 2, t + seconds / 2]
   // (kernels/shared/motion.h), and the punctual lights (then chosen by power) and deforming
-  // meshes; 0 seconds: none.
-  void setShutter(double seconds, int cameraIndex, int width, int height);
+  // meshes; 0 seconds: none. sweeps: also what moves while it is open (LightData.sweeps), which
+  // path reuse and resampling test their paths against and the path tracer alone never reads.
+  void setShutter(double seconds, int cameraIndex, int width, int height, bool sweeps = true);
   // The last setTime's motion steps (1: none) and the camera at each (a placeholder at 1).
   uint32_t motionSteps() const { return motionSteps_; }
   const cl::Buffer& cameraSteps() const { return cameraSteps_; }
@@ -204,6 +205,7 @@ class GpuScene {
   glm::vec3 sceneCentre_{0.0f};
   bool lightsAnimated_ = false;
   double shutter_ = 0.0;  // seconds (setShutter)
+  bool sweepsWanted_ = true;
   int shutterCamera_ = 0, shutterWidth_ = 1, shutterHeight_ = 1;
   std::vector<accel::Aabb> meshBounds_;  // per dynamic mesh, object space (motionTimes)
   // Per deforming mesh, what motionTimes measures its deformation by (setShutter): each morph

@@ -126,7 +126,9 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
     throw InputError(
         "--light-tracing: weighs its paths against the eye paths, which --no-eye-paths "
         "turns off");
-  if (o.shutter > 0.0) gpu_->setShutter(o.shutter / o.fps, camera_, width_, height_);
+  if (o.shutter > 0.0)
+    gpu_->setShutter(o.shutter / o.fps, camera_, width_, height_,
+                     o.mode != RenderMode::PathTrace || resample.enabled);
   if (!(resample.distance > 0.0f)) resample.distance = 0.01f * gpu_->sceneRadius();
   if (o.mode == RenderMode::PathTrace) {
     PathTracerSettings p;
