@@ -287,8 +287,8 @@ PR_KERNEL void pt_resample(PR_PARAMS(PR_ARGS_PT_RESAMPLE_SPATIAL)) {
   if (e.prim == PR_INVALID_INDEX) return;  // no x_1: nothing was resampled
   // The scene at this sample's time (--shutter; its x_1's and paths' time).
   SceneData s = PR_SCENE();
-  const SceneData frame_scene = s;
   scene_at_sample(&s, seed, frame, j, sample);
+  const int timed = s.geom.motion_steps > 1u || s.lights.motion_steps > 1u;
   // The previous frame's shapes, at that frame's time, on which its x_1 are rebuilt
   // (rsp.prev_known: they are known; they differ from this frame's only on what moved).
   SceneData sp = s;
@@ -342,24 +342,29 @@ PR_KERNEL void pt_resample(PR_PARAMS(PR_ARGS_PT_RESAMPLE_SPATIAL)) {
     // The same x_1 seen the same way, where it did not move: the shift is the identity.
     const int same = past && !x_moved && rs_same_eye(&ei, &e);
     // A neighbour's sample is at its own time: its scene and camera then.
-    SceneData si = past ? s : frame_scene;
-    if (!past) scene_at_sample(&si, seed, frame, nb[d], sample);
+    SceneData si;
+    const SceneData* sc_i = &s;
+    if (!past && timed) {
+      si = s;
+      scene_at_sample(&si, seed, frame, nb[d], sample);
+      sc_i = &si;
+    }
     RsPrimary xi;
     if (same) {
       xi = x;
     } else if (has_c || has_dc || past) {
       const CameraParams ci =
           past ? cam : rs_camera_at(&cam, cam_steps, cam_step_count, seed, frame, nb[d], sample);
-      xi = rs_primary(past ? &sp : &si, &ei, &rsp, &ci);
+      xi = rs_primary(past ? &sp : sc_i, &ei, &rsp, &ci);
     }
     xi.then_moved = past && !same && !rs_unmoved(&s, ei.inst);
     const float u_d = rng_next(&rng_d);
     if (!past || c_t > 0.0f)
-      rs_merge_path(&s, &si, &x, &xi, rc, past ? &history[q].r : rs_res + nb[d], past, same,
+      rs_merge_path(&s, sc_i, &x, &xi, rc, past ? &history[q].r : rs_res + nb[d], past, same,
                     past ? c_t : 1.0f, (float)dom_p, total_p, past ? u_t : un[d], d, moved, &rsp,
                     &sw, &mp, &traced);
     if (!past || c_td > 0.0f)
-      rs_merge_direct(&s, &si, &x, &xi, dc, past ? &history[q].d : di_res + nb[d], past, same,
+      rs_merge_direct(&s, sc_i, &x, &xi, dc, past ? &history[q].d : di_res + nb[d], past, same,
                       past ? c_td : 1.0f, (float)dom_d, total_d, u_d, d, moved, &rsp, &sw, &md,
                       &traced);
   }

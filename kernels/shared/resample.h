@@ -410,15 +410,14 @@ PR_INLINE int rs_sweeps_none(const RsSweeps* w, int past) {
 }
 
 // Whether path r, its x_2 at p2, is the same path at every time of the sweeps' intervals: x_2 in
-// none and its suffix meeting none; with from (a previous x_1), the segment from it meeting none
-// either.
+// none and its suffix meeting none (each segment's test holds its first point, so x_2's is the
+// first segment's); with from (a previous x_1), the segment from it meeting none either.
 PR_INLINE int rs_path_still(const RsSweeps* w, int past, PR_GLOBAL const PathReservoir* r,
                             float3 p2, int has_from, float3 from) {
   if (rs_sweeps_none(w, past)) return 1;
   const u32 n = r->suffix & PR_RS_COUNT_MASK;
   if ((r->suffix & PR_RS_LONG) || n == 0u) return 0;
   float3 a = p2;
-  if (!rs_sweeps_clear(w, past, a, make_float3(0.0f, 0.0f, 0.0f), 0.0f)) return 0;
   if (has_from && !rs_sweeps_clear(w, past, from, a - from, 1.0f)) return 0;
   for (u32 k = 0u; k < n; ++k) {
     const float3 p = make_float3(r->sp[3u * k], r->sp[3u * k + 1u], r->sp[3u * k + 2u]);

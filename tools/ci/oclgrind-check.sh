@@ -108,8 +108,9 @@ run "cornell-orbit-pathtrace-shutter" scenes/cornell-orbit.gltf --frames 0-1 --m
 run "cornell-skinned-pathtrace-shutter" scenes/cornell-skinned.gltf --frames 0-1 \
   --mode pathtrace --shutter 0.5
 # Path reuse over the shutter: light paths joined at the samples' times where they meet nothing
-# that moves (the sweeps), strategy T at a time of its own with a moving camera; the eye paths
-# resampled from the previous frame (its sweeps too), and with neighbours at their own times.
+# that moves (the sweeps), strategy T at a time of its own with a moving camera; and resampling
+# (off by default under a shutter, asked for on the skinned demo), from the previous frame (its
+# sweeps too) and from neighbours at their own times.
 run "lanterns-reuse-shutter" "$work/lanterns/atrium.gltf" --frames 0-1 --mode reuse \
   --light-sampler bvh --shutter 1
 run "cornell-orbit-reuse-shutter" scenes/cornell-orbit.gltf --frames 0-1 --mode reuse --shutter 0.5
