@@ -12,6 +12,7 @@
 #include <stb_image_write.h>
 
 #include "io/image.h"
+#include "portability/compare.h"
 #include "render/options.h"
 #include "scene/environment_map.h"
 #include "scene/gltf_loader.h"
@@ -457,6 +458,72 @@ TEST(Environment, SceneWithoutLightsIsLitByDefaultAndNoneKeepsItDark) {
   const auto strong = run("--env-strength 2 --env-color 1,0.5,0.25");
   EXPECT_FLOAT_EQ(strong.second.pixel(0, 0)[0], 2.0f);
   EXPECT_FLOAT_EQ(strong.second.pixel(0, 0)[2], 0.5f);
+}
+
+// The floor of a map is the darkest texel's luminance over the mean over the sphere.
+TEST(Environment, UniformShareIsTheDarkestTexelOverTheMean) {
+  EXPECT_FLOAT_EQ(environmentUniformShare(constantEnvironment({0.5f, 0.6f, 0.8f})), 1.0f);
+  const Environment map = testMap(16, 8, 11, 2);
+  float mean = 0.0f;
+  environmentTables(map, &mean);
+  double lowest = 1e30;
+  for (size_t i = 0; i < map.rgb.size() / 3; ++i)
+    lowest = std::min(lowest, 0.2126 * map.rgb[3 * i] + 0.7152 * map.rgb[3 * i + 1] +
+                                  0.0722 * map.rgb[3 * i + 2]);
+  EXPECT_NEAR(environmentUniformShare(map), lowest / mean, 1e-4);
+  Environment dark = map;
+  dark.rgb[0] = dark.rgb[1] = dark.rgb[2] = 0.0f;
+  EXPECT_EQ(environmentUniformShare(dark), 0.0f);
+  EXPECT_EQ(environmentUniformShare(Environment{}), 0.0f);
+}
+
+// A room lit by a point light under its ceiling, a uniform sky seen through a small hole in
+// the ceiling. By its whole power the sky takes most of light sampling's choices, which its
+// radiance, the same in every direction, does not need (BSDF sampling draws it as well) and
+// which the ceiling mostly blocks; by the part above its floor (the default) the point light
+// takes them. Both choices are unbiased, and the default's error is lower.
+TEST(Environment, AUniformSkyLeavesLightSamplingToTheOtherLights) {
+  test::GltfBuilder g;
+  const int grey = g.addMaterial({glm::vec4(0.6f, 0.6f, 0.6f, 1.0f)});
+  const float h = 0.3f;  // half the hole's side
+  g.addNode(g.addQuad({-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, {-2, 0, -2}, grey));
+  for (const glm::vec3& c :
+       {glm::vec3(-2, 0, 2), glm::vec3(2, 0, 2), glm::vec3(2, 0, -2), glm::vec3(-2, 0, -2)}) {
+    const glm::vec3 n(c.z / 2.0f, 0.0f, -c.x / 2.0f);  // to the next corner, halved
+    g.addNode(g.addQuad(c, c + glm::vec3(0, 2, 0), c + 2.0f * n + glm::vec3(0, 2, 0), c + 2.0f * n,
+                        grey));
+  }
+  g.addNode(g.addQuad({-2, 2, -2}, {2, 2, -2}, {2, 2, -h}, {-2, 2, -h}, grey));
+  g.addNode(g.addQuad({-2, 2, h}, {2, 2, h}, {2, 2, 2}, {-2, 2, 2}, grey));
+  g.addNode(g.addQuad({-2, 2, -h}, {-h, 2, -h}, {-h, 2, h}, {-2, 2, h}, grey));
+  g.addNode(g.addQuad({h, 2, -h}, {2, 2, -h}, {2, 2, h}, {h, 2, h}, grey));
+  g.addPointLight({1.0f, 1.7f, 0.5f}, {1.0f, 1.0f, 1.0f}, 4.0f);
+  g.addCamera({0.0f, 1.2f, 1.9f}, {0.0f, 0.3f, -1.0f}, 1.2f, 1.0f);
+  const std::string scene = g.write(test::tempDir("envshare"), "room");
+  const std::string common = " --width 24 --height 24 --env-color 1,1,1 --max-depth 5 ";
+  auto render = [&](const std::string& args) {
+    return test::frameImage(test::renderFrames(scene, "0", common + args, "envshare-r"), 0);
+  };
+  // Unbiased: the two choices agree region by region, in both modes.
+  for (const char* mode : {"pathtrace", "reuse"}) {
+    SCOPED_TRACE(mode);
+    const Image a = render(std::string("--spp 96 --mode ") + mode);
+    const Image b = render(std::string("--spp 96 --env-light-choice power --mode ") + mode);
+    for (int y0 = 0; y0 < 24; y0 += 12)
+      for (int x0 = 0; x0 < 24; x0 += 12)
+        for (int c = 0; c < 3; ++c) {
+          const test::Moments ma = test::regionMean(a, x0, y0, x0 + 12, y0 + 12, c);
+          const test::Moments mb = test::regionMean(b, x0, y0, x0 + 12, y0 + 12, c);
+          EXPECT_NEAR(ma.mean, mb.mean, 4.5 * std::hypot(ma.stderr_, mb.stderr_) + 1e-4)
+              << "channel " << c << " region " << x0 << "," << y0;
+        }
+  }
+  // Less error at the same samples, against one reference.
+  const Image ref = render("--spp 1024 --mode pathtrace --seed 9");
+  const double fine = compareImages(render("--spp 4 --mode pathtrace"), ref).relMse;
+  const double coarse =
+      compareImages(render("--spp 4 --mode pathtrace --env-light-choice power"), ref).relMse;
+  EXPECT_LT(fine, 0.7 * coarse) << "auto " << fine << ", power " << coarse;
 }
 
 TEST(Environment, BadOptionsExitTwoWithOneLine) {

@@ -176,6 +176,7 @@ const std::map<std::string, std::string> kSampleValues = {
     {"--max-depth", "4"},
     {"--seed", "9"},
     {"--light-sampler", "bvh"},
+    {"--env-light-choice", "power"},
     {"--resample-neighbors", "2"},
     {"--resample-radius", "4"},
     {"--resample-roughness", "0.5"},

@@ -197,6 +197,12 @@ std::vector<Row> samplingRows() {
           "has more than 16 lights, exhaustive where it has at most 4, power between)"}
           .oneOf({"auto", "bvh", "exhaustive", "power"})
           .withDefault(),
+      Row{"--env-light-choice", kSamplingResearch, kResearch, kEstimator, PR_FIELD(envLightChoice),
+          "How light sampling weighs the environment against the other lights: auto (by the "
+          "power above its darkest texel's: the uniform part, which BSDF sampling draws as well, "
+          "leaves its samples to the other lights) or power (by its whole power)"}
+          .oneOf({"auto", "power"})
+          .withDefault(),
       Row{"--resample", kResampling, kResearch, kEstimator, PR_FIELD(resample),
           "Resample the paths beyond each first surface with those of neighbouring pixels and "
           "of the previous frame, reconnected there and weighed by pairwise MIS (unbiased; with "
@@ -600,6 +606,7 @@ RenderOptions toRenderOptions(const RenderArgs& a, const CLI::App& render) {
                     : a.lightSampler == "exhaustive" ? LightSampler::Exhaustive
                     : a.lightSampler == "power"      ? LightSampler::Power
                                                      : LightSampler::Auto;
+  ro.envChoiceByPower = a.envLightChoice == "power";
   ro.bvhWidth = a.bvhWidth == "auto" ? 0 : std::stoi(a.bvhWidth);
   if (a.resample || a.noResample) ro.resample.asked = a.resample;
   if (ro.connect.eyePaths && render.get_option("--connection-mis")->count() > 0 && !ro.quiet)

@@ -29,7 +29,8 @@ enum class OptionEffect { Estimator, RunOnly };
 struct RenderArgs {
   RenderOptions ro;
   std::string frames;
-  std::string mode = "reuse", lightSampler = "auto", materialModel = "energy";
+  std::string mode = "reuse", lightSampler = "auto", envLightChoice = "auto",
+              materialModel = "energy";
   std::string terminator = "on", bvhWidth = "auto", connections = "auto";
   bool resample = false, noResample = false;
 };

@@ -149,6 +149,9 @@ GpuScene::GpuScene(Context& ctx, const Scene& scene, const GpuSceneOptions& opti
   std::vector<float> envData = {0.0f};
   if (options_.environment.present())
     envData = environmentTables(options_.environment, &envMeanLuminance_);
+  if (options_.environment.present() && !options_.envChoiceByPower)
+    envChoiceShare_ =
+        std::max(1.0f - environmentUniformShare(options_.environment), kEnvChoiceFloor);
   envBuffer_ =
       upload("environment map", envData.data(), envData.size() * sizeof(float), &shadingBytes_);
   // The light-tracing selection table, at time 0 once and for all.
@@ -579,6 +582,7 @@ uint32_t GpuScene::environmentLight() const {
 
 void GpuScene::buildLights(double t) {
   std::vector<dev::Light> next = lightsAt(t);
+  if (options_.environment.present()) next.back().power *= envChoiceShare_;  // the last light
   const bool sameTable = lights_.size() == next.size();
   for (size_t i = 0; i < next.size(); ++i) {
     next[i].moved = (!sameTable || !sameGeometry(lights_[i], next[i])) ? 1u : 0u;

@@ -31,6 +31,9 @@ struct GpuSceneOptions {
   LightSampler lightSampler = LightSampler::Auto;
   int bvhWidth = 0;         // children per BVH node; 0: defaultBvhWidth of the device
   Environment environment;  // the environment light; none where !present()
+  // Light sampling weighs the environment by its whole power (--env-light-choice power), not
+  // by the part above its uniform floor (GpuScene::envChoiceShare_).
+  bool envChoiceByPower = false;
 };
 
 // A transform as the kernels keep it: its top three rows, row-major (ShadingInstance).
@@ -237,6 +240,11 @@ class GpuScene {
   uint64_t vertexCount_ = 0;
   cl::Buffer lightBuffer_, cdfBuffer_, lightNodeBuffer_, primLightBuffer_, envBuffer_;
   float envMeanLuminance_ = 0.0f;
+  // The share of the environment's power by which light sampling chooses it (buildLights): the
+  // part above its floor, which BSDF sampling draws as well as light sampling does (a uniform
+  // environment's radiance is the same in every direction: the BSDF's own distribution is as
+  // good as any), at least kEnvChoiceFloor. The light tracer keeps its whole power.
+  float envChoiceShare_ = 1.0f;
   uint64_t lightNodeBytes_ = 0;
   uint64_t shadingBytes_ = 0, instanceBytes_ = 0, lightBytes_ = 0;
   size_t lightCapacity_ = 0, instanceCapacity_ = 0;

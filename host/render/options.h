@@ -17,6 +17,9 @@ enum class RenderMode { Reuse, Retrace, PathTrace };
 enum class LightSampler { Auto, Bvh, Exhaustive, Power };
 constexpr int kAutoLightBvhMin = 16;
 constexpr int kAutoExhaustiveMax = 4;
+// The least share of the environment's power by which light sampling chooses it where its
+// uniform floor is all of it (GpuScene::envChoiceShare_; docs/experiments/env-light-choice.md).
+constexpr float kEnvChoiceFloor = 1.0f / 32.0f;
 
 // Children per BVH node for a device (0: auto): CPUs 8 (float8 slab tests), GPUs 4. Measured in
 // docs/ray-benchmark.md (CPU) and docs/experiments/bvh-width.md (an H200).
@@ -122,7 +125,8 @@ struct RenderOptions {
   MaterialModel materialModel = MaterialModel::Energy;
   bool shadowTerminator = true;  // the terminator offset (kernels/shared/transport.h)
   LightSampler lightSampler = LightSampler::Auto;
-  int bvhWidth = 0;  // 0: defaultBvhWidth of the device
+  bool envChoiceByPower = false;  // --env-light-choice power (GpuSceneOptions)
+  int bvhWidth = 0;               // 0: defaultBvhWidth of the device
   std::string statsFile;
   bool resume = false;  // skip frames whose complete EXR exists; append to the stats file
   // With path resampling: frames rendered, not written, before a frame whose previous frame the

@@ -113,6 +113,7 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
   sceneOptions.materialModel = options.materialModel;
   sceneOptions.shadowTerminator = options.shadowTerminator;
   sceneOptions.lightSampler = options.lightSampler;
+  sceneOptions.envChoiceByPower = options.envChoiceByPower;
   sceneOptions.bvhWidth = options.bvhWidth;
   sceneOptions.environment = resolveEnvironment(options, scene);
   gpu_ = std::make_unique<GpuScene>(ctx_, scene, sceneOptions);

@@ -54,6 +54,9 @@ SETTINGS = {
     "reuse, 1 neighbour": ("reuse", ("--resample-neighbors", "1")),
     "reuse, connection history": ("reuse", ("--connection-history", "20")),
     "reuse, no light tracing": ("reuse", ("--no-light-tracing",)),
+    # Light sampling weighing the environment by its whole power (before 2026-12-06's default).
+    "pathtrace, env by power": ("pathtrace", ("--env-light-choice", "power")),
+    "reuse, env by power": ("reuse", ("--env-light-choice", "power")),
 }
 
 
