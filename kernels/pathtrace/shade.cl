@@ -272,10 +272,12 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
       p.alive = 0u;
     } else {
       tp = tp * step.weight;
-      // From the third vertex on (the camera's throughput starts at 1).
+      // From the third vertex on (the camera's throughput starts at 1), surviving with the
+      // square root of the throughput (Cycles' rule; pbrt-v4's, the throughput itself, ends
+      // paths whose light is still much of the pixel's: docs/experiments/russian-roulette.md).
       const float rr = rng_next(&rng);
-      const float q = p.depth >= 3u ? fmin(max3(tp), 1.0f) : 1.0f;
-      if (p.depth >= 3u && !russian_roulette(max3(tp), rr, &tp)) p.alive = 0u;
+      const float q = p.depth >= 3u ? fmin(sqrt(max3(tp)), 1.0f) : 1.0f;
+      if (!russian_roulette(q, rr, &tp)) p.alive = 0u;
       if (PR_RESAMPLE && p.x1_depth > 0u && p.alive)
         rs_track_step(track, &rsp, p.depth - p.x1_depth, &h, &f, wo, dist2, &step, q);
       if (PR_EYE_PATHS) ep_leave(&p, &f, step.wi, wo, dist2, rsp.lt_scale, has_rev, delta_here);

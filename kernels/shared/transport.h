@@ -289,9 +289,9 @@ PR_INLINE int path_step(const SceneData* s, const SurfaceHit* h, const ShadingFr
   return side > 0.0f || surface_lifted(s, h, f);
 }
 
-// Russian roulette (pbrt-v4's rule) where q, the path's throughput relative to its start, fell
-// below 1: the path survives with probability q (u uniform), and *w is divided by q so the
-// estimate keeps its expectation. Brighter paths always go on.
+// Russian roulette: the path survives with probability q (u uniform; the caller's rule: the
+// light tracer's throughput relative to its start, the eye paths' square root of theirs), and
+// *w is divided by q so the estimate keeps its expectation. At q >= 1 the path always goes on.
 PR_INLINE int russian_roulette(float q, float u, float3* w) {
   if (q >= 1.0f) return 1;
   if (u >= q) return 0;
