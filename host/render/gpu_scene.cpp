@@ -150,8 +150,8 @@ GpuScene::GpuScene(Context& ctx, const Scene& scene, const GpuSceneOptions& opti
   if (options_.environment.present())
     envData = environmentTables(options_.environment, &envMeanLuminance_);
   if (options_.environment.present() && !options_.envChoiceByPower)
-    envChoiceShare_ =
-        std::max(1.0f - environmentUniformShare(options_.environment), kEnvChoiceFloor);
+    envChoiceShare_ = std::max(
+        1.0f - environmentUniformShare(options_.environment, envMeanLuminance_), kEnvChoiceFloor);
   envBuffer_ =
       upload("environment map", envData.data(), envData.size() * sizeof(float), &shadingBytes_);
   // The light-tracing selection table, at time 0 once and for all.

@@ -87,21 +87,12 @@ std::vector<float> environmentTables(const Environment& env, float* meanLuminanc
   return out;
 }
 
-float environmentUniformShare(const Environment& env) {
-  const size_t w = size_t(env.width), h = size_t(env.height);
-  if (w == 0 || h == 0) return 0.0f;
-  double weighted = 0.0, solidAngle = 0.0, lowest = HUGE_VAL;
-  for (size_t j = 0; j < h; ++j) {
-    const double s = std::sin(M_PI * (double(j) + 0.5) / double(h));
-    for (size_t i = 0; i < w; ++i) {
-      const double l = luminanceOf(&env.rgb[3 * (j * w + i)]);
-      weighted += l * s;
-      lowest = std::min(lowest, l);
-    }
-    solidAngle += s * double(w);
-  }
-  const double mean = solidAngle > 0.0 ? weighted / solidAngle : 0.0;
-  return mean > 0.0 ? float(std::clamp(lowest / mean, 0.0, 1.0)) : 0.0f;
+float environmentUniformShare(const Environment& env, float meanLuminance) {
+  const size_t texels = size_t(env.width) * size_t(env.height);
+  if (texels == 0 || !(meanLuminance > 0.0f)) return 0.0f;
+  double lowest = HUGE_VAL;
+  for (size_t i = 0; i < texels; ++i) lowest = std::min(lowest, luminanceOf(&env.rgb[3 * i]));
+  return float(std::clamp(lowest / double(meanLuminance), 0.0, 1.0));
 }
 
 }  // namespace pr

@@ -33,9 +33,9 @@ Environment loadEnvironment(const std::string& path);
 // luminance of the map over the sphere.
 std::vector<float> environmentTables(const Environment& env, float* meanLuminance);
 
-// The share of the map's mean luminance (over the sphere) that is its floor, the darkest
-// texel's: 1 for a uniform environment, near 0 for a map with dark texels. Light sampling's
-// choice leaves that part to BSDF sampling (render/gpu_scene.h, envLightChoice).
-float environmentUniformShare(const Environment& env);
+// The share of the map's mean luminance over the sphere (environmentTables') that is its floor,
+// the darkest texel's: 1 for a uniform environment, near 0 for a map with dark texels. Light
+// sampling's choice leaves that part to BSDF sampling (GpuScene::envChoiceShare_).
+float environmentUniformShare(const Environment& env, float meanLuminance);
 
 }  // namespace pr

@@ -65,7 +65,7 @@ typedef struct {
   float le_r, le_g, le_b;      // radiance factor (triangle), intensity in cd (point, spot), or lux
   float area;                  // world area (triangle)
   float cos_inner, cos_outer;  // spot cone
-  float power;                 // selection weight by power: light_power()
+  float power;                 // light_power(); the environment's x GpuScene::envChoiceShare_
   u32 material;
   u32 moved;        // changed since the previous frame (for invalidation)
   u32 leaf;         // the light's node in the light BVH; PR_INVALID_INDEX for directional lights
