@@ -57,6 +57,12 @@ SETTINGS = {
     # Light sampling weighing the environment by its whole power (before 2026-12-06's default).
     "pathtrace, env by power": ("pathtrace", ("--env-light-choice", "power")),
     "reuse, env by power": ("reuse", ("--env-light-choice", "power")),
+    # The previous frame's confidence capped lower than the default 20.
+    "reuse, history 1": ("reuse", ("--resample-history", "1")),
+    "reuse, history 4": ("reuse", ("--resample-history", "4")),
+    # Fewer light paths per camera sample (default 4).
+    "reuse, 2 paths per pixel": ("reuse", ("--paths-per-pixel", "2")),
+    "reuse, 1 path per pixel": ("reuse", ("--paths-per-pixel", "1")),
 }
 
 
