@@ -5,6 +5,7 @@
 
 #include "cl/kernel_binding.h"
 #include "util/check.h"
+#include "render/counter_lanes.h"
 #include "render/kernel_programs.h"
 #include "render/path_tracer.h"
 #include "shared/reuse.h"
@@ -83,7 +84,7 @@ PathReuse::PathReuse(Context& ctx, GpuScene& scene, Film& film, const PathReuseS
   CL_CHECK(ctx_.queue().enqueueWriteBuffer(allSlots_, CL_TRUE, 0, all.size() * 4, all.data()));
   eye_ = alloc("eye vertices", uint64_t(film.pixels()) * sizeof(dev::EyeVertex));
   radiance_ = alloc("sample radiance", uint64_t(film.pixels()) * 16);
-  counters_ = alloc("reuse counters", dev::PR_C_COUNT * 4);
+  counters_ = alloc("reuse counters", counterBytes(dev::PR_C_ROW));
   splat_ =
       alloc("camera splats", (lightTracing_ ? uint64_t(film.pixels()) : 1) * PR_SPLAT_WORDS * 4);
   // Without a history, one element each: the kernels take them but never read them.
@@ -147,7 +148,7 @@ dev::ReuseParams PathReuse::frameParams(int64_t frame) const {
 void PathReuse::renderFrame(int64_t frame, const dev::CameraParams& camera, FrameStats* stats) {
   const Clock::time_point start = Clock::now();
   StageTimer timer;
-  ctx_.zero(counters_, dev::PR_C_COUNT * 4);
+  ctx_.zero(counters_, counterBytes(dev::PR_C_ROW));
   dev::ReuseParams rp = frameParams(frame);
   if (lightTracing_)
     rp.lt_scale =
@@ -335,8 +336,7 @@ int PathReuse::tracePasses(int64_t frame, const dev::CameraParams& camera,
 }
 
 void PathReuse::report(StageTimer* timer, cl_uint toTrace, FrameStats* stats) {
-  cl_uint c[dev::PR_C_COUNT] = {};
-  CL_CHECK(ctx_.queue().enqueueReadBuffer(counters_, CL_TRUE, 0, sizeof c, c));
+  const auto c = readCounters<dev::PR_C_COUNT>(ctx_, counters_, dev::PR_C_ROW);
   PR_CHECK(c[dev::PR_C_RECORD_OVERFLOW] == 0);  // recordCap_ bounds connect's terms
   auto times = timer->collect();
   if (!stats) return;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cl/kernel_binding.h"
+#include "render/counter_lanes.h"
 #include "render/history_format.h"
 #include "render/kernel_programs.h"
 #include "shared/path_state.h"
@@ -54,7 +55,7 @@ PathTracer::PathTracer(Context& ctx, GpuScene& scene, Film& film,
   for (cl::Buffer& q : queues_) q = alloc("path queue", band * 4);
   shadowQueue_ = alloc("shadow queue", band * 4);
   queueSizes_ = alloc("queue sizes", dev::PR_QUEUE_COUNT * 4);
-  rays_ = alloc("ray counters", dev::PR_PT_COUNT * 4);
+  rays_ = alloc("ray counters", counterBytes(dev::PR_PT_ROW));
   noEye_ = alloc("no eye vertices", 64);
   // Without resampling, one unread element each. The reservoirs span the frame (neighbours and
   // the history read them); a path's track and candidates are its band's.
@@ -160,7 +161,7 @@ void PathTracer::beginFrame(int64_t frame, const dev::CameraParams& camera,
   const cl_uint n = film_.end();
   const cl_uint rngFrame = settings_.fixedNoise ? 0 : rngFrameKey(frame);
   syncChains();
-  ctx_.zero(rays_, dev::PR_PT_COUNT * 4);
+  ctx_.zero(rays_, counterBytes(dev::PR_PT_ROW));
   dev::ResampleParams rsp = resampleParams();
   if (settings_.lightTracingSlots > 0 && settings_.pathsPerPixel > 0)
     rsp.lt_scale = lightTracingScale(camera, settings_.lightTracingSlots, settings_.spp,
@@ -391,8 +392,7 @@ void PathTracer::applyHistory(const std::string& data) {
 }
 
 void PathTracer::reportRays(FrameStats* stats) {
-  cl_uint rays[dev::PR_PT_COUNT] = {};
-  CL_CHECK(ctx_.queue().enqueueReadBuffer(rays_, CL_TRUE, 0, sizeof rays, rays));
+  const auto rays = readCounters<dev::PR_PT_COUNT>(ctx_, rays_, dev::PR_PT_ROW);
   if (!stats) return;
 #define PR_PT_REPORT(name, key) stats->rays[key] += rays[dev::PR_PT_##name];
   PR_PT_COUNTERS(PR_PT_REPORT)

@@ -11,7 +11,7 @@ PR_KERNEL void pt_extend(PR_PARAMS(PR_ARGS_PT_EXTEND)) {
   SceneData s = PR_SCENE();
   scene_at_sample(&s, seed, frame, i, sample);
   const uint k = i - base;  // the path's own state in the band
-  atomic_inc(rays + (states[k].depth == 0u ? PR_PT_CAMERA : PR_PT_BOUNCE));
+  atomic_inc(counter_lane(rays, PR_PT_ROW) + (states[k].depth == 0u ? PR_PT_CAMERA : PR_PT_BOUNCE));
   Hit hit;
   if (!trace_closest(&s, states[k].ray, &hit)) hit = hit_none();
   hits[k] = hit;

@@ -375,7 +375,7 @@ PR_KERNEL void pt_resample(PR_PARAMS(PR_ARGS_PT_RESAMPLE_SPATIAL)) {
   if (has_dc)
     rs_merge_canonical(&md, dc->p_hat, dc->w_sum, make_float3(dc->f_r, dc->f_g, dc->f_b), 0.0f,
                        dom_d, total_d, u_dc);
-  if (traced) atomic_add(rays + PR_PT_RECONNECT, traced);
+  if (traced) atomic_add(counter_lane(rays, PR_PT_ROW) + PR_PT_RECONNECT, traced);
   out->r.m = total_p;
   out->d.m = total_d;
   if (mp.p > 0.0f) {

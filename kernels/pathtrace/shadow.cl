@@ -15,7 +15,7 @@ PR_KERNEL void pt_shadow(PR_PARAMS(PR_ARGS_PT_SHADOW)) {
   const ShadowRay r = shadows[k];
   SceneData s = PR_SCENE();
   scene_at_sample(&s, seed, frame, i, sample);
-  atomic_inc(rays + PR_PT_SHADOW);
+  atomic_inc(counter_lane(rays, PR_PT_ROW) + PR_PT_SHADOW);
   if (trace_occluded(&s, r.ray)) return;
   if (resample && r.op) {
     const RsKey key = {seed, frame, i, sample};

@@ -91,5 +91,5 @@ PR_KERNEL void camera_splat(PR_PARAMS(PR_ARGS_CAMERA_SPLAT)) {
     }
     yp = y;
   }
-  if (rays) atomic_add(counters + PR_C_SPLAT_RAYS, rays);
+  if (rays) atomic_add(counter_lane(counters, PR_C_ROW) + PR_C_SPLAT_RAYS, rays);
 }

@@ -567,7 +567,8 @@ PR_INLINE void connector_empty(Connector* cn) {
 
 // Adds an eye sample's counts to the frame's counters.
 PR_INLINE void connect_count(const ConnectCounts* n, uint shadow_rays, uint bounce_rays,
-                             __global uint* counters) {
+                             __global uint* all_counters) {
+  __global uint* counters = counter_lane(all_counters, PR_C_ROW);
   if (shadow_rays) atomic_add(counters + PR_C_SHADOW_RAYS, shadow_rays);
   if (n->rays) atomic_add(counters + PR_C_CONNECT_RAYS, n->rays);
   if (bounce_rays) atomic_add(counters + PR_C_BOUNCE_RAYS, bounce_rays);
@@ -718,7 +719,7 @@ PR_KERNEL void connect(PR_PARAMS(PR_ARGS_CONNECT)) {
   reservoir_resolve(&cn);
 #if PR_EYE_PATHS
   record_counts[q - record_first] = cn.n_rec;
-  if (cn.overflow) atomic_inc(counters + PR_C_RECORD_OVERFLOW);
+  if (cn.overflow) atomic_inc(counter_lane(counters, PR_C_ROW) + PR_C_RECORD_OVERFLOW);
 #else
   radiance[i] += (float4)(cn.L.x, cn.L.y, cn.L.z, 0.0f);
 #endif

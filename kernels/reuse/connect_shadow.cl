@@ -22,5 +22,5 @@ PR_KERNEL void connect_shadow(PR_PARAMS(PR_ARGS_CONNECT_SHADOW)) {
     connect_record_apply(&L, &g, make_float3(r[k].c_r, r[k].c_g, r[k].c_b), op);
   }
   radiance[i] += (float4)(L.x, L.y, L.z, 0.0f);
-  if (unoccluded) atomic_add(counters + PR_C_CONNECTED, unoccluded);
+  if (unoccluded) atomic_add(counter_lane(counters, PR_C_ROW) + PR_C_CONNECTED, unoccluded);
 }

@@ -54,6 +54,6 @@ PR_KERNEL void eye_hit(PR_PARAMS(PR_ARGS_EYE_HIT)) {
   }
   eye[i] = e;
   radiance[i] = (float4)(L.x, L.y, L.z, 0.0f);
-  if (max_depth) atomic_inc(counters + PR_C_CAMERA_RAYS);
-  if (bounces) atomic_add(counters + PR_C_BOUNCE_RAYS, bounces);
+  if (max_depth) atomic_inc(counter_lane(counters, PR_C_ROW) + PR_C_CAMERA_RAYS);
+  if (bounces) atomic_add(counter_lane(counters, PR_C_ROW) + PR_C_BOUNCE_RAYS, bounces);
 }

@@ -44,7 +44,7 @@ PR_KERNEL void invalidate(PR_PARAMS(PR_ARGS_INVALIDATE)) {
       if (occluded_dynamic(&s.geom, r)) ok = 0;
     }
   }
-  if (rays) atomic_add(counters + PR_C_INVALID_RAYS, rays);
+  if (rays) atomic_add(counter_lane(counters, PR_C_ROW) + PR_C_INVALID_RAYS, rays);
   if (!ok && frame_stamp > 0u) changed[slot] = frame_stamp;
   if (mark_only) return;
   if (!ok) {
@@ -59,6 +59,6 @@ PR_KERNEL void invalidate(PR_PARAMS(PR_ARGS_INVALIDATE)) {
     else
       ++dsg;
   }
-  if (ssg) atomic_add(counters + PR_C_SSG_VERTICES, ssg);
-  if (dsg) atomic_add(counters + PR_C_DSG_VERTICES, dsg);
+  if (ssg) atomic_add(counter_lane(counters, PR_C_ROW) + PR_C_SSG_VERTICES, ssg);
+  if (dsg) atomic_add(counter_lane(counters, PR_C_ROW) + PR_C_DSG_VERTICES, dsg);
 }

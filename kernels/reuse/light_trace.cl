@@ -209,7 +209,7 @@ PR_KERNEL void light_trace(PR_PARAMS(PR_ARGS_LIGHT_TRACE)) {
   }
   h.vertex_count = count;
   headers[slot] = h;
-  atomic_add(counters + PR_C_LIGHT_RAYS, rays);
-  if (ssg) atomic_add(counters + PR_C_SSG_VERTICES, ssg);
-  if (dsg) atomic_add(counters + PR_C_DSG_VERTICES, dsg);
+  atomic_add(counter_lane(counters, PR_C_ROW) + PR_C_LIGHT_RAYS, rays);
+  if (ssg) atomic_add(counter_lane(counters, PR_C_ROW) + PR_C_SSG_VERTICES, ssg);
+  if (dsg) atomic_add(counter_lane(counters, PR_C_ROW) + PR_C_DSG_VERTICES, dsg);
 }

@@ -15,6 +15,7 @@ PR_NAMESPACE_BEGIN
 #define PR_PT_ENUM(name, key) PR_PT_##name,
 enum { PR_PT_COUNTERS(PR_PT_ENUM) PR_PT_COUNT };
 #undef PR_PT_ENUM
+enum { PR_PT_ROW = PR_COUNTER_ROW(PR_PT_COUNT) };  // one lane of the `rays` buffer
 
 // The sizes of the queues pt_shade appends to (its queue_sizes buffer).
 enum { PR_QUEUE_LIVE, PR_QUEUE_SHADOW, PR_QUEUE_COUNT };

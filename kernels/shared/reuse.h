@@ -62,9 +62,9 @@ PR_INLINE void connect_record_apply(float3* L, float3* g, float3 v, u32 op) {
   }
 }
 
-// Counters the kernels add to (one atomic add per work-item and counter), and where `--stats`
-// reports each: X(NAME, group, "key") adds counter PR_C_NAME, reported as rays.key or
-// counters.key (group rays / counters), or not at all (internal).
+// Counters the kernels add to (one atomic add per work-item and counter, in its work-group's
+// lane), and where `--stats` reports each: X(NAME, group, "key") adds counter PR_C_NAME, reported
+// as rays.key or counters.key (group rays / counters), or not at all (internal).
 #define PR_REUSE_COUNTERS(X)                                                           \
   X(LIST, internal, "")                 /* invalid slots listed by invalidate */       \
   X(INVALID_RAYS, rays, "invalidation") /* DSG rays of invalidation */                 \
@@ -87,6 +87,7 @@ PR_INLINE void connect_record_apply(float3* L, float3* g, float3 v, u32 op) {
 #define PR_C_ENUM(name, group, key) PR_C_##name,
 enum { PR_REUSE_COUNTERS(PR_C_ENUM) PR_C_COUNT };
 #undef PR_C_ENUM
+enum { PR_C_ROW = PR_COUNTER_ROW(PR_C_COUNT) };  // one lane of `counters` (shared/types.h)
 
 // Where the segment leaving a stored vertex (at p on triangle prim of instance inst, at
 // barycentrics (b1, b2), with its encoded normals) in direction dir starts: the exact point for

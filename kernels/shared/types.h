@@ -25,6 +25,21 @@ typedef struct {
 
 #define PR_INVALID_INDEX 0xffffffffu
 
+// Statistics counters (rays traced and the like) are kept in PR_COUNTER_LANES copies, a lane of
+// PR_COUNTER_ROW(n) u32 for n counters (whole 64-byte lines). A work-group adds to lane
+// group id mod PR_COUNTER_LANES, so that compute units do not fight over one cache line once per
+// work-item (3% of a CPU frame); the host adds the lanes. Counters that index a list stay in lane
+// 0, which starts the buffer.
+enum { PR_COUNTER_LANES = 16 };
+#define PR_COUNTER_ROW(n) ((((n) + 15) / 16) * 16)
+
+#ifdef PR_DEVICE_CODE
+// This work-group's lane of a counter buffer whose lanes are `row` u32 long.
+PR_INLINE __global u32* counter_lane(__global u32* counters, u32 row) {
+  return counters + row * ((u32)get_group_id(0) % (u32)PR_COUNTER_LANES);
+}
+#endif
+
 // BVH width: children per node. CPUs take 8 (one float8 slab test per node, AVX), GPUs 4
 // (host/render/options.cpp: faster than 2 and 8 on an H200); 2 is the binary node holding both
 // children's boxes, as Aila and Laine 2009 lay it out for SIMT. The host builds the layout the
