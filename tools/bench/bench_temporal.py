@@ -63,6 +63,8 @@ SETTINGS = {
     # Fewer light paths per camera sample (default 4).
     "reuse, 2 paths per pixel": ("reuse", ("--paths-per-pixel", "2")),
     "reuse, 1 path per pixel": ("reuse", ("--paths-per-pixel", "1")),
+    # One shadow ray per eye vertex, to a candidate chosen by RIS (the CPU default: all).
+    "reuse, 1 connection": ("reuse", ("--connections", "1")),
 }
 
 
