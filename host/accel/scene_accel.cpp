@@ -15,6 +15,7 @@
 
 #include "util/check.h"
 #include "util/error.h"
+#include "util/parallel.h"
 
 namespace pr::accel {
 
@@ -121,17 +122,24 @@ TriangleBvh buildTriangleBvh(const std::vector<glm::vec3>& positions,
   if (indices.size() % 3 != 0)
     throw InputError(std::string(what) + ": " + std::to_string(indices.size()) +
                      " indices is not a whole number of triangles");
-  for (size_t i = 0; i < positions.size(); ++i) {
-    const glm::vec3& p = positions[i];
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+  auto finite = [](const glm::vec3& p) {
+    return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+  };
+  for (size_t i = 0; i < positions.size(); ++i)
+    if (!finite(positions[i]))
       throw InputError(std::string(what) + ": position " + std::to_string(i) + " is not finite");
-  }
+  for (size_t k = 0; k < stepCount; ++k)
+    if (!std::all_of((*steps)[k].begin(), (*steps)[k].end(), finite))
+      throw InputError(std::string(what) + ": motion step " + std::to_string(k) +
+                       ": a position is not finite");
   const size_t count = indices.size() / 3;
   std::vector<dev::BvhTriangle> packed;
-  std::vector<std::vector<dev::BvhTriangle>> stepPacked(stepCount);
+  std::vector<uint32_t> kept;      // the triangle of each of `packed`
   std::vector<Aabb> boxes, swept;  // at the frame's time; over every step
   packed.reserve(count);
+  kept.reserve(count);
   boxes.reserve(count);
+  swept.reserve(count);
   for (size_t t = 0; t < count; ++t) {
     Aabb box;
     for (int k = 0; k < 3; ++k) {
@@ -146,19 +154,10 @@ TriangleBvh buildTriangleBvh(const std::vector<glm::vec3>& positions,
         packTriangle(positions[indices[3 * t]], positions[indices[3 * t + 1]],
                      positions[indices[3 * t + 2]], primBase + uint32_t(t));
     if (zeroArea(tri)) continue;
-    for (size_t k = 0; k < stepCount; ++k) {
-      const std::vector<glm::vec3>& at = (*steps)[k];
-      for (int c = 0; c < 3; ++c) {
-        const glm::vec3& p = at[indices[3 * t + size_t(c)]];
-        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-          throw InputError(std::string(what) + ": motion step " + std::to_string(k) +
-                           ": a position is not finite");
-        sweep.grow(p);
-      }
-      stepPacked[k].push_back(packTriangle(at[indices[3 * t]], at[indices[3 * t + 1]],
-                                           at[indices[3 * t + 2]], primBase + uint32_t(t)));
-    }
+    for (size_t k = 0; k < stepCount; ++k)
+      for (int c = 0; c < 3; ++c) sweep.grow((*steps)[k][indices[3 * t + size_t(c)]]);
     packed.push_back(tri);
+    kept.push_back(uint32_t(t));
     boxes.push_back(box);
     swept.push_back(sweep);
   }
@@ -181,26 +180,31 @@ TriangleBvh buildTriangleBvh(const std::vector<glm::vec3>& positions,
     PR_CHECK(count <= PR_BVH_PACKET && size_t(leaf.index) + count <= out.triangles.size());
     out.packets.push_back(packTriangles(out.triangles.data() + leaf.index, count));
   }
-  for (size_t k = 0; k < stepCount; ++k) {
-    std::vector<dev::BvhTriangle> ordered;
-    ordered.reserve(bvh.order.size());
-    for (uint32_t i : bvh.order) ordered.push_back(stepPacked[k][i]);
-    std::vector<dev::BvhTriPacket> packets;
-    for (const BinaryNode& leaf : out.wide.leaves)
-      packets.push_back(packTriangles(ordered.data() + leaf.index, leaf.meta & ~PR_BVH_LEAF_BIT));
-    out.stepPackets.push_back(std::move(packets));
-  }
-  // Node by node, its steps side by side: a node reads two neighbours.
+  // Each step's packets and node boxes on its own core; node by node, its steps side by side
+  // in stepBounds: a node reads two neighbours.
   const size_t nodeFloats = 6 * size_t(out.wide.width), nodes = out.wide.nodeCount();
-  out.stepBounds.assign(nodes * stepCount * nodeFloats, 0.0f);
-  std::vector<float> step(nodes * nodeFloats);
-  for (size_t k = 0; k < stepCount && nodes > 0; ++k) {
-    std::fill(step.begin(), step.end(), 0.0f);
-    refitNode(out.wide, out.stepPackets[k], 0, step.data());
-    for (size_t n = 0; n < nodes; ++n)
-      std::copy_n(step.data() + n * nodeFloats, nodeFloats,
-                  out.stepBounds.data() + (n * stepCount + k) * nodeFloats);
-  }
+  out.stepPackets.resize(stepCount);
+  out.stepBounds.resize(nodes * stepCount * nodeFloats);
+  if (stepCount > 0)
+    parallelFor(int(stepCount), [&](int k) {
+      const std::vector<glm::vec3>& at = (*steps)[size_t(k)];
+      std::vector<dev::BvhTriangle> ordered(bvh.order.size());
+      for (size_t j = 0; j < ordered.size(); ++j) {
+        const size_t t = kept[bvh.order[j]];
+        ordered[j] = packTriangle(at[indices[3 * t]], at[indices[3 * t + 1]],
+                                  at[indices[3 * t + 2]], primBase + uint32_t(t));
+      }
+      std::vector<dev::BvhTriPacket>& packets = out.stepPackets[size_t(k)];
+      packets.reserve(out.wide.leaves.size());
+      for (const BinaryNode& leaf : out.wide.leaves)
+        packets.push_back(packTriangles(ordered.data() + leaf.index, leaf.meta & ~PR_BVH_LEAF_BIT));
+      if (nodes == 0) return;
+      std::vector<float> step(nodes * nodeFloats, 0.0f);
+      refitNode(out.wide, packets, 0, step.data());
+      for (size_t n = 0; n < nodes; ++n)
+        std::copy_n(step.data() + n * nodeFloats, nodeFloats,
+                    out.stepBounds.data() + (n * stepCount + size_t(k)) * nodeFloats);
+    });
   if (stepCount > 0) holdEveryStep(&out.wide, out.stepBounds, stepCount);
   return out;
 }

@@ -128,16 +128,21 @@ DeviceTextures packTextures(const std::vector<Texture>& textures) {
   return out;
 }
 
-dev::ShadingVertex shadingVertex(const TriangleMesh& m, size_t v) {
+dev::ShadingVertex shadingVertex(const TriangleMesh& mesh, const TriangleMesh& shape, size_t v) {
   dev::ShadingVertex sv{};
-  sv.px = m.positions[v].x, sv.py = m.positions[v].y, sv.pz = m.positions[v].z;
-  if (v < m.normals.size()) sv.nx = m.normals[v].x, sv.ny = m.normals[v].y, sv.nz = m.normals[v].z;
-  if (v < m.uvs.size()) sv.u = m.uvs[v].x, sv.v = m.uvs[v].y;
-  const glm::vec2 uv1 = v < m.uvs1.size() ? m.uvs1[v] : glm::vec2(sv.u, sv.v);
+  const TriangleMesh& s = shape;
+  sv.px = s.positions[v].x, sv.py = s.positions[v].y, sv.pz = s.positions[v].z;
+  if (v < s.normals.size()) sv.nx = s.normals[v].x, sv.ny = s.normals[v].y, sv.nz = s.normals[v].z;
+  if (v < mesh.uvs.size()) sv.u = mesh.uvs[v].x, sv.v = mesh.uvs[v].y;
+  const glm::vec2 uv1 = v < mesh.uvs1.size() ? mesh.uvs1[v] : glm::vec2(sv.u, sv.v);
   sv.u1 = uv1.x, sv.v1 = uv1.y;
-  const glm::vec4 t = v < m.tangents.size() ? m.tangents[v] : glm::vec4(1, 0, 0, 1);
+  const glm::vec4 t = v < s.tangents.size() ? s.tangents[v] : glm::vec4(1, 0, 0, 1);
   sv.tx = t.x, sv.ty = t.y, sv.tz = t.z, sv.tw = t.w;
   return sv;
+}
+
+dev::ShadingVertex shadingVertex(const TriangleMesh& m, size_t v) {
+  return shadingVertex(m, m, v);
 }
 
 }  // namespace pr

@@ -33,5 +33,8 @@ DeviceTextures packTextures(const std::vector<Texture>& textures);
 // Vertex v of a mesh: position, normal, both uv sets (TEXCOORD_0 standing in for a missing
 // TEXCOORD_1) and tangent.
 dev::ShadingVertex shadingVertex(const TriangleMesh& m, size_t v);
+// The same for a deformed shape of `mesh` (Scene::deformMesh): its positions, normals and
+// tangents from `shape`, the rest from `mesh`.
+dev::ShadingVertex shadingVertex(const TriangleMesh& mesh, const TriangleMesh& shape, size_t v);
 
 }  // namespace pr

@@ -256,25 +256,26 @@ bool GpuScene::deformMeshes(double t, const std::vector<double>& times,
     lastNormals_[m] = shape.normals;
     (*changed)[m] = any = true;
     if (previousKnown_) copyToPrevious(meshFirstVertex_[m], shape.vertexCount(), false);
-    // Each step's shape on its own core (deformMesh only reads the scene).
+    // Each step's shape on its own core (deformMesh only reads the scene and writes positions,
+    // normals and tangents), its shading vertices straight into their place in stepVertices.
+    const size_t nv = shape.vertexCount(), first = stepVertices.size();
     std::vector<std::vector<glm::vec3>> steps(times.size());
-    std::vector<std::vector<dev::ShadingVertex>> stepShading(times.size());
+    stepVertices.resize(first + times.size() * nv);
     parallelFor(int(times.size()), [&](int k) {
       // The middle step is the frame's time itself (an odd count): its shape is `shape`.
       TriangleMesh deformed;
       const TriangleMesh* s = &shape;
       if (times[size_t(k)] != t) {
-        deformed = scene_.dynamicMeshes[m];
         scene_.deformMesh(m, times[size_t(k)], &deformed);
         s = &deformed;
       }
-      steps[size_t(k)] = s->positions;
-      stepShading[size_t(k)].reserve(s->vertexCount());
-      for (size_t v = 0; v < s->vertexCount(); ++v)
-        stepShading[size_t(k)].push_back(shadingVertex(*s, v));
+      dev::ShadingVertex* out = stepVertices.data() + first + size_t(k) * nv;
+      for (size_t v = 0; v < nv; ++v) out[v] = shadingVertex(scene_.dynamicMeshes[m], *s, v);
+      if (s == &shape)
+        steps[size_t(k)] = shape.positions;
+      else
+        steps[size_t(k)] = std::move(deformed.positions);
     });
-    for (const std::vector<dev::ShadingVertex>& step : stepShading)
-      stepVertices.insert(stepVertices.end(), step.begin(), step.end());
     if (!times.empty()) vm[3] = uint32_t(times.size());
     accel::BuildOptions build;
     build.width = bvhWidth_;
@@ -650,10 +651,35 @@ float blendError(const accel::Aabb& box, const glm::mat4& a, const glm::mat4& b,
   return worst;
 }
 
-// A deforming mesh's shape blended between two steps against its shape midway, over the mesh's
-// size: each joint's skinning matrix blended, at the box of the bind-pose vertices it moves (a
-// skinned vertex is a weighted sum of them), and each morph weight blended, times its target's
-// largest displacement.
+// Box `box` placed by m: the box of its corners' images.
+accel::Aabb placedBox(const accel::Aabb& box, const glm::mat4& m) {
+  accel::Aabb out;
+  for (int c = 0; c < 8; ++c)
+    out.grow(glm::vec3(m * glm::vec4((c & 1) ? box.hi.x : box.lo.x, (c & 2) ? box.hi.y : box.lo.y,
+                                     (c & 4) ? box.hi.z : box.lo.z, 1.0f)));
+  return out;
+}
+
+// The length one pixel spans at the point of a world box nearest the camera (at the middle of
+// the shutter interval), never nearer than the near plane: what an error there looks like on
+// the film. Shadows and reflections show an object's error at about its own size.
+class PixelFootprint {
+ public:
+  PixelFootprint(const CameraPose& view, int height, float tiny)
+      : position_(view.position),
+        near_(std::max(view.znear, tiny)),
+        angle_(2.0f * std::tan(0.5f * view.yfov) / float(std::max(height, 1))) {}
+  float angle() const { return angle_; }
+  float operator()(const accel::Aabb& box) const {
+    const glm::vec3 nearest = glm::clamp(position_, box.lo, box.hi);
+    return std::max(glm::length(nearest - position_), near_) * angle_;
+  }
+
+ private:
+  glm::vec3 position_;
+  float near_, angle_;
+};
+
 // What a deforming mesh's deformation is measured by (GpuScene::setShutter, once): each morph
 // target's largest displacement, and each joint's box of the bind-pose vertices it moves.
 void deformationReach(const Scene& scene, std::vector<std::vector<float>>* morphReach,
@@ -680,18 +706,21 @@ void deformationReach(const Scene& scene, std::vector<std::vector<float>>* morph
   }
 }
 
-// A deforming mesh's shape blended between two steps against its shape midway, over the mesh's
-// size: each joint's skinning matrix blended, at its box (a skinned vertex is a weighted sum of
-// them), and each morph weight blended, times its target's reach.
+// A deforming mesh's shape blended between two steps against its shape midway, in pixels (pixel):
+// each joint's skinning matrix blended, at the box of the bind-pose vertices it moves (a skinned
+// vertex is a weighted sum of them), and each morph weight blended, times its target's largest
+// displacement.
 class DeformationError {
  public:
   DeformationError(const Scene& scene, const std::vector<accel::Aabb>& meshBounds,
                    const std::vector<std::vector<float>>& morphReach,
-                   const std::vector<std::vector<accel::Aabb>>& jointBoxes, float tiny)
+                   const std::vector<std::vector<accel::Aabb>>& jointBoxes,
+                   const PixelFootprint& pixel, float tiny)
       : scene_(scene),
         meshBounds_(meshBounds),
         morphReach_(morphReach),
         jointBoxes_(jointBoxes),
+        pixel_(pixel),
         tiny_(tiny) {}
 
   float operator()(size_t m, double a, double b, double mid) const {
@@ -699,22 +728,26 @@ class DeformationError {
     const accel::Aabb& box = meshBounds_[m];
     if (box.empty()) return 0.0f;
     float worst = 0.0f;
+    accel::Aabb placed;  // the mesh where it is midway
     if (!jointBoxes_[m].empty()) {
       const Skin& skin = scene_.skins[size_t(d.skin)];
       auto at = [&](size_t j, double u) {
         return scene_.nodeWorldTransform(skin.joints[j], u) * skin.inverseBind[j];
       };
-      // The mesh's size: its bind box under the first joint.
-      float size = 0.0f, unused = 0.0f;
-      const glm::mat4 first = at(0, mid);
-      blendError(box, first, first, first, &size);
-      size = std::max(size, tiny_);
-      for (size_t j = 0; j < jointBoxes_[m].size(); ++j)
-        if (!jointBoxes_[m][j].empty())
-          worst = std::max(
-              worst, blendError(jointBoxes_[m][j], at(j, a), at(j, b), at(j, mid), &unused) / size);
+      float unused = 0.0f;
+      for (size_t j = 0; j < jointBoxes_[m].size(); ++j) {
+        if (jointBoxes_[m][j].empty()) continue;
+        const glm::mat4 jm = at(j, mid);
+        const accel::Aabb world = placedBox(jointBoxes_[m][j], jm);
+        placed.grow(world.lo);
+        placed.grow(world.hi);
+        worst = std::max(
+            worst, blendError(jointBoxes_[m][j], at(j, a), at(j, b), jm, &unused) / pixel_(world));
+      }
+    } else {
+      placed = placedBox(box, scene_.nodeWorldTransform(d.node, mid));
     }
-    if (!morphReach_[m].empty()) {
+    if (!morphReach_[m].empty() && !placed.empty()) {
       const TriangleMesh& base = scene_.dynamicMeshes[m];
       const std::vector<float> wa = scene_.morphWeightsAt(d.node, base, a),
                                wb = scene_.morphWeightsAt(d.node, base, b),
@@ -722,7 +755,10 @@ class DeformationError {
       float off = 0.0f;
       for (size_t k = 0; k < wm.size() && k < morphReach_[m].size(); ++k)
         off += std::abs(0.5f * (wa[k] + wb[k]) - wm[k]) * morphReach_[m][k];
-      worst = std::max(worst, off / std::max(0.5f * glm::length(box.hi - box.lo), tiny_));
+      // The targets' displacements are the mesh's own units: scaled as its box is placed.
+      const float scale =
+          glm::length(placed.hi - placed.lo) / std::max(glm::length(box.hi - box.lo), tiny_);
+      worst = std::max(worst, off * scale / pixel_(placed));
     }
     return worst;
   }
@@ -732,6 +768,7 @@ class DeformationError {
   const std::vector<accel::Aabb>& meshBounds_;
   const std::vector<std::vector<float>>& morphReach_;
   const std::vector<std::vector<accel::Aabb>>& jointBoxes_;
+  const PixelFootprint& pixel_;
   float tiny_;
 };
 
@@ -759,23 +796,26 @@ std::vector<double> GpuScene::motionTimes(double t) const {
       times[size_t(k)] = t + shutter_ * (double(k) / double(steps - 1) - 0.5);
     return times;
   };
+  // Moving instances and deforming meshes: a blend of two steps within half a pixel of where the
+  // animation puts them midway, where the camera sees them (PixelFootprint): fewer steps for a
+  // preview or a far object, more for a near one at a high resolution. The camera's turn counts
+  // the same in pixels; its and the lights' moves, in the scene's size. Two pixels moved the
+  // city's blocks 2% at 2 fps (docs/experiments/motion-blur.md).
+  constexpr float kPixels = 0.5f;
   constexpr float kTolerance = 1e-3f;
-  // Deforming meshes get three times as much: about a pixel for a mesh that fills the frame's
-  // height at 720 lines, and 1e-3 took BrainStem at 24 fps to 5-17 steps (3-5 now) and a shutter
-  // of half a frame from 1.2x a sharp frame's time to 1.6x (docs/experiments/motion-blur.md).
-  constexpr float kDeformTolerance = 3e-3f;
+  const PixelFootprint pixel(scene_.cameraAt(shutterCamera_, t), shutterHeight_,
+                             1e-6f * sceneRadius_);
   auto instanceError = [&](const accel::Aabb& box, const glm::mat4& a, const glm::mat4& b,
                            const glm::mat4& mid) {
     float size = 0.0f;
-    const float worst = blendError(box, a, b, mid, &size);
-    return worst / std::max(size, 1e-6f * sceneRadius_);
+    return blendError(box, a, b, mid, &size) / pixel(placedBox(box, mid));
   };
-  auto cameraError = [&](const CameraPose& a, const CameraPose& b, const CameraPose& mid) {
+  auto cameraFine = [&](const CameraPose& a, const CameraPose& b, const CameraPose& mid) {
     const float moved = glm::length(0.5f * (a.position + b.position) - mid.position) / sceneRadius_;
     const float turned =
         glm::length(glm::normalize(a.forward + b.forward) - glm::normalize(mid.forward)) +
         glm::length(glm::normalize(a.up + b.up) - glm::normalize(mid.up));
-    return std::max(moved, turned);
+    return moved <= kTolerance && turned / pixel.angle() <= kPixels;
   };
   auto lightError = [&](const PunctualLight& a, const PunctualLight& b, const PunctualLight& mid) {
     const float moved = glm::length(0.5f * (a.position + b.position) - mid.position) / sceneRadius_;
@@ -785,7 +825,7 @@ std::vector<double> GpuScene::motionTimes(double t) const {
                              : 2.0f;
     return std::max(moved, turned);
   };
-  const DeformationError deformError(scene_, meshBounds_, morphReach_, jointBoxes_,
+  const DeformationError deformError(scene_, meshBounds_, morphReach_, jointBoxes_, pixel,
                                      1e-6f * sceneRadius_);
   for (int steps = 3;; steps = 2 * steps - 1) {
     const std::vector<double> times = timesOf(steps);
@@ -794,9 +834,9 @@ std::vector<double> GpuScene::motionTimes(double t) const {
     for (size_t k = 0; fine && k + 1 < times.size(); ++k) {
       const double mid = 0.5 * (times[k] + times[k + 1]);
       // (A non-finite error, a degenerate placement, asks for more steps, up to the most.)
-      fine = cameraError(scene_.cameraAt(shutterCamera_, times[k]),
-                         scene_.cameraAt(shutterCamera_, times[k + 1]),
-                         scene_.cameraAt(shutterCamera_, mid)) <= kTolerance;
+      fine = cameraFine(scene_.cameraAt(shutterCamera_, times[k]),
+                        scene_.cameraAt(shutterCamera_, times[k + 1]),
+                        scene_.cameraAt(shutterCamera_, mid));
       for (size_t i = 0; fine && i < scene_.lights.size(); ++i)
         fine = !scene_.lights[i].dynamic ||
                lightError(scene_.lightAt(i, times[k]), scene_.lightAt(i, times[k + 1]),
@@ -805,11 +845,10 @@ std::vector<double> GpuScene::motionTimes(double t) const {
         const accel::Aabb& box = meshBounds_[scene_.instances[i].mesh];
         fine = box.empty() || instanceError(box, scene_.instanceTransform(i, times[k]),
                                             scene_.instanceTransform(i, times[k + 1]),
-                                            scene_.instanceTransform(i, mid)) <= kTolerance;
+                                            scene_.instanceTransform(i, mid)) <= kPixels;
       }
       for (size_t m = 0; fine && m < scene_.dynamicMeshes.size(); ++m)
-        fine = !scene_.meshDeforms(m) ||
-               deformError(m, times[k], times[k + 1], mid) <= kDeformTolerance;
+        fine = !scene_.meshDeforms(m) || deformError(m, times[k], times[k + 1], mid) <= kPixels;
     }
     if (fine) return times;
   }

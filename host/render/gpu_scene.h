@@ -134,8 +134,9 @@ class GpuScene {
   void copyToPrevious(uint64_t firstVertex, uint64_t vertexCount, bool instances);
   void buildLights(double t);
   // The fewest motion steps (3, 5, 9, 17, 33) at which a blend of two steps places every moving
-  // instance's box and the camera within a thousandth of their size of where the animation puts
-  // them midway; the times of those steps around t.
+  // instance's box and deforming mesh within half a pixel of where the animation puts them
+  // midway, as the camera sees them, and the camera and lights within a thousandth of the scene;
+  // the times of those steps around t.
   std::vector<double> motionTimes(double t) const;
   // Under a shutter: each instance's transforms at `times` (*motion) and the camera's, uploaded
   // to cameraSteps_.

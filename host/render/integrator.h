@@ -35,6 +35,7 @@ struct FrameStats {
   uint64_t deviceBytes = 0;
   std::map<std::string, uint64_t> deviceBuffers;  // deviceBytes by buffer name
   uint64_t badSamples = 0;
+  uint32_t motionSteps = 1;  // under --shutter, the times the scene was placed at (1: none)
   int passes = 0;  // sample passes rendered (each pixel's samples; fewer under --time-limit)
   // Under --noise-threshold, the mean and maximum of the pixels' samples (-1: `passes` each).
   double sppMean = -1.0;

@@ -229,6 +229,7 @@ Image MultiDeviceSession::renderFrame(int64_t frame, FrameStats* total,
   if (total) {
     FrameStats& t = *total;
     t.frame = frame;
+    t.motionSteps = p[0].stats.motionSteps;  // every device places the scene alike
     // Each pixel's samples: every device's passes where they split them, else one's.
     t.passes = 0;
     for (size_t i = 0; i < n; ++i)

@@ -198,6 +198,7 @@ std::string statsLine(int64_t f, const RenderOptions& o, const FrameStats& fs,
   j["wall_s"] = fs.wallSeconds;
   j["stages_s"] = fs.stageSeconds;
   j["host_s"] = fs.hostSeconds;
+  if (fs.motionSteps > 1) j["motion_steps"] = fs.motionSteps;
   if (!fs.buildSeconds.empty()) j["build_s"] = fs.buildSeconds;
   j["rays"] = fs.rays;
   if (!fs.counters.empty()) j["counters"] = fs.counters;

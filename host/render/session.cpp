@@ -277,6 +277,7 @@ void RenderSession::render(int64_t frame, FrameStats* fs) {
   fs->hostSeconds["scene"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   fs->hostSeconds["deform"] = gpu_->lastDeformSeconds();
+  fs->motionSteps = gpu_->motionSteps();
   film_->clear();
   fs->frame = frame;
   for (const auto& [k, v] : ctx_.takeBuildSeconds()) fs->buildSeconds[k] += v;
