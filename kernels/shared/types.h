@@ -28,7 +28,7 @@ typedef struct {
 // Statistics counters (rays traced and the like) are kept in PR_COUNTER_LANES copies, a lane of
 // PR_COUNTER_ROW(n) u32 for n counters (whole 64-byte lines). A work-group adds to lane
 // group id mod PR_COUNTER_LANES, so that compute units do not fight over one cache line once per
-// work-item (3% of a CPU frame); the host adds the lanes. Counters that index a list stay in lane
+// work-item (3-6% of a CPU frame); the host adds the lanes. Counters that index a list stay in lane
 // 0, which starts the buffer.
 enum { PR_COUNTER_LANES = 16 };
 #define PR_COUNTER_ROW(n) ((((n) + 15) / 16) * 16)
