@@ -262,11 +262,9 @@ TEST(MotionBlur, AlbedoIsBlurredAndZIsTheFramesOwn) {
 }
 
 // The motion steps: none without a shutter, the fewest (3) for motion that blends exactly (a
-// translation, a still scene, a skin's joint sliding), more for a turn, of an instance or of a
-// skin's joint (its vertices sweep arcs: a mesh placed by its joints alone, whose own transform
-// never moves).
-// The steps follow what moves as the film sees it: a slide and a pan blend exactly (3 steps); a
-// turn does not, and takes more steps the finer the film (half a pixel's error midway).
+// translation, a pan, a skin's joint sliding); a turn, of an instance or of a skin's joint (its
+// vertices sweep arcs: a mesh placed by its joints alone, whose own transform never moves), takes
+// more the finer the film, as the steps keep within half a pixel of it: 3 on a 16x12 film.
 TEST(MotionBlur, StepsFollowTheMotion) {
   Context& ctx = test::testContext();
   auto stepsOf = [&](Moving what, const std::string& tag, double shutter, int height) {
