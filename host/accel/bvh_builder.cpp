@@ -27,6 +27,12 @@ void Aabb::grow(const Aabb& b) {
   hi = glm::max(hi, b.hi);
 }
 
+Aabb Aabb::transformed(const glm::mat4& m) const {
+  Aabb out;
+  for (int c = 0; c < 8; ++c) out.grow(glm::vec3(m * glm::vec4(corner(c), 1.0f)));
+  return out;
+}
+
 float Aabb::halfArea() const {
   if (empty()) return 0.0f;
   const glm::vec3 e = hi - lo;

@@ -9,6 +9,7 @@
 #include <limits>
 #include <vector>
 
+#include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
 
 #include "shared/types.h"
@@ -23,6 +24,11 @@ struct Aabb {
   void grow(const glm::vec3& p);
   void grow(const Aabb& b);
   glm::vec3 centre() const { return (lo + hi) * 0.5f; }
+  // Corner c (bit 0: x, 1: y, 2: z; set: hi) and the box of the eight corners under m.
+  glm::vec3 corner(int c) const {
+    return {(c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z};
+  }
+  Aabb transformed(const glm::mat4& m) const;
   // Half the surface area: all SAH needs (ratios).
   float halfArea() const;
 };

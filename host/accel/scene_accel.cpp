@@ -360,14 +360,7 @@ void DynamicAccel::setInstances(const std::vector<InstanceInput>& instances,
     const glm::mat4 inv = glm::inverse(in.objectToWorld);
     if (!(std::fabs(det) > 0.0f) || !finite(inv)) continue;
     Aabb box;
-    for (const glm::mat4& m : placements) {
-      for (int c = 0; c < 8; ++c) {
-        const glm::vec3 corner((c & 1) ? mesh.bounds.hi.x : mesh.bounds.lo.x,
-                               (c & 2) ? mesh.bounds.hi.y : mesh.bounds.lo.y,
-                               (c & 4) ? mesh.bounds.hi.z : mesh.bounds.lo.z);
-        box.grow(glm::vec3(m * glm::vec4(corner, 1.0f)));
-      }
-    }
+    for (const glm::mat4& m : placements) box.grow(mesh.bounds.transformed(m));
     // Rays are tested in object space; pad the world box by a few ulps of its coordinates so
     // the transform's rounding never culls a hit at the box's edge.
     const glm::vec3 pad = (glm::abs(box.lo) + glm::abs(box.hi)) * 1e-6f + 1e-30f;

@@ -128,9 +128,8 @@ DeviceTextures packTextures(const std::vector<Texture>& textures) {
   return out;
 }
 
-dev::ShadingVertex shadingVertex(const TriangleMesh& mesh, const TriangleMesh& shape, size_t v) {
+dev::ShadingVertex shadingVertex(const TriangleMesh& mesh, const TriangleMesh& s, size_t v) {
   dev::ShadingVertex sv{};
-  const TriangleMesh& s = shape;
   sv.px = s.positions[v].x, sv.py = s.positions[v].y, sv.pz = s.positions[v].z;
   if (v < s.normals.size()) sv.nx = s.normals[v].x, sv.ny = s.normals[v].y, sv.nz = s.normals[v].z;
   if (v < mesh.uvs.size()) sv.u = mesh.uvs[v].x, sv.v = mesh.uvs[v].y;

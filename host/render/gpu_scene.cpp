@@ -641,23 +641,13 @@ float blendError(const accel::Aabb& box, const glm::mat4& a, const glm::mat4& b,
   float worst = 0.0f;
   *size = 0.0f;
   for (int c = 0; c < 8; ++c) {
-    const glm::vec4 corner((c & 1) ? box.hi.x : box.lo.x, (c & 2) ? box.hi.y : box.lo.y,
-                           (c & 4) ? box.hi.z : box.lo.z, 1.0f);
+    const glm::vec4 corner(box.corner(c), 1.0f);
     const glm::vec3 exact(mid * corner);
     const glm::vec3 blend(0.5f * (a * corner + b * corner));
     worst = std::max(worst, glm::length(blend - exact));
     *size = std::max(*size, glm::length(exact - glm::vec3(mid * glm::vec4(box.centre(), 1.0f))));
   }
   return worst;
-}
-
-// Box `box` placed by m: the box of its corners' images.
-accel::Aabb placedBox(const accel::Aabb& box, const glm::mat4& m) {
-  accel::Aabb out;
-  for (int c = 0; c < 8; ++c)
-    out.grow(glm::vec3(m * glm::vec4((c & 1) ? box.hi.x : box.lo.x, (c & 2) ? box.hi.y : box.lo.y,
-                                     (c & 4) ? box.hi.z : box.lo.z, 1.0f)));
-  return out;
 }
 
 // The length one pixel spans at the point of a world box nearest the camera (at the middle of
@@ -738,14 +728,13 @@ class DeformationError {
       for (size_t j = 0; j < jointBoxes_[m].size(); ++j) {
         if (jointBoxes_[m][j].empty()) continue;
         const glm::mat4 jm = at(j, mid);
-        const accel::Aabb world = placedBox(jointBoxes_[m][j], jm);
-        placed.grow(world.lo);
-        placed.grow(world.hi);
+        const accel::Aabb world = jointBoxes_[m][j].transformed(jm);
+        placed.grow(world);
         worst = std::max(
             worst, blendError(jointBoxes_[m][j], at(j, a), at(j, b), jm, &unused) / pixel_(world));
       }
     } else {
-      placed = placedBox(box, scene_.nodeWorldTransform(d.node, mid));
+      placed = box.transformed(scene_.nodeWorldTransform(d.node, mid));
     }
     if (!morphReach_[m].empty() && !placed.empty()) {
       const TriangleMesh& base = scene_.dynamicMeshes[m];
@@ -808,7 +797,7 @@ std::vector<double> GpuScene::motionTimes(double t) const {
   auto instanceError = [&](const accel::Aabb& box, const glm::mat4& a, const glm::mat4& b,
                            const glm::mat4& mid) {
     float size = 0.0f;
-    return blendError(box, a, b, mid, &size) / pixel(placedBox(box, mid));
+    return blendError(box, a, b, mid, &size) / pixel(box.transformed(mid));
   };
   auto cameraFine = [&](const CameraPose& a, const CameraPose& b, const CameraPose& mid) {
     const float moved = glm::length(0.5f * (a.position + b.position) - mid.position) / sceneRadius_;
