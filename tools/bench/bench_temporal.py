@@ -49,6 +49,7 @@ SETTINGS = {
     "resample, one frame": ("pathtrace", ("--resample", "--resample-history", "0")),
     "resample": ("pathtrace", ("--resample",)),
     "resample, 3 neighbours": ("pathtrace", ("--resample", "--resample-neighbors", "3")),
+    "resample, no neighbours": ("pathtrace", ("--resample", "--resample-neighbors", "0")),
     "reuse, no resample": ("reuse", ("--no-resample",)),
     "reuse": ("reuse", ()),  # resampled, no neighbours: the default
     "reuse, 1 neighbour": ("reuse", ("--resample-neighbors", "1")),
