@@ -634,18 +634,15 @@ void GpuScene::buildLights(double t) {
 
 namespace {
 
-// How far the blend of a and b lies from `mid` at the box's corners; *size: the box's size under
-// mid (the largest corner's distance from its centre).
+// How far the blend of a and b lies from `mid` at the box's corners.
 float blendError(const accel::Aabb& box, const glm::mat4& a, const glm::mat4& b,
-                 const glm::mat4& mid, float* size) {
+                 const glm::mat4& mid) {
   float worst = 0.0f;
-  *size = 0.0f;
   for (int c = 0; c < 8; ++c) {
     const glm::vec4 corner(box.corner(c), 1.0f);
     const glm::vec3 exact(mid * corner);
     const glm::vec3 blend(0.5f * (a * corner + b * corner));
     worst = std::max(worst, glm::length(blend - exact));
-    *size = std::max(*size, glm::length(exact - glm::vec3(mid * glm::vec4(box.centre(), 1.0f))));
   }
   return worst;
 }
@@ -724,14 +721,13 @@ class DeformationError {
       auto at = [&](size_t j, double u) {
         return scene_.nodeWorldTransform(skin.joints[j], u) * skin.inverseBind[j];
       };
-      float unused = 0.0f;
       for (size_t j = 0; j < jointBoxes_[m].size(); ++j) {
         if (jointBoxes_[m][j].empty()) continue;
         const glm::mat4 jm = at(j, mid);
         const accel::Aabb world = jointBoxes_[m][j].transformed(jm);
         placed.grow(world);
-        worst = std::max(
-            worst, blendError(jointBoxes_[m][j], at(j, a), at(j, b), jm, &unused) / pixel_(world));
+        worst =
+            std::max(worst, blendError(jointBoxes_[m][j], at(j, a), at(j, b), jm) / pixel_(world));
       }
     } else {
       placed = box.transformed(scene_.nodeWorldTransform(d.node, mid));
@@ -796,8 +792,7 @@ std::vector<double> GpuScene::motionTimes(double t) const {
                              1e-6f * sceneRadius_);
   auto instanceError = [&](const accel::Aabb& box, const glm::mat4& a, const glm::mat4& b,
                            const glm::mat4& mid) {
-    float size = 0.0f;
-    return blendError(box, a, b, mid, &size) / pixel(box.transformed(mid));
+    return blendError(box, a, b, mid) / pixel(box.transformed(mid));
   };
   auto cameraFine = [&](const CameraPose& a, const CameraPose& b, const CameraPose& mid) {
     const float moved = glm::length(0.5f * (a.position + b.position) - mid.position) / sceneRadius_;
