@@ -290,6 +290,30 @@ TEST(MotionBlur, StepsFollowTheMotion) {
   }
 }
 
+// --motion-tolerance: a turn that half a pixel asks more steps of takes fewer under a looser
+// tolerance, and never more; a slide blends exactly under any.
+TEST(MotionBlur, ALooserToleranceTakesNoMoreSteps) {
+  Context& ctx = test::testContext();
+  auto stepsOf = [&](Moving what, const std::string& tag, double pixels) {
+    const Scene scene = loadScene(movingScene(what, tag));
+    GpuScene gpu(ctx, scene);
+    gpu.setShutter(0.5, 0, 1600, 1200, true, pixels);
+    gpu.setTime(1.0);
+    return gpu.motionSteps();
+  };
+  EXPECT_EQ(stepsOf(Moving::Object, "mb-tol-slide", 0.01), 3u);
+  for (Moving turning : {Moving::Rotating, Moving::SkinTurning}) {
+    SCOPED_TRACE(int(turning));
+    const std::string tag = "mb-tol-turn-" + std::to_string(int(turning));
+    const uint32_t tight = stepsOf(turning, tag, 0.5);
+    const uint32_t loose = stepsOf(turning, tag, 8.0);
+    EXPECT_GT(tight, 3u);
+    EXPECT_LT(loose, tight);
+    EXPECT_LE(stepsOf(turning, tag, 100.0), loose);
+    EXPECT_GE(stepsOf(turning, tag, 0.05), tight);
+  }
+}
+
 // The stats line says how many times the scene was placed at: a turn seen on a fine film takes
 // more than a sharp frame's one (no field) or a slide's three.
 TEST(MotionBlur, TheStatsLineGivesTheMotionSteps) {
@@ -304,8 +328,12 @@ TEST(MotionBlur, TheStatsLineGivesTheMotionSteps) {
   };
   EXPECT_EQ(stepsOf(Moving::Rotating, "mb-stats-sharp", "--width 16 --height 12"), 1);
   EXPECT_EQ(stepsOf(Moving::Object, "mb-stats-slide", "--width 16 --height 12 --shutter 0.5"), 3);
-  EXPECT_GT(stepsOf(Moving::Rotating, "mb-stats-turn", "--width 640 --height 480 --shutter 0.5"),
-            3);
+  const int turn =
+      stepsOf(Moving::Rotating, "mb-stats-turn", "--width 640 --height 480 --shutter 0.5");
+  EXPECT_GT(turn, 3);
+  EXPECT_LT(stepsOf(Moving::Rotating, "mb-stats-loose",
+                    "--width 640 --height 480 --shutter 0.5 --motion-tolerance 20"),
+            turn);
 }
 
 // What is not built for an open shutter is refused in one line, exit 2: the connection history,

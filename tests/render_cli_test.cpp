@@ -112,6 +112,7 @@ TEST(RenderCli, OptionsBuiltInCodeMeetTheTablesRanges) {
       {[](RenderOptions& o) { o.resample.radius = 0.5f; }, "--resample-radius 0.5: "},
       {[](RenderOptions& o) { o.envStrength = std::nanf(""); }, "--env-strength nan: "},
       {[](RenderOptions& o) { o.exposure = 100.0f; }, "--exposure 100: "},
+      {[](RenderOptions& o) { o.motionTolerance = 0.0; }, "--motion-tolerance 0: "},
   };
   for (const auto& [edit, message] : bad) {
     RenderOptions o;
@@ -159,6 +160,7 @@ const std::map<std::string, std::string> kSampleValues = {
     {"--frames", "2-3"},
     {"--fps", "25"},
     {"--shutter", "0.5"},
+    {"--motion-tolerance", "2"},
     {"--camera", "1"},
     {"--width", "33"},
     {"--height", "21"},

@@ -107,6 +107,11 @@ std::vector<Row> sceneAndOutputRows() {
           "(0: none; not with --connection-history)"}
           .range(0, 2)
           .withDefault(),
+      Row{"--motion-tolerance", kScene, kEveryday, kEstimator, PR_FIELD(ro.motionTolerance),
+          "With --shutter: how far, in pixels, the motion steps' blend of a moving object or "
+          "skin may stray from its animation (larger: fewer steps, faster frames)"}
+          .range(0.01, 100)
+          .withDefault(),
       Row{"--camera", kScene, kEveryday, kEstimator, PR_FIELD(ro.camera),
           "Camera index (default: the scene's first)"}
           .range(0, 1 << 20),

@@ -759,8 +759,10 @@ class DeformationError {
 
 }  // namespace
 
-void GpuScene::setShutter(double seconds, int cameraIndex, int width, int height, bool sweeps) {
+void GpuScene::setShutter(double seconds, int cameraIndex, int width, int height, bool sweeps,
+                          double tolerancePixels) {
   shutter_ = seconds > 0.0 ? seconds : 0.0;
+  motionPixels_ = static_cast<float>(tolerancePixels);
   sweepsWanted_ = sweeps;
   shutterCamera_ = cameraIndex;
   shutterWidth_ = width;
@@ -781,12 +783,13 @@ std::vector<double> GpuScene::motionTimes(double t) const {
       times[size_t(k)] = t + shutter_ * (double(k) / double(steps - 1) - 0.5);
     return times;
   };
-  // Moving instances and deforming meshes: a blend of two steps within half a pixel of where the
-  // animation puts them midway, where the camera sees them (PixelFootprint): fewer steps for a
-  // preview or a far object, more for a near one at a high resolution. The camera's turn counts
-  // the same in pixels; its and the lights' moves, in the scene's size. Two pixels moved the
-  // city's blocks 2% at 2 fps (docs/experiments/motion-blur.md).
-  constexpr float kPixels = 0.5f;
+  // Moving instances and deforming meshes: a blend of two steps within --motion-tolerance pixels
+  // (half a pixel by default) of where the animation puts them midway, where the camera sees them
+  // (PixelFootprint): fewer steps for a preview or a far object, more for a near one at a high
+  // resolution. The camera's turn counts the same in pixels; its and the lights' moves, in the
+  // scene's size. Two pixels moved the city's blocks 2% at 2 fps
+  // (docs/experiments/motion-blur.md).
+  const float pixels = motionPixels_;
   constexpr float kTolerance = 1e-3f;
   const PixelFootprint pixel(scene_.cameraAt(shutterCamera_, t), shutterHeight_,
                              1e-6f * sceneRadius_);
@@ -799,7 +802,7 @@ std::vector<double> GpuScene::motionTimes(double t) const {
     const float turned =
         glm::length(glm::normalize(a.forward + b.forward) - glm::normalize(mid.forward)) +
         glm::length(glm::normalize(a.up + b.up) - glm::normalize(mid.up));
-    return moved <= kTolerance && turned / pixel.angle() <= kPixels;
+    return moved <= kTolerance && turned / pixel.angle() <= pixels;
   };
   auto lightError = [&](const PunctualLight& a, const PunctualLight& b, const PunctualLight& mid) {
     const float moved = glm::length(0.5f * (a.position + b.position) - mid.position) / sceneRadius_;
@@ -829,10 +832,10 @@ std::vector<double> GpuScene::motionTimes(double t) const {
         const accel::Aabb& box = meshBounds_[scene_.instances[i].mesh];
         fine = box.empty() || instanceError(box, scene_.instanceTransform(i, times[k]),
                                             scene_.instanceTransform(i, times[k + 1]),
-                                            scene_.instanceTransform(i, mid)) <= kPixels;
+                                            scene_.instanceTransform(i, mid)) <= pixels;
       }
       for (size_t m = 0; fine && m < scene_.dynamicMeshes.size(); ++m)
-        fine = !scene_.meshDeforms(m) || deformError(m, times[k], times[k + 1], mid) <= kPixels;
+        fine = !scene_.meshDeforms(m) || deformError(m, times[k], times[k + 1], mid) <= pixels;
     }
     if (fine) return times;
   }

@@ -99,6 +99,9 @@ struct RenderOptions {
   // --shutter: frames the shutter stays open, centred on each frame's time (motion blur,
   // kernels/shared/motion.h); 0 = none.
   double shutter = 0.0;
+  // --motion-tolerance: how far, in pixels, a blend of two motion steps may stray from the
+  // animation midway between them (GpuScene::motionTimes).
+  double motionTolerance = 0.5;
   int width = 0;  // 0: the camera's aspect with height, else 640x480
   int height = 0;
   int spp = 4;

@@ -129,7 +129,7 @@ RenderSession::RenderSession(const Scene& scene, const DeviceEntry& device,
         "turns off");
   if (o.shutter > 0.0)
     gpu_->setShutter(o.shutter / o.fps, camera_, width_, height_,
-                     o.mode != RenderMode::PathTrace || resample.enabled);
+                     o.mode != RenderMode::PathTrace || resample.enabled, o.motionTolerance);
   if (!(resample.distance > 0.0f)) resample.distance = 0.01f * gpu_->sceneRadius();
   if (o.mode == RenderMode::PathTrace) {
     PathTracerSettings p;
