@@ -260,6 +260,32 @@ void checkWide(const TriangleBvh& t) {
   for (const auto& tri : t.triangles) EXPECT_EQ(primSeen[tri.prim], 1) << "prim " << tri.prim;
 }
 
+// A box moved by a matrix holds its eight corners moved; an empty one stays empty, its bounds
+// the infinities they were.
+TEST(Aabb, TransformedHoldsTheCornersAndAnEmptyBoxStaysEmpty) {
+  Aabb box;
+  box.grow(glm::vec3(-1.0f, 0.0f, 2.0f));
+  box.grow(glm::vec3(1.0f, 2.0f, 3.0f));
+  const glm::mat4 m = glm::rotate(glm::translate(glm::mat4(1.0f), glm::vec3(5.0f, 0.0f, 0.0f)),
+                                  glm::radians(90.0f), glm::vec3(0.0f, 0.0f, 1.0f));
+  const Aabb moved = box.transformed(m);
+  for (int c = 0; c < 8; ++c) {
+    const glm::vec3 p = glm::vec3(m * glm::vec4(box.corner(c), 1.0f));
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_LE(moved.lo[a], p[a]);
+      EXPECT_GE(moved.hi[a], p[a]);
+    }
+  }
+  EXPECT_NEAR(moved.lo.x, 3.0f, 1e-5f);  // y in [0, 2] turned to x in [-2, 0], then moved by 5
+  EXPECT_NEAR(moved.hi.x, 5.0f, 1e-5f);
+  for (const glm::mat4& t : {glm::mat4(1.0f), m}) {
+    const Aabb e = Aabb{}.transformed(t);
+    EXPECT_TRUE(e.empty());
+    EXPECT_EQ(e.lo, Aabb{}.lo);
+    EXPECT_EQ(e.hi, Aabb{}.hi);
+  }
+}
+
 TEST(BvhBuild, WideTreesOfEveryWidth) {
   for (int width : {2, 4, 8}) {
     for (size_t n : {0, 1, 3, 5, 100, 3000}) {

@@ -29,6 +29,7 @@ void Aabb::grow(const Aabb& b) {
 
 Aabb Aabb::transformed(const glm::mat4& m) const {
   Aabb out;
+  if (empty()) return out;  // not by grow skipping the NaN that its infinite corners become
   for (int c = 0; c < 8; ++c) out.grow(glm::vec3(m * glm::vec4(corner(c), 1.0f)));
   return out;
 }
