@@ -11,6 +11,12 @@
 
 #include <CLI/CLI.hpp>
 
+#if defined(__GLIBC__)
+#include <malloc.h>
+
+#include <climits>
+#endif
+
 #include "app/cli_checks.h"
 #include "app/render_cli.h"
 #include "cl/device.h"
@@ -201,9 +207,22 @@ int runReportingErrors(Command command) {
   }
 }
 
+// Every frame frees and allocates again buffers of many MiB (a deforming mesh at each motion
+// step, its tree, its packets). glibc maps blocks that large on their own and unmaps them when
+// freed, so each frame faulted their pages in anew; kept in the heap, they are reused (BrainStem
+// at 2 fps with the shutter open: frames 0.34 -> 0.26 s, peak memory +6%;
+// docs/experiments/motion-blur.md).
+void keepLargeBlocksInTheHeap() {
+#if defined(__GLIBC__)
+  mallopt(M_MMAP_THRESHOLD, 1 << 30);
+  mallopt(M_TRIM_THRESHOLD, INT_MAX);
+#endif
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  keepLargeBlocksInTheHeap();
   CLI::App app{"pathreuse: global illumination of animated glTF scenes by reusing light paths"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "pathreuse 0.1.0");
