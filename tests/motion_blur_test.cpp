@@ -265,14 +265,20 @@ TEST(MotionBlur, AlbedoIsBlurredAndZIsTheFramesOwn) {
 // translation, a pan, a skin's joint sliding); a turn, of an instance or of a skin's joint (its
 // vertices sweep arcs: a mesh placed by its joints alone, whose own transform never moves), takes
 // more the finer the film, as the steps keep within half a pixel of it: 3 on a 16x12 film.
+// The motion steps of scene `what` at time 1 with the shutter open `shutter` seconds, on a 4:3
+// film `height` pixels high, within `pixels` (--motion-tolerance).
+uint32_t motionStepsOf(Moving what, const std::string& tag, double shutter, int height,
+                       double pixels = 0.5) {
+  const Scene scene = loadScene(movingScene(what, tag));
+  GpuScene gpu(test::testContext(), scene);
+  gpu.setShutter(shutter, 0, height * 4 / 3, height, true, pixels);
+  gpu.setTime(1.0);
+  return gpu.motionSteps();
+}
+
 TEST(MotionBlur, StepsFollowTheMotion) {
-  Context& ctx = test::testContext();
-  auto stepsOf = [&](Moving what, const std::string& tag, double shutter, int height) {
-    const Scene scene = loadScene(movingScene(what, tag));
-    GpuScene gpu(ctx, scene);
-    gpu.setShutter(shutter, 0, height * 4 / 3, height);
-    gpu.setTime(1.0);
-    return gpu.motionSteps();
+  const auto stepsOf = [](Moving what, const std::string& tag, double shutter, int height) {
+    return motionStepsOf(what, tag, shutter, height);
   };
   EXPECT_EQ(stepsOf(Moving::Object, "mb-steps-none", 0.0, 12), 1u);
   EXPECT_EQ(stepsOf(Moving::Object, "mb-steps-slide", 0.5, 1200), 3u);
@@ -293,13 +299,8 @@ TEST(MotionBlur, StepsFollowTheMotion) {
 // --motion-tolerance: a turn that half a pixel asks more steps of takes fewer under a looser
 // tolerance, and never more; a slide blends exactly under any.
 TEST(MotionBlur, ALooserToleranceTakesNoMoreSteps) {
-  Context& ctx = test::testContext();
-  auto stepsOf = [&](Moving what, const std::string& tag, double pixels) {
-    const Scene scene = loadScene(movingScene(what, tag));
-    GpuScene gpu(ctx, scene);
-    gpu.setShutter(0.5, 0, 1600, 1200, true, pixels);
-    gpu.setTime(1.0);
-    return gpu.motionSteps();
+  const auto stepsOf = [](Moving what, const std::string& tag, double pixels) {
+    return motionStepsOf(what, tag, 0.5, 1200, pixels);
   };
   EXPECT_EQ(stepsOf(Moving::Object, "mb-tol-slide", 0.01), 3u);
   for (Moving turning : {Moving::Rotating, Moving::SkinTurning}) {
