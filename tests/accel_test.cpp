@@ -675,6 +675,117 @@ TEST(DynamicTraversal, NoInstancesAndBadMesh) {
   EXPECT_THROW(d.setInstances({{3, glm::mat4(1.0f)}}), InputError);
 }
 
+// Deforming meshes under a shutter: meshes 0 and 2 of three each have their own motion steps
+// (mesh 1 none), so their steps' packets lie in two runs end to end.
+struct DeformingScene {
+  DynamicScene d;
+  std::vector<std::vector<std::vector<glm::vec3>>> steps;  // per mesh; empty: it does not deform
+};
+
+constexpr uint32_t kDeformSteps = 4;  // even: at the frame's time a ray blends two of them
+
+void makeDeforming(DeformingScene* s) {
+  s->d.meshes = {randomSoup(500, 0.2f, 61), randomSoup(300, 0.2f, 62), randomSoup(700, 0.15f, 63)};
+  for (const Soup& m : s->d.meshes) s->d.accel.addMesh(m.positions, m.indices);
+  s->steps.assign(3, {});
+  std::mt19937 rng(64);
+  std::uniform_real_distribution<float> u(-0.05f, 0.05f);
+  for (uint32_t m : {0u, 2u}) {
+    const Soup& soup = s->d.meshes[m];
+    const glm::vec3 drift = m == 0 ? glm::vec3(0.3f, 0.0f, 0.1f) : glm::vec3(-0.1f, 0.4f, 0.0f);
+    std::vector<glm::vec3> wobble(soup.positions.size());
+    for (glm::vec3& w : wobble) w = glm::vec3(u(rng), u(rng), u(rng));
+    for (uint32_t k = 0; k < kDeformSteps; ++k) {
+      const float x = float(k) - 0.5f * float(kDeformSteps - 1);
+      std::vector<glm::vec3> at(soup.positions.size());
+      for (size_t v = 0; v < at.size(); ++v) at[v] = soup.positions[v] + (drift + wobble[v]) * x;
+      s->steps[m].push_back(at);
+    }
+    s->d.accel.replaceMesh(m, soup.positions, soup.indices, BuildOptions{}, &s->steps[m]);
+  }
+  const std::vector<glm::mat4> still(kDeformSteps, glm::mat4(1.0f));
+  for (uint32_t i = 0; i < 3; ++i) s->d.instances.push_back({i, glm::mat4(1.0f)});
+  s->d.accel.setInstances(s->d.instances, {still, still, still});
+}
+
+// Each mesh's triangles at `time`, blended as the kernels blend a packet's two steps.
+std::vector<std::vector<BvhTriangle>> trianglesAt(const DeformingScene& s, float time) {
+  std::vector<std::vector<BvhTriangle>> out;
+  uint32_t base = 0;
+  for (size_t m = 0; m < s.d.meshes.size(); ++m) {
+    const Soup& soup = s.d.meshes[m];
+    std::vector<BvhTriangle> tris;
+    float a = 0.0f;
+    const uint32_t k = dev::motion_step(kDeformSteps, time, &a);
+    for (size_t t = 0; t < soup.size(); ++t) {
+      const uint32_t prim = base + uint32_t(t);
+      if (s.steps[m].empty()) {
+        tris.push_back(packTriangle(soup.vertex(t, 0), soup.vertex(t, 1), soup.vertex(t, 2), prim));
+        continue;
+      }
+      auto at = [&](uint32_t step, int c) {
+        return s.steps[m][step][soup.indices[3 * t + size_t(c)]];
+      };
+      const BvhTriangle p0 = packTriangle(at(k, 0), at(k, 1), at(k, 2), prim);
+      const BvhTriangle p1 = packTriangle(at(k + 1, 0), at(k + 1, 1), at(k + 1, 2), prim);
+      BvhTriangle q = p0;  // v0, e1, e2 blended as the kernel's
+      for (float BvhTriangle::*f : {&BvhTriangle::v0x, &BvhTriangle::v0y, &BvhTriangle::v0z,
+                                    &BvhTriangle::e1x, &BvhTriangle::e1y, &BvhTriangle::e1z,
+                                    &BvhTriangle::e2x, &BvhTriangle::e2y, &BvhTriangle::e2z})
+        q.*f += (p1.*f - p0.*f) * a;
+      tris.push_back(q);
+    }
+    out.push_back(tris);
+    base += uint32_t(soup.size());
+  }
+  return out;
+}
+
+std::vector<glm::vec3> centresOf(const std::vector<std::vector<BvhTriangle>>& meshes) {
+  std::vector<glm::vec3> c;
+  for (const auto& tris : meshes)
+    for (const BvhTriangle& t : tris)
+      c.push_back(glm::vec3(t.v0x, t.v0y, t.v0z) +
+                  (glm::vec3(t.e1x, t.e1y, t.e1z) + glm::vec3(t.e2x, t.e2y, t.e2z)) / 3.0f);
+  return c;
+}
+
+TEST(DeformingTraversal, EachMeshHitsItsOwnStepsAtEveryTime) {
+  DeformingScene s;
+  makeDeforming(&s);
+  const auto runs = s.d.accel.motionPacketRuns();
+  ASSERT_EQ(runs.size(), 2u);
+  EXPECT_EQ(s.d.accel.motionPacketCount(), runs[0].count + runs[1].count);
+  const std::vector<uint32_t>& mm = s.d.accel.meshMotion();
+  EXPECT_EQ(mm[2 * PR_MESH_MOTION_WORDS + 2], runs[0].count);  // mesh 2's run after mesh 0's
+  EXPECT_EQ(mm[PR_MESH_MOTION_WORDS + 3], 1u);                 // mesh 1: no steps
+  StaticAccel empty;
+  empty.build({}, {});
+  const HostGeom hg(empty, &s.d.accel);
+  for (float time : {0.0f, 0.3f, 0.5f, 0.77f, 1.0f}) {
+    SCOPED_TRACE("time " + std::to_string(time));
+    SceneGeom g = hg.geom();
+    g.time = time;
+    const auto tris = trianglesAt(s, time);
+    const auto rays = randomRays(1500, centresOf(tris), 70 + uint32_t(time * 100.0f));
+    HitChecker c;
+    for (size_t i = 0; i < rays.size(); ++i) {
+      Hit want = dev::hit_none();
+      for (uint32_t m = 0; m < 3; ++m) {
+        Ray r = rays[i];
+        if (want.prim != PR_INVALID_INDEX) r.tmax = want.t;
+        const Hit h = bruteForce(tris[m], r, m);
+        if (h.prim != PR_INVALID_INDEX) want = h;
+      }
+      Hit got;
+      dev::intersect_dynamic(&g, rays[i], &got);
+      c.check(got, want, i, "dynamic");
+      EXPECT_EQ(dev::occluded_dynamic(&g, rays[i]), want.prim != PR_INVALID_INDEX) << "ray " << i;
+    }
+    EXPECT_GT(c.hits, 300);
+  }
+}
+
 // The whole scene: the nearer of the SSG and the DSG hit.
 TEST(SceneTraversal, NearerOfStaticAndDynamic) {
   const Soup s = randomSoup(2000, 0.1f, 77);
@@ -882,6 +993,23 @@ TEST(DeviceTraversal, EveryWidthMatchesCpuReference) {
   // A device compiled for one width refuses BVHs of another.
   DeviceAccel four(4);
   EXPECT_THROW(four.uploadStatic(ctx, ref), RuntimeError);
+}
+
+// The steps' packets reach the device in their runs, each where its mesh's words say.
+TEST(DeviceTraversal, DeformingMeshesMatchCpuReference) {
+  Context& ctx = test::testContext();
+  DeformingScene s;
+  makeDeforming(&s);
+  StaticAccel empty;
+  empty.build({}, {});
+  DeviceAccel dacc(PR_BVH_WIDTH);
+  dacc.uploadStatic(ctx, empty);
+  dacc.uploadMeshes(ctx, s.d.accel);
+  dacc.uploadFrame(ctx, s.d.accel);
+  const HostGeom hg(empty, &s.d.accel);  // the frame's time, as the device's arguments
+  const auto rays = randomRays(3000, centresOf(trianglesAt(s, 0.5f)), 81);
+  for (cl_uint mode : {0u, 2u})
+    compareDevice(hg.geom(), dacc, rays, mode, "mode " + std::to_string(mode));
 }
 
 }  // namespace

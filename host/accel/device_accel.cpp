@@ -21,7 +21,8 @@ void DeviceAccel::upload(Context& ctx, Slot& slot, const char* name, const void*
     slot.bytes = want;
     ctx.zero(slot.buffer, want);
   }
-  if (bytes > 0) CL_CHECK(ctx.queue().enqueueWriteBuffer(slot.buffer, CL_TRUE, 0, bytes, data));
+  if (bytes > 0 && data)
+    CL_CHECK(ctx.queue().enqueueWriteBuffer(slot.buffer, CL_TRUE, 0, bytes, data));
 }
 
 template <class T>
@@ -48,9 +49,16 @@ void DeviceAccel::uploadMeshes(Context& ctx, const DynamicAccel& dsg, bool grow)
          byteSize(dsg.meshPackets()), grow);
   upload(ctx, meshMotion_, "dynamic mesh motion table", dsg.meshMotion().data(),
          byteSize(dsg.meshMotion()), grow);
-  if (!dsg.motionPackets().empty()) {
-    upload(ctx, motionTris_, "deforming mesh motion steps", dsg.motionPackets().data(),
-           byteSize(dsg.motionPackets()), grow);
+  if (dsg.motionPacketCount() > 0) {
+    const uint64_t packet = sizeof(dev::BvhTriPacket);
+    upload(ctx, motionTris_, "deforming mesh motion steps", nullptr,
+           dsg.motionPacketCount() * packet, grow);
+    uint64_t at = 0;
+    for (const DynamicAccel::PacketRun& run : dsg.motionPacketRuns()) {
+      CL_CHECK(ctx.queue().enqueueWriteBuffer(motionTris_.buffer, CL_TRUE, at * packet,
+                                              run.count * packet, run.data));
+      at += run.count;
+    }
     upload(ctx, motionBounds_, "deforming mesh node boxes at the motion steps",
            dsg.motionBounds().data(), byteSize(dsg.motionBounds()), grow);
   }

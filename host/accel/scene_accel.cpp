@@ -50,10 +50,24 @@ dev::BvhTriPacket packTriangles(const dev::BvhTriangle* first, uint32_t count) {
 
 namespace {
 
-// Child i's box of wide node `node` over `packets` (one motion step's), written to `bounds` (node
-// by node, 6 * width floats each) for the whole subtree; returns the node's box. Boxes grow by
-// a few ulps, as a blended triangle's rounding may step outside the blend of exact boxes.
-Aabb refitNode(const WideBvh& wide, const std::vector<dev::BvhTriPacket>& packets, uint32_t node,
+// The box of a packet's triangles as the kernels see them: v0, v0 + e1, v0 + e2.
+Aabb packetBox(const dev::BvhTriPacket& p) {
+  Aabb box;
+  for (int l = 0; l < PR_BVH_PACKET; ++l) {
+    if (p.prim[l] == PR_INVALID_INDEX) continue;
+    const glm::vec3 v0(p.v0x[l], p.v0y[l], p.v0z[l]);
+    box.grow(v0);
+    box.grow(v0 + glm::vec3(p.e1x[l], p.e1y[l], p.e1z[l]));
+    box.grow(v0 + glm::vec3(p.e2x[l], p.e2y[l], p.e2z[l]));
+  }
+  return box;
+}
+
+// Child i's box of wide node `node` (a leaf's: leafBoxes[leaf * stride], one motion step's),
+// written to `bounds` (node by node, 6 * width floats each) for the whole subtree; returns the
+// node's box. Boxes grow by a few ulps, as a blended triangle's rounding may step outside the
+// blend of exact boxes.
+Aabb refitNode(const WideBvh& wide, const Aabb* leafBoxes, size_t stride, uint32_t node,
                float* bounds) {
   const int w = wide.width;
   Aabb all;
@@ -62,16 +76,9 @@ Aabb refitNode(const WideBvh& wide, const std::vector<dev::BvhTriPacket>& packet
     Aabb box;
     if (ref == PR_INVALID_INDEX) {
     } else if (ref & PR_BVH_LEAF_BIT) {
-      const dev::BvhTriPacket& p = packets[ref & ~PR_BVH_LEAF_BIT];
-      for (int l = 0; l < PR_BVH_PACKET; ++l) {
-        if (p.prim[l] == PR_INVALID_INDEX) continue;
-        const glm::vec3 v0(p.v0x[l], p.v0y[l], p.v0z[l]);
-        box.grow(v0);
-        box.grow(v0 + glm::vec3(p.e1x[l], p.e1y[l], p.e1z[l]));
-        box.grow(v0 + glm::vec3(p.e2x[l], p.e2y[l], p.e2z[l]));
-      }
+      box = leafBoxes[size_t(ref & ~PR_BVH_LEAF_BIT) * stride];
     } else {
-      box = refitNode(wide, packets, ref, bounds);
+      box = refitNode(wide, leafBoxes, stride, ref, bounds);
     }
     float b[6] = {1e30f, -1e30f, 1e30f, -1e30f, 1e30f, -1e30f};  // finite: blends stay inverted
     if (!box.empty()) {
@@ -134,12 +141,11 @@ TriangleBvh buildTriangleBvh(const std::vector<glm::vec3>& positions,
                        ": a position is not finite");
   const size_t count = indices.size() / 3;
   std::vector<dev::BvhTriangle> packed;
-  std::vector<uint32_t> kept;      // the triangle of each of `packed`
-  std::vector<Aabb> boxes, swept;  // at the frame's time; over every step
+  std::vector<uint32_t> kept;  // the triangle of each of `packed`
+  std::vector<Aabb> boxes;     // at the frame's time
   packed.reserve(count);
   kept.reserve(count);
   boxes.reserve(count);
-  swept.reserve(count);
   for (size_t t = 0; t < count; ++t) {
     Aabb box;
     for (int k = 0; k < 3; ++k) {
@@ -149,17 +155,13 @@ TriangleBvh buildTriangleBvh(const std::vector<glm::vec3>& positions,
                          std::to_string(i) + " of " + std::to_string(positions.size()));
       box.grow(positions[i]);
     }
-    Aabb sweep = box;
     const dev::BvhTriangle tri =
         packTriangle(positions[indices[3 * t]], positions[indices[3 * t + 1]],
                      positions[indices[3 * t + 2]], primBase + uint32_t(t));
     if (zeroArea(tri)) continue;
-    for (size_t k = 0; k < stepCount; ++k)
-      for (int c = 0; c < 3; ++c) sweep.grow((*steps)[k][indices[3 * t + size_t(c)]]);
     packed.push_back(tri);
     kept.push_back(uint32_t(t));
     boxes.push_back(box);
-    swept.push_back(sweep);
   }
   BuildOptions o = options;
   o.leafPacket = PR_BVH_PACKET;
@@ -172,7 +174,7 @@ TriangleBvh buildTriangleBvh(const std::vector<glm::vec3>& positions,
   out.triangles.reserve(packed.size());
   for (uint32_t k : bvh.order) {
     out.triangles.push_back(packed[k]);
-    out.bounds.grow(swept[k]);
+    out.bounds.grow(boxes[k]);
   }
   out.packets.reserve(out.wide.leaves.size());
   for (const BinaryNode& leaf : out.wide.leaves) {
@@ -180,27 +182,42 @@ TriangleBvh buildTriangleBvh(const std::vector<glm::vec3>& positions,
     PR_CHECK(count <= PR_BVH_PACKET && size_t(leaf.index) + count <= out.triangles.size());
     out.packets.push_back(packTriangles(out.triangles.data() + leaf.index, count));
   }
-  // Each step's packets and node boxes on its own core; node by node, its steps side by side
-  // in stepBounds: a node reads two neighbours.
+  // The steps' packets in the kernels' layout and their boxes, a run of leaves on each core
+  // (each writes its own stretch); then each step's node boxes on its own core.
   const size_t nodeFloats = 6 * size_t(out.wide.width), nodes = out.wide.nodeCount();
-  out.stepPackets.resize(stepCount);
+  const std::vector<BinaryNode>& leaves = out.wide.leaves;
+  out.stepCount = uint32_t(stepCount);
+  out.stepPackets.resize(leaves.size() * stepCount);
   out.stepBounds.resize(nodes * stepCount * nodeFloats);
-  if (stepCount > 0)
-    parallelFor(int(stepCount), [&](int k) {
-      const std::vector<glm::vec3>& at = (*steps)[size_t(k)];
-      std::vector<dev::BvhTriangle> ordered(bvh.order.size());
-      for (size_t j = 0; j < ordered.size(); ++j) {
-        const size_t t = kept[bvh.order[j]];
-        ordered[j] = packTriangle(at[indices[3 * t]], at[indices[3 * t + 1]],
-                                  at[indices[3 * t + 2]], primBase + uint32_t(t));
+  constexpr size_t kLeavesPerTask = 1024;
+  const size_t tasks = stepCount > 0 ? (leaves.size() + kLeavesPerTask - 1) / kLeavesPerTask : 0;
+  std::vector<Aabb> taskBox(tasks), leafBoxes(leaves.size() * stepCount);
+  parallelFor(int(tasks), [&](int task) {
+    const size_t end = std::min(leaves.size(), (size_t(task) + 1) * kLeavesPerTask);
+    Aabb& box = taskBox[size_t(task)];
+    for (size_t k = 0; k < stepCount; ++k) {
+      const std::vector<glm::vec3>& at = (*steps)[k];  // one step at a time: it stays in cache
+      for (size_t j = size_t(task) * kLeavesPerTask; j < end; ++j) {
+        const uint32_t n = leaves[j].meta & ~PR_BVH_LEAF_BIT;
+        dev::BvhTriangle tris[PR_BVH_PACKET];
+        for (uint32_t l = 0; l < n; ++l) {
+          const size_t t = kept[bvh.order[leaves[j].index + l]];
+          const glm::vec3 &a = at[indices[3 * t]], &b = at[indices[3 * t + 1]],
+                          &c = at[indices[3 * t + 2]];
+          tris[l] = packTriangle(a, b, c, primBase + uint32_t(t));
+          box.grow(a), box.grow(b), box.grow(c);
+        }
+        dev::BvhTriPacket& packet = out.stepPackets[j * stepCount + k];
+        packet = packTriangles(tris, n);
+        leafBoxes[j * stepCount + k] = packetBox(packet);
       }
-      std::vector<dev::BvhTriPacket>& packets = out.stepPackets[size_t(k)];
-      packets.reserve(out.wide.leaves.size());
-      for (const BinaryNode& leaf : out.wide.leaves)
-        packets.push_back(packTriangles(ordered.data() + leaf.index, leaf.meta & ~PR_BVH_LEAF_BIT));
-      if (nodes == 0) return;
+    }
+  });
+  for (const Aabb& b : taskBox) out.bounds.grow(b);
+  if (stepCount > 0 && nodes > 0)
+    parallelFor(int(stepCount), [&](int k) {
       std::vector<float> step(nodes * nodeFloats, 0.0f);
-      refitNode(out.wide, packets, 0, step.data());
+      refitNode(out.wide, leafBoxes.data() + k, stepCount, 0, step.data());
       for (size_t n = 0; n < nodes; ++n)
         std::copy_n(step.data() + n * nodeFloats, nodeFloats,
                     out.stepBounds.data() + (n * stepCount + size_t(k)) * nodeFloats);
@@ -237,12 +254,12 @@ uint32_t DynamicAccel::addMesh(const std::vector<glm::vec3>& positions,
   m.primBase = primBase;
   m.bounds = bvh.bounds;
   m.stats = bvh.stats;
-  parts_.push_back({bvh.wide.words, bvh.packets, bvh.triangles, {}, {}});
+  parts_.push_back({bvh.wide.words, bvh.packets, bvh.triangles, 0, {}, {}});
   previous_.emplace_back();
   // Rebase to absolute indices in the concatenated buffers.
   meshMotion_.insert(meshMotion_.end(),
                      {uint32_t(meshPackets_.size()), uint32_t(bvh.packets.size()),
-                      uint32_t(motionPackets_.size()), 1u, m.rootNode, 0u, 0u, 0u});
+                      uint32_t(motionPacketCount_), 1u, m.rootNode, 0u, 0u, 0u});
   rebaseWide(bvh.wide.words, width_, m.rootNode, uint32_t(meshPackets_.size()));
   meshNodes_.insert(meshNodes_.end(), bvh.wide.words.begin(), bvh.wide.words.end());
   meshPackets_.insert(meshPackets_.end(), bvh.packets.begin(), bvh.packets.end());
@@ -260,21 +277,34 @@ void DynamicAccel::replaceMesh(uint32_t index, const std::vector<glm::vec3>& pos
   BuildOptions o = options;
   o.width = width_;
   Mesh& m = meshes_[index];
+  // The old steps are read no more (the device has them): their memory goes to the new ones.
+  parts_[index].stepCount = 0;
+  parts_[index].steps = {};
   TriangleBvh bvh = buildTriangleBvh(positions, indices, m.primBase, o, what.c_str(), steps);
   m.triangleCount = uint32_t(bvh.triangles.size());
   m.bounds = bvh.bounds;
   m.stats = bvh.stats;
   previous_[index] = std::move(parts_[index]);
-  parts_[index] = {std::move(bvh.wide.words), std::move(bvh.packets), std::move(bvh.triangles),
+  previous_[index].steps = {};  // only its tree is read (concatenate); the steps are large
+  previous_[index].stepBounds = {};
+  parts_[index] = {std::move(bvh.wide.words),  std::move(bvh.packets),
+                   std::move(bvh.triangles),   bvh.stepCount,
                    std::move(bvh.stepPackets), std::move(bvh.stepBounds)};
   concatenate();
+}
+
+std::vector<DynamicAccel::PacketRun> DynamicAccel::motionPacketRuns() const {
+  std::vector<PacketRun> runs;
+  for (const Part& p : parts_)
+    if (!p.steps.empty()) runs.push_back({p.steps.data(), p.steps.size()});
+  return runs;
 }
 
 void DynamicAccel::concatenate() {
   meshNodes_.clear();
   meshPackets_.clear();
   meshTris_.clear();
-  motionPackets_.clear();
+  motionPacketCount_ = 0;
   motionBounds_.clear();
   meshMotion_.assign(meshes_.size() * PR_MESH_MOTION_WORDS, 0u);
   for (size_t i = 0; i < meshes_.size(); ++i) {
@@ -284,14 +314,12 @@ void DynamicAccel::concatenate() {
     m.firstTriangle = uint32_t(meshTris_.size());
     uint32_t* mm = &meshMotion_[i * PR_MESH_MOTION_WORDS];
     mm[0] = uint32_t(meshPackets_.size()), mm[1] = uint32_t(p.packets.size());
-    mm[2] = uint32_t(motionPackets_.size());
-    mm[3] = std::max<uint32_t>(uint32_t(p.steps.size()), 1);
+    mm[2] = uint32_t(motionPacketCount_);
+    mm[3] = std::max<uint32_t>(p.stepCount, 1);
     mm[4] = m.rootNode;
     mm[5] = uint32_t(motionBounds_.size() / (6 * size_t(width_)));
     motionBounds_.insert(motionBounds_.end(), p.stepBounds.begin(), p.stepBounds.end());
-    // Packet by packet, its steps side by side: a leaf reads two neighbours.
-    for (size_t j = 0; j < p.packets.size() && !p.steps.empty(); ++j)
-      for (const auto& step : p.steps) motionPackets_.push_back(step[j]);
+    motionPacketCount_ += p.steps.size();
     std::vector<uint32_t> words = p.words;
     rebaseWide(words, width_, m.rootNode, uint32_t(meshPackets_.size()));
     meshNodes_.insert(meshNodes_.end(), words.begin(), words.end());
@@ -423,7 +451,9 @@ HostGeom::HostGeom(const StaticAccel& ssg, const DynamicAccel* dsg) {
     geom_.instance_count = uint32_t(dsg->instances().size());
     geom_.motion = dsg->motion().empty() ? nullptr : dsg->motion().data();
     geom_.motion_steps = dsg->motionSteps();
-    geom_.motion_tris = dsg->motionPackets().empty() ? nullptr : dsg->motionPackets().data();
+    for (const DynamicAccel::PacketRun& run : dsg->motionPacketRuns())
+      motionPackets_.insert(motionPackets_.end(), run.data, run.data + run.count);
+    geom_.motion_tris = motionPackets_.empty() ? nullptr : motionPackets_.data();
     geom_.mesh_motion = dsg->meshMotion().empty() ? nullptr : dsg->meshMotion().data();
     geom_.motion_bounds = dsg->motionBounds().empty() ? nullptr : dsg->motionBounds().data();
   }

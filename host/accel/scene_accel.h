@@ -13,6 +13,7 @@
 #include "accel/bvh_builder.h"
 #include "shared/bvh.h"
 #include "shared/types.h"
+#include "util/default_init.h"
 
 namespace pr::accel {
 
@@ -26,13 +27,19 @@ bool zeroArea(const dev::BvhTriangle& t);
 // leaf k is packets[k], each triangle keeping primBase + its index in the input. `binary` and
 // `triangles` (in the binary tree's leaf order) are the tree it was collapsed from, kept on the
 // host for statistics and tests.
+// Written whole where it is made, so never zeroed first.
+using StepPackets = std::vector<dev::BvhTriPacket, DefaultInitAllocator<dev::BvhTriPacket>>;
+
 struct TriangleBvh {
   WideBvh wide;
   std::vector<dev::BvhTriPacket> packets;
-  // With motion steps: the packets at each step, leaf for leaf as `packets`, and the wide nodes'
-  // child boxes refitted to each step (node by node, its steps side by side, 6 * width floats
-  // each as BvhNode.bounds): a box blended between two steps holds the blended triangles.
-  std::vector<std::vector<dev::BvhTriPacket>> stepPackets;
+  // With motion steps: the packets at each step, leaf by leaf with a leaf's steps side by side
+  // (leaf j at step k is stepPackets[j * stepCount + k], the kernels' layout: a blend reads two
+  // neighbours), and the wide nodes' child boxes refitted to each step (node by node, its steps
+  // side by side, 6 * width floats each as BvhNode.bounds): a box blended between two steps
+  // holds the blended triangles.
+  uint32_t stepCount = 0;
+  StepPackets stepPackets;
   std::vector<float> stepBounds;
   std::vector<BinaryNode> binary;
   std::vector<dev::BvhTriangle> triangles;
@@ -137,8 +144,15 @@ class DynamicAccel {
   uint32_t motionSteps() const { return motionSteps_; }
   const std::vector<float>& motion() const { return motion_; }
   // Deforming meshes' packets and node boxes at their motion steps, and per mesh
-  // PR_MESH_MOTION_WORDS words (SceneGeom.mesh_motion).
-  const std::vector<dev::BvhTriPacket>& motionPackets() const { return motionPackets_; }
+  // PR_MESH_MOTION_WORDS words (SceneGeom.mesh_motion). The packets stay where each mesh's were
+  // built (hundreds of MB on a skinned character): motionPacketRuns gives them mesh by mesh, to
+  // be laid end to end.
+  struct PacketRun {
+    const dev::BvhTriPacket* data;
+    size_t count;
+  };
+  std::vector<PacketRun> motionPacketRuns() const;
+  uint64_t motionPacketCount() const { return motionPacketCount_; }
   const std::vector<float>& motionBounds() const { return motionBounds_; }
   const std::vector<uint32_t>& meshMotion() const { return meshMotion_; }
 
@@ -154,8 +168,9 @@ class DynamicAccel {
     std::vector<uint32_t> words;
     std::vector<dev::BvhTriPacket> packets;
     std::vector<dev::BvhTriangle> triangles;
-    std::vector<std::vector<dev::BvhTriPacket>> steps;  // under a shutter (replaceMesh)
-    std::vector<float> stepBounds;                      // TriangleBvh.stepBounds
+    uint32_t stepCount = 0;  // under a shutter (replaceMesh): TriangleBvh's step parts
+    StepPackets steps;
+    std::vector<float> stepBounds;
   };
   void concatenate();
   int width_;
@@ -172,7 +187,7 @@ class DynamicAccel {
   BvhStats tlasStats_;
   uint32_t motionSteps_ = 1;
   std::vector<float> motion_;
-  std::vector<dev::BvhTriPacket> motionPackets_;
+  uint64_t motionPacketCount_ = 0;
   std::vector<float> motionBounds_;
   std::vector<uint32_t> meshMotion_;
 };
@@ -189,6 +204,7 @@ class HostGeom {
 
  private:
   std::vector<dev::BvhNode> staticNodes_, tlasNodes_, meshNodes_;
+  std::vector<dev::BvhTriPacket> motionPackets_;  // the DSG's runs laid end to end
   dev::SceneGeom geom_{};
 };
 
