@@ -58,7 +58,7 @@ class GpuScene {
   // meshes; 0 seconds: none. sweeps: also what moves while it is open (LightData.sweeps), which
   // path reuse and resampling test their paths against and the path tracer alone never reads.
   void setShutter(double seconds, int cameraIndex, int width, int height, bool sweeps = true,
-                  double tolerancePixels = 0.5);
+                  double tolerancePixels = kDefaultMotionTolerance);
   // The last setTime's motion steps (1: none) and the camera at each (a placeholder at 1).
   uint32_t motionSteps() const { return motionSteps_; }
   const cl::Buffer& cameraSteps() const { return cameraSteps_; }
@@ -212,7 +212,8 @@ class GpuScene {
   double shutter_ = 0.0;  // seconds (setShutter)
   bool sweepsWanted_ = true;
   int shutterCamera_ = 0, shutterWidth_ = 1, shutterHeight_ = 1;
-  float motionPixels_ = 0.5f;  // what a motion step's blend may stray, in pixels (setShutter)
+  // What a motion step's blend may stray, in pixels (setShutter).
+  float motionPixels_ = float(kDefaultMotionTolerance);
   std::vector<accel::Aabb> meshBounds_;  // per dynamic mesh, object space (motionTimes)
   // Per deforming mesh, what motionTimes measures its deformation by (setShutter): each morph
   // target's largest displacement, each joint's box of the bind-pose vertices it moves.

@@ -89,6 +89,10 @@ struct FrameRange {
 // The default band of a pass's paths (render/path_tracer.h): 720p in one band, 4K in eight.
 constexpr uint32_t kWavefrontPixels = uint32_t(1) << 20;
 
+// --motion-tolerance's default, in pixels: 2 let the city's fast camera at 2 fps move 16x16
+// blocks by 2% (docs/experiments/motion-blur.md).
+constexpr double kDefaultMotionTolerance = 0.5;
+
 struct RenderOptions {
   std::string scene;
   bool allowOutsideUris = false;  // LoadOptions::allowOutsideUris
@@ -101,7 +105,7 @@ struct RenderOptions {
   double shutter = 0.0;
   // --motion-tolerance: how far, in pixels, a blend of two motion steps may stray from the
   // animation midway between them (GpuScene::motionTimes).
-  double motionTolerance = 0.5;
+  double motionTolerance = kDefaultMotionTolerance;
   int width = 0;  // 0: the camera's aspect with height, else 640x480
   int height = 0;
   int spp = 4;
