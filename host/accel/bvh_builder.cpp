@@ -17,27 +17,11 @@
 
 namespace pr::accel {
 
-void Aabb::grow(const glm::vec3& p) {
-  lo = glm::min(lo, p);
-  hi = glm::max(hi, p);
-}
-
-void Aabb::grow(const Aabb& b) {
-  lo = glm::min(lo, b.lo);
-  hi = glm::max(hi, b.hi);
-}
-
 Aabb Aabb::transformed(const glm::mat4& m) const {
   Aabb out;
   if (empty()) return out;  // not by grow skipping the NaN that its infinite corners become
   for (int c = 0; c < 8; ++c) out.grow(glm::vec3(m * glm::vec4(corner(c), 1.0f)));
   return out;
-}
-
-float Aabb::halfArea() const {
-  if (empty()) return 0.0f;
-  const glm::vec3 e = hi - lo;
-  return e.x * e.y + e.y * e.z + e.z * e.x;
 }
 
 BinaryNode makeNode(const Aabb& b, uint32_t index, uint32_t meta) {
@@ -102,10 +86,11 @@ class Builder {
     if (sahAllowed && extent[axis] > 0.0f) {
       float bestCost = 0.0f;
       int bestAxis = -1, bestBin = 0;
+      binAxes(begin, end, cbounds);
       for (int a = 0; a < 3; ++a) {
         if (!(extent[a] > 0.0f)) continue;
         int bin = 0;
-        float cost = sahSplit(begin, end, cbounds, a, &bin);
+        float cost = sweep(bins_[size_t(a)], n, &bin);
         if (bestAxis < 0 || cost < bestCost) bestCost = cost, bestAxis = a, bestBin = bin;
       }
       const float area = bounds.halfArea();
@@ -179,34 +164,50 @@ class Builder {
     return std::clamp(b, 0, o_.bins - 1);
   }
 
-  // Best binned split on `axis`: returns sum(area * count) of both sides, bin of the last left.
-  float sahSplit(uint32_t begin, uint32_t end, const Aabb& cbounds, int axis, int* bestBin) {
-    bins_.assign(size_t(o_.bins), Bin{});
-    const float lo = cbounds.lo[axis];
-    const float scale = float(o_.bins) / (cbounds.hi[axis] - lo);
+  // The primitives of [begin, end) binned by centroid on each axis with extent, in one pass:
+  // each reads its box once (the build's cost is those reads).
+  void binAxes(uint32_t begin, uint32_t end, const Aabb& cbounds) {
+    float lo[3], scale[3];
+    bool active[3];
+    for (int a = 0; a < 3; ++a) {
+      bins_[size_t(a)].assign(size_t(o_.bins), Bin{});
+      const float extent = cbounds.hi[a] - cbounds.lo[a];
+      active[a] = extent > 0.0f;
+      lo[a] = cbounds.lo[a];
+      scale[a] = active[a] ? float(o_.bins) / extent : 0.0f;
+    }
     for (uint32_t i = begin; i < end; ++i) {
       const uint32_t p = order_[i];
-      Bin& b = bins_[size_t(binOf(centroids_[p][axis], lo, scale))];
-      b.box.grow(boxes_[p]);
-      ++b.count;
+      const Aabb& box = boxes_[p];
+      const glm::vec3& c = centroids_[p];
+      for (int a = 0; a < 3; ++a) {
+        if (!active[a]) continue;
+        Bin& b = bins_[size_t(a)][size_t(binOf(c[a], lo[a], scale[a]))];
+        b.box.grow(box);
+        ++b.count;
+      }
     }
+  }
+
+  // Best split of one axis's bins (`total` primitives): returns sum(area * count) of both sides,
+  // and the bin of the last left.
+  float sweep(const std::vector<Bin>& bins, uint32_t total, int* bestBin) {
     // Right-side sums from the top, then sweep from the left.
     rightCost_.assign(size_t(o_.bins), 0.0f);
     Aabb acc;
     uint32_t count = 0;
     for (int i = o_.bins - 1; i > 0; --i) {
-      acc.grow(bins_[size_t(i)].box);
-      count += bins_[size_t(i)].count;
+      acc.grow(bins[size_t(i)].box);
+      count += bins[size_t(i)].count;
       rightCost_[size_t(i)] = count > 0 ? acc.halfArea() * blocks(count) : 0.0f;
     }
     float best = std::numeric_limits<float>::infinity();
     *bestBin = 0;
     acc = Aabb{};
     count = 0;
-    const uint32_t total = end - begin;
     for (int i = 0; i < o_.bins - 1; ++i) {
-      acc.grow(bins_[size_t(i)].box);
-      count += bins_[size_t(i)].count;
+      acc.grow(bins[size_t(i)].box);
+      count += bins[size_t(i)].count;
       if (count == 0 || count == total) continue;
       const float cost = acc.halfArea() * blocks(count) + rightCost_[size_t(i) + 1];
       if (cost < best) best = cost, *bestBin = i;
@@ -227,7 +228,7 @@ class Builder {
   std::vector<uint32_t>& order_;
   const BuildOptions& o_;
   const int parallelDepth_;
-  std::vector<Bin> bins_;
+  std::vector<Bin> bins_[3];  // per axis (binAxes)
   std::vector<float> rightCost_;
 };
 

@@ -9,6 +9,7 @@
 #include <limits>
 #include <vector>
 
+#include <glm/common.hpp>
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
 
@@ -21,8 +22,15 @@ struct Aabb {
   glm::vec3 hi{-std::numeric_limits<float>::infinity()};
 
   bool empty() const { return !(lo.x <= hi.x && lo.y <= hi.y && lo.z <= hi.z); }
-  void grow(const glm::vec3& p);
-  void grow(const Aabb& b);
+  // Inline: the builder, refits and the motion steps' packing call them per vertex.
+  void grow(const glm::vec3& p) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+  void grow(const Aabb& b) {
+    lo = glm::min(lo, b.lo);
+    hi = glm::max(hi, b.hi);
+  }
   glm::vec3 centre() const { return (lo + hi) * 0.5f; }
   // Corner c (bit 0: x, 1: y, 2: z; set: hi) and the box of the eight corners under m.
   glm::vec3 corner(int c) const {
@@ -30,7 +38,11 @@ struct Aabb {
   }
   Aabb transformed(const glm::mat4& m) const;
   // Half the surface area: all SAH needs (ratios).
-  float halfArea() const;
+  float halfArea() const {
+    if (empty()) return 0.0f;
+    const glm::vec3 e = hi - lo;
+    return e.x * e.y + e.y * e.z + e.z * e.x;
+  }
 };
 
 struct BuildOptions {
