@@ -285,8 +285,7 @@ void DynamicAccel::replaceMesh(uint32_t index, const std::vector<glm::vec3>& pos
   m.bounds = bvh.bounds;
   m.stats = bvh.stats;
   previous_[index] = std::move(parts_[index]);
-  previous_[index].steps = {};  // only its tree is read (concatenate); the steps are large
-  previous_[index].stepBounds = {};
+  previous_[index].stepBounds = {};  // only its tree is read (concatenate)
   parts_[index] = {std::move(bvh.wide.words),  std::move(bvh.packets),
                    std::move(bvh.triangles),   bvh.stepCount,
                    std::move(bvh.stepPackets), std::move(bvh.stepBounds)};
