@@ -210,8 +210,7 @@ int runReportingErrors(Command command) {
 // Every frame frees and allocates again buffers of many MiB (a deforming mesh at each motion
 // step, its tree, its packets). glibc maps blocks that large on their own and unmaps them when
 // freed, so each frame faulted their pages in anew; kept in the heap, they are reused (BrainStem
-// at 2 fps with the shutter open: frames 0.34 -> 0.26 s, peak memory +6%;
-// docs/experiments/motion-blur.md).
+// at 2 fps with the shutter open: frames 0.34 -> 0.26 s; docs/experiments/motion-blur.md).
 void keepLargeBlocksInTheHeap() {
 #if defined(__GLIBC__)
   mallopt(M_MMAP_THRESHOLD, 1 << 30);
