@@ -87,7 +87,8 @@ std::string programCacheDir() {
   return "";
 }
 
-Context::Context(const DeviceEntry& device) : device_(device) {
+Context::Context(const DeviceEntry& device)
+    : device_(device), pocl_(device.platformVendor == "The pocl project") {
   cl_int err = CL_SUCCESS;
   context_ = cl::Context(device_.device, nullptr, nullptr, nullptr, &err);
   CL_CHECK(err);
@@ -242,11 +243,16 @@ void Context::launch1D(const cl::Kernel& kernel, size_t first, size_t end, const
   if (kernel.getWorkGroupInfo(device_.device, CL_KERNEL_PREFERRED_WORK_GROUP_SIZE_MULTIPLE,
                               &preferred) == CL_SUCCESS &&
       preferred > 0 && preferred <= local) {
-    // A multiple of the preferred size, up to 256, keeps GPUs busy and PoCL's loops long.
+    // A multiple of the preferred size, up to 256, keeps GPUs busy.
     size_t want = preferred;
     while (want * 2 <= local && want * 2 <= 256) want *= 2;
     local = want;
   }
+  // PoCL keeps a private copy of a kernel's variables for each work-item of a group on its worker
+  // thread's stack (8 MiB under Debian's default `ulimit -s`): at 256 items pt_resample needed
+  // 7.2-7.7 MiB, and a little more code in it overran into another thread's stack. At 64 it needs
+  // 1.5-2 MiB and runs no slower (tools/ci/pocl-stack-check.sh holds it within 3 MiB).
+  if (pocl_) local = std::min<size_t>(local, 64);
   if (local == 0) local = 1;
   const size_t padded = (global + local - 1) / local * local;
   const size_t chunk = std::max(local, kMaxLaunchItems / local * local);

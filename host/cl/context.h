@@ -89,6 +89,7 @@ class Context {
   uint64_t bytesInUse_ = 0;
   std::map<std::string, uint64_t> bytesByName_;
   bool buildNotice_ = false;
+  bool pocl_ = false;  // launch1D's groups: PoCL's worker stacks hold them
   bool noticeGiven_ = false;
   std::map<std::string, double> buildSeconds_;
 };
