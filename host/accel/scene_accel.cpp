@@ -50,19 +50,6 @@ dev::BvhTriPacket packTriangles(const dev::BvhTriangle* first, uint32_t count) {
 
 namespace {
 
-// The box of a packet's triangles as the kernels see them: v0, v0 + e1, v0 + e2.
-Aabb packetBox(const dev::BvhTriPacket& p) {
-  Aabb box;
-  for (int l = 0; l < PR_BVH_PACKET; ++l) {
-    if (p.prim[l] == PR_INVALID_INDEX) continue;
-    const glm::vec3 v0(p.v0x[l], p.v0y[l], p.v0z[l]);
-    box.grow(v0);
-    box.grow(v0 + glm::vec3(p.e1x[l], p.e1y[l], p.e1z[l]));
-    box.grow(v0 + glm::vec3(p.e2x[l], p.e2y[l], p.e2z[l]));
-  }
-  return box;
-}
-
 // Child i's box of wide node `node` (a leaf's: leafBoxes[leaf * stride], one motion step's),
 // written to `bounds` (node by node, 6 * width floats each) for the whole subtree; returns the
 // node's box. Boxes grow by a few ulps, as a blended triangle's rounding may step outside the
@@ -192,24 +179,36 @@ TriangleBvh buildTriangleBvh(const std::vector<glm::vec3>& positions,
   constexpr size_t kLeavesPerTask = 1024;
   const size_t tasks = stepCount > 0 ? (leaves.size() + kLeavesPerTask - 1) / kLeavesPerTask : 0;
   std::vector<Aabb> taskBox(tasks), leafBoxes(leaves.size() * stepCount);
+  std::vector<uint32_t> corners(stepCount > 0 ? 3 * out.triangles.size() : 0);  // tree order
+  for (size_t i = 0; i < corners.size() / 3; ++i)
+    std::copy_n(&indices[3 * size_t(kept[bvh.order[i]])], 3, &corners[3 * i]);
   parallelFor(int(tasks), [&](int task) {
     const size_t end = std::min(leaves.size(), (size_t(task) + 1) * kLeavesPerTask);
     Aabb& box = taskBox[size_t(task)];
     for (size_t k = 0; k < stepCount; ++k) {
       const std::vector<glm::vec3>& at = (*steps)[k];  // one step at a time: it stays in cache
       for (size_t j = size_t(task) * kLeavesPerTask; j < end; ++j) {
-        const uint32_t n = leaves[j].meta & ~PR_BVH_LEAF_BIT;
-        dev::BvhTriangle tris[PR_BVH_PACKET];
-        for (uint32_t l = 0; l < n; ++l) {
-          const size_t t = kept[bvh.order[leaves[j].index + l]];
-          const glm::vec3 &a = at[indices[3 * t]], &b = at[indices[3 * t + 1]],
-                          &c = at[indices[3 * t + 2]];
-          tris[l] = packTriangle(a, b, c, primBase + uint32_t(t));
+        const uint32_t first = leaves[j].index, n = leaves[j].meta & ~PR_BVH_LEAF_BIT;
+        // packTriangle and packTriangles' packet, and packetBox's box, written in one pass.
+        dev::BvhTriPacket& p = out.stepPackets[j * stepCount + k];
+        p = dev::BvhTriPacket{};
+        Aabb leafBox;
+        for (uint32_t l = 0; l < PR_BVH_PACKET; ++l) {
+          if (l >= n) {
+            p.prim[l] = PR_INVALID_INDEX;
+            continue;
+          }
+          const uint32_t* v = &corners[3 * size_t(first + l)];
+          const glm::vec3 &a = at[v[0]], &b = at[v[1]], &c = at[v[2]];
+          const glm::vec3 e1 = b - a, e2 = c - a;
+          p.v0x[l] = a.x, p.v0y[l] = a.y, p.v0z[l] = a.z;
+          p.e1x[l] = e1.x, p.e1y[l] = e1.y, p.e1z[l] = e1.z;
+          p.e2x[l] = e2.x, p.e2y[l] = e2.y, p.e2z[l] = e2.z;
+          p.prim[l] = out.triangles[first + l].prim;
           box.grow(a), box.grow(b), box.grow(c);
+          leafBox.grow(a), leafBox.grow(a + e1), leafBox.grow(a + e2);
         }
-        dev::BvhTriPacket& packet = out.stepPackets[j * stepCount + k];
-        packet = packTriangles(tris, n);
-        leafBoxes[j * stepCount + k] = packetBox(packet);
+        leafBoxes[j * stepCount + k] = leafBox;
       }
     }
   });
