@@ -249,9 +249,10 @@ void Context::launch1D(const cl::Kernel& kernel, size_t first, size_t end, const
     local = want;
   }
   // PoCL keeps a private copy of a kernel's variables for each work-item of a group on its worker
-  // thread's stack (8 MiB under Debian's default `ulimit -s`): at 256 items pt_resample needed
-  // 7.2-7.7 MiB, and a little more code in it overran into another thread's stack. At 64 it needs
-  // 1.5-2 MiB and runs no slower (tools/ci/pocl-stack-check.sh holds it within 3 MiB).
+  // thread's stack (8 MiB under Debian's default `ulimit -s`, 4 MiB at least: enumerateDevices):
+  // at 256 items pt_resample needed 7.2-7.7 MiB, and a little more code in it overran into
+  // another thread's stack. At 64 it needs 1.5-2 MiB and runs no slower
+  // (tools/ci/pocl-stack-check.sh).
   if (pocl_) local = std::min<size_t>(local, 64);
   if (local == 0) local = 1;
   const size_t padded = (global + local - 1) / local * local;

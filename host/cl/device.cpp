@@ -6,6 +6,8 @@
 #include <cstdlib>
 #include <sstream>
 
+#include <pthread.h>
+
 #include <nlohmann/json.hpp>
 
 #include "util/files.h"
@@ -53,7 +55,29 @@ std::string deviceTypeName(cl_device_type type) {
   return "OTHER";
 }
 
+namespace {
+
+// PoCL runs a work-group on one of its worker threads and keeps each work-item's private
+// variables on that thread's stack (Context::launch1D). Its threads take the process's default
+// stack size: `ulimit -s`, or 2 MiB where that is unlimited, which the reuse kernels outgrew
+// (docs/experiments/pocl-work-group-method.md). Raised to kWorkerStackBytes where smaller, before
+// the first OpenCL call creates them.
+constexpr size_t kWorkerStackBytes = size_t(4) << 20;
+
+void raiseDefaultThreadStack() {
+  pthread_attr_t attr;
+  if (pthread_getattr_default_np(&attr) != 0) return;
+  size_t size = 0;
+  if (pthread_attr_getstacksize(&attr, &size) == 0 && size < kWorkerStackBytes &&
+      pthread_attr_setstacksize(&attr, kWorkerStackBytes) == 0)
+    pthread_setattr_default_np(&attr);
+  pthread_attr_destroy(&attr);
+}
+
+}  // namespace
+
 std::vector<DeviceEntry> enumerateDevices() {
+  raiseDefaultThreadStack();
   // PoCL compiles a work-group function for each launch's local size, global offset (zero or
   // not) and grid width (below 65,535 or not) the first time it meets them, outside any
   // program binary: a new image size cost up to a minute of compiling (the demo: 42 s at a

@@ -21,9 +21,11 @@ cd build-asan
 #   tests at a few spp, resampling's error comparisons and the grazing-light prism (about 110 s
 #   of the 2-core run).
 # - denoising, whose time and memory are Open Image Denoise's, a library built without the
-#   sanitizers (its missing-library error stays in).
+#   sanitizers (its missing-library error stays in);
+# - the PoCL stack check, which measures the kernels' use of PoCL's thread stacks under a 1 MiB
+#   `ulimit -s` that is no measure of sanitized host code.
 skip="PortabilityCli.EveryPlatformAgrees|Evaluate.QuickFormWritesEveryOutputWithSaneNumbers"
-skip+="|Denoise.TheColourIsDenoisedAndTheNoisyOneKept"
+skip+="|Denoise.TheColourIsDenoisedAndTheNoisyOneKept|PoclStack.ReuseRendersUnderAOneMiBStackLimit"
 skip+="|SlurmChunks.EqualOneProcess|Environment.CoatedAndSpecularMaterialsAgreeInBothModes"
 skip+="|MaterialFurnace.EveryClassAndRoughnessReflectsAllThatArrives|Resample.SlatsHideNeighboursPaths"
 skip+="|Resample.WithReuseConvergesToThePathTracerRegionByRegion"
