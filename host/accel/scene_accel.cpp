@@ -35,16 +35,21 @@ bool zeroArea(const dev::BvhTriangle& t) {
   return c.x == 0.0f && c.y == 0.0f && c.z == 0.0f;
 }
 
+namespace {
+
+void setPacketLane(dev::BvhTriPacket* p, uint32_t i, const dev::BvhTriangle& t) {
+  p->v0x[i] = t.v0x, p->v0y[i] = t.v0y, p->v0z[i] = t.v0z;
+  p->e1x[i] = t.e1x, p->e1y[i] = t.e1y, p->e1z[i] = t.e1z;
+  p->e2x[i] = t.e2x, p->e2y[i] = t.e2y, p->e2z[i] = t.e2z;
+  p->prim[i] = t.prim;
+}
+
+}  // namespace
+
 dev::BvhTriPacket packTriangles(const dev::BvhTriangle* first, uint32_t count) {
   dev::BvhTriPacket p{};
   for (uint32_t i = 0; i < PR_BVH_PACKET; ++i) p.prim[i] = PR_INVALID_INDEX;
-  for (uint32_t i = 0; i < count && i < PR_BVH_PACKET; ++i) {
-    const dev::BvhTriangle& t = first[i];
-    p.v0x[i] = t.v0x, p.v0y[i] = t.v0y, p.v0z[i] = t.v0z;
-    p.e1x[i] = t.e1x, p.e1y[i] = t.e1y, p.e1z[i] = t.e1z;
-    p.e2x[i] = t.e2x, p.e2y[i] = t.e2y, p.e2z[i] = t.e2z;
-    p.prim[i] = t.prim;
-  }
+  for (uint32_t i = 0; i < count && i < PR_BVH_PACKET; ++i) setPacketLane(&p, i, first[i]);
   return p;
 }
 
@@ -189,24 +194,19 @@ TriangleBvh buildTriangleBvh(const std::vector<glm::vec3>& positions,
       const std::vector<glm::vec3>& at = (*steps)[k];  // one step at a time: it stays in cache
       for (size_t j = size_t(task) * kLeavesPerTask; j < end; ++j) {
         const uint32_t first = leaves[j].index, n = leaves[j].meta & ~PR_BVH_LEAF_BIT;
-        // packTriangle and packTriangles' packet, and packetBox's box, written in one pass.
+        // The packet and its box as the kernels see it (v0, v0 + e1, v0 + e2), in one pass.
         dev::BvhTriPacket& p = out.stepPackets[j * stepCount + k];
-        p = dev::BvhTriPacket{};
+        p = packTriangles(nullptr, 0);
         Aabb leafBox;
-        for (uint32_t l = 0; l < PR_BVH_PACKET; ++l) {
-          if (l >= n) {
-            p.prim[l] = PR_INVALID_INDEX;
-            continue;
-          }
+        for (uint32_t l = 0; l < n; ++l) {
           const uint32_t* v = &corners[3 * size_t(first + l)];
           const glm::vec3 &a = at[v[0]], &b = at[v[1]], &c = at[v[2]];
-          const glm::vec3 e1 = b - a, e2 = c - a;
-          p.v0x[l] = a.x, p.v0y[l] = a.y, p.v0z[l] = a.z;
-          p.e1x[l] = e1.x, p.e1y[l] = e1.y, p.e1z[l] = e1.z;
-          p.e2x[l] = e2.x, p.e2y[l] = e2.y, p.e2z[l] = e2.z;
-          p.prim[l] = out.triangles[first + l].prim;
+          const dev::BvhTriangle t = packTriangle(a, b, c, out.triangles[first + l].prim);
+          setPacketLane(&p, l, t);
           box.grow(a), box.grow(b), box.grow(c);
-          leafBox.grow(a), leafBox.grow(a + e1), leafBox.grow(a + e2);
+          leafBox.grow(a);
+          leafBox.grow(a + glm::vec3(t.e1x, t.e1y, t.e1z));
+          leafBox.grow(a + glm::vec3(t.e2x, t.e2y, t.e2z));
         }
         leafBoxes[j * stepCount + k] = leafBox;
       }
