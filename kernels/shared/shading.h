@@ -369,8 +369,18 @@ PR_INLINE float material_anisotropy(const ShadingData* sd, const SurfaceHit* s, 
   return clamp(strength, 0.0f, 1.0f);
 }
 
+// A key of a surface point for choices that every kernel and every device must make alike there
+// (alpha coverage, glass or not): its triangle, instance and barycentrics on a grid of 2^-16.
+// Not their float bits: those differ in the last place between compilers, and each difference
+// would be another choice (docs/experiments/portability.md).
+PR_INLINE u32 surface_point_key(u32 salt, u32 prim, u32 inst, float b1, float b2) {
+  const u32 q1 = (u32)(fmin(fmax(b1, 0.0f), 1.0f) * 65536.0f);
+  const u32 q2 = (u32)(fmin(fmax(b2, 0.0f), 1.0f) * 65536.0f);
+  return pr_hash_u32(salt ^ prim ^ pr_hash_u32(inst ^ pr_hash_u32(q1 ^ pr_hash_u32(q2))));
+}
+
 // Whether a transmissive material is glass at the point (else it is its opaque base): the
-// transmission factor x its texture is the chance, decided by a hash of the point so that every
+// transmission factor x its texture is the chance, decided by the point's key so that every
 // kernel that shades the point sees the same surface (as alpha coverage, surface_passes).
 PR_INLINE int material_transmits_at(const ShadingData* sd, PR_GLOBAL const Material* m,
                                     const SurfaceHit* s) {
@@ -381,10 +391,7 @@ PR_INLINE int material_transmits_at(const ShadingData* sd, PR_GLOBAL const Mater
              .x;
   if (t >= 1.0f) return 1;
   if (!(t > 0.0f)) return 0;
-  const u32 key = pr_hash_u32(
-      0x7a3c91e5u ^ s->prim ^
-      pr_hash_u32(s->inst ^ pr_hash_u32(pr_as_uint(s->b1) ^ pr_hash_u32(pr_as_uint(s->b2)))));
-  return pr_u32_to_unit(key) < t;
+  return pr_u32_to_unit(surface_point_key(0x7a3c91e5u, s->prim, s->inst, s->b1, s->b2)) < t;
 }
 
 // The BSDF's parameters at the surface; in *aniso the anisotropy direction (cos, sin) from the

@@ -25,15 +25,13 @@ PR_INLINE void scene_at_sample(SceneData* s, u32 seed, u32 frame, u32 pixel, u32
 }
 
 // Alpha coverage: MASK cuts out below the cutoff; BLEND lets a ray pass with probability
-// 1 - alpha, decided by a hash of the point so that the same point always answers the same.
+// 1 - alpha, decided by the point's key so that the same point always answers the same.
 PR_INLINE int surface_passes(const SceneData* s, const SurfaceHit* h) {
   PR_GLOBAL const Material* m = s->sd.materials + h->material;
   if (!(m->flags & (PR_MAT_ALPHA_MASK | PR_MAT_ALPHA_BLEND))) return 0;
   const float alpha = material_base(&s->sd, h).w;
   if (m->flags & PR_MAT_ALPHA_MASK) return alpha < m->alpha_cutoff;
-  const u32 key =
-      pr_hash_u32(h->prim ^ pr_hash_u32(pr_as_uint(h->uv.x) ^ pr_hash_u32(pr_as_uint(h->uv.y))));
-  return (float)(key >> 8) * (1.0f / 16777216.0f) >= alpha;
+  return pr_u32_to_unit(surface_point_key(0x3b5e17c9u, h->prim, h->inst, h->b1, h->b2)) >= alpha;
 }
 
 #define PR_MAX_ALPHA_LAYERS 16
