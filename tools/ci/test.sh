@@ -17,13 +17,13 @@ export OCL_ICD_VENDORS
 export PATHREUSE_REQUIRE_PLATFORMS="${PATHREUSE_REQUIRE_PLATFORMS:-2}"
 for device in pocl "intel(r) opencl"; do
   echo "== test suite on OpenCL device '$device'"
-  # The cross-platform portability test compares every platform already: once is enough. So
-  # do the tests whose subject is host code, a Python tool or a script, whose kernels other
-  # tests run on both platforms: the kernel-build notice (a fresh build of every kernel, 23 s on
+  # The cross-platform tests (portability, coverage) compare every platform already: once is
+  # enough. So do the tests whose subject is host code, a Python tool or a script, whose kernels
+  # other tests run on both platforms: the kernel-build notice (a fresh build of every kernel, 23 s on
   # Intel's compiler), the evaluation tool's quick form, the Slurm chunks and the kernels'
   # conformance gate (clang's check, on no device); and the PoCL stack check, PoCL's alone.
   skip=()
-  [ "$device" = pocl ] || skip=(-E "PortabilityCli.EveryPlatformAgrees|Cli.KernelBuildsAreAnnouncedOnceAndTimedInTheFirstStatsLine|Evaluate.QuickFormWritesEveryOutputWithSaneNumbers|SlurmChunks.EqualOneProcess|KernelConformance|PoclStack")
+  [ "$device" = pocl ] || skip=(-E "PortabilityCli.EveryPlatformAgrees|AlphaCoveragePlatforms|Cli.KernelBuildsAreAnnouncedOnceAndTimedInTheFirstStatsLine|Evaluate.QuickFormWritesEveryOutputWithSaneNumbers|SlurmChunks.EqualOneProcess|KernelConformance|PoclStack")
   (cd build && PATHREUSE_TEST_DEVICE="$device" \
     ctest --output-on-failure -j"$(nproc)" --timeout 900 "${skip[@]}") || status=1
   # Each test skipped for want of a third-party scene says so once in ctest's log.
