@@ -2,7 +2,6 @@
 // cuts out below the cutoff, and each point's choice is the same on every OpenCL platform.
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -83,24 +82,14 @@ INSTANTIATE_TEST_SUITE_P(Modes, AlphaCoverage, ::testing::Values("pathtrace", "r
 // compiler, and the choice is the same function in both. Needs two OpenCL platforms (CI sets up
 // Intel's beside PoCL and requires both).
 TEST(AlphaCoveragePlatforms, EveryPlatformMakesTheSameChoices) {
-  const auto list = test::runPathreuse("devices --json");
-  ASSERT_EQ(list.exitCode, 0) << list.err;
-  std::vector<std::string> platforms, devices;
-  const auto found = nlohmann::json::parse(list.out);
-  for (const auto& d : found["devices"]) {
-    const std::string platform = d["platform"];
-    if (std::find(platforms.begin(), platforms.end(), platform) != platforms.end()) continue;
-    platforms.push_back(platform);
-    devices.push_back(std::to_string(d["index"].get<int>()));
-  }
-  const char* required = std::getenv("PATHREUSE_REQUIRE_PLATFORMS");
-  ASSERT_GE(platforms.size(), required ? std::strtoul(required, nullptr, 10) : 0u) << list.out;
-  if (platforms.size() < 2)
+  const test::PlatformDevices found = test::firstDevicePerPlatform();
+  ASSERT_FALSE(HasFailure());
+  if (found.platforms.size() < 2)
     GTEST_SKIP() << "one OpenCL platform only; tools/setup/intel-opencl.sh sets up a second "
                     "(Intel's CPU runtime)";
   const std::string scene = coverageScene("coverage-platforms");
   std::vector<Image> frames;
-  for (const std::string& d : devices)
+  for (const std::string& d : found.devices)
     frames.push_back(test::frameImage(
         test::renderFrames(
             scene, "0-1",
@@ -116,7 +105,8 @@ TEST(AlphaCoveragePlatforms, EveryPlatformMakesTheSameChoices) {
             ++differ;
             break;
           }
-    EXPECT_LE(differ, 16) << "pixels of " << platforms[k] << " against " << platforms[0];
+    EXPECT_LE(differ, 16) << "pixels of " << found.platforms[k] << " against "
+                          << found.platforms[0];
   }
 }
 

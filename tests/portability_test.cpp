@@ -3,7 +3,6 @@
 // found.
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -241,29 +240,18 @@ TEST(PortabilityCli, TwoPoclDriversAgreeOnTheSuite) {
 // every OpenCL platform found. tools/ci/test.sh sets PATHREUSE_REQUIRE_PLATFORMS=2 after setting up
 // Intel's CPU runtime beside PoCL, so there a missing platform fails instead of skipping.
 TEST(PortabilityCli, EveryPlatformAgreesOnTheDefaultSuite) {
-  const auto list = test::runPathreuse("devices --json");
-  ASSERT_EQ(list.exitCode, 0) << list.err;
-  std::string devices;
-  std::vector<std::string> platforms;
-  const auto found = nlohmann::json::parse(list.out);
-  for (const auto& d : found["devices"]) {
-    const std::string platform = d["platform"];
-    if (std::find(platforms.begin(), platforms.end(), platform) != platforms.end()) continue;
-    platforms.push_back(platform);
-    devices += " --device " + std::to_string(d["index"].get<int>());
-  }
-  const char* required = std::getenv("PATHREUSE_REQUIRE_PLATFORMS");
-  const size_t need = required ? std::strtoul(required, nullptr, 10) : 0;
-  ASSERT_GE(platforms.size(), need)
-      << "PATHREUSE_REQUIRE_PLATFORMS=" << need << " but found: " << list.out;
-  if (platforms.size() < 2)
+  const test::PlatformDevices found = test::firstDevicePerPlatform();
+  ASSERT_FALSE(HasFailure());
+  if (found.platforms.size() < 2)
     GTEST_SKIP() << "one OpenCL platform only; tools/setup/intel-opencl.sh sets up a second "
                     "(Intel's CPU runtime)";
+  std::string devices;
+  for (const std::string& d : found.devices) devices += " --device " + d;
   const auto r = test::runPathreuse("portability --json --quiet" + devices + " --out '" +
                                     test::tempDir("port-platforms") + "'");
   ASSERT_EQ(r.exitCode, 0) << r.out << r.err;
   const auto j = nlohmann::json::parse(r.out);
-  ASSERT_EQ(j["results"].size(), 24u * (platforms.size() - 1));
+  ASSERT_EQ(j["results"].size(), 24u * (found.platforms.size() - 1));
   for (const auto& e : j["results"]) EXPECT_TRUE(e["agree"].get<bool>()) << e.dump();
   EXPECT_EQ(j["summary"]["disagree"], 0);
 }

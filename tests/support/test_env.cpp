@@ -3,6 +3,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -114,6 +115,27 @@ CommandResult runPathreuse(const std::string& args, const std::string& env) {
 }
 
 const char* const kTwoPoclDrivers = "POCL_DEVICES='pthread basic'";
+
+PlatformDevices firstDevicePerPlatform() {
+  PlatformDevices out;
+  const auto list = runPathreuse("devices --json");
+  EXPECT_EQ(list.exitCode, 0) << list.err;
+  const auto found =
+      list.exitCode == 0 ? nlohmann::json::parse(list.out) : nlohmann::json::object();
+  if (found.contains("devices"))
+    for (const auto& d : found["devices"]) {
+      const std::string platform = d["platform"];
+      if (std::find(out.platforms.begin(), out.platforms.end(), platform) != out.platforms.end())
+        continue;
+      out.platforms.push_back(platform);
+      out.devices.push_back(std::to_string(d["index"].get<int>()));
+    }
+  const char* required = std::getenv("PATHREUSE_REQUIRE_PLATFORMS");
+  const size_t need = required ? std::strtoul(required, nullptr, 10) : 0;
+  EXPECT_GE(out.platforms.size(), need)
+      << "PATHREUSE_REQUIRE_PLATFORMS=" << need << " but found: " << list.out;
+  return out;
+}
 
 std::string twoPoclDevices() {
   const auto r = runPathreuse("devices --json", kTwoPoclDrivers);

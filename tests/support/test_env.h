@@ -3,6 +3,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "cl/context.h"
 
@@ -37,6 +38,14 @@ struct CommandResult {
 // Runs the pathreuse binary with `args` (a shell-quoted string); `env` is prefixed as-is. Under
 // $PATHREUSE_TEST_DEVICE its renders use that device (as $PATHREUSE_DEVICE) unless `env` names one.
 CommandResult runPathreuse(const std::string& args, const std::string& env = "");
+
+// The first device of every OpenCL platform that `pathreuse devices` lists, as `--device` indexes,
+// with the platforms' names; fails the test where the listing fails or where fewer platforms are
+// found than $PATHREUSE_REQUIRE_PLATFORMS asks (tools/ci/test.sh: 2).
+struct PlatformDevices {
+  std::vector<std::string> platforms, devices;
+};
+PlatformDevices firstDevicePerPlatform();
 
 // The lines of `s` (its newline characters): an error must be exactly one.
 size_t lineCount(const std::string& s);
