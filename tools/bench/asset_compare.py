@@ -17,6 +17,11 @@ gives the part furthest from Cycles ("parts worst"), --json every part.
   /usr/bin/python3 -m tools.bench.asset_compare --cycles ~/.cache/pathreuse/bpy-5.2.3/bin/python \\
       --binary build/pathreuse --assets StainedGlassLamp,ToyCar --spp 256 --width 256
 
+`coarse-sphere` is no asset of ../shared/scenes but one the tool writes: a Lambertian sphere of
+albedo 0.5 (specularFactor 0) of 12 x 6 flat facets with a smooth sphere's vertex normals. Under the
+white sky its exact radiance is 0.5 at every point, so its line also gives each renderer against
+that (what smooth normals on coarse facets lose or gain: Cycles darkens the facets' edges).
+
 Cycles is a benchmark peer, not a dependency: --cycles names a Python 3.13 with PyPI's bpy 5.2.3.
 Writes WORK/NAME/{ours,cycles}/f_0000.exr, the ratio map WORK/NAME/ratio.png, and with --json the
 figures.
@@ -32,6 +37,8 @@ from pathlib import Path
 
 import numpy as np
 
+from tools.scenes import gltf_writer as gw
+
 from .benchlib import run_tool
 from .blender_compare import LUMA, Images, compare, ratio_png
 
@@ -39,9 +46,30 @@ HERE = Path(__file__).resolve().parent
 REPO = HERE.parents[1]
 
 
+COARSE = "coarse-sphere"
+COARSE_ALBEDO = 0.5
+
+
+def coarse_sphere(path):
+    """The coarse-sphere asset (the module's docstring) at path."""
+    g = gw.Gltf("asset_compare coarse-sphere")
+    mat = g._append("materials", {
+        "name": "lambert-0.5", "pbrMetallicRoughness": {
+            "baseColorFactor": [COARSE_ALBEDO] * 3 + [1.0], "metallicFactor": 0.0,
+            "roughnessFactor": 1.0},
+        "extensions": {"KHR_materials_specular": {"specularFactor": 0.0}}})
+    g.extensions.add("KHR_materials_specular")
+    mesh = g.mesh("sphere", [(gw.uv_sphere(1.0, 12, 6), mat)])
+    path.parent.mkdir(parents=True, exist_ok=True)
+    g.write(str(path), [g.node("sphere", mesh=mesh)], embedded=True)
+
+
 def wrapper(name, scenes, work):
     """The framed wrapper of asset `name` and its camera's index."""
     src = Path(scenes) / name / f"{name}.gltf"
+    if name == COARSE:
+        src = Path(work) / name / "source" / f"{name}.gltf"
+        coarse_sphere(src)
     if not src.is_file():
         sys.exit(f"asset_compare: {src}: no such asset")
     out = Path(work) / name / f"{name}-framed.gltf"
@@ -111,7 +139,7 @@ def parts(ours, cyc, mask, ids, names, min_pixels):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--assets", default="StainedGlassLamp,ToyCar,DamagedHelmet,FlightHelmet,"
-                    "CesiumMan,Fox,BrainStem")
+                    "CesiumMan,Fox,BrainStem," + COARSE)
     ap.add_argument("--scenes", default=str(REPO.parent / "shared" / "scenes"))
     ap.add_argument("--binary", default=str(REPO / "build" / "pathreuse"))
     ap.add_argument("--cycles", required=True, help="a Python with bpy 5.2.3")
@@ -150,13 +178,20 @@ def main():
                "parts": parts(ours, cyc, mask, ids, material_names(scene), a.part_pixels)}
         worst = row["parts"][0] if row["parts"] else {"material": "none", "ratio": float("nan")}
         ratio_png(d / "ratio.png", ours, cyc, mask)
+        if name == COARSE:
+            inner = shrink(mask)
+            row["exact"] = COARSE_ALBEDO
+            row["ours_exact"] = float(ours[inner].mean() / COARSE_ALBEDO)
+            row["cycles_exact"] = float(cyc[inner].mean() / COARSE_ALBEDO)
         rows.append(row)
         print(f"{name:18s} luminance {row['mean_ratio']:.3f}  rgb "
               + " ".join(f"{x:.3f}" for x in row["rgb_ratio"])
               + f"  blocks p95 {row['p95_block']:.3f} max {row['max_block']:.3f}"
               + f"  pixels {row['pixel_deviation']:.4f}"
               + f" ({row['blocks']} blocks, {row['pixels']} px)"
-              + f"  parts worst {worst['ratio']:.3f} ({worst['material']}) of {len(row['parts'])}",
+              + f"  parts worst {worst['ratio']:.3f} ({worst['material']}) of {len(row['parts'])}"
+              + (f"  exact {row['exact']}: ours {row['ours_exact']:.4f} Cycles "
+                 f"{row['cycles_exact']:.4f}" if "exact" in row else ""),
               flush=True)
     if a.json:
         Path(a.json).write_text(json.dumps(rows, indent=1))

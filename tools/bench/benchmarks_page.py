@@ -76,20 +76,22 @@ def asset_table(text):
     """asset_compare.py prints one line per asset, not a table: its figures as one."""
     pat = re.compile(r"^(\S+)\s+luminance (\S+)\s+rgb (\S+) (\S+) (\S+)\s+blocks p95 (\S+) "
                      r"max (\S+)\s+pixels (\S+) \((\d+) blocks, (\d+) px\)"
-                     r"(?:\s+parts worst (\S+) \((.*)\) of (\d+))?")
+                     r"(?:\s+parts worst (\S+) \((.*)\) of (\d+))?"
+                     r"(?:\s+exact \S+: ours (\S+) Cycles (\S+))?")
     rows = [m.groups() for m in map(pat.match, text.splitlines()) if m]
     if not rows:
         return ""
     head = ["Ours / Cycles per asset (asset_compare's lines as a table):", "",
             "| asset | luminance | R G B | p95 block | max block | pixels | blocks | px "
-            "| worst part (of the materials) |",
-            "|---|---:|---|---:|---:|---:|---:|---:|---|"]
+            "| worst part (of the materials) | ours, Cycles / exact |",
+            "|---|---:|---|---:|---:|---:|---:|---:|---|---|"]
 
     def worst(r):
         return f"{r[10]} {r[11]} (of {r[12]})" if r[10] else ""
 
     return "\n".join(head + [f"| {r[0]} | {r[1]} | {r[2]} {r[3]} {r[4]} | {r[5]} | {r[6]} | "
-                             f"{r[7]} | {r[8]} | {r[9]} | {worst(r)} |" for r in rows]) + "\n"
+                             f"{r[7]} | {r[8]} | {r[9]} | {worst(r)} | "
+                             f"{f'{r[13]}, {r[14]}' if r[13] else ''} |" for r in rows]) + "\n"
 
 
 MATERIALS = (PY, "-m", "tools.bench.blender_compare", "--binary", "{build}/pathreuse",

@@ -182,7 +182,8 @@ def _catalogue():
     no_spec = {"KHR_materials_specular": {"specularFactor": 0.0}}
     add("lambert-grey", "lambert", (0.8,) * 3, 0.0, 1.0, no_spec)
     add("lambert-white", "lambert", (1.0,) * 3, 0.0, 1.0, no_spec)
-    for tone, base in (("grey", (0.8,) * 3), ("white", (1.0,) * 3)):
+    # a dark base shows the specular layer's own albedo, which a white one hides
+    for tone, base in (("dark", (0.1,) * 3), ("grey", (0.8,) * 3), ("white", (1.0,) * 3)):
         for x in ROUGH:
             add(f"dielectric-{tone}-{r(x)}", "dielectric", base, 0.0, x)
     for tone, base in (("white", (1.0,) * 3), ("gold", GOLD)):
