@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "render/albedo_tables.h"
+#include "render/sheen_volume.h"
 #include "shared/bsdf.h"
 #include "shared/rng.h"
 #include "shared/srgb.h"
@@ -842,13 +843,75 @@ TEST(BsdfTables, CommittedHeaderIsWhatTheToolWrites) {
        "pr_fresnel_wavg");
 }
 
+// The committed sheen tables are what tools/tables/sheen_tables writes (host/render/
+// sheen_volume.cpp): every 37th grid point's walks and fit again (all take a minute and a half).
+// A point where too few walks come back to fit a lobe borrows its neighbour's in the committed
+// tables, so only its reflectance is compared.
+TEST(SheenTables, CommittedHeaderIsWhatTheToolWrites) {
+  constexpr int kStride = 37;
+  const SheenTables t =
+      computeSheenTables(kSheenTableCos, kSheenTableRoughness, kSheenWalks, kStride);
+  ASSERT_EQ(t.cosines, PR_SHEEN_TABLE_COS);
+  ASSERT_EQ(t.roughnesses, PR_SHEEN_TABLE_R);
+  ASSERT_EQ(t.r.size(), sizeof pr_sheen_r / sizeof(float));
+  int fitted = 0;
+  for (size_t i = 0; i < t.r.size(); i += kStride) {
+    ASSERT_NEAR(t.r[i], pr_sheen_r[i], 2e-6f) << i;
+    if (t.a[i] == 1.0f && t.b[i] == 0.0f) continue;  // no lobe fitted here
+    ++fitted;
+    ASSERT_NEAR(t.a[i], pr_sheen_ltc_a[i], 2e-6f) << i;
+    ASSERT_NEAR(t.b[i], pr_sheen_ltc_b[i], 2e-6f) << i;
+  }
+  EXPECT_GE(fitted, 4);
+}
+
+// The energy model's sheen is the fibre layer it stands for: over a black base (no specular
+// layer), its sampled directional albedo is the layer's reflectance from independent walks, at
+// views and roughnesses between the tables' grid points, and a white base under it makes the
+// material white (what the layer does not reflect reaches the base). Its lobe is close to where
+// the walks leave: the LTC's mean absolute difference from their density, over the
+// hemisphere, is a small part of the lobe.
+TEST(SheenVolume, AlbedoAndLobeAreTheFibreLayers) {
+  for (const float rough : {0.3f, 0.55f, 0.9f})
+    for (const float mu : {0.12f, 0.4f, 0.8f}) {
+      BsdfParams m = sheened(make_float3(0, 0, 0), make_float3(1, 1, 1), rough);
+      m.f0 = make_float3(0, 0, 0);
+      m.f90 = 0.0f;
+      const float3 wo = dirFromCos(mu, 0.7f);
+      const Estimate e = albedoBySampling(m, wo, 200000, 11);
+      const SheenWalks w = sheenWalks(mu, rough, 400000, 12);
+      const double se = std::sqrt(w.reflectance * (1 - w.reflectance) / 400000.0);
+      // Table interpolation: within 2% of the reflectance or 0.004.
+      EXPECT_NEAR(e.mean, w.reflectance,
+                  std::fmax(0.02 * w.reflectance, 0.004) + 4 * (e.stderr_ + se))
+          << "roughness " << rough << " cos " << mu;
+      const Estimate white = albedoBySampling(
+          sheened(make_float3(1, 1, 1), make_float3(1, 1, 1), rough), wo, 50000, 13);
+      EXPECT_NEAR(white.mean, 1.0, 0.01 + 4 * white.stderr_) << rough << " " << mu;
+      if (w.reflectance < 0.05) continue;
+      double a, b, l1 = 0;
+      fitSheenLtc(w, &a, &b);
+      const double cell = 2.0 * (1.0 / kSheenBins) * (PR_PI / kSheenBins);
+      for (int i = 0; i < kSheenBins; ++i)
+        for (int j = 0; j < kSheenBins; ++j) {
+          const double z = (i + 0.5) / kSheenBins, phi = PR_PI * (j + 0.5) / kSheenBins;
+          const double sz = std::sqrt(1 - z * z);
+          l1 += std::fabs(sheenLtc(a, b, sz * std::cos(phi), sz * std::sin(phi), z) -
+                          w.density[size_t(i * kSheenBins + j)] / w.reflectance) *
+                cell;
+        }
+      EXPECT_LT(l1, 0.3) << "roughness " << rough << " cos " << mu;
+    }
+}
+
 // Every __constant table of the kernels together fits the smallest constant buffer OpenCL 1.2
 // promises (64 KiB; NVIDIA's is that size): a program that declares more fails to build there.
 TEST(BsdfTables, KernelTablesFitTheMinimumConstantBuffer) {
   const size_t bytes = sizeof pr_ggx_e + sizeof pr_ggx_es + sizeof pr_ggx_eavg + sizeof pr_sheen_e +
                        sizeof pr_ggx_e_aniso + sizeof pr_ggx_es_aniso + sizeof pr_ggx_eavg_aniso +
                        sizeof pr_glass_e + sizeof pr_glass_eavg + sizeof pr_ggx_ed +
-                       sizeof pr_fresnel_wavg + sizeof pr_srgb_to_linear +
+                       sizeof pr_fresnel_wavg + sizeof pr_srgb_to_linear + sizeof pr_sheen_r +
+                       sizeof pr_sheen_ltc_a + sizeof pr_sheen_ltc_b +
                        256;  // rng.h's pr_reversed_byte (PR_BITREVERSE_TABLE)
   EXPECT_LE(bytes, size_t(65536));
 }

@@ -6,6 +6,7 @@
 
 #include "shared/microfacet.h"
 #include "shared/sampling.h"
+#include "render/table_text.h"
 #include "util/parallel.h"
 
 namespace pr {
@@ -263,15 +264,7 @@ std::string bsdfTablesHeader(const BsdfTables& t) {
   };
   grid({{"PR_BSDF_TABLE_COS", t.cosines}, {"PR_BSDF_TABLE_R", t.roughnesses}});
   auto table = [&](const char* name, const char* what, const std::vector<float>& v) {
-    s += std::string("// ") + what + "\n";
-    s += std::string("PR_TABLE float ") + name + "[" + std::to_string(v.size()) + "] = {\n";
-    for (size_t i = 0; i < v.size(); ++i) {
-      char buf[32];
-      std::snprintf(buf, sizeof buf, "%.6ff,", double(v[i]));
-      s += (i % 8 == 0 ? "    " : " ") + std::string(buf);
-      if (i % 8 == 7 || i + 1 == v.size()) s += "\n";
-    }
-    s += "};\n\n";
+    appendKernelTable(s, name, what, v);
   };
   table("pr_ggx_e", "GGX albedo with F = 1.", t.ggxE);
   table("pr_ggx_es", "GGX albedo weighted by Schlick's (1 - v.h)^5.", t.ggxEs);

@@ -26,6 +26,7 @@
 #include "shared/math.h"
 #include "shared/microfacet.h"
 #include "shared/sampling.h"
+#include "shared/sheen_tables.h"
 
 PR_NAMESPACE_BEGIN
 
@@ -145,6 +146,14 @@ PR_INLINE float bsdf_table2(PR_CONSTANT const float* t, float mu, float r) {
   return bsdf_table_bilinear(t + j * PR_BSDF_TABLE_COS + i, PR_BSDF_TABLE_COS, fx, fy);
 }
 
+// The energy model's sheen tables (kernels/shared/sheen_tables.h) at cos mu and roughness r.
+PR_INLINE float sheen_table(PR_CONSTANT const float* t, float mu, float r) {
+  int i, j;
+  const float fx = bsdf_table_at(sqrt(fmax(mu, 0.0f)), PR_SHEEN_TABLE_COS, &i);
+  const float fy = bsdf_table_at(bsdf_table_roughness(r), PR_SHEEN_TABLE_R, &j);
+  return bsdf_table_bilinear(t + j * PR_SHEEN_TABLE_COS + i, PR_SHEEN_TABLE_COS, fx, fy);
+}
+
 PR_INLINE float bsdf_table1(PR_CONSTANT const float* t, float r) {
   int j;
   const float fy = bsdf_table_at(bsdf_table_roughness(r), PR_BSDF_TABLE_R, &j);
@@ -221,7 +230,6 @@ typedef struct {
   float coat_ms, coat_albedo;        // the coat's factor, and its albedo x weight (PR_MODEL_GLTF:
                                      // weight x Fresnel at N.V)
   float sheen_albedo;                // max(sheen colour) x the sheen's albedo
-  float sheen_scale;                 // 1, or what brings the sheen's albedo down to 1
 } BsdfLayers;
 
 PR_INLINE BsdfLayers bsdf_layers(const BsdfParams* m, float3 w) {
@@ -234,14 +242,13 @@ PR_INLINE BsdfLayers bsdf_layers(const BsdfParams* m, float3 w) {
   l.coat_ms = 1.0f;
   l.coat_albedo = 0.0f;
   l.sheen_albedo = 0.0f;
-  l.sheen_scale = 1.0f;
   if (bsdf_has_sheen(m)) {
     const float sheen = max3(m->sheen);
-    const float e = bsdf_table2(pr_sheen_e, w.z, sqrt(m->sheen_alpha));
-    // The Charlie lobe reflects more than arrives at grazing views when it is smooth (albedo
-    // up to 3.7): the energy model scales it down there.
-    if (!bsdf_gltf(m) && e > 1.0f) l.sheen_scale = 1.0f / e;
-    l.sheen_albedo = sheen * e * l.sheen_scale;
+    if (bsdf_gltf(m)) {
+      l.sheen_albedo = sheen * bsdf_table2(pr_sheen_e, w.z, sqrt(m->sheen_alpha));
+    } else {
+      l.sheen_albedo = sheen * sheen_table(pr_sheen_r, w.z, sqrt(m->sheen_alpha));
+    }
   }
   const float cc = dot(w, m->coat_n);
   if (bsdf_gltf(m)) {
@@ -426,8 +433,43 @@ PR_INLINE float3 lobe_coat_eval(const BsdfParams* m, const BsdfEval* e, float3 b
   return below * fmax(1.0f - lv->coat_albedo, 0.0f) + make_float3(coat_spec, coat_spec, coat_spec);
 }
 
-// ---- Sheen: the Charlie lobe (KHR_materials_sheen), sampled uniformly over the hemisphere:
-// it peaks at grazing directions, which cosine-weighted samples reach too rarely.
+// ---- Sheen. PR_MODEL_GLTF: the Charlie lobe (KHR_materials_sheen), sampled uniformly over the
+// hemisphere (it peaks at grazing directions, which cosine-weighted samples reach too rarely).
+// PR_MODEL_ENERGY: a layer of fibres along the normal (Zeltner, Burley and Chiang 2022; Cycles'
+// and OpenPBR's sheen), f cos = R D: R its reflectance at the view and D a linearly transformed
+// cosine about the view, both from sheen_tables.h (host/render/sheen_volume.cpp). D is sampled
+// exactly; f is not reciprocal, so the view is wo for radiance and wi for importance.
+
+// The LTC about view v (v.z > 0) of a sheen of roughness r: its a and b, and v's azimuth (c, s).
+typedef struct {
+  float a, b, c, s;
+} SheenLtc;
+
+PR_INLINE SheenLtc sheen_ltc(float r, float3 v) {
+  SheenLtc t;
+  t.a = sheen_table(pr_sheen_ltc_a, v.z, r);
+  t.b = sheen_table(pr_sheen_ltc_b, v.z, r);
+  const float l = sqrt(v.x * v.x + v.y * v.y);
+  t.c = l > 1e-7f ? v.x / l : 1.0f;
+  t.s = l > 1e-7f ? v.y / l : 0.0f;
+  return t;
+}
+
+// D at w (solid-angle density over the upper hemisphere): the cosine lobe at M^-1 w, with
+// M^-1 = [[a, 0, b], [0, a, 0], [0, 0, 1]] in the frame where the view's azimuth is 0.
+PR_INLINE float sheen_ltc_eval(const SheenLtc* t, float3 w) {
+  if (!(w.z > 0.0f)) return 0.0f;
+  const float x = t->c * w.x + t->s * w.y, y = t->c * w.y - t->s * w.x;
+  const float px = t->a * x + t->b * w.z, py = t->a * y;
+  const float l2 = px * px + py * py + w.z * w.z;
+  return w.z * t->a * t->a * PR_INV_PI / (l2 * l2);
+}
+
+PR_INLINE float3 sheen_ltc_sample(const SheenLtc* t, float u1, float u2) {
+  const float3 c = sample_cosine_hemisphere(u1, u2);
+  const float x = (c.x - t->b * c.z) / t->a, y = c.y / t->a;
+  return normalize(make_float3(t->c * x - t->s * y, t->s * x + t->c * y, c.z));
+}
 
 PR_INLINE float lobe_sheen_weight(const BsdfParams* m, float3 wo, const BsdfLayers* l) {
   (void)wo;
@@ -442,28 +484,36 @@ PR_INLINE float lobe_sheen_choice(const BsdfParams* m, float3 wo, const BsdfLobe
 }
 
 PR_INLINE float3 lobe_sheen_sample(const BsdfParams* m, float3 wo, float u1, float u2) {
-  (void)m;
-  (void)wo;
-  return sample_uniform_hemisphere(u1, u2);
+  if (bsdf_gltf(m)) return sample_uniform_hemisphere(u1, u2);
+  const SheenLtc t = sheen_ltc(sqrt(m->sheen_alpha), wo);
+  return sheen_ltc_sample(&t, u1, u2);
 }
 
 PR_INLINE float lobe_sheen_pdf(const BsdfParams* m, float3 wo, float3 wi, float3 h) {
-  (void)m;
-  (void)wo;
-  (void)wi;
   (void)h;
-  return 0.5f * PR_INV_PI;
+  if (bsdf_gltf(m)) return 0.5f * PR_INV_PI;
+  const SheenLtc t = sheen_ltc(sqrt(m->sheen_alpha), wo);
+  return sheen_ltc_eval(&t, wi);
 }
 
 PR_INLINE float3 lobe_sheen_eval(const BsdfParams* m, const BsdfEval* e, float3 below) {
   if (!bsdf_has_sheen(m)) return below;
   const BsdfLayers* lv = bsdf_view(e);
-  const float s = sheen_lobe(e->wo.z, e->wi.z, e->h.z, m->sheen_alpha);
-  // The glTF model's scaling is the smaller of both directions' (reciprocal); the energy
-  // model's is the view's.
-  const float keep = bsdf_gltf(m) ? fmin(1.0f - e->lo.sheen_albedo, 1.0f - e->li.sheen_albedo)
-                                  : 1.0f - lv->sheen_albedo;
-  return m->sheen * (s * lv->sheen_scale) + below * fmax(keep, 0.0f);
+  if (bsdf_gltf(m)) {
+    // The glTF model's scaling is the smaller of both directions' (reciprocal).
+    const float s = sheen_lobe(e->wo.z, e->wi.z, e->h.z, m->sheen_alpha);
+    const float keep = fmin(1.0f - e->lo.sheen_albedo, 1.0f - e->li.sheen_albedo);
+    return m->sheen * s + below * fmax(keep, 0.0f);
+  }
+  const int radiance = e->mode == PR_RADIANCE;
+  const float3 view = radiance ? e->wo : e->wi, light = radiance ? e->wi : e->wo;
+  float f = 0.0f;
+  if (view.z > 0.0f && light.z > 0.0f) {
+    const SheenLtc t = sheen_ltc(sqrt(m->sheen_alpha), view);
+    const float r = lv->sheen_albedo / max3(m->sheen);
+    f = r * sheen_ltc_eval(&t, light) / light.z;
+  }
+  return m->sheen * f + below * fmax(1.0f - lv->sheen_albedo, 0.0f);
 }
 
 // ---- Spec: the base's GGX lobe, a conductor (metallic) and a dielectric specular layer over
