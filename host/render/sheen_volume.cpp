@@ -15,7 +15,7 @@ namespace pr {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-// Scattering orders followed; the walks still inside after them (fewer than 1e-4) are dropped.
+// Scattering orders followed; a walk still inside after them is dropped.
 constexpr int kMaxBounces = 64;
 // Walks that must come back before their density is fitted.
 constexpr int64_t kMinReflected = 2000;

@@ -303,7 +303,8 @@ class Gltf:
         return self._append("textures", {"name": name, "sampler": 0, "source": image})
 
     def material(self, name, base, metallic=0.0, roughness=1.0, emissive=None,
-                 strength=None, double_sided=False, normal_texture=None):
+                 strength=None, double_sided=False, normal_texture=None, extensions=None):
+        """extensions: more KHR_materials_* objects by name (e.g. KHR_materials_specular)."""
         mat = {"name": name, "pbrMetallicRoughness": {
             "baseColorFactor": list(base) + [1.0] if len(base) == 3 else list(base),
             "metallicFactor": metallic, "roughnessFactor": roughness}}
@@ -317,6 +318,9 @@ class Gltf:
             mat["doubleSided"] = True
         if normal_texture is not None:
             mat["normalTexture"] = {"index": normal_texture}
+        for ext, value in (extensions or {}).items():
+            mat.setdefault("extensions", {})[ext] = value
+            self.extensions.add(ext)
         return self._append("materials", mat)
 
     def mesh(self, name, primitives):
