@@ -22,6 +22,9 @@ albedo 0.5 (specularFactor 0) of 12 x 6 flat facets with a smooth sphere's verte
 white sky its exact radiance is 0.5 at every point, so its line also gives each renderer against
 that (what smooth normals on coarse facets lose or gain: Cycles darkens the facets' edges).
 
+--ours-args passes more options to our renderer, e.g. --ours-args='--shadow-terminator off' (how
+much of a difference is the smooth normals' handling).
+
 Cycles is a benchmark peer, not a dependency: --cycles names a Python 3.13 with PyPI's bpy 5.2.3.
 Writes WORK/NAME/{ours,cycles}/f_0000.exr, the ratio map WORK/NAME/ratio.png, and with --json the
 figures.
@@ -30,6 +33,7 @@ figures.
 import argparse
 import json
 import os
+import shlex
 import subprocess
 import sys
 import tempfile
@@ -145,6 +149,9 @@ def main():
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--block", type=int, default=16)
     ap.add_argument("--work", default="/tmp/pathreuse-asset-compare")
+    ap.add_argument("--ours-args", default="",
+                    help="more options for ours, written with '=' since they start with --: "
+                    "--ours-args='--shadow-terminator off'")
     ap.add_argument("--part-pixels", type=int, default=200,
                     help="pixels a material needs to count as a part (default 200)")
     ap.add_argument("--json", help="write the figures here")
@@ -159,7 +166,7 @@ def main():
                         str(camera), "--mode", "pathtrace", "--spp", str(a.spp), "--max-depth",
                         str(a.max_depth), "--env-color", "1,1,1", "--exr-float", "--frames", "0",
                         "--out", str(d / "ours" / "f_%04d.exr"), "-q", "--aov", "material",
-                        *size], check=True,
+                        *size, *shlex.split(a.ours_args)], check=True,
                        env=dict(os.environ, POCL_MAX_PTHREAD_COUNT=str(a.threads)))
         subprocess.run([a.cycles, str(HERE / "cycles_frames.py"), str(scene), str(d / "cycles"),
                         "--frames", "0-0", "--spp", str(a.spp), "--max-depth", str(a.max_depth),
