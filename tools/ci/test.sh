@@ -18,10 +18,11 @@ export PATHREUSE_REQUIRE_PLATFORMS="${PATHREUSE_REQUIRE_PLATFORMS:-2}"
 for device in pocl "intel(r) opencl"; do
   echo "== test suite on OpenCL device '$device'"
   # The cross-platform tests (portability, coverage) compare every platform already: once is
-  # enough. So do the tests whose subject is host code, a Python tool or a script, whose kernels
-  # other tests run on both platforms: the kernel-build notice (a fresh build of every kernel, 23 s on
-  # Intel's compiler), the evaluation tool's quick form, the Slurm chunks and the kernels'
-  # conformance gate (clang's check, on no device); and the PoCL stack check, PoCL's alone.
+  # enough. So do the tests whose subject is host code, a Python tool or a script, whose
+  # kernels other tests run on both platforms: the kernel-build notice (a fresh build of every
+  # kernel, 23 s on Intel's compiler), the evaluation tool's quick form, the Slurm chunks and the
+  # kernels' conformance gate (clang's check, on no device); and the PoCL stack check, PoCL's
+  # alone.
   skip=()
   [ "$device" = pocl ] || skip=(-E "PortabilityCli.EveryPlatformAgrees|AlphaCoveragePlatforms|Cli.KernelBuildsAreAnnouncedOnceAndTimedInTheFirstStatsLine|Evaluate.QuickFormWritesEveryOutputWithSaneNumbers|SlurmChunks.EqualOneProcess|KernelConformance|PoclStack")
   (cd build && PATHREUSE_TEST_DEVICE="$device" \
