@@ -284,6 +284,29 @@ TEST(EyePathShare, TheSharesOfTAndLAndTheEyePathAddToOne) {
   }
 }
 
+// Where L cannot make a path (under a shutter, a segment of its light path meets what moves), T's
+// share and the eye path's add to 1 and are the power heuristic over T, N and H alone; where it
+// can, they are the shares with L, bit for bit.
+TEST(EyePathShare, WithoutLTheSharesOfTAndTheEyePathAddToOne) {
+  const float inf = std::numeric_limits<float>::infinity();
+  DensityDraw draw(31);
+  for (int trial = 0; trial < 20000; ++trial) {
+    const float t = draw(), n = draw(), h = draw();
+    ASSERT_EQ(eye_paths_camera_share_l(t, n, h, 1), eye_paths_camera_share(t, n, h));
+    ASSERT_EQ(eye_paths_eye_share_l(n, h, t, 1), eye_paths_eye_share(n, h, t));
+    const float w_t = eye_paths_camera_share_l(t, n, h, 0);
+    const float w_e = eye_paths_eye_share_l(n, h, t, 0);
+    ASSERT_GE(w_t, 0.0f);
+    ASSERT_LE(w_t, 1.0f);
+    ASSERT_NEAR(double(w_t) + w_e, 1.0, 1e-5) << t << " " << n << " " << h;
+    if (!(t > 0.0f)) ASSERT_EQ(w_e, 1.0f);
+    if (t > 0.0f && t < inf && n == n && h == h && n < inf && h < inf) {
+      const double a = double(t) * t, den = a + double(n) * n + double(h) * h;
+      if (den > 0.0) ASSERT_NEAR(w_t, a / den, 1e-5) << t << " " << n << " " << h;
+    }
+  }
+}
+
 // The power heuristic over density ratios for any number of strategies: each strategy's weight,
 // from its own view of the same densities (the others over its own), adds to 1 over all of
 // them, with densities 0, tiny, huge, infinite or NaN (NaN: the strategy is left out, as a

@@ -20,14 +20,21 @@
 namespace pr {
 namespace {
 
-enum class Moving { Object, Rotating, Camera, Lamp, Light, Morph, Skin, SkinTurning, Blinds };
+enum class Moving {
+  Object,
+  Rotating,
+  Camera,
+  Lamp,
+  Light,
+  Morph,
+  Skin,
+  SkinTurning,
+  Blinds,
+  Bounce
+};
 
-// A ceiling lit only by the pool of light that a spot casts on the floor below, and a dark slab
-// just under the spot that covers it at t = 0.75 and 1.25 and is far aside at t = 1: frame 1's
-// light paths (traced at t = 1) pass where the slab is for about half of a half-frame shutter.
-// The camera sees the ceiling beside the slab's path (x < -3), lit from the floor alone.
-std::string blindsScene(const std::string& tag) {
-  test::GltfBuilder b;
+// A grey floor (y = 0) and ceiling (y = 3), 16 wide; returns a dark material for what moves.
+int addFloorAndCeiling(test::GltfBuilder& b) {
   test::MaterialSpec grey;
   grey.baseColor = glm::vec4(0.8f, 0.8f, 0.8f, 1.0f);
   const int g = b.addMaterial(grey);
@@ -35,13 +42,45 @@ std::string blindsScene(const std::string& tag) {
   b.addNode(b.addQuad({-8, 3, -8}, {8, 3, -8}, {8, 3, 8}, {-8, 3, 8}, g));
   test::MaterialSpec dark;
   dark.baseColor = glm::vec4(0.02f, 0.02f, 0.02f, 1.0f);
-  const int d = b.addMaterial(dark);
+  return b.addMaterial(dark);
+}
+
+// A ceiling lit only by the pool of light that a spot casts on the floor below, and a dark slab
+// just under the spot that covers it at t = 0.75 and 1.25 and is far aside at t = 1: frame 1's
+// light paths (traced at t = 1) pass where the slab is for about half of a half-frame shutter.
+// The camera sees the ceiling beside the slab's path (x < -3), lit from the floor alone.
+std::string blindsScene(const std::string& tag) {
+  test::GltfBuilder b;
+  const int d = addFloorAndCeiling(b);
   b.addSpotLight({0, 2.9f, 0}, {0, 0, 0}, {1, 1, 1}, 40.0f, 0.3f, 0.5f);
   const int slab =
       b.addNode(b.addBox({-2.5f, -0.05f, -2.5f}, {2.5f, 0.05f, 2.5f}, d), glm::vec3(0, 2.5f, 0));
   b.animateTranslation(slab, {0.75f, 1.0f, 1.25f}, {{0, 2.5f, 0}, {6, 2.5f, 0}, {0, 2.5f, 0}});
   b.addCamera({-2, 1, 0.5f}, {-5, 3, -0.5f}, 0.9f, 4.0f / 3.0f);
   return b.write(test::tempDir(tag), "blinds");
+}
+
+// A ceiling lit by a lamp that slides fast along the floor under a dark lid (they move together):
+// the lamp's light reaches the ceiling through the floor, so the camera, which sees the ceiling
+// alone, sees paths that strategies N, H and T all make and L, under the shutter, cannot (every
+// path of the lamp starts in its sweep). Their weights split the path between N, H and T alone,
+// and T joins a light path to the camera where the lamp is at the path's time.
+std::string bounceScene(const std::string& tag) {
+  test::GltfBuilder b;
+  const int dark = addFloorAndCeiling(b);
+  test::MaterialSpec lamp;
+  lamp.baseColor = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
+  lamp.emissive = glm::vec3(1.0f, 0.9f, 0.8f);
+  lamp.emissiveStrength = 200.0f;
+  const int l = b.addNode(b.addQuad({-0.5f, 0, -0.5f}, {0.5f, 0, -0.5f}, {0.5f, 0, 0.5f},
+                                    {-0.5f, 0, 0.5f}, b.addMaterial(lamp)),
+                          glm::vec3(0, 0.5f, 0));
+  const int lid =
+      b.addNode(b.addBox({-0.6f, 0.0f, -0.6f}, {0.6f, 0.05f, 0.6f}, dark), glm::vec3(0, 0.51f, 0));
+  b.animateTranslation(l, {0.0f, 2.0f}, {{-16, 0.5f, 0}, {16, 0.5f, 0}});
+  b.animateTranslation(lid, {0.0f, 2.0f}, {{-16, 0.51f, 0}, {16, 0.51f, 0}});
+  b.addCamera({0, 1.5f, 5}, {0, 3, 0}, 1.2f, 4.0f / 3.0f);
+  return b.write(test::tempDir(tag), "bounce");
 }
 
 // A grey back wall and floor lit by a point light, a dark quad before the wall; one thing moves
@@ -51,6 +90,7 @@ std::string blindsScene(const std::string& tag) {
 // morph target, a skin; SkinTurning: a skin whose joint turns as the bar does).
 std::string movingScene(Moving what, const std::string& tag) {
   if (what == Moving::Blinds) return blindsScene(tag);
+  if (what == Moving::Bounce) return bounceScene(tag);
   test::GltfBuilder b;
   test::MaterialSpec grey;
   grey.baseColor = glm::vec4(0.6f, 0.6f, 0.6f, 1.0f);
@@ -181,8 +221,8 @@ void expectBlurIsTheMeanOfInstants(Moving what, const std::string& tag,
 class MeanOfInstants : public ::testing::TestWithParam<Moving> {};
 
 std::string motionName(const ::testing::TestParamInfo<Moving>& info) {
-  static const char* const kNames[] = {"Sliding",  "Turning", "Camera",      "Lamp",  "PointLight",
-                                       "Morphing", "Skinned", "SkinTurning", "Blinds"};
+  static const char* const kNames[] = {"Sliding",  "Turning", "Camera",      "Lamp",   "PointLight",
+                                       "Morphing", "Skinned", "SkinTurning", "Blinds", "Bounce"};
   return kNames[int(info.param)];
 }
 
@@ -214,6 +254,13 @@ INSTANTIATE_TEST_SUITE_P(MotionBlur, MeanOfInstants,
                                            Moving::Light, Moving::Morph, Moving::Skin,
                                            Moving::Camera, Moving::Blinds),
                          motionName);
+
+// Strategy T under the shutter (light_trace, camera_splat): where a light path meets what moves,
+// it is traced again at the slot's own time and joined to the camera then, weighted against N and
+// H alone where L cannot make the path. The bounce scene's ceiling is lit through such paths only.
+TEST(MotionBlur, LightTracingJoinsMovingPathsAtTheirOwnTime) {
+  expectBlurIsTheMeanOfInstants(Moving::Bounce, "mb-reuse-bounce", "reuse");
+}
 
 // The auxiliary images under a shutter: albedo blurred as the colour is (the mean of the instants'
 // albedo, block by block), Z and object ids of the frame's own time (the sharp frame's).

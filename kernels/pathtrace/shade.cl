@@ -16,36 +16,39 @@
 
 // The path tracer's weight w of a path ending on a light, as *ew's first part; the connections'
 // parts are 0 until a hook sets them, and T's length is that of x_1 .. x_t, t = p->depth.
-PR_INLINE void pt_weight_parts(const PathState* p, float w, u32 max_depth, EyeWeight* ew) {
+PR_INLINE void pt_weight_parts(const PathState* p, float w, u32 max_depth, int last_still,
+                               EyeWeight* ew) {
   ew->pt = w;
   ew->n = ew->h = ew->l = ew->t = 0.0f;
   ew->t_len = eye_paths_camera_len(p->depth, max_depth);
+  ew->l_ok = ep_l_ok(p, last_still);
 }
 
 // The weight of emission found at h along d (dist2 from the previous vertex): against next-event
-// estimation, and where the connections can make the path too (joinable), times their share;
-// its parts into *ew.
+// estimation, and where the connections can make the path too (joinable; L only where the
+// segment to h is still too), times their share; its parts into *ew.
 PR_INLINE float pt_emission_weight(const SceneData* s, const PathState* p, const SurfaceHit* h,
-                                   float3 d, float dist2, int joinable, const EyeMis* em,
-                                   u32 max_depth, EyeWeight* ew) {
+                                   float3 d, float dist2, int joinable, int last_still,
+                                   const EyeMis* em, u32 max_depth, EyeWeight* ew) {
   const float3 prev = make_float3(p->prev_x, p->prev_y, p->prev_z);
   const float3 prev_n = make_float3(p->prev_nx, p->prev_ny, p->prev_nz);
   float w = 1.0f;
   if (!(p->flags & PR_PATH_SPECULAR))
     w = power_heuristic(p->last_pdf, emitter_pdf(s, h, prev, prev_n));
-  pt_weight_parts(p, w, max_depth, ew);  // T's ratio was fixed at x_2
+  pt_weight_parts(p, w, max_depth, last_still, ew);  // T's ratio was fixed at x_2
   if (PR_EYE_PATHS && joinable) w = ep_emission_share(s, p, h, d, dist2, em, w, ew);
   return w;
 }
 
 // The weight of a next-event sample at vertex h: the power heuristic against BSDF sampling,
-// times, where h is joinable, what the connections leave of the path; its parts into *ew.
+// times, where h is joinable, what the connections leave of the path (L only where the shadow
+// ray's segment is still too); its parts into *ew.
 PR_INLINE float pt_next_event_weight(const SceneData* s, const PathState* p, const SurfaceHit* h,
                                      const ShadingFrame* f, const NextEventChoice* ch, int joinable,
-                                     int has_rev, float dist2, const EyeMis* em, u32 max_depth,
-                                     EyeWeight* ew) {
+                                     int last_still, int has_rev, float dist2, const EyeMis* em,
+                                     u32 max_depth, EyeWeight* ew) {
   const float w = ch->delta ? 1.0f : power_heuristic(ch->pdf_light, ch->pdf_bsdf);
-  pt_weight_parts(p, w, max_depth, ew);
+  pt_weight_parts(p, w, max_depth, last_still, ew);
   if (PR_EYE_PATHS && joinable)
     return ep_next_event_share(s, p, h, f, ch, has_rev, dist2, em, w, ew);
   return w;
@@ -58,12 +61,13 @@ PR_INLINE float4 pt_rgb(float3 c) {
 
 // The weight of the environment found along d (escaped), pdf_light next-event estimation's
 // density of d: against next-event estimation, and where the connections can make the path
-// (joinable), times their share; its parts into *ew.
+// (joinable; L only where the escaping ray is still too), times their share; its parts into *ew.
 PR_INLINE float pt_escape_weight(const SceneData* s, const PathState* p, float3 d, float pdf_light,
-                                 int joinable, const EyeMis* em, u32 max_depth, EyeWeight* ew) {
+                                 int joinable, int last_still, const EyeMis* em, u32 max_depth,
+                                 EyeWeight* ew) {
   const int spec = (p->flags & PR_PATH_SPECULAR) != 0u;
   float w = spec ? 1.0f : power_heuristic(p->last_pdf, pdf_light);
-  pt_weight_parts(p, w, max_depth, ew);
+  pt_weight_parts(p, w, max_depth, last_still, ew);
   if (PR_EYE_PATHS && joinable) w = ep_escape_share(s, p, d, em, w, ew);
   return w;
 }
@@ -83,8 +87,9 @@ PR_INLINE void pt_escape(const SceneData* s, const PathState* p, uint rel, const
   const float pdf_light =
       (p->flags & PR_PATH_SPECULAR) && !rel ? 0.0f : environment_pdf(s, prev, prev_n, d);
   EyeWeight ew;
-  const int joinable = pt_joinable(p, 1u) && ep_ray_still(s, prev, d, PR_INF_F);
-  const float w = pt_escape_weight(s, p, d, pdf_light, joinable, em, max_depth, &ew);
+  const int joinable = pt_joinable(p, 1u);
+  const int still = joinable && ep_ray_still(s, prev, d, PR_INF_F);
+  const float w = pt_escape_weight(s, p, d, pdf_light, joinable, still, em, max_depth, &ew);
   if (PR_RESAMPLE && rel == 1u &&
       di_offer_hit(s, p, track, s->lights.env_light, 0.0f, 0.0f, d, le, 1.0f, w, di, key))
     return;
@@ -220,15 +225,15 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
                  solid_angle_to_area_pdf(p.last_pdf, fabs(dot(h.ng, d)), dist2));
 
   // Under a shutter, whether the segment just traced meets nothing that moves (shade_eye_paths.h):
-  // asked only of x_1 x_2 and of the segments of paths the connections can still make.
+  // asked only of the segments from x_2 on of paths that L can still make.
   const float3 prev = make_float3(p.prev_x, p.prev_y, p.prev_z);
-  const int seg_asked =
-      p.x1_depth > 0u && (p.depth == p.x1_depth || (p.eye_flags & PR_EYE_JOINABLE) != 0u);
+  const int seg_asked = p.x1_depth > 0u && p.depth > p.x1_depth &&
+                        (p.eye_flags & (PR_EYE_JOINABLE | PR_EYE_MOVED)) == PR_EYE_JOINABLE;
   const int seg_still = !seg_asked || ep_ray_still(&s, prev, h.p - prev, 1.0f);
   if (s.sd.materials[h.material].flags & PR_MAT_EMISSIVE) {
     EyeWeight ew;
     // Connections can make the paths that end after x_t, t >= 2 (x_t: the vertex `ray` left).
-    const float w = pt_emission_weight(&s, &p, &h, d, dist2, pt_joinable(&p, 1u) && seg_still, &em,
+    const float w = pt_emission_weight(&s, &p, &h, d, dist2, pt_joinable(&p, 1u), seg_still, &em,
                                        max_depth, &ew);
     pt_emission(&s, &p, &h, rel, d, dist2, w, &ew, tp, track, rs_res + i, di_res + i, &key,
                 radiance + i);
@@ -251,9 +256,9 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
       const int here_joinable = pt_joinable(&p, 1u);
       if (next_event(&s, &h, &f, wo, !here_joinable, &rng, &shadow, &c, &ch)) {
         EyeWeight ew;
-        const int joins = here_joinable && ep_next_event_still(&s, &h, &ch);
-        const float w =
-            pt_next_event_weight(&s, &p, &h, &f, &ch, joins, has_rev, dist2, &em, max_depth, &ew);
+        const int still = here_joinable && ep_next_event_still(&s, &h, &ch);
+        const float w = pt_next_event_weight(&s, &p, &h, &f, &ch, here_joinable, still, has_rev,
+                                             dist2, &em, max_depth, &ew);
         if (here_joinable) c = c * w;  // next_event left the weight to this
         const uint op = PR_RESAMPLE
                             ? rs_next_event_pending(&s, track, rs_pending + k, di_pending + k, &rsp,

@@ -45,7 +45,7 @@ PR_INLINE float pt_light_density(const ShadingFrame* f, const PathState* p, floa
 PR_INLINE float pt_eye_share(const PathState* p, float w, float dens_n, float dens_h, float dens_l,
                              EyeWeight* ew) {
   ew->t = p->x1_depth == 1u && ew->t_len ? p->lt : 0.0f;
-  if (dens_l > 0.0f) w *= eye_paths_eye_share(dens_n / dens_l, dens_h / dens_l, ew->t);
+  if (dens_l > 0.0f) w *= eye_paths_eye_share_l(dens_n / dens_l, dens_h / dens_l, ew->t, ew->l_ok);
   ew->n = dens_n;
   ew->h = dens_h;
   ew->l = dens_l;
@@ -53,9 +53,10 @@ PR_INLINE float pt_eye_share(const PathState* p, float w, float dens_n, float de
 }
 
 // Under a shutter (--mode reuse): whether the ray o + t d, 0 <= t <= tmax, of the eye path meets
-// nothing that moves while the shutter is open. Where one of the segments a light path would hold
-// does, the connections (traced at the frame's time) cannot make the path at this sample's time:
-// L and T take no share of it (sweep_clear). 1 without a shutter or eye paths.
+// nothing that moves while the shutter is open. Where one of the segments that L's light path
+// would hold does, L (whose paths are the frame's) cannot make the path at this sample's time and
+// takes no share of it (sweep_clear); T can (light_trace traces such paths at a time of their
+// own). 1 without a shutter or eye paths.
 PR_INLINE int ep_ray_still(const SceneData* s, float3 o, float3 d, float tmax) {
   return !PR_EYE_PATHS || s->lights.sweep_count == 0u || sweep_clear(s, o, d, tmax);
 }
@@ -68,6 +69,12 @@ PR_INLINE int ep_next_event_still(const SceneData* s, const SurfaceHit* h,
   if (light_at_infinity(s->lights.lights[ch->light].type))
     return sweep_clear(s, h->p, ch->wi, PR_INF_F);
   return sweep_clear(s, h->p, ch->pos - h->p, 1.0f);
+}
+
+// Whether L can make the paths that end after this path's last vertex along a last segment that
+// is still (last_still): none of the segments from x_2 on meets what moves.
+PR_INLINE int ep_l_ok(const PathState* p, int last_still) {
+  return last_still && !(p->eye_flags & PR_EYE_MOVED);
 }
 
 // Whether the connections can make the paths that end after this path's last vertex x_t: x_2 is
@@ -122,7 +129,7 @@ PR_INLINE float ep_next_event_share(const SceneData* s, const PathState* p, cons
   // beyond x_2 as fixed there.
   if (p->x1_depth == 1u && ew->t_len)
     ew->t = p->depth == 2u ? eye_paths_camera_ratio(p->lt, ch->pdf_bsdf_rev, dist2) : p->lt;
-  if (dens_l > 0.0f) w *= eye_paths_eye_share(dens_n / dens_l, dens_h / dens_l, ew->t);
+  if (dens_l > 0.0f) w *= eye_paths_eye_share_l(dens_n / dens_l, dens_h / dens_l, ew->t, ew->l_ok);
   ew->n = dens_n;
   ew->h = dens_h;
   ew->l = dens_l;
@@ -148,16 +155,14 @@ PR_INLINE float ep_escape_share(const SceneData* s, const PathState* p, float3 d
 }
 
 // The eye path's density of this vertex x_t (t >= 2; 1 when sampled from a delta vertex) into
-// its running ratio, and whether x_2 is joinable. Under a shutter a segment that meets what moves
-// (seg_still 0) ends T's share where it is x_1 x_2, and L's and T's from x_3 on.
+// its running ratio, and whether x_2 is joinable. Under a shutter a segment from x_2 on that
+// meets what moves (seg_still 0) ends L's share (ep_l_ok).
 PR_INLINE void pt_eye_arrive(PathState* p, const SurfaceHit* h, float3 d, float dist2,
                              int delta_here, int seg_still) {
-  if (p->depth == p->x1_depth + 1u) {
+  if (p->depth == p->x1_depth + 1u)
     p->eye_flags = delta_here ? 0u : PR_EYE_JOINABLE;
-    if (!seg_still) p->lt = 0.0f;
-  } else if (!seg_still) {
-    p->eye_flags &= ~PR_EYE_JOINABLE;
-  }
+  else if (!seg_still)
+    p->eye_flags |= PR_EYE_MOVED;
   p->eye_ratio = mis_ratio_arrive(p->eye_ratio,
                                   solid_angle_to_area_pdf(p->last_pdf, fabs(dot(h->ng, d)), dist2),
                                   (p->flags & PR_PATH_SPECULAR) != 0u);

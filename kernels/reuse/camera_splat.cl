@@ -14,11 +14,12 @@
 
 // z_k's splat (light point y, arrival record vk), seen from the camera along `dir` (unit, camera
 // to z_k), the path before it z_{k-1} (light point yp, whose ratios are r_prev): its value at the
-// pixel times T's share of the path; 0 where the camera cannot see it so or T takes no share.
+// pixel times T's share of the path (against L too where l_ok: z_0 .. z_{k-1} is the same at every
+// time of the shutter interval); 0 where the camera cannot see it so or T takes no share.
 PR_INLINE float3 camera_splat_value(const SceneData* s, const ReuseParams* rp,
                                     const CameraParams* cam, const LightPoint* y,
                                     const LightPoint* yp, PR_GLOBAL const LightVertex* vk,
-                                    EyePathRatio r_prev, uint k, float3 dir) {
+                                    EyePathRatio r_prev, uint k, float3 dir, int l_ok) {
   const float3 zero = make_float3(0.0f, 0.0f, 0.0f);
   float3 f;
   float pdf_cam, pdf_x, cos_y, corr;
@@ -36,7 +37,7 @@ PR_INLINE float3 camera_splat_value(const SceneData* s, const ReuseParams* rp,
   float n, h;
   eye_path_ratios(r_prev, k - 1u, pdf_x, fabs(dot(yp->h.ng, w)), dz2, pdf_rev,
                   rp->eye_count / (float)rp->paths_per_pixel, &n, &h);
-  const float share = eye_paths_camera_share(t, n, h);
+  const float share = eye_paths_camera_share_l(t, n, h, l_ok);
   if (!(share > 0.0f)) return zero;
   // The pixel's importance W H / (A cos^3 d^2) (camera.h) over the N_L paths.
   const float importance =
@@ -57,21 +58,20 @@ PR_KERNEL void camera_splat(PR_PARAMS(PR_ARGS_CAMERA_SPLAT)) {
   if (!eye_paths_light(&l)) return;
   __global const LightVertex* v = vertices + (size_t)slot * rp.stride;
   __global const EyePathRatio* r = ratios + (size_t)slot * rp.stride;
-  // Under a shutter the path meets the camera at a time of its own, uniform over the interval as
-  // the eye paths' are, and only as far as it holds at every time (light_segment_still).
+  // Under a shutter the path meets the camera at the slot's time, uniform over the interval as the
+  // eye paths' are: the path is what tracing gives then, whether it is the same at every time or
+  // light_trace traced it at that time (PR_PATH_TIMED).
   CameraParams cam_t = cam;
   if (cam_step_count > 1u) {  // the shutter is open (a scene without instances moves no mesh)
-    Rng tr = rng_make(rp.seed, PR_RNG_SPLAT, rp.frame, slot, 0u);
-    s.geom.time = s.sd.time = rng_next(&tr);
+    s.geom.time = s.sd.time = light_path_time(&rp, slot);
     cam_t = camera_at_time(cam_steps, cam_step_count, s.geom.time);
   }
-  const int sweeps = s.lights.sweep_count > 0u;
-  if (sweeps && !light_segment_still(&s, l.type, v, 1u)) return;
   const float3 c = camera_position(&cam_t);
   uint rays = 0u;
   LightPoint yp = light_point(&s, v + 1);
+  int l_ok = 1;  // L's light path z_0 .. z_{k-1} is the same at every time (light_segment_still)
   for (uint k = 2u; k < hd.vertex_count && eye_paths_camera_len(k, rp.max_depth); ++k) {
-    if (sweeps && !light_segment_still(&s, l.type, v, k)) break;
+    if (l_ok && s.lights.sweep_count > 0u) l_ok = light_segment_still(&s, l.type, v, k - 1u);
     const LightPoint y = light_point(&s, v + k);
     const int skip = y.delta || yp.delta;
     const uint px = skip ? PR_INVALID_INDEX : camera_pixel(&cam_t, y.h.p);
@@ -80,7 +80,7 @@ PR_KERNEL void camera_splat(PR_PARAMS(PR_ARGS_CAMERA_SPLAT)) {
       const float d2 = dot(dc, dc);
       const float3 dir = dc * (1.0f / sqrt(d2));
       const float3 val =
-          camera_splat_value(&s, &rp, &cam_t, &y, &yp, v + k, r[k - 1u], k, dir) * film_scale;
+          camera_splat_value(&s, &rp, &cam_t, &y, &yp, v + k, r[k - 1u], k, dir, l_ok) * film_scale;
       if (max3(val) > 0.0f) {
         ++rays;
         // Towards the camera as far as its near plane: nothing nearer is seen.

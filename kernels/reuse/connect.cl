@@ -269,10 +269,9 @@ PR_INLINE float3 light_vertex_value(const Connector* cn, const EyePoint* x, cons
       solid_angle_to_area_pdf(pdf_arrive, fabs(dot(y->f.ng, vertex_dir(vk))), vk->t * vk->t);
   const float p_e =
       pdf_arrive > 0.0f ? solid_angle_to_area_pdf(pdf_x, fabs(dot(y->f.ng, dir)), dist2) : 0.0f;
-  // T's density over L's: the path has k + 1 vertices before the light. Under a shutter T's light
-  // path holds the segment x y too, which must then meet nothing that moves (sweep_clear).
-  const float t = eye_paths_camera_len(k + 1u, cn->rp->max_depth) &&
-                          (cn->s->lights.sweep_count == 0u || sweep_clear(cn->s, x->h.p, dxy, 1.0f))
+  // T's density over L's: the path has k + 1 vertices before the light (under a shutter too:
+  // light_trace traces a path that meets what moves at its own time, camera_splat's).
+  const float t = eye_paths_camera_len(k + 1u, cn->rp->max_depth)
                       ? eye_paths_camera_ratio(cn->cam_x, pdf_leave, dist2)
                       : 0.0f;
   const float mis = PR_EYE_PATHS

@@ -1,12 +1,13 @@
 // invalidate: one work-item per slot. A stored path stays valid only if tracing it again now
 // would give the same vertices (docs/design.md section 5): it is invalid when (c) its light moved,
-// (b) a vertex lies on a DSG instance that moved, or (a) a segment, or the final escaping ray,
-// now meets DSG geometry before its stored end. Only the DSG is tested. Reads the headers, the
-// vertices, the instances' moved flags and the light table; clears `valid` of invalid slots,
-// appends them to `list` (its order varies, the set does not), and counts the light vertices
-// of the paths that stay valid. Where frame_stamp > 0 (the connection history), it stamps each
-// invalid slot in `changed` with it; with `mark_only` (--mode retrace, which traces every slot
-// anyway) it does that alone, so that both modes learn the same changed slots.
+// (b) a vertex lies on a DSG instance that moved, (a) a segment, or the final escaping ray, now
+// meets DSG geometry before its stored end, or (d) under a shutter, it meets what moves. Only the
+// DSG is tested. Reads the headers, the vertices, the instances' moved flags and the light table;
+// clears `valid` of invalid slots, appends them to `list` (its order varies, the set does not), and
+// counts the light vertices of the paths that stay valid. Where frame_stamp > 0 (the connection
+// history), it stamps each invalid slot in `changed` with it; with `mark_only` (--mode retrace,
+// which traces every slot anyway) it does that alone, so that both modes learn the same changed
+// slots.
 #include "shared/reuse.h"
 
 PR_KERNEL void invalidate(PR_PARAMS(PR_ARGS_INVALIDATE)) {
@@ -15,7 +16,8 @@ PR_KERNEL void invalidate(PR_PARAMS(PR_ARGS_INVALIDATE)) {
   const SceneData s = PR_SCENE();
   const PathHeader h = headers[slot];
   __global const LightVertex* v = vertices + (size_t)slot * rp.stride;
-  int ok = h.valid != 0u;
+  // A path traced at the previous frame's own time (PR_PATH_TIMED) is that frame's alone.
+  int ok = h.valid == 1u;
   uint rays = 0u;
   if (ok && h.light != PR_INVALID_INDEX && s.lights.lights[h.light].moved) ok = 0;  // (c)
   for (uint k = 1u; ok && k < h.vertex_count; ++k) {                                // (b)
@@ -44,6 +46,9 @@ PR_KERNEL void invalidate(PR_PARAMS(PR_ARGS_INVALIDATE)) {
       if (occluded_dynamic(&s.geom, r)) ok = 0;
     }
   }
+  // (d) Under a shutter, a path that meets what moves while it is open is traced at the slot's
+  // time (light_trace).
+  if (ok && !light_path_still(&s, &h, v)) ok = 0;
   if (rays) atomic_add(counter_lane(counters, PR_C_ROW) + PR_C_INVALID_RAYS, rays);
   if (!ok && frame_stamp > 0u) changed[slot] = frame_stamp;
   if (mark_only) return;

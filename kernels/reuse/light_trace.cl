@@ -111,78 +111,68 @@ PR_INLINE void light_walk_leave(EyePathWalk* walk, uint k, const ShadingFrame* f
   eye_path_walk_leave(walk, k, delta, pdf_fwd, pdf_rev);
 }
 
-PR_KERNEL void light_trace(PR_PARAMS(PR_ARGS_LIGHT_TRACE)) {
-  const uint i = (uint)get_global_id(0);
-  if (i >= list_count) return;
-  const uint slot = list[i];
-  const SceneData s = PR_SCENE();
-  PathHeader h = light_header_empty(headers[slot].generation);
-  __global LightVertex* out = vertices + (size_t)slot * rp.stride;
-  Rng rng = rng_make(rp.seed, PR_RNG_LIGHT, 0u, slot, h.generation);
+// Traces the light sub-path of `slot` (header *h, its generation set) in s's scene, at s's time,
+// from the light as it is then (`timed`: blended to that time, light_at_time), into out and
+// ratio_out; adds its rays and its SSG and DSG vertices to n[0..2].
+PR_INLINE void light_trace_path(const SceneData* s, const ReuseParams* rp,
+                                PR_GLOBAL const float* trace_cdf, uint slot, int timed,
+                                PathHeader* h, PR_GLOBAL LightVertex* out,
+                                PR_GLOBAL EyePathRatio* ratio_out, uint* n) {
+  Rng rng = rng_make(rp->seed, PR_RNG_LIGHT, 0u, slot, h->generation);
   const float us = rng_next(&rng);
   const float2 u12 = rng_next2(&rng);
   const float u3 = rng_next(&rng);
   const float2 u45 = rng_next2(&rng);
   const float u1 = u12.x, u2 = u12.y, u4 = u45.x, u5 = u45.y;
-  uint rays = 0u, ssg = 0u, dsg = 0u;
-  if (s.lights.count == 0u || !(rp.trace_total > 0.0f)) {
-    headers[slot] = h;
-    return;
-  }
-  const uint li = light_select(trace_cdf, s.lights.count, us);
-  const float pmf = (trace_cdf[li] - (li > 0u ? trace_cdf[li - 1u] : 0.0f)) / rp.trace_total;
-  const Light L = s.lights.lights[li];
-  h.light = li;
+  if (s->lights.count == 0u || !(rp->trace_total > 0.0f)) return;
+  const uint li = light_select(trace_cdf, s->lights.count, us);
+  const float pmf = (trace_cdf[li] - (li > 0u ? trace_cdf[li - 1u] : 0.0f)) / rp->trace_total;
+  Light L = s->lights.lights[li];
+  if (timed) light_at_time(s, li, &L);
+  h->light = li;
 
   // Vertex 0 on the light, and the first direction (shared/lights.h).
-  const LightEmission em = light_emit(&s, &L, &rp, pmf, u1, u2, u3, u4, u5);
+  const LightEmission em = light_emit(s, &L, rp, pmf, u1, u2, u3, u4, u5);
   float3 tp = em.tp, dir = em.dir;
-  if (!(pmf > 0.0f) || !(max3(tp) > 0.0f) || !(max3(tp) < PR_INF_F)) {
-    headers[slot] = h;
-    return;
-  }
+  if (!(pmf > 0.0f) || !(max3(tp) > 0.0f) || !(max3(tp) < PR_INF_F)) return;
   const uint n0_oct = oct_encode(em.n);
   LightVertex v = light_vertex(em.p, 0.0f, make_float3(0.0f, 0.0f, 0.0f), n0_oct, n0_oct, em.tp0,
                                em.prim, em.inst, em.b1, em.b2);
   out[0] = v;
   uint count = 1u;
   Ray ray = make_ray(
-      light_segment_origin(&s.sd, em.p, v.ng_oct, v.ns_oct, em.prim, em.inst, em.b1, em.b2, dir),
+      light_segment_origin(&s->sd, em.p, v.ng_oct, v.ns_oct, em.prim, em.inst, em.b1, em.b2, dir),
       dir, 0.0f, PR_INF_F);
   // With eye paths, the light side of L's weight at each vertex (shared/eye_paths.h).
-  const int walk_on = rp.eye_paths && eye_paths_light(&L);
+  const int walk_on = rp->eye_paths && eye_paths_light(&L);
   EyePathWalk walk;
   if (walk_on)
     walk = eye_path_walk_start(
         &L, li,
-        light_is_triangle(L.type) ? eye_paths_light_normal(&s, &L) : make_float3(0.0f, 0.0f, 1.0f),
-        trace_cdf, rp.trace_total, eye_paths_direction_density(&L, s.lights.env, -em.dir));
-  __global EyePathRatio* ratio_out = ratios + (size_t)slot * rp.stride;
+        light_is_triangle(L.type) ? eye_paths_light_normal(s, &L) : make_float3(0.0f, 0.0f, 1.0f),
+        trace_cdf, rp->trace_total, eye_paths_direction_density(&L, s->lights.env, -em.dir));
   const float tp0 = max3(tp);  // Russian roulette weighs the throughput against this
 
-  for (uint k = 1u; k < rp.stride; ++k) {
+  for (uint k = 1u; k < rp->stride; ++k) {
     Hit hit;
-    ++rays;
-    if (!trace_closest(&s, ray, &hit)) {
-      h.end = PR_END_ESCAPED;
-      h.escape_x = dir.x;
-      h.escape_y = dir.y;
-      h.escape_z = dir.z;
+    ++n[0];
+    if (!trace_closest(s, ray, &hit)) {
+      h->end = PR_END_ESCAPED;
+      h->escape_x = dir.x;
+      h->escape_y = dir.y;
+      h->escape_z = dir.z;
       break;
     }
-    const SurfaceHit sh = surface_at(&s.sd, hit.prim, hit.inst, hit.u, hit.v);
-    tp = tp * volume_transmittance(&s, &sh, dir, hit.t);
+    const SurfaceHit sh = surface_at(&s->sd, hit.prim, hit.inst, hit.u, hit.v);
+    tp = tp * volume_transmittance(s, &sh, dir, hit.t);
     v = light_vertex(sh.p, hit.t, dir, oct_encode(sh.ng), oct_encode(sh.ns), tp, hit.prim, hit.inst,
                      hit.u, hit.v);
     out[k] = v;
     if (walk_on) ratio_out[k] = eye_path_walk_arrive(&walk, k, dir, hit.t, oct_decode(v.ng_oct));
     count = k + 1u;
-    if (hit.inst == PR_INVALID_INDEX)
-      ++ssg;
-    else
-      ++dsg;
-    if (k + 1u >= rp.stride) {
-      h.end = PR_END_MAX_DEPTH;
+    ++n[hit.inst == PR_INVALID_INDEX ? 1 : 2];
+    if (k + 1u >= rp->stride) {
+      h->end = PR_END_MAX_DEPTH;
       break;
     }
     // Scatter, in the frame of the stored (decoded) normals.
@@ -193,9 +183,9 @@ PR_KERNEL void light_trace(PR_PARAMS(PR_ARGS_LIGHT_TRACE)) {
     q.ng = oct_decode(v.ng_oct);
     q.ns = oct_decode(v.ns_oct);
     const float3 wo = -dir;
-    const ShadingFrame f = shading_frame(&s, &q, wo);
+    const ShadingFrame f = shading_frame(s, &q, wo);
     PathStep step;
-    if (!path_step(&s, &q, &f, wo, u0, v1, v2, PR_IMPORTANCE, &step)) break;
+    if (!path_step(s, &q, &f, wo, u0, v1, v2, PR_IMPORTANCE, &step)) break;
     if (walk_on) light_walk_leave(&walk, k, &f, wo, step.wi);
     float3 w = step.weight * shading_normal_correction(wo, step.wi, f.n, f.ng);
     // On the throughput relative to what left the light, from the third vertex on.
@@ -203,13 +193,37 @@ PR_KERNEL void light_trace(PR_PARAMS(PR_ARGS_LIGHT_TRACE)) {
     tp = tp * w;
     if (!(max3(tp) > 0.0f) || !(max3(tp) < PR_INF_F)) break;
     dir = step.wi;
-    ray = make_ray(light_segment_origin(&s.sd, sh.p, v.ng_oct, v.ns_oct, hit.prim, hit.inst, hit.u,
+    ray = make_ray(light_segment_origin(&s->sd, sh.p, v.ng_oct, v.ns_oct, hit.prim, hit.inst, hit.u,
                                         hit.v, dir),
                    dir, 0.0f, PR_INF_F);
   }
-  h.vertex_count = count;
+  h->vertex_count = count;
+}
+
+PR_KERNEL void light_trace(PR_PARAMS(PR_ARGS_LIGHT_TRACE)) {
+  const uint i = (uint)get_global_id(0);
+  if (i >= list_count) return;
+  const uint slot = list[i];
+  const SceneData s = PR_SCENE();
+  const uint generation = headers[slot].generation;
+  __global LightVertex* out = vertices + (size_t)slot * rp.stride;
+  __global EyePathRatio* ratio_out = ratios + (size_t)slot * rp.stride;
+  PathHeader h = light_header_empty(generation);
+  uint n[3] = {0u, 0u, 0u};  // rays, SSG and DSG vertices
+  light_trace_path(&s, &rp, trace_cdf, slot, 0, &h, out, ratio_out, n);
+  // Under a shutter a path that meets what moves is traced again, with the same numbers, at the
+  // slot's time: so every stored path is what tracing gives at that time, which strategy T needs
+  // (camera_splat); L keeps to the part of it that is the same at every time (connect).
+  if (s.lights.sweep_count > 0u && !light_path_still(&s, &h, out)) {
+    SceneData st = s;
+    st.geom.time = st.sd.time = light_path_time(&rp, slot);
+    n[1] = n[2] = 0u;
+    h = light_header_empty(generation);
+    light_trace_path(&st, &rp, trace_cdf, slot, 1, &h, out, ratio_out, n);
+    h.valid = PR_PATH_TIMED;
+  }
   headers[slot] = h;
-  atomic_add(counter_lane(counters, PR_C_ROW) + PR_C_LIGHT_RAYS, rays);
-  if (ssg) atomic_add(counter_lane(counters, PR_C_ROW) + PR_C_SSG_VERTICES, ssg);
-  if (dsg) atomic_add(counter_lane(counters, PR_C_ROW) + PR_C_DSG_VERTICES, dsg);
+  if (n[0]) atomic_add(counter_lane(counters, PR_C_ROW) + PR_C_LIGHT_RAYS, n[0]);
+  if (n[1]) atomic_add(counter_lane(counters, PR_C_ROW) + PR_C_SSG_VERTICES, n[1]);
+  if (n[2]) atomic_add(counter_lane(counters, PR_C_ROW) + PR_C_DSG_VERTICES, n[2]);
 }

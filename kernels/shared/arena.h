@@ -12,6 +12,9 @@ PR_NAMESPACE_BEGIN
 #define PR_END_ABSORBED 0u  // Russian roulette or a BSDF that gave no direction
 #define PR_END_ESCAPED 1u   // the last ray left the scene (escape_* holds its direction)
 #define PR_END_MAX_DEPTH 2u
+// PathHeader.valid of a path that meets what moves while the shutter is open, traced at its own
+// time in the interval (light_path_time): this frame's alone.
+#define PR_PATH_TIMED 2u
 
 // 32 bytes.
 typedef struct {
@@ -19,7 +22,7 @@ typedef struct {
   u32 generation;    // RNG key part: re-tracing with the same generation reproduces the path
   u32 vertex_count;  // stored vertices, vertex 0 (on the light) included; 0 = none
   u32 end;           // PR_END_*
-  u32 valid;         // 1: the stored path is what tracing would give now
+  u32 valid;         // 1: the stored path is what tracing would give now; PR_PATH_TIMED
   float escape_x, escape_y, escape_z;  // direction of the escaping last ray (PR_END_ESCAPED)
 } PathHeader;
 

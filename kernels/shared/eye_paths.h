@@ -213,4 +213,18 @@ PR_INLINE float eye_paths_eye_share(float n, float h, float t) {
   return (1.0f - mis_power_share(n, h)) * eye_paths_camera_rest(t, n, h);
 }
 
+// T's share of a path that L cannot make (under a shutter, a segment of L's light path meets what
+// moves), against the eye path's N and H alone; l_ok 1: eye_paths_camera_share.
+PR_INLINE float eye_paths_camera_share_l(float t, float n, float h, int l_ok) {
+  if (l_ok) return eye_paths_camera_share(t, n, h);
+  if (!(t > 0.0f)) return 0.0f;
+  return mis_power_share(n / t, h / t);
+}
+
+// The eye path's share of a path that L makes too where l_ok, else of one that T alone makes too.
+PR_INLINE float eye_paths_eye_share_l(float n, float h, float t, int l_ok) {
+  if (l_ok) return eye_paths_eye_share(n, h, t);
+  return 1.0f - eye_paths_camera_share_l(t, n, h, 0);
+}
+
 PR_NAMESPACE_END

@@ -45,6 +45,8 @@ typedef struct {
 
 #define PR_PATH_SPECULAR 1u  // the last bounce was delta (or the ray is the camera ray)
 #define PR_EYE_JOINABLE 1u   // x_2 is non-delta: stored light paths can make this path's ends
+// Under a shutter, a segment from x_2 on meets what moves: L cannot make the path (T still can).
+#define PR_EYE_MOVED 2u
 
 // A shadow ray with the contribution it carries if unoccluded: the path tracer's next-event
 // estimation (traced where the path is in the bounce's shadow queue) and connect's terms for
@@ -132,6 +134,9 @@ typedef struct {
 // A PR_RS_JOINED path short enough for strategy T (eye_paths_camera_len), which makes it where
 // its x_1 is seen straight from the camera.
 #define PR_RS_CAMERA 0x40u
+// A PR_RS_JOINED path that L cannot make (under a shutter, a segment from x_2 on meets what
+// moves): its f holds what T leaves of it (eye_paths_eye_share_l).
+#define PR_RS_NO_L 0x80u
 
 // Where a path's candidates stand as pt_shade follows it (one per pixel). 160 bytes.
 typedef struct {

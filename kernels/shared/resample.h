@@ -54,10 +54,12 @@ PR_INLINE float rs_weight2(u32 kind, float pdf_light, float pdf_bsdf) {
 // (L) make too: the path tracer's weight `pt` and, with l > 0, the densities of the path beyond
 // x_1 under next-event estimation (n), BSDF sampling (h) and L (l), in the ratios pt_shade
 // weighs with (shared/eye_paths.h). l = 0: L does not make the path. t: T's density over L's
-// (eye_paths_camera_ratio; 0: T does not make it); t_len: the path is short enough for T.
+// (eye_paths_camera_ratio; 0: T does not make it); t_len: the path is short enough for T;
+// l_ok: L makes it (under a shutter, none of its segments from x_2 on meets what moves), else
+// its densities still give T's share, against the eye path's alone.
 typedef struct {
   float pt, n, h, l, t;
-  int t_len;
+  int t_len, l_ok;
 } EyeWeight;
 
 // The eye path's share of a PR_RS_JOINED path, what L and T leave of it, at an x_1 whose density
@@ -69,7 +71,8 @@ typedef struct {
 PR_INLINE float rs_eye_share(u32 kind, float rn, float rh, float p2, float pdf2, float t) {
   if (!(kind & PR_RS_JOINED)) return 1.0f;
   const float u = p2 * pdf2;
-  return eye_paths_eye_share(rn * ((kind & PR_RS_LAST2) ? p2 : u), rh * u, t);
+  const float n = rn * ((kind & PR_RS_LAST2) ? p2 : u), h = rh * u;
+  return eye_paths_eye_share_l(n, h, t, !(kind & PR_RS_NO_L));
 }
 
 // A pixel sample's x_1, rebuilt from its EyeVertex; ok: rough enough to reconnect from; cam:
@@ -128,9 +131,8 @@ PR_INLINE float3 rs_shift(const SceneData* s, const RsPrimary* x, PR_GLOBAL cons
   const float3 w2l = to_local(w2, f2.t, f2.b, f2.n);
   // T's density over L's here, where T can make the path: the light tracer's of x_1 from x_2
   // (x_2's reverse pdf, evaluated only then) against the camera's.
-  // (Under a shutter T joins the path only where x_1 x_2 meets nothing that moves: ep_ray_still.)
-  const int camera = (r->kind & PR_RS_CAMERA) && x->cam > 0.0f &&
-                     (s->lights.sweep_count == 0u || sweep_clear(s, x->h.p, d, 1.0f));
+  // (Under a shutter too: light paths that meet what moves are traced at their own time.)
+  const int camera = (r->kind & PR_RS_CAMERA) && x->cam > 0.0f;
   const float3 wo2l = to_local(wo2, f2.t, f2.b, f2.n);
   pdf2_rev = 0.0f;
   const float3 fx2 = (camera ? bsdf_eval_both(&f2.bsdf, wo2l, w2l, &pdf2, &pdf2_rev)
@@ -196,12 +198,13 @@ PR_INLINE void rs_candidate(PathReservoir* c, PR_GLOBAL const PathTrack* t, floa
   float w = rs_weight2(kind, pdf_light, pdf_bsdf);
   c->rn = c->rh = 0.0f;
   if (ew->l > 0.0f) {
-    w *= eye_paths_eye_share(ew->n / ew->l, ew->h / ew->l, ew->t);
+    w *= eye_paths_eye_share_l(ew->n / ew->l, ew->h / ew->l, ew->t, ew->l_ok);
     const float pdf2 = last2 ? pdf_bsdf : t->pdf2;
     const float base = ew->l * t->p2;
     c->rn = ew->n / (last2 ? base : base * pdf2);
     c->rh = ew->h > 0.0f ? ew->h / (base * pdf2) : 0.0f;
-    kind |= PR_RS_JOINED | (last2 ? PR_RS_LAST2 : 0u) | (ew->t_len ? PR_RS_CAMERA : 0u);
+    kind |= PR_RS_JOINED | (last2 ? PR_RS_LAST2 : 0u) | (ew->t_len ? PR_RS_CAMERA : 0u) |
+            (ew->l_ok ? 0u : PR_RS_NO_L);
   }
   const float3 f = make_float3(t->f1_r, t->f1_g, t->f1_b) * f2 * rest * w;
   c->f_r = f.x;

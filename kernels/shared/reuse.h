@@ -155,6 +155,26 @@ PR_INLINE int light_prefix_still(const SceneData* s, u32 light, PR_GLOBAL const 
   return 1;
 }
 
+// Whether the whole stored path is the same at every time of the shutter interval: its segments
+// and its escaping ray meet nothing that moves (1 without a shutter).
+PR_INLINE int light_path_still(const SceneData* s, const PathHeader* h,
+                               PR_GLOBAL const LightVertex* v) {
+  if (s->lights.sweep_count == 0u || h->light == PR_INVALID_INDEX || h->vertex_count == 0u)
+    return 1;
+  const u32 last = h->vertex_count - 1u;
+  if (!light_prefix_still(s, h->light, v, last)) return 0;
+  return h->end != PR_END_ESCAPED ||
+         sweep_clear(s, vertex_pos(v + last), make_float3(h->escape_x, h->escape_y, h->escape_z),
+                     PR_INF_F);
+}
+
+// A slot's time in the shutter interval this frame, uniform as the eye paths' are: where strategy
+// T joins its path to the camera, and where light_trace traces a path that is not still.
+PR_INLINE float light_path_time(const ReuseParams* rp, uint slot) {
+  Rng tr = rng_make(rp->seed, PR_RNG_SPLAT, rp->frame, slot, 0u);
+  return rng_next(&tr);
+}
+
 // Veach's correction for shading normals on light paths (importance transport), for light that
 // came from direction wo and leaves along wi: |wo.ns| |wi.ng| / (|wo.ng| |wi.ns|).
 PR_INLINE float shading_normal_correction(float3 wo, float3 wi, float3 ns, float3 ng) {

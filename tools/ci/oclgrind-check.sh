@@ -114,6 +114,10 @@ run "cornell-skinned-pathtrace-shutter" scenes/cornell-skinned.gltf --frames 0-1
 run "lanterns-reuse-shutter" "$work/lanterns/atrium.gltf" --frames 0-1 --mode reuse \
   --light-sampler bvh --shutter 1
 run "cornell-orbit-reuse-shutter" scenes/cornell-orbit.gltf --frames 0-1 --mode reuse --shutter 0.5
+# Light paths that meet the moving sphere traced again at their own times, dropped the next frame;
+# reuse's resampling with them.
+run "cornell-dynamic-reuse-resample-shutter" scenes/cornell-dynamic.gltf --frames 0-2 --mode reuse \
+  --resample --shutter 0.5
 run "cornell-skinned-resample-shutter" scenes/cornell-skinned.gltf --frames 0-2 --mode pathtrace \
   --resample --resample-neighbors 2 --shutter 0.5
 run "lanterns-reuse-connections" "$work/lanterns/atrium.gltf" --frames 0-1 --mode reuse \
