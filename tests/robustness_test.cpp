@@ -169,7 +169,9 @@ TEST(Resume, FinishesARunBitForBitAsAnUninterruptedOne) {
 // options) is not used: the run starts afresh and says so.
 TEST(Resume, GoesOnFromTheResampledPathsOfTheLastFrame) {
   const std::string base = "render '" + kScene + "' --exr-float --width 64 --height 48 --resume";
-  for (const char* mode : {"--mode reuse", "--mode pathtrace --resample"}) {
+  // Under a shutter too, where a kept path may be one that L cannot make (PR_RS_NO_L).
+  for (const char* mode :
+       {"--mode reuse", "--mode pathtrace --resample", "--mode reuse --resample --shutter 0.5"}) {
     SCOPED_TRACE(mode);
     const std::string dir = test::tempDir("resume-rs");
     const std::string common = base + " --spp 2 " + mode;
