@@ -1,8 +1,9 @@
 // light_trace: one work-item per slot in the compacted list of invalid slots. Traces the slot's
-// light sub-path from scratch with the random numbers keyed by (seed, slot, generation), and
-// stores its vertices. Reads the scene, the light-tracing power table and the slot's
-// generation; writes the slot's PathHeader and LightVertex records (with --eye-paths, their
-// EyePathRatio records too) and adds to the counters.
+// light sub-path from scratch with the random numbers keyed by (seed, slot, generation) (under a
+// shutter, one that meets what moves again at the slot's own time), and stores its vertices.
+// Reads the scene, the light-tracing power table and the slot's generation; writes the slot's
+// PathHeader and LightVertex records (with --eye-paths, their EyePathRatio records too) and adds
+// to the counters.
 #include "shared/reuse.h"
 // After reuse.h: its FP_CONTRACT OFF (shared/bvh.h) holds for the ratios too (shared/mis.h keeps
 // them safe without it).
