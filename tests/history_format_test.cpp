@@ -119,12 +119,14 @@ TEST(HistoryFormat, EveryFloatOfAnArrayFieldIsChecked) {
 // Kinds and their flags as the kernels make them pass; other bits do not.
 TEST(HistoryFormat, KindsAreThoseTheKernelsMake) {
   for (uint32_t kind : {PR_RS_DEEP, PR_RS_NEE2, PR_RS_HIT2, PR_RS_HIT2 | PR_RS_JOINED | PR_RS_LAST2,
-                        PR_RS_DEEP | PR_RS_JOINED | PR_RS_CAMERA}) {
+                        PR_RS_DEEP | PR_RS_JOINED | PR_RS_CAMERA,
+                        PR_RS_DEEP | PR_RS_JOINED | PR_RS_CAMERA | PR_RS_NO_L}) {
     dev::PathHistory h = validRecord();
     h.r.kind = kind;
     EXPECT_TRUE(accepted(h)) << kind;
   }
-  for (uint32_t kind : {3u, 0x80u, PR_RS_NEE2 | 0x1000u}) {
+  // 0x80: PR_RS_NO_L on a path that is not PR_RS_JOINED.
+  for (uint32_t kind : {3u, 0x80u, 0x100u, PR_RS_NEE2 | 0x1000u}) {
     dev::PathHistory h = validRecord();
     h.r.kind = kind;
     EXPECT_FALSE(accepted(h)) << kind;

@@ -74,7 +74,8 @@ bool validKind(uint32_t kind) {
   const uint32_t base = kind & PR_RS_KIND_MASK;
   const uint32_t flags = PR_RS_JOINED | PR_RS_LAST2 | PR_RS_CAMERA | PR_RS_NO_L;
   return (base == PR_RS_DEEP || base == PR_RS_NEE2 || base == PR_RS_HIT2) &&
-         (kind & ~(PR_RS_KIND_MASK | flags)) == 0u;
+         (kind & ~(PR_RS_KIND_MASK | flags)) == 0u &&
+         ((kind & PR_RS_NO_L) == 0u || (kind & PR_RS_JOINED) != 0u);  // only on a joined path
 }
 
 // The checks of one field alone; the relational ones (Reservoir, Surface, Light, Bary) follow in
