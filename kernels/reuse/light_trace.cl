@@ -209,19 +209,20 @@ PR_KERNEL void light_trace(PR_PARAMS(PR_ARGS_LIGHT_TRACE)) {
   const uint generation = headers[slot].generation;
   __global LightVertex* out = vertices + (size_t)slot * rp.stride;
   __global EyePathRatio* ratio_out = ratios + (size_t)slot * rp.stride;
-  PathHeader h = light_header_empty(generation);
+  SceneData st = s;
+  PathHeader h;
   uint n[3] = {0u, 0u, 0u};  // rays, SSG and DSG vertices
-  light_trace_path(&s, &rp, trace_cdf, slot, 0, &h, out, ratio_out, n);
   // Under a shutter a path that meets what moves is traced again, with the same numbers, at the
   // slot's time: so every stored path is what tracing gives at that time, which strategy T needs
-  // (camera_splat); L keeps to the part of it that is the same at every time (connect).
-  if (s.lights.sweep_count > 0u && !light_path_still(&s, &h, out)) {
-    SceneData st = s;
-    st.geom.time = st.sd.time = light_path_time(&rp, slot);
-    n[1] = n[2] = 0u;
+  // (camera_splat); L keeps to the part of it that is the same at every time (connect). One loop,
+  // not two calls: the tracing code is compiled once.
+  for (int timed = 0;; timed = 1) {
     h = light_header_empty(generation);
-    light_trace_path(&st, &rp, trace_cdf, slot, 1, &h, out, ratio_out, n);
-    h.valid = PR_PATH_TIMED;
+    n[1] = n[2] = 0u;
+    light_trace_path(&st, &rp, trace_cdf, slot, timed, &h, out, ratio_out, n);
+    if (timed) h.valid = PR_PATH_TIMED;
+    if (timed || s.lights.sweep_count == 0u || light_path_still(&s, &h, out)) break;
+    st.geom.time = st.sd.time = light_path_time(&rp, slot);
   }
   headers[slot] = h;
   if (n[0]) atomic_add(counter_lane(counters, PR_C_ROW) + PR_C_LIGHT_RAYS, n[0]);
