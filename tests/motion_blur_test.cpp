@@ -262,6 +262,27 @@ TEST(MotionBlur, LightTracingJoinsMovingPathsAtTheirOwnTime) {
   expectBlurIsTheMeanOfInstants(Moving::Bounce, "mb-reuse-bounce", "reuse");
 }
 
+// Strategy L under a still camera (connect's at_own): an x_1 whose segment from the camera meets
+// nothing that moves is joined to a light path that does at the path's own time. Every path of
+// the blinds scene's spot passes the slab's sweep, so L joins them only so; with the shutter open
+// it finds about as many connections as in the sharp frame (where the slab is aside). Its
+// weights are PathReuseGivesTheMeanOfItsInstants/Blinds'.
+TEST(MotionBlur, AStillCameraJoinsLightPathsThatMeetWhatMoves) {
+  auto candidates = [&](const std::string& shutter, const std::string& tag) {
+    const std::string dir = test::tempDir(tag + "-out");
+    const test::CommandResult r =
+        test::runPathreuse("render " + blindsScene(tag) + " " + kArgs +
+                           " --mode reuse --spp 4 --fps 1 --frames 1" + " --shutter " + shutter +
+                           " --quiet --out " + dir + "/f_%04d.exr --stats " + dir + "/stats.jsonl");
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    const nlohmann::json line = nlohmann::json::parse(test::statsLines(dir).at(0));
+    return line["counters"]["connection_candidates"].get<double>();
+  };
+  const double sharp = candidates("0", "mb-l-sharp");
+  EXPECT_GT(sharp, 100.0);
+  EXPECT_GT(candidates("0.5", "mb-l-blur"), 0.5 * sharp);
+}
+
 // The auxiliary images under a shutter: albedo blurred as the colour is (the mean of the instants'
 // albedo, block by block), Z and object ids of the frame's own time (the sharp frame's).
 TEST(MotionBlur, AlbedoIsBlurredAndZIsTheFramesOwn) {

@@ -363,6 +363,7 @@ void GpuScene::setTime(double t) {
   const std::vector<glm::mat4> was = lastTransforms_;
   std::vector<bool> reshapedInstance(n);
   std::vector<std::vector<glm::mat4>> motion;
+  cameraMoves_ = false;
   if (!times.empty()) placeOverShutter(times, &motion);
   motionSteps_ = times.empty() ? 1u : uint32_t(times.size());
   for (size_t i = 0; i < n; ++i) {
@@ -862,6 +863,9 @@ void GpuScene::placeOverShutter(const std::vector<double>& times,
   }
   std::vector<dev::CameraParams> cams;
   for (double at : times) cams.push_back(camera(shutterCamera_, at, shutterWidth_, shutterHeight_));
+  cameraMoves_ = false;
+  for (const dev::CameraParams& c : cams)
+    cameraMoves_ = cameraMoves_ || std::memcmp(&c, &cams.front(), sizeof c) != 0;
   const uint64_t bytes = cams.size() * sizeof(dev::CameraParams);
   if (bytes > cameraStepBytes_) {
     if (cameraStepBytes_) ctx_.release("camera motion steps", cameraStepBytes_);
@@ -904,6 +908,7 @@ kargs::SceneArgs GpuScene::kernelArgs() {
   a.pr_l_motion_steps = lightMotionSteps_;
   a.pr_l_sweeps = sweeps_;
   a.pr_l_sweep_count = sweepCount_;
+  a.pr_l_camera_moves = cameraMoves_ ? 1u : 0u;
   return a;
 }
 

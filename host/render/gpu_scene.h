@@ -234,7 +234,8 @@ class GpuScene {
   std::vector<std::vector<std::vector<glm::vec3>>> stepPositions_;
   uint64_t sweepBytes_ = 0;
   uint32_t sweepCount_ = 0;
-  cl::Buffer prevSweeps_;  // the previous setTime's sweeps_, swapped with it
+  bool cameraMoves_ = false;  // at the motion steps of the shutter interval
+  cl::Buffer prevSweeps_;     // the previous setTime's sweeps_, swapped with it
   uint64_t prevSweepBytes_ = 0;
   uint32_t prevSweepCount_ = 0;
 

@@ -133,13 +133,16 @@ PR_INLINE void pt_write_eye(__global EyeVertex* out, const SurfaceHit* h, const 
 // vertex becomes x_1, the eye vertex that connect joins to the stored light paths (and,
 // resampling, the vertex pt_resample reconnects from); p->lt, cos^3 of the camera ray's angle
 // until now, becomes its camera factor for strategy T. With eye paths, later vertices carry the
-// eye path's densities for the MIS weights against the connections.
+// eye path's densities for the MIS weights against the connections. prefix_still: the segment
+// just traced is the camera's and still (camera_segment_still).
 PR_INLINE void pt_eye_vertex(PathState* p, const SurfaceHit* h, const Hit* hit, float3 d,
-                             float dist2, float3 tp, int delta_here, int seg_still, uint max_depth,
-                             float lt_scale, __global EyeVertex* eye) {
+                             float dist2, float3 tp, int delta_here, int seg_still,
+                             int prefix_still, uint max_depth, float lt_scale,
+                             __global EyeVertex* eye) {
   if (p->x1_depth == 0u) {
     if (!delta_here && p->depth < max_depth) {
       p->x1_depth = p->depth;
+      if (prefix_still) p->eye_flags |= PR_EYE_PREFIX_STILL;
       p->lt = p->depth == 1u ? eye_paths_camera_factor(lt_scale, p->lt * dist2) : 0.0f;
       pt_write_eye(eye, h, hit, -d, tp, p->depth);
     }
@@ -227,9 +230,13 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
   // Under a shutter, whether the segment just traced meets nothing that moves (shade_eye_paths.h):
   // asked only of the segments from x_2 on of paths that L can still make.
   const float3 prev = make_float3(p.prev_x, p.prev_y, p.prev_z);
-  const int seg_asked = p.x1_depth > 0u && p.depth > p.x1_depth &&
-                        (p.eye_flags & (PR_EYE_JOINABLE | PR_EYE_MOVED)) == PR_EYE_JOINABLE;
+  const int seg_asked =
+      p.x1_depth > 0u && p.depth > p.x1_depth &&
+      (p.eye_flags & (PR_EYE_JOINABLE | PR_EYE_MOVED | PR_EYE_PREFIX_STILL)) == PR_EYE_JOINABLE;
   const int seg_still = !seg_asked || ep_ray_still(&s, prev, h.p - prev, 1.0f);
+  // The camera's segment to a first hit (x_1 where it is not delta), as connect asks it.
+  const int prefix_still = PR_EYE_PATHS && p.depth == 0u && s.lights.sweep_count > 0u &&
+                           camera_segment_still(&s, prev, h.p);
   if (s.sd.materials[h.material].flags & PR_MAT_EMISSIVE) {
     EyeWeight ew;
     // Connections can make the paths that end after x_t, t >= 2 (x_t: the vertex `ray` left).
@@ -242,8 +249,8 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
   const ShadingFrame f = shading_frame(&s, &h, wo);
   const int delta_here = bsdf_is_delta(&f.bsdf);
   if (PR_EYE_PATHS || PR_RESAMPLE)
-    pt_eye_vertex(&p, &h, &hit, d, dist2, tp, delta_here, seg_still, max_depth, rsp.lt_scale,
-                  eye + p.pixel);
+    pt_eye_vertex(&p, &h, &hit, d, dist2, tp, delta_here, seg_still, prefix_still, max_depth,
+                  rsp.lt_scale, eye + p.pixel);
   // x_t with t >= 3: the light tracer's density of x_{t-1}, reached from this vertex.
   const int has_rev = pt_joinable(&p, 2u);
   if (p.depth >= max_depth) {
@@ -256,7 +263,8 @@ PR_INLINE uint pt_shade_path(PR_PARAMS(PR_ARGS_PT_SHADE), uint i) {
       const int here_joinable = pt_joinable(&p, 1u);
       if (next_event(&s, &h, &f, wo, !here_joinable, &rng, &shadow, &c, &ch)) {
         EyeWeight ew;
-        const int still = here_joinable && ep_next_event_still(&s, &h, &ch);
+        const int still = here_joinable &&
+                          ((p.eye_flags & PR_EYE_PREFIX_STILL) || ep_next_event_still(&s, &h, &ch));
         const float w = pt_next_event_weight(&s, &p, &h, &f, &ch, here_joinable, still, has_rev,
                                              dist2, &em, max_depth, &ew);
         if (here_joinable) c = c * w;  // next_event left the weight to this

@@ -72,9 +72,10 @@ PR_INLINE int ep_next_event_still(const SceneData* s, const SurfaceHit* h,
 }
 
 // Whether L can make the paths that end after this path's last vertex along a last segment that
-// is still (last_still): none of the segments from x_2 on meets what moves.
+// is still (last_still): x_1's segment from the camera is still (L joins at the light path's
+// time), or none of the segments from x_2 on meets what moves (at this sample's).
 PR_INLINE int ep_l_ok(const PathState* p, int last_still) {
-  return last_still && !(p->eye_flags & PR_EYE_MOVED);
+  return (p->eye_flags & PR_EYE_PREFIX_STILL) || (last_still && !(p->eye_flags & PR_EYE_MOVED));
 }
 
 // Whether the connections can make the paths that end after this path's last vertex x_t: x_2 is
@@ -160,7 +161,7 @@ PR_INLINE float ep_escape_share(const SceneData* s, const PathState* p, float3 d
 PR_INLINE void pt_eye_arrive(PathState* p, const SurfaceHit* h, float3 d, float dist2,
                              int delta_here, int seg_still) {
   if (p->depth == p->x1_depth + 1u)
-    p->eye_flags = delta_here ? 0u : PR_EYE_JOINABLE;
+    p->eye_flags = (p->eye_flags & PR_EYE_PREFIX_STILL) | (delta_here ? 0u : PR_EYE_JOINABLE);
   else if (!seg_still)
     p->eye_flags |= PR_EYE_MOVED;
   p->eye_ratio = mis_ratio_arrive(p->eye_ratio,

@@ -14,8 +14,9 @@
 
 // z_k's splat (light point y, arrival record vk), seen from the camera along `dir` (unit, camera
 // to z_k), the path before it z_{k-1} (light point yp, whose ratios are r_prev): its value at the
-// pixel times T's share of the path (against L too where l_ok: z_0 .. z_{k-1} is the same at every
-// time of the shutter interval); 0 where the camera cannot see it so or T takes no share.
+// pixel times T's share of the path (against L too where l_ok: z_0 .. z_{k-1}, or the camera's
+// segment to z_k, is the same at every time of the shutter interval); 0 where the camera cannot
+// see it so or T takes no share.
 PR_INLINE float3 camera_splat_value(const SceneData* s, const ReuseParams* rp,
                                     const CameraParams* cam, const LightPoint* y,
                                     const LightPoint* yp, PR_GLOBAL const LightVertex* vk,
@@ -79,8 +80,11 @@ PR_KERNEL void camera_splat(PR_PARAMS(PR_ARGS_CAMERA_SPLAT)) {
       const float3 dc = y.h.p - c;
       const float d2 = dot(dc, dc);
       const float3 dir = dc * (1.0f / sqrt(d2));
+      // L makes the path from a still x_1 at this time too (connect's at_own).
+      const int l_can = l_ok || camera_segment_still(&s, c, y.h.p);
       const float3 val =
-          camera_splat_value(&s, &rp, &cam_t, &y, &yp, v + k, r[k - 1u], k, dir, l_ok) * film_scale;
+          camera_splat_value(&s, &rp, &cam_t, &y, &yp, v + k, r[k - 1u], k, dir, l_can) *
+          film_scale;
       if (max3(val) > 0.0f) {
         ++rays;
         // Towards the camera as far as its near plane: nothing nearer is seen.

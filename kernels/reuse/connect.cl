@@ -48,7 +48,8 @@ typedef struct {
   float c[3 * PR_MAX_CONNECTIONS];  // unshadowed contributions
   float w[PR_MAX_CONNECTIONS];      // their weights
   u32 strategy[PR_MAX_CONNECTIONS];
-  float w_sum;  // all candidates' weights
+  u32 time[PR_MAX_CONNECTIONS];  // their rays' time (Connector.rec_time)
+  float w_sum;                   // all candidates' weights
   u32 candidates;
 } Reservoir;
 
@@ -92,6 +93,11 @@ typedef struct {
   uint n_rec, cap, overflow;
   uint members;  // terms in the partial sum g since it was last closed
   float3 L, g;
+  // Under a shutter: x_1's segment from the camera is still (camera_segment_still), so L joins it
+  // to a light path that meets what moves at that path's own time, whose op bits (PR_REC_TIMED)
+  // rec_time holds while such a connection is made (0: the sample's time).
+  int at_own;
+  u32 rec_time;
 } Connector;
 
 // One term of the estimate, of value v where `ray` (if not 0) is unoccluded.
@@ -187,6 +193,7 @@ PR_INLINE void connection_trace_or_keep(Connector* cn, float3 c, Ray ray, u32 st
           res->c[3 * k] = c.x, res->c[3 * k + 1] = c.y, res->c[3 * k + 2] = c.z;
           res->w[k] = w;
           res->strategy[k] = strategy;
+          res->time[k] = cn->rec_time;
         }
       }
     }
@@ -194,7 +201,7 @@ PR_INLINE void connection_trace_or_keep(Connector* cn, float3 c, Ray ray, u32 st
   }
   ++cn->n.rays;
   cn->n.mis_rays += mis;
-  connect_term(cn, c, &ray, PR_REC_GROUP | PR_REC_COUNTED);
+  connect_term(cn, c, &ray, PR_REC_GROUP | PR_REC_COUNTED | cn->rec_time);
 }
 
 // One connection's unshadowed contribution from its two sides (each side's BSDF and |cos|, the
@@ -228,7 +235,7 @@ PR_INLINE void reservoir_resolve(Connector* cn) {
       cn->n.mis_rays += res->strategy[k] == PR_STRATEGY_E;
       const float3 c = make_float3(res->c[3 * k], res->c[3 * k + 1], res->c[3 * k + 2]) *
                        ris_contribution_weight(res->w_sum, res->w[k], (float)cn->rp->resample);
-      connect_term(cn, c, &res->ray[k], PR_REC_GROUP | PR_REC_COUNTED);
+      connect_term(cn, c, &res->ray[k], PR_REC_GROUP | PR_REC_COUNTED | res->time[k]);
     }
     connect_close(cn);
   }
@@ -334,6 +341,7 @@ PR_INLINE void strategy_light_vertices(Connector* cn, const EyePoint* x, int his
   const SceneData* s = cn->s;
   const ReuseParams* rp = cn->rp;
   const int mis = rp->mis_threshold > 0.0f;
+  SceneData at = *s;  // the scene at a light path's own time (cn->at_own)
   for (uint c = 0u; c < rp->paths_per_pixel; ++c) {
     const uint slot = connector_slot(cn, c);
     const uint count = cn->headers[slot].vertex_count;
@@ -343,13 +351,19 @@ PR_INLINE void strategy_light_vertices(Connector* cn, const EyePoint* x, int his
                          ? light_emit_pdf(s, cn->headers[slot].light, v, vertex_dir(v + 1))
                          : 0.0f;
     if (PR_EYE_PATHS && !eye_paths_slot(cn, slot)) continue;  // the path tracer's alone
+    cn->rec_time = 0u;
     for (uint k = 1u; k < count && x->depth + k + 1u <= rp->max_depth; ++k) {
-      // Under a shutter, z_k and what follows only where the path up to it meets nothing that
-      // moves: then it is the path of this sample's time too.
-      if (s->lights.sweep_count &&
-          !light_segment_still(s, s->lights.lights[cn->headers[slot].light].type, v, k))
-        break;
-      const LightPoint y = light_point(s, v + k);
+      // Under a shutter, z_k and what follows where the path up to it meets nothing that moves:
+      // then it is the path of this sample's time too. Where it meets something, at the path's
+      // own time (light_trace traced it then), where x_1 is the same at every time.
+      if (s->lights.sweep_count && !cn->rec_time &&
+          !light_segment_still(s, s->lights.lights[cn->headers[slot].light].type, v, k)) {
+        if (!cn->at_own) break;
+        cn->rec_time = light_path_time_op(rp, slot);
+        at.geom.time = at.sd.time = record_time(cn->rec_time);
+      }
+      cn->s = cn->rec_time ? &at : s;
+      const LightPoint y = light_point(cn->s, v + k);
       const float pdf_arrive = pdf_step;
       pdf_step = 0.0f;
       if (mis && !y.delta && k + 1u < count) {
@@ -370,6 +384,8 @@ PR_INLINE void strategy_light_vertices(Connector* cn, const EyePoint* x, int his
       }
     }
   }
+  cn->s = s;
+  cn->rec_time = 0u;
   connect_close(cn);
 }
 
@@ -562,6 +578,8 @@ PR_INLINE void connector_empty(Connector* cn) {
   cn->hr.p_sum = cn->he.p_sum = 0.0f;
   cn->n_rec = cn->overflow = cn->members = 0u;
   cn->L = cn->g = make_float3(0.0f, 0.0f, 0.0f);
+  cn->at_own = 0;
+  cn->rec_time = 0u;
 }
 
 // Adds an eye sample's counts to the frame's counters.
@@ -635,6 +653,9 @@ PR_KERNEL void connect(PR_PARAMS(PR_ARGS_CONNECT)) {
   EyePoint x = eye_point_at(&s, e.prim, e.inst, e.b1, e.b2, make_float3(e.wx, e.wy, e.wz),
                             make_float3(e.tp_r, e.tp_g, e.tp_b), e.depth);
   cn.cam_x = connect_camera_factor(&rp, &c, &e, x.h.p);
+  // As pt_shade flags the eye path (PR_EYE_PREFIX_STILL): x_1 the first hit, its segment still.
+  cn.at_own = PR_EYE_PATHS && s.lights.sweep_count > 0u && e.depth == 1u &&
+              camera_segment_still(&s, camera_position(&c), make_float3(e.px, e.py, e.pz));
   uint shadow_rays = 0u, bounce_rays = 0u;
   // The first eye vertex's connections go to the history, where there is one.
   int history_open = history_cap > 0u;

@@ -12,12 +12,14 @@ PR_KERNEL void connect_shadow(PR_PARAMS(PR_ARGS_CONNECT_SHADOW)) {
   const uint i = listed ? pixels[q] : q;
   SceneData s = PR_SCENE();
   scene_at_sample(&s, seed, frame, i, sample);  // the sample's time (--shutter)
+  SceneData at = s;                             // a light path's own (PR_REC_TIMED)
   __global const ShadowRay* r = records + (size_t)(q - record_first) * record_cap;
   float3 L = make_float3(0.0f, 0.0f, 0.0f), g = L;
   uint unoccluded = 0u;
   for (uint k = 0u; k < n; ++k) {
     const u32 op = r[k].op;
-    if ((op & PR_REC_RAY) && trace_occluded(&s, r[k].ray)) continue;
+    if (op & PR_REC_TIMED) at.geom.time = at.sd.time = record_time(op);
+    if ((op & PR_REC_RAY) && trace_occluded((op & PR_REC_TIMED) ? &at : &s, r[k].ray)) continue;
     if (op & PR_REC_COUNTED) ++unoccluded;
     connect_record_apply(&L, &g, make_float3(r[k].c_r, r[k].c_g, r[k].c_b), op);
   }

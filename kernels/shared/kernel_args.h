@@ -67,7 +67,8 @@
   X(LIGHTS, VAL, uint, motion_count) \
   X(LIGHTS, VAL, uint, motion_steps) \
   X(LIGHTS, IN, float, sweeps)       \
-  X(LIGHTS, VAL, uint, sweep_count)
+  X(LIGHTS, VAL, uint, sweep_count)  \
+  X(LIGHTS, VAL, uint, camera_moves)
 
 #define PR_ARGS_SCENE(F, X) PR_ARGS_SCENE_GEOM(F, X) PR_ARGS_SHADING(X, X) PR_ARGS_LIGHTS(X, X)
 

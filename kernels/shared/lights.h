@@ -814,6 +814,8 @@ typedef struct {
   // light paths must not meet to be joined at any time (sweep_clear).
   PR_GLOBAL const float* sweeps;
   u32 sweep_count;
+  // --shutter: 1 where the camera moves while the shutter is open (camera_segment_still).
+  u32 camera_moves;
 } LightData;
 
 // The receiver-aware choice among lights [0, tree_count) with ut (and ur, the tree's

@@ -47,6 +47,9 @@ typedef struct {
 #define PR_EYE_JOINABLE 1u   // x_2 is non-delta: stored light paths can make this path's ends
 // Under a shutter, a segment from x_2 on meets what moves: L cannot make the path (T still can).
 #define PR_EYE_MOVED 2u
+// Under a shutter, x_1 is the first hit and the camera's segment to it the same at every time
+// (camera_segment_still): L joins it to a light path at that path's time, whatever moves beyond.
+#define PR_EYE_PREFIX_STILL 4u
 
 // A shadow ray with the contribution it carries if unoccluded: the path tracer's next-event
 // estimation (traced where the path is in the bounce's shadow queue) and connect's terms for

@@ -48,6 +48,10 @@ typedef struct {
 #define PR_REC_SUM_MASK 3u
 #define PR_REC_RAY 4u      // a shadow ray to trace
 #define PR_REC_COUNTED 8u  // counted in connections_unoccluded where unoccluded
+// Under a shutter: the ray is traced at the time in the op's top 24 bits (light_path_time_op), a
+// light path's own, not at the sample's.
+#define PR_REC_TIMED 16u
+#define PR_REC_TIME_SHIFT 8u
 
 // L and g after one more term of value v (where unoccluded).
 PR_INLINE void connect_record_apply(float3* L, float3* g, float3 v, u32 op) {
@@ -173,6 +177,15 @@ PR_INLINE int light_path_still(const SceneData* s, const PathHeader* h,
 PR_INLINE float light_path_time(const ReuseParams* rp, uint slot) {
   Rng tr = rng_make(rp->seed, PR_RNG_SPLAT, rp->frame, slot, 0u);
   return rng_next(&tr);
+}
+
+// The same time as a record's op bits (PR_REC_TIMED), and back: a draw is a multiple of 2^-24
+// below 1 (pr_u32_to_unit), so both ways are exact.
+PR_INLINE u32 light_path_time_op(const ReuseParams* rp, uint slot) {
+  return PR_REC_TIMED | ((u32)(light_path_time(rp, slot) * 16777216.0f) << PR_REC_TIME_SHIFT);
+}
+PR_INLINE float record_time(u32 op) {
+  return (float)(op >> PR_REC_TIME_SHIFT) * (1.0f / 16777216.0f);
 }
 
 // Veach's correction for shading normals on light paths (importance transport), for light that

@@ -346,6 +346,13 @@ PR_INLINE int sweep_clear(const SceneData* s, float3 o, float3 d, float tmax) {
   return sweeps_clear(s->lights.sweeps, s->lights.sweep_count, o, d, tmax);
 }
 
+// Whether a camera sample's segment from the camera at c to its x_1 at p is the same at every time
+// of the shutter interval: the camera still and nothing that moves met (p included). Then its path
+// is that of any time, and strategy L may join x_1 to a light path at the path's own time.
+PR_INLINE int camera_segment_still(const SceneData* s, float3 c, float3 p) {
+  return !s->lights.camera_moves && sweep_clear(s, c, p - c, 1.0f);
+}
+
 // Light idx where it is at the path's time: the light table holds the lights at the frame's
 // (motion blur). An emissive DSG triangle is placed as its instance is (emitter_pdf reads the same
 // triangle); a punctual light's position and axis are blended between its motion steps.

@@ -118,6 +118,10 @@ run "cornell-orbit-reuse-shutter" scenes/cornell-orbit.gltf --frames 0-1 --mode 
 # reuse's resampling with them.
 run "cornell-dynamic-reuse-resample-shutter" scenes/cornell-dynamic.gltf --frames 0-2 --mode reuse \
   --resample --shutter 0.5
+# Under the still camera, connections across the sphere's sweep at the light paths' own times,
+# kept by the reservoirs of resampled connections (their rays' times).
+run "cornell-dynamic-reuse-connections-shutter" scenes/cornell-dynamic.gltf --frames 0-1 \
+  --mode reuse --connections 2 --shutter 0.5
 run "cornell-skinned-resample-shutter" scenes/cornell-skinned.gltf --frames 0-2 --mode pathtrace \
   --resample --resample-neighbors 2 --shutter 0.5
 run "lanterns-reuse-connections" "$work/lanterns/atrium.gltf" --frames 0-1 --mode reuse \
