@@ -230,9 +230,10 @@ TEST_P(MeanOfInstants, TheBlurredFrameIsTheMeanOfItsInstants) {
   expectBlurIsTheMeanOfInstants(GetParam(), "mb-" + motionName({GetParam(), 0}));
 }
 
-// The same with path reuse: light paths traced at the frame's time and joined to samples at
-// other times (strategies L and T) only where they meet nothing that moves while the shutter is
-// open, and the eye paths' weights saying the same of the same segments.
+// The same with path reuse: light paths that meet what moves while the shutter is open traced at
+// their own time, joined to the camera then (T) and, from an x_1 the same at every time, to the
+// samples (L); others joined at the samples' times; the eye paths' weights saying the same of the
+// same segments.
 TEST_P(MeanOfInstants, PathReuseGivesTheMeanOfItsInstants) {
   expectBlurIsTheMeanOfInstants(GetParam(), "mb-reuse-" + motionName({GetParam(), 0}), "reuse");
 }

@@ -863,9 +863,9 @@ void GpuScene::placeOverShutter(const std::vector<double>& times,
   }
   std::vector<dev::CameraParams> cams;
   for (double at : times) cams.push_back(camera(shutterCamera_, at, shutterWidth_, shutterHeight_));
-  cameraMoves_ = false;
-  for (const dev::CameraParams& c : cams)
-    cameraMoves_ = cameraMoves_ || std::memcmp(&c, &cams.front(), sizeof c) != 0;
+  cameraMoves_ = std::any_of(cams.begin(), cams.end(), [&](const dev::CameraParams& c) {
+    return std::memcmp(&c, &cams.front(), sizeof c) != 0;
+  });
   const uint64_t bytes = cams.size() * sizeof(dev::CameraParams);
   if (bytes > cameraStepBytes_) {
     if (cameraStepBytes_) ctx_.release("camera motion steps", cameraStepBytes_);

@@ -214,7 +214,7 @@ PR_KERNEL void light_trace(PR_PARAMS(PR_ARGS_LIGHT_TRACE)) {
   uint n[3] = {0u, 0u, 0u};  // rays, SSG and DSG vertices
   // Under a shutter a path that meets what moves is traced again, with the same numbers, at the
   // slot's time: so every stored path is what tracing gives at that time, which strategy T needs
-  // (camera_splat); L keeps to the part of it that is the same at every time (connect). One loop,
+  // (camera_splat) and L from an x_1 the same at every time (connect's at_own). One loop,
   // not two calls: the tracing code is compiled once.
   for (int timed = 0;; timed = 1) {
     h = light_header_empty(generation);

@@ -214,7 +214,8 @@ PR_INLINE float eye_paths_eye_share(float n, float h, float t) {
 }
 
 // T's share of a path that L cannot make (under a shutter, a segment of L's light path meets what
-// moves), against the eye path's N and H alone; l_ok 1: eye_paths_camera_share.
+// moves and x_1's segment from the camera does too, or the camera moves), against the eye path's N
+// and H alone; l_ok 1: eye_paths_camera_share.
 PR_INLINE float eye_paths_camera_share_l(float t, float n, float h, int l_ok) {
   if (l_ok) return eye_paths_camera_share(t, n, h);
   if (!(t > 0.0f)) return 0.0f;

@@ -45,7 +45,8 @@ typedef struct {
 
 #define PR_PATH_SPECULAR 1u  // the last bounce was delta (or the ray is the camera ray)
 #define PR_EYE_JOINABLE 1u   // x_2 is non-delta: stored light paths can make this path's ends
-// Under a shutter, a segment from x_2 on meets what moves: L cannot make the path (T still can).
+// Under a shutter, a segment from x_2 on meets what moves: L cannot make the path (T still can)
+// unless PR_EYE_PREFIX_STILL.
 #define PR_EYE_MOVED 2u
 // Under a shutter, x_1 is the first hit and the camera's segment to it the same at every time
 // (camera_segment_still): L joins it to a light path at that path's time, whatever moves beyond.
@@ -138,7 +139,8 @@ typedef struct {
 // its x_1 is seen straight from the camera.
 #define PR_RS_CAMERA 0x40u
 // A PR_RS_JOINED path that L cannot make (under a shutter, a segment from x_2 on meets what
-// moves): its f holds what T leaves of it (eye_paths_eye_share_l).
+// moves and x_1 is not PR_EYE_PREFIX_STILL): its f holds what T leaves of it
+// (eye_paths_eye_share_l).
 #define PR_RS_NO_L 0x80u
 
 // Where a path's candidates stand as pt_shade follows it (one per pixel). 160 bytes.
