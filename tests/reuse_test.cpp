@@ -635,6 +635,7 @@ TEST(Reuse, DirectionalLightPathsConvergeToThePathTracer) {
   expectSameImage(sunScene(), "--max-depth 6 --eye-paths --light-tracing --no-resample", 48, 36, 32,
                   2);
   expectSameImage(sunScene(), "--max-depth 6 --eye-paths --light-tracing", 48, 36, 32, 2);
+  expectSameImage(sunScene(), "--max-depth 6 --no-eye-paths --no-resample", 48, 36, 32, 2);
 }
 
 // The room under an environment alone (a uniform one, and a map with a bright patch): its light
@@ -656,6 +657,7 @@ TEST(Reuse, EnvironmentLightPathsConvergeToThePathTracer) {
     expectSameImage(room, "--max-depth 6 --eye-paths --light-tracing --no-resample " + env, 48, 36,
                     32, 2);
     expectSameImage(room, "--max-depth 6 --eye-paths --light-tracing " + env, 48, 36, 32, 2);
+    expectSameImage(room, "--max-depth 6 --no-eye-paths --no-resample " + env, 48, 36, 32, 2);
   }
 }
 
