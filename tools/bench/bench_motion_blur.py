@@ -11,7 +11,12 @@ renderers path trace the frame at --spp with the shutter open each of --shutters
 over 16x16 blocks the share within 2% of Cycles' and the median and 95th-percentile deviation, for
 the blurred pair and, as the control that shows the blur is measured at all, our sharp frame
 against Cycles' blurred one; then the cost of the shutter over a sharp frame at 4 spp (median
-seconds per frame of frames after the first). Needs numpy, hence /usr/bin/python3.
+seconds per frame of frames after the first). With --cost-runs N the sharp and blurred runs
+alternate N times and the cost is the median of the pairs' ratios (the machine's drift cancels in
+a pair); --cost-only measures that alone, without Cycles. Needs numpy, hence /usr/bin/python3.
+
+  /usr/bin/python3 -m tools.bench.bench_motion_blur --build build --cost-only --cost-runs 5 \
+      --shutters 0.5 --scenes cesiumman-2fps,fox-2fps
 """
 
 import argparse
@@ -47,12 +52,20 @@ SCENES = {
 def parse_args():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--build", default="build", help="the folder with pathreuse and exr_compare")
-    ap.add_argument("--cycles", required=True, help="a Python with bpy 5.2 (Blender's Cycles)")
+    ap.add_argument("--cycles", help="a Python with bpy 5.2 (Blender's Cycles)")
+    ap.add_argument("--cost-runs", type=int, default=1,
+                    help="paired sharp / blurred runs for the cost (the median of their ratios)")
+    ap.add_argument("--cost-only", action="store_true",
+                    help="the cost of the shutter alone (no images, no Cycles)")
+    ap.add_argument("--fps", type=int, help="this frame rate instead of each scene's own")
     ap.add_argument("--spp", type=int, default=512, help="samples per pixel of the compared frames")
     ap.add_argument("--shutters", default="0.5,2", help="frames the shutter is open, A,B,...")
     ap.add_argument("--work", default="out/bench-motion-blur")
     ap.add_argument("--scenes", default=",".join(SCENES))
-    return ap.parse_args()
+    args = ap.parse_args()
+    if not args.cost_only and not args.cycles:
+        ap.error("--cycles is needed unless --cost-only")
+    return args
 
 
 def wrapper(kind, source, work):
@@ -117,16 +130,19 @@ def blocks(a, b, n=16):
 
 
 def cost(args, sc, shutter_open, work):
-    """Median seconds per frame at 4 spp, sharp and with the shutter open (frames 1..5 of 6)."""
-    walls = {}
-    for shutter in (0.0, shutter_open):
-        stats = work / f"cost-{shutter}.jsonl"
-        stats.unlink(missing_ok=True)
-        first = max(0, sc[2] - 3)
-        ours(args, sc, 4, shutter, work / "cost", stats, f"{first}-{first + 5}")
-        lines = [json.loads(x) for x in stats.read_text().splitlines()]
-        walls[shutter] = median([x["wall_s"] for x in lines[1:]])
-    return walls[0.0], walls[shutter_open]
+    """Median seconds per frame at 4 spp, sharp and with the shutter open (frames 1..5 of 6), over
+    --cost-runs alternating runs, and the median of the runs' ratios."""
+    walls, ratios = {0.0: [], shutter_open: []}, []
+    for _ in range(args.cost_runs):
+        for shutter in (0.0, shutter_open):
+            stats = work / f"cost-{shutter}.jsonl"
+            stats.unlink(missing_ok=True)
+            first = max(0, sc[2] - 3)
+            ours(args, sc, 4, shutter, work / "cost", stats, f"{first}-{first + 5}")
+            lines = [json.loads(x) for x in stats.read_text().splitlines()]
+            walls[shutter].append(median([x["wall_s"] for x in lines[1:]]))
+        ratios.append(walls[shutter_open][-1] / walls[0.0][-1])
+    return median(walls[0.0]), median(walls[shutter_open]), median(ratios)
 
 
 def main():
@@ -136,18 +152,28 @@ def main():
     rows = {}
     for key in args.scenes.split(","):
         kind, source, cam, name, frame, fps, world, size = SCENES[key]
+        if args.fps:  # the same moment at another frame rate
+            frame, fps = round(frame * args.fps / fps), args.fps
         sc = (wrapper(kind, source, work), cam, frame, fps, world, size)
         d = work / key
+        if args.cost_only:
+            for shutter in (float(x) for x in args.shutters.split(",")):
+                sharp_s, blur_s, ratio = cost(args, sc, shutter, d)
+                print(json.dumps({"scene": key, "fps": fps, "shutter": shutter, "sharp_s": sharp_s,
+                                  "shutter_s": blur_s, "cost": ratio}), flush=True)
+            continue
         sharp = read(args.build, ours(args, sc, args.spp, 0.0, d / "ours-sharp"))
         for shutter in (float(x) for x in args.shutters.split(",")):
             blur = read(args.build, ours(args, sc, args.spp, shutter, d / f"ours-{shutter}"))
             peer = read(args.build, cycles(args, sc, name, shutter,
                                            d / f"cycles-{args.spp}-{shutter}"))
-            sharp_s, blur_s = cost(args, sc, shutter, d)
+            sharp_s, blur_s, ratio = cost(args, sc, shutter, d)
             row = {"blurred": blocks(blur, peer), "sharp_vs_blurred": blocks(sharp, peer),
-                   "sharp_s": sharp_s, "shutter_s": blur_s, "cost": blur_s / sharp_s}
+                   "sharp_s": sharp_s, "shutter_s": blur_s, "cost": ratio}
             rows[(key, shutter)] = row
             print(json.dumps({"scene": key, "shutter": shutter, **row}), flush=True)
+    if args.cost_only:
+        return 0
     print("| scene | shutter | mean vs Cycles | 16x16 blocks within 2% | median / p95 deviation "
           "| our sharp frame: within 2%, p95 | cost of the shutter |")
     print("|---|---:|---:|---:|---:|---:|---:|")
