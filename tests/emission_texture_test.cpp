@@ -3,6 +3,7 @@
 // image is the same as where that triangle emits nothing at all.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 
@@ -134,6 +135,70 @@ TEST(EmissionTexture, BlackTrianglesAreNoLightsAndTheImageConverges) {
         EXPECT_NEAR(ma.mean, mb.mean, 4.0 * std::hypot(ma.stderr_, mb.stderr_) + 1e-6)
             << "region " << rx << "," << ry;
       }
+  }
+}
+
+// The panel of panelScene made of one material "panel" whose base colour is the half-white
+// texture times (1, 0.5, 0.25): with `emissive` it also emits that, at strength 4, as glTF says
+// it; else it emits nothing of its own.
+std::string baseColourPanel(bool emissive, const std::string& tag) {
+  const std::string path = panelScene(true, tag);
+  nlohmann::json doc = nlohmann::json::parse(std::ifstream(path));
+  nlohmann::json& panel = doc["materials"][1];
+  panel["name"] = "panel";
+  panel["pbrMetallicRoughness"] = {{"baseColorFactor", {1.0, 0.5, 0.25, 1.0}},
+                                   {"baseColorTexture", {{"index", 0}}},
+                                   {"metallicFactor", 0.0},
+                                   {"roughnessFactor", 1.0}};
+  panel.erase("extensions");
+  panel.erase("emissiveFactor");
+  panel.erase("emissiveTexture");
+  if (emissive) {
+    panel["emissiveFactor"] = {1.0, 0.5, 0.25};
+    panel["emissiveTexture"] = {{"index", 0}};
+    panel["extensions"] = {{"KHR_materials_emissive_strength", {{"emissiveStrength", 4.0}}}};
+  }
+  doc["materials"][2] = panel;  // the left quad: the same material under another index
+  doc["materials"][2]["name"] = "panel-left";
+  std::ofstream(path) << doc.dump();
+  return path;
+}
+
+// --emit-base-color: a material named by name, index or range emits its base colour (factor and
+// texture) at --emit-strength, the same frame as where the file says so; an unknown name is a
+// one-line error, exit 2, with nothing written.
+TEST(EmissionTexture, EmitBaseColorLightsWhatTheFileLeavesUnlit) {
+  const std::string emissive = baseColourPanel(true, "emit-file");
+  const std::string unlit = baseColourPanel(false, "emit-option");
+  for (const char* mode : {"pathtrace", "reuse"}) {
+    SCOPED_TRACE(mode);
+    const std::string args =
+        std::string("--width 24 --height 24 --spp 4 --env none --mode ") + mode;
+    const Image want = test::frameImage(test::renderFrames(emissive, "0", args, "emit-want"), 0);
+    EXPECT_GT(test::regionMean(want, 0, 0, 24, 24, 0).mean, 0.01) << "an unlit reference";
+    for (const char* which : {"panel,panel-left", "1,2", "1-2"}) {
+      SCOPED_TRACE(which);
+      const Image got = test::frameImage(
+          test::renderFrames(
+              unlit, "0", args + " --emit-base-color " + which + " --emit-strength 4", "emit-got"),
+          0);
+      EXPECT_EQ(got.rgba, want.rgba);
+    }
+    // Not asked: the panel is dark and nothing lights the floor.
+    const Image dark = test::frameImage(test::renderFrames(unlit, "0", args, "emit-none"), 0);
+    EXPECT_EQ(test::regionMean(dark, 0, 0, 24, 24, 0).mean, 0.0);
+  }
+  const std::string out = test::tempDir("emit-bad");
+  for (const char* bad : {"nosuch", "1-9", "1,"}) {
+    SCOPED_TRACE(bad);
+    const test::CommandResult r =
+        test::runPathreuse("render '" + unlit + "' --emit-base-color '" + bad +
+                           "' --frames 0 --out " + out + "/f_%04d.exr");
+    EXPECT_EQ(r.exitCode, 2) << r.err;
+    EXPECT_NE(r.err.find(unlit + ": --emit-base-color"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("materials: 0, 1 (panel), 2 (panel-left)"), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_FALSE(std::ifstream(out + "/f_0000.exr").good());
   }
 }
 

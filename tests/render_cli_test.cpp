@@ -198,6 +198,8 @@ const std::map<std::string, std::string> kSampleValues = {
     {"--env-color", "1,1,1"},
     {"--env-strength", "2"},
     {"--env-rotate", "10"},
+    {"--emit-base-color", "1"},
+    {"--emit-strength", "2"},
     {"--device", "cpu"},
     {"--bvh-width", "2"},
 };

@@ -339,6 +339,14 @@ std::vector<Row> sceneLookRows() {
           "above)"}
           .range(-1e6, 1e6)
           .withDefault(),
+      Row{"--emit-base-color", kEnvironment, kEveryday, kEstimator, PR_FIELD(ro.emitBaseColor),
+          "Materials, by name or index (comma-separated; A-B a range of indices), that emit "
+          "their base colour (factor and texture) as light: lights a sky dome or backdrop "
+          "meant to be drawn unlit"},
+      Row{"--emit-strength", kEnvironment, kEveryday, kEstimator, PR_FIELD(ro.emitStrength),
+          "Scales what --emit-base-color's materials emit"}
+          .range(0, 1e20)
+          .withDefault(),
       Row{"--device", kDevices, kEveryday, kRunOnly, PR_FIELD(ro.devices),
           "OpenCL device: index, P:D, cpu, gpu or part of its name (default: $PATHREUSE_DEVICE, "
           "else the first GPU, else the first CPU); repeatable, each device renders a share of "

@@ -97,6 +97,8 @@ struct RenderOptions {
   std::string scene;
   bool allowOutsideUris = false;  // LoadOptions::allowOutsideUris
   std::string animation;          // LoadOptions::animation: "" = every animation
+  std::string emitBaseColor;      // LoadOptions::emitBaseColor: "" = none
+  float emitStrength = 1.0f;      // LoadOptions::emitStrength
   FrameRange frames;
   bool framesGiven = false;
   double fps = 24.0;

@@ -539,6 +539,8 @@ int runRender(const RenderOptions& o) {
   LoadOptions loadOptions;
   loadOptions.allowOutsideUris = o.allowOutsideUris;
   loadOptions.animation = o.animation;
+  loadOptions.emitBaseColor = o.emitBaseColor;
+  loadOptions.emitStrength = o.emitStrength;
   loadOptions.digestInputs = keepsHistory(o);
   const Scene scene = loadScene(o.scene, loadOptions);
   noteUnlitScene(scene, o);

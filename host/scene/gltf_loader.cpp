@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <optional>
 #include <set>
@@ -600,6 +601,57 @@ class Converter : Stage {
     }
   }
 
+  // --emit-base-color: the materials it names emit their base colour (factor and texture, with
+  // the texture's uv set and transform) at --emit-strength, in place of their own emission.
+  void emitBaseColors() {
+    const std::string& list = doc_.options.emitBaseColor;
+    if (list.empty()) return;
+    const size_t count = model_.materials.size();
+    std::vector<bool> chosen(count, false);
+    for (size_t start = 0; start <= list.size();) {
+      const size_t comma = std::min(list.find(',', start), list.size());
+      const std::string item = list.substr(start, comma - start);
+      start = comma + 1;
+      if (!selectMaterials(item, &chosen))
+        fail("--emit-base-color " + list + ": no material " + item + " (" + materialNames() + ")");
+    }
+    for (size_t i = 0; i < count; ++i) {
+      if (!chosen[i]) continue;
+      Material& m = scene_.materials[i];
+      m.emissiveFactor = glm::vec3(m.baseColorFactor);
+      m.emissiveTexture = m.baseColorTexture;
+      m.emissiveStrength = doc_.options.emitStrength;
+    }
+  }
+
+  // Marks the materials `item` names: a name, an index or a range A-B of indices.
+  bool selectMaterials(const std::string& item, std::vector<bool>* chosen) const {
+    bool any = false;
+    for (size_t i = 0; i < chosen->size(); ++i)
+      if (!item.empty() && (model_.materials[i].name == item || std::to_string(i) == item))
+        (*chosen)[i] = any = true;
+    if (any) return true;
+    unsigned long a = 0, b = 0;
+    int used = 0;
+    if (std::sscanf(item.c_str(), "%lu-%lu%n", &a, &b, &used) != 2 || size_t(used) != item.size() ||
+        a > b || b >= chosen->size())
+      return false;
+    for (size_t i = a; i <= b; ++i) (*chosen)[i] = true;
+    return true;
+  }
+
+  // "the scene has N materials: 0 (name), 1, ..." (the first dozen).
+  std::string materialNames() const {
+    const size_t n = model_.materials.size();
+    if (n == 0) return "the scene has no materials";
+    std::string names =
+        "the scene has " + std::to_string(n) + (n == 1 ? " material: " : " materials: ");
+    for (size_t i = 0; i < n && i < 12; ++i)
+      names += (i ? ", " : "") + std::to_string(i) +
+               (model_.materials[i].name.empty() ? "" : " (" + model_.materials[i].name + ")");
+    return names + (n > 12 ? ", ..." : "");
+  }
+
   // The uv set a texture reads: TEXCOORD_0 or TEXCOORD_1 (others warned of, TEXCOORD_0 read).
   int uvSet(int texCoord, const std::string& where) {
     if (texCoord == 0 || texCoord == 1) return texCoord;
@@ -796,6 +848,7 @@ class Converter : Stage {
     scene_.path = doc_.path;
     buildNodes();
     buildMaterials();
+    emitBaseColors();
     meshCache_.clear();
     buildSkins();
     std::map<int, uint32_t> dynamicIndex;  // glTF mesh -> dynamic mesh

@@ -25,6 +25,11 @@ struct LoadOptions {
   // --animation: the one animation that plays, by index or name; "" = all of them (the first
   // where two animate the same node's same property).
   std::string animation;
+  // --emit-base-color: materials, by name or index (comma-separated; A-B a range of indices),
+  // that emit their base colour (factor and texture) at emitStrength, as a sky dome or backdrop
+  // meant to be drawn unlit would look; "" = none.
+  std::string emitBaseColor;
+  float emitStrength = 1.0f;
 };
 
 Scene loadScene(const std::string& path, const LoadOptions& options = {});
