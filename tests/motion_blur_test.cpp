@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -362,6 +363,27 @@ TEST(MotionBlur, StepsFollowTheMotion) {
     EXPECT_GT(fine, 3u);
     EXPECT_LE(fine, 33u);
     EXPECT_LE(stepsOf(turning, tag, 0.5, 120), fine);
+  }
+}
+
+// A camera still over the shutter is one step, pt_generate's camera, the same bit for bit as the
+// frame's (so it is not blended per sample); a moving one has every step.
+TEST(MotionBlur, AStillCameraIsOneStep) {
+  for (Moving what : {Moving::Object, Moving::Camera}) {
+    SCOPED_TRACE(int(what));
+    const Scene scene =
+        loadScene(movingScene(what, "mb-still-camera-" + std::to_string(int(what))));
+    GpuScene gpu(test::testContext(), scene);
+    gpu.setShutter(0.5, 0, 160, 120);
+    gpu.setTime(1.0);
+    ASSERT_EQ(gpu.motionSteps(), 3u);
+    if (what == Moving::Camera) {
+      EXPECT_EQ(gpu.cameraMotionSteps(), 3u);
+      continue;
+    }
+    EXPECT_EQ(gpu.cameraMotionSteps(), 1u);
+    const dev::CameraParams frame = gpu.camera(0, 1.0, 160, 120);
+    EXPECT_EQ(std::memcmp(&frame, &gpu.stillCamera(), sizeof frame), 0);
   }
 }
 

@@ -866,6 +866,7 @@ void GpuScene::placeOverShutter(const std::vector<double>& times,
   cameraMoves_ = std::any_of(cams.begin(), cams.end(), [&](const dev::CameraParams& c) {
     return std::memcmp(&c, &cams.front(), sizeof c) != 0;
   });
+  stillCamera_ = cams.front();
   const uint64_t bytes = cams.size() * sizeof(dev::CameraParams);
   if (bytes > cameraStepBytes_) {
     if (cameraStepBytes_) ctx_.release("camera motion steps", cameraStepBytes_);

@@ -62,6 +62,10 @@ class GpuScene {
   // The last setTime's motion steps (1: none) and the camera at each (a placeholder at 1).
   uint32_t motionSteps() const { return motionSteps_; }
   const cl::Buffer& cameraSteps() const { return cameraSteps_; }
+  // The camera's motion steps where it moves over the shutter interval; else 1, and the one
+  // camera every step holds is stillCamera() (camera_at_time gives it bit for bit).
+  uint32_t cameraMotionSteps() const { return cameraMoves_ ? motionSteps_ : 1u; }
+  const dev::CameraParams& stillCamera() const { return stillCamera_; }
 
   // The scene's kernel arguments (PR_ARGS_SCENE) as they are now; copy them into a kernel's
   // argument struct with kargs::setScene after each setTime.
@@ -234,8 +238,9 @@ class GpuScene {
   std::vector<std::vector<std::vector<glm::vec3>>> stepPositions_;
   uint64_t sweepBytes_ = 0;
   uint32_t sweepCount_ = 0;
-  bool cameraMoves_ = false;  // at the motion steps of the shutter interval
-  cl::Buffer prevSweeps_;     // the previous setTime's sweeps_, swapped with it
+  bool cameraMoves_ = false;         // at the motion steps of the shutter interval
+  dev::CameraParams stillCamera_{};  // the first step's camera (setShutter)
+  cl::Buffer prevSweeps_;            // the previous setTime's sweeps_, swapped with it
   uint64_t prevSweepBytes_ = 0;
   uint32_t prevSweepCount_ = 0;
 

@@ -154,6 +154,23 @@ dev::ResampleParams PathTracer::resampleParams() const {
   return p;
 }
 
+// The instances that moved since the last frame, in moved_ for pt_resample; their count.
+cl_uint PathTracer::uploadMovedInstances() {
+  const std::vector<dev::MovedInstance>& moved = scene_.movedInstances();
+  const uint64_t bytes = std::max<uint64_t>(moved.size(), 1) * sizeof(dev::MovedInstance);
+  if (bytes > movedBytes_) {
+    if (movedBytes_) ctx_.release("moved instances", movedBytes_);
+    bytes_ += bytes - movedBytes_;
+    moved_ = ctx_.allocate("moved instances", bytes, CL_MEM_READ_ONLY);
+    ctx_.zero(moved_, bytes);
+    movedBytes_ = bytes;
+  }
+  if (!moved.empty())
+    CL_CHECK(ctx_.queue().enqueueWriteBuffer(
+        moved_, CL_FALSE, 0, moved.size() * sizeof(dev::MovedInstance), moved.data()));
+  return cl_uint(moved.size());
+}
+
 void PathTracer::beginFrame(int64_t frame, const dev::CameraParams& camera,
                             const kargs::SceneArgs& sceneArgs, const cl::Buffer& radiance,
                             const cl::Buffer& eye) {
@@ -176,19 +193,7 @@ void PathTracer::beginFrame(int64_t frame, const dev::CameraParams& camera,
   written_ = 0;
   ++stamp_;
   if (settings_.resample.enabled) {
-    const std::vector<dev::MovedInstance>& moved = scene_.movedInstances();
-    const uint64_t bytes = std::max<uint64_t>(moved.size(), 1) * sizeof(dev::MovedInstance);
-    if (bytes > movedBytes_) {
-      if (movedBytes_) ctx_.release("moved instances", movedBytes_);
-      bytes_ += bytes - movedBytes_;
-      moved_ = ctx_.allocate("moved instances", bytes, CL_MEM_READ_ONLY);
-      ctx_.zero(moved_, bytes);
-      movedBytes_ = bytes;
-    }
-    if (!moved.empty())
-      CL_CHECK(ctx_.queue().enqueueWriteBuffer(
-          moved_, CL_FALSE, 0, moved.size() * sizeof(dev::MovedInstance), moved.data()));
-    rsp.moved_count = cl_uint(moved.size());
+    rsp.moved_count = uploadMovedInstances();
     rsp.prev_known = temporal_ && scene_.previousKnown() ? 1u : 0u;
   }
   // Resampling needs every sample's x_1, which the path tracer alone does not keep.
@@ -259,7 +264,6 @@ void PathTracer::beginFrame(int64_t frame, const dev::CameraParams& camera,
     resampleArgs_.cam_step_count = scene_.motionSteps();
     resampleArgs_.set(resample_, kargs::kScene | kargs::kFrame);
   }
-  generateArgs_.cam = camera;
   generateArgs_.seed = settings_.seed;
   generateArgs_.frame = rngFrame;
   generateArgs_.states = states_;
@@ -273,7 +277,9 @@ void PathTracer::beginFrame(int64_t frame, const dev::CameraParams& camera,
   generateArgs_.queue_size = queueSizes_;
   generateArgs_.budget = film_.budget();
   generateArgs_.cam_steps = scene_.cameraSteps();
-  generateArgs_.cam_step_count = scene_.motionSteps();
+  generateArgs_.cam_step_count = scene_.cameraMotionSteps();  // 1: not blended per sample
+  generateArgs_.cam =
+      scene_.cameraMotionSteps() < scene_.motionSteps() ? scene_.stillCamera() : camera;
   generateArgs_.set(generate_);
 }
 

@@ -81,6 +81,8 @@ class PathTracer : public Integrator, public FrameHistory {
   void setChain(int pass, const std::string& records) override;
 
  private:
+  // The instances that moved since the last frame, in moved_ for pt_resample; their count.
+  cl_uint uploadMovedInstances();
   dev::ResampleParams resampleParams() const;
   // The paths of the film's pixels [first, end) (one band: at most band_) through every bounce.
   void traceBand(cl_uint first, cl_uint end, cl_uint masked, StageTimer* timer);

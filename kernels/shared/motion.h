@@ -94,11 +94,17 @@ PR_INLINE void motion_transform(PR_GLOBAL const float* motion, u32 steps, u32 in
 }
 
 // The camera at `time`: position, field of view and clipping planes blended, its axes blended
-// and made orthonormal again (forward first).
+// and made orthonormal again (forward first). Two equal steps give the step itself, bit for bit,
+// as pt_generate reads a camera still over the shutter (GpuScene::stillCamera).
 PR_INLINE CameraParams camera_at_time(PR_GLOBAL const CameraParams* steps, u32 count, float time) {
   float a;
   const u32 k = motion_step(count, time, &a);
   const CameraParams c0 = steps[k], c1 = steps[k + 1u];
+  if (c0.px == c1.px && c0.py == c1.py && c0.pz == c1.pz && c0.fx == c1.fx && c0.fy == c1.fy &&
+      c0.fz == c1.fz && c0.ux == c1.ux && c0.uy == c1.uy && c0.uz == c1.uz &&
+      c0.tan_half_fov == c1.tan_half_fov && c0.aspect == c1.aspect && c0.znear == c1.znear &&
+      c0.zfar == c1.zfar)
+    return c0;
   CameraParams c = c0;
   const float3 p0 = make_float3(c0.px, c0.py, c0.pz), p1 = make_float3(c1.px, c1.py, c1.pz);
   const float3 p = p0 + (p1 - p0) * a;
